@@ -1,0 +1,752 @@
+//! Validation of a polygon soup and construction of the halfedge structure.
+//!
+//! The builder runs in linear time apart from sorting each vertex's few incident edges:
+//!
+//! 1. check sizes, coordinates, index ranges, repeated vertices and zero-area faces;
+//! 2. group face sides into undirected edges with a counting sort keyed by the smaller
+//!    endpoint (no hash map), finding non-manifold edges and duplicate faces on the way;
+//! 3. orient each edge-connected component by a breadth-first search over face
+//!    neighbours, flipping the minority of faces when the component is consistently
+//!    orientable and failing when it is not;
+//! 4. drop unreferenced vertices, create one boundary halfedge per boundary edge and link
+//!    boundary loops, and check that the faces around every vertex form one fan.
+
+use std::collections::HashMap;
+
+use nalgebra::Point3;
+
+use crate::mesh::{Mesh, MeshData};
+use crate::vertex_map::NO_VERTEX;
+use crate::{ComponentId, EdgeId, HalfedgeId, MeshError, PolygonSoup, VertexId, VertexMap};
+
+const NONE: u32 = u32::MAX;
+
+/// What the builder may repair instead of failing. Nothing is repaired unless asked, and
+/// everything repaired is listed in the [`BuildReport`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Repair {
+    /// Drop faces with a repeated vertex or an area at most the degeneracy threshold.
+    pub drop_degenerate_faces: bool,
+    /// Drop faces whose vertex set equals that of an earlier face (the later one goes).
+    pub drop_duplicate_faces: bool,
+    /// Merge vertices with bit-identical positions into the first of them.
+    pub merge_coincident_vertices: bool,
+}
+
+impl Repair {
+    /// Repair nothing: every defect is an error.
+    pub const NONE: Repair = Repair {
+        drop_degenerate_faces: false,
+        drop_duplicate_faces: false,
+        merge_coincident_vertices: false,
+    };
+    /// Every safe repair.
+    pub const ALL: Repair = Repair {
+        drop_degenerate_faces: true,
+        drop_duplicate_faces: true,
+        merge_coincident_vertices: true,
+    };
+}
+
+/// Options of [`Mesh::build`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BuildOptions {
+    /// A face is degenerate when its area is at most
+    /// `degenerate_area_tolerance * d^2`, with `d` the bounding-box diagonal of all input
+    /// vertices. Default `1e-12`.
+    pub degenerate_area_tolerance: f64,
+    /// What to repair instead of failing. Default: nothing.
+    pub repair: Repair,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        Self {
+            degenerate_area_tolerance: 1e-12,
+            repair: Repair::NONE,
+        }
+    }
+}
+
+/// What the builder changed on its way from the soup to the mesh. All face and vertex
+/// indices here are input indices.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BuildReport {
+    /// Faces whose vertex order was reversed to orient their component consistently.
+    pub faces_reoriented: usize,
+    /// Input vertices that no face uses (left out of the mesh).
+    pub unreferenced_vertices: Vec<usize>,
+    /// Faces dropped as degenerate (repair).
+    pub dropped_degenerate_faces: Vec<usize>,
+    /// Faces dropped as duplicates of an earlier face (repair).
+    pub dropped_duplicate_faces: Vec<usize>,
+    /// Vertices merged into an earlier vertex at the same position, as
+    /// `(merged, kept)` (repair).
+    pub merged_vertices: Vec<(usize, usize)>,
+    /// The absolute area threshold used for degenerate faces.
+    pub degenerate_area_threshold: f64,
+}
+
+impl BuildReport {
+    /// True if any repair changed the input.
+    pub fn repaired(&self) -> bool {
+        !(self.dropped_degenerate_faces.is_empty()
+            && self.dropped_duplicate_faces.is_empty()
+            && self.merged_vertices.is_empty())
+    }
+}
+
+/// Faces as the builder works on them: flat vertex indices (input numbering, after
+/// merging) with offsets, and each face's input index.
+struct WorkFaces {
+    indices: Vec<u32>,
+    offsets: Vec<u32>,
+    input: Vec<u32>,
+}
+
+impl WorkFaces {
+    fn len(&self) -> usize {
+        self.input.len()
+    }
+
+    fn face(&self, f: usize) -> &[u32] {
+        &self.indices[self.offsets[f] as usize..self.offsets[f + 1] as usize]
+    }
+
+    fn retain(&mut self, keep: impl Fn(usize) -> bool) {
+        let mut out = WorkFaces {
+            indices: Vec::with_capacity(self.indices.len()),
+            offsets: Vec::with_capacity(self.offsets.len()),
+            input: Vec::with_capacity(self.input.len()),
+        };
+        out.offsets.push(0);
+        for f in 0..self.len() {
+            if keep(f) {
+                out.indices.extend_from_slice(self.face(f));
+                out.offsets.push(out.indices.len() as u32);
+                out.input.push(self.input[f]);
+            }
+        }
+        *self = out;
+    }
+
+    /// Reverses face `f` keeping its first vertex: (v0, v1, .., vn) -> (v0, vn, .., v1).
+    fn reverse(&mut self, f: usize) {
+        let (a, b) = (self.offsets[f] as usize, self.offsets[f + 1] as usize);
+        self.indices[a + 1..b].reverse();
+    }
+}
+
+/// Sorted vertex set of a face, padded, for duplicate detection.
+fn vertex_set(face: &[u32]) -> [u32; 4] {
+    let mut key = [NONE; 4];
+    key[..face.len()].copy_from_slice(face);
+    key.sort_unstable();
+    key
+}
+
+/// Norm of the polygon vector area: half the cross product of the diagonals for a quad,
+/// half the cross product of two sides for a triangle.
+fn polygon_area(p: &[Point3<f64>], face: &[u32]) -> f64 {
+    let at = |k: usize| p[face[k] as usize];
+    let twice = if face.len() == 3 {
+        (at(1) - at(0)).cross(&(at(2) - at(0)))
+    } else {
+        (at(2) - at(0)).cross(&(at(3) - at(1)))
+    };
+    0.5 * twice.norm()
+}
+
+/// Undirected edges of the work faces.
+struct EdgeGroups {
+    /// Edge of each corner (corner `c` is the side from vertex `c` to the next vertex).
+    corner_edge: Vec<u32>,
+    /// The other corner on the same edge, or `NONE` on a boundary edge.
+    corner_twin: Vec<u32>,
+    edge_count: usize,
+}
+
+/// Result of grouping: either the edge groups or duplicate pairs `(later, earlier)` in
+/// work-face indices, which must be removed before grouping again.
+enum Grouping {
+    Edges(EdgeGroups),
+    Duplicates(Vec<(usize, usize)>),
+}
+
+fn corner_faces(faces: &WorkFaces) -> (Vec<u32>, Vec<u32>) {
+    let nc = faces.indices.len();
+    let mut corner_face = vec![0u32; nc];
+    let mut next_corner = vec![0u32; nc];
+    for f in 0..faces.len() {
+        let (a, b) = (faces.offsets[f], faces.offsets[f + 1]);
+        for c in a..b {
+            corner_face[c as usize] = f as u32;
+            next_corner[c as usize] = if c + 1 == b { a } else { c + 1 };
+        }
+    }
+    (corner_face, next_corner)
+}
+
+fn group_edges(
+    faces: &WorkFaces,
+    corner_face: &[u32],
+    next_corner: &[u32],
+    vertex_count: usize,
+) -> Result<Grouping, MeshError> {
+    let idx = &faces.indices;
+    let nc = idx.len();
+    let ends = |c: usize| {
+        let (u, w) = (idx[c], idx[next_corner[c] as usize]);
+        (u.min(w), u.max(w))
+    };
+
+    // Counting sort of corners by their edge's smaller endpoint.
+    let mut start = vec![0u32; vertex_count + 1];
+    for c in 0..nc {
+        start[ends(c).0 as usize + 1] += 1;
+    }
+    for v in 0..vertex_count {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut by_lo = vec![0u32; nc];
+    for c in 0..nc {
+        let lo = ends(c).0 as usize;
+        by_lo[fill[lo] as usize] = c as u32;
+        fill[lo] += 1;
+    }
+    drop(fill);
+
+    let mut corner_edge = vec![NONE; nc];
+    let mut corner_twin = vec![NONE; nc];
+    let mut edge_count = 0usize;
+    let mut duplicates = Vec::new();
+    for v in 0..vertex_count {
+        let bucket = &mut by_lo[start[v] as usize..start[v + 1] as usize];
+        bucket.sort_unstable_by_key(|&c| ends(c as usize).1);
+        for group in bucket.chunk_by(|&a, &b| ends(a as usize).1 == ends(b as usize).1) {
+            let e = edge_count as u32;
+            edge_count += 1;
+            for &c in group {
+                corner_edge[c as usize] = e;
+            }
+            if group.len() == 1 {
+                continue;
+            }
+            let mut found_duplicate = false;
+            for (i, &a) in group.iter().enumerate() {
+                let fa = corner_face[a as usize] as usize;
+                for &b in &group[i + 1..] {
+                    let fb = corner_face[b as usize] as usize;
+                    if vertex_set(faces.face(fa)) == vertex_set(faces.face(fb)) {
+                        found_duplicate = true;
+                        duplicates.push((fa.max(fb), fa.min(fb)));
+                    }
+                }
+            }
+            if found_duplicate {
+                continue;
+            }
+            if group.len() > 2 {
+                let (a, b) = ends(group[0] as usize);
+                let mut on_edge: Vec<usize> = group
+                    .iter()
+                    .map(|&c| faces.input[corner_face[c as usize] as usize] as usize)
+                    .collect();
+                on_edge.sort_unstable();
+                return Err(MeshError::NonManifoldEdge {
+                    a: a as usize,
+                    b: b as usize,
+                    faces: on_edge,
+                });
+            }
+            corner_twin[group[0] as usize] = group[1];
+            corner_twin[group[1] as usize] = group[0];
+        }
+    }
+    if duplicates.is_empty() {
+        Ok(Grouping::Edges(EdgeGroups {
+            corner_edge,
+            corner_twin,
+            edge_count,
+        }))
+    } else {
+        duplicates.sort_unstable();
+        duplicates.dedup();
+        Ok(Grouping::Duplicates(duplicates))
+    }
+}
+
+/// Orientation of every face relative to its component's majority, and components.
+struct Orientation {
+    flip: Vec<bool>,
+    face_component: Vec<u32>,
+    component_count: usize,
+}
+
+/// Breadth-first search over face neighbours: across an edge, two faces agree when they
+/// traverse it in opposite directions. Each component keeps the orientation of the
+/// majority of its faces.
+fn orient(
+    faces: &WorkFaces,
+    groups: &EdgeGroups,
+    corner_face: &[u32],
+) -> Result<Orientation, MeshError> {
+    const UNSEEN: u8 = 2;
+    let nf = faces.len();
+    let idx = &faces.indices;
+    let mut state = vec![UNSEEN; nf];
+    let mut face_component = vec![0u32; nf];
+    let mut queue: Vec<u32> = Vec::with_capacity(nf);
+    let mut component_count = 0usize;
+    for seed in 0..nf {
+        if state[seed] != UNSEEN {
+            continue;
+        }
+        let first = queue.len();
+        state[seed] = 0;
+        queue.push(seed as u32);
+        let mut head = first;
+        while head < queue.len() {
+            let f = queue[head] as usize;
+            head += 1;
+            face_component[f] = component_count as u32;
+            for c in faces.offsets[f]..faces.offsets[f + 1] {
+                let t = groups.corner_twin[c as usize];
+                if t == NONE {
+                    continue;
+                }
+                let g = corner_face[t as usize] as usize;
+                let same_direction = idx[c as usize] == idx[t as usize];
+                let want = state[f] ^ u8::from(same_direction);
+                if state[g] == UNSEEN {
+                    state[g] = want;
+                    queue.push(g as u32);
+                } else if state[g] != want {
+                    let (a, b) = (idx[c as usize], idx[t as usize]);
+                    let (a, b) = if same_direction {
+                        let n = faces.face(f);
+                        let k = c as usize - faces.offsets[f] as usize;
+                        (n[k], n[(k + 1) % n.len()])
+                    } else {
+                        (a, b)
+                    };
+                    return Err(MeshError::NonOrientable {
+                        face: faces.input[f] as usize,
+                        neighbor: faces.input[g] as usize,
+                        a: a.min(b) as usize,
+                        b: a.max(b) as usize,
+                    });
+                }
+            }
+        }
+        let members = &queue[first..];
+        let flipped = members.iter().filter(|&&f| state[f as usize] == 1).count();
+        if 2 * flipped > members.len() {
+            for &f in members {
+                state[f as usize] ^= 1;
+            }
+        }
+        component_count += 1;
+    }
+    Ok(Orientation {
+        flip: state.iter().map(|&s| s == 1).collect(),
+        face_component,
+        component_count,
+    })
+}
+
+/// For each vertex, the first vertex with a bit-identical position (itself if none).
+fn coincident_representatives(positions: &[Point3<f64>]) -> Vec<u32> {
+    let mut first: HashMap<[u64; 3], u32> = HashMap::with_capacity(positions.len());
+    positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            // Adding 0.0 turns -0.0 into +0.0 so both land on the same key.
+            let key = [
+                (p.x + 0.0).to_bits(),
+                (p.y + 0.0).to_bits(),
+                (p.z + 0.0).to_bits(),
+            ];
+            *first.entry(key).or_insert(i as u32)
+        })
+        .collect()
+}
+
+fn squared_bbox_diagonal(positions: &[Point3<f64>]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum()
+}
+
+/// Checks every face and copies the valid ones (through the vertex representatives) into
+/// the working face list; drops degenerate faces when repairing.
+fn collect_faces(
+    soup: &PolygonSoup,
+    representative: Option<&[u32]>,
+    threshold: f64,
+    repair: Repair,
+    report: &mut BuildReport,
+) -> Result<WorkFaces, MeshError> {
+    let nv = soup.vertex_count();
+    let mut faces = WorkFaces {
+        indices: Vec::with_capacity(soup.face_count() * 3),
+        offsets: Vec::with_capacity(soup.face_count() + 1),
+        input: Vec::with_capacity(soup.face_count()),
+    };
+    faces.offsets.push(0);
+    let mut buf = [0u32; 4];
+    for (fi, face) in soup.faces().enumerate() {
+        if !(3..=4).contains(&face.len()) {
+            return Err(MeshError::UnsupportedFaceSize {
+                face: fi,
+                size: face.len(),
+            });
+        }
+        for (k, &v) in face.iter().enumerate() {
+            if v as usize >= nv {
+                return Err(MeshError::VertexIndexOutOfRange {
+                    face: fi,
+                    index: v as usize,
+                    vertex_count: nv,
+                });
+            }
+            buf[k] = representative.map_or(v, |r| r[v as usize]);
+        }
+        let mapped = &buf[..face.len()];
+        let repeated = (1..mapped.len()).find(|&k| mapped[..k].contains(&mapped[k]));
+        if let Some(k) = repeated {
+            if repair.drop_degenerate_faces {
+                report.dropped_degenerate_faces.push(fi);
+                continue;
+            }
+            return Err(MeshError::RepeatedVertex {
+                face: fi,
+                vertex: face[k] as usize,
+            });
+        }
+        let area = polygon_area(&soup.positions, mapped);
+        if area <= threshold {
+            if repair.drop_degenerate_faces {
+                report.dropped_degenerate_faces.push(fi);
+                continue;
+            }
+            return Err(MeshError::DegenerateFace {
+                face: fi,
+                area,
+                threshold,
+            });
+        }
+        faces.indices.extend_from_slice(mapped);
+        faces.offsets.push(faces.indices.len() as u32);
+        faces.input.push(fi as u32);
+    }
+    Ok(faces)
+}
+
+pub(crate) fn build(
+    soup: &PolygonSoup,
+    options: &BuildOptions,
+) -> Result<(Mesh, BuildReport), MeshError> {
+    let nv = soup.vertex_count();
+    if nv >= NONE as usize {
+        return Err(MeshError::TooLarge { what: "vertices" });
+    }
+    // Four corners per face plus as many boundary halfedges must fit in u32.
+    if soup.face_count() >= (NONE as usize) / 8 {
+        return Err(MeshError::TooLarge { what: "faces" });
+    }
+    if soup.face_count() == 0 {
+        return Err(MeshError::NoFaces);
+    }
+    if let Some((i, p)) = soup
+        .positions
+        .iter()
+        .enumerate()
+        .find(|(_, p)| !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()))
+    {
+        return Err(MeshError::NonFiniteCoordinate {
+            vertex: i,
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        });
+    }
+
+    let repair = options.repair;
+    let threshold = options.degenerate_area_tolerance * squared_bbox_diagonal(&soup.positions);
+    let mut report = BuildReport {
+        degenerate_area_threshold: threshold,
+        ..BuildReport::default()
+    };
+    let representative = repair
+        .merge_coincident_vertices
+        .then(|| coincident_representatives(&soup.positions));
+    if let Some(rep) = &representative {
+        report.merged_vertices = rep
+            .iter()
+            .enumerate()
+            .filter(|&(i, &r)| r as usize != i)
+            .map(|(i, &r)| (i, r as usize))
+            .collect();
+    }
+
+    let mut faces = collect_faces(soup, representative.as_deref(), threshold, repair, &mut report)?;
+
+    let (groups, orientation, corner_face, next_corner) = loop {
+        if faces.len() == 0 {
+            return Err(MeshError::NoFaces);
+        }
+        let (corner_face, next_corner) = corner_faces(&faces);
+        let groups = match group_edges(&faces, &corner_face, &next_corner, nv)? {
+            Grouping::Edges(groups) => groups,
+            Grouping::Duplicates(pairs) => {
+                if !repair.drop_duplicate_faces {
+                    let (later, earlier) = pairs[0];
+                    return Err(MeshError::DuplicateFace {
+                        face: faces.input[later] as usize,
+                        first: faces.input[earlier] as usize,
+                    });
+                }
+                let mut drop = vec![false; faces.len()];
+                for &(later, _) in &pairs {
+                    drop[later] = true;
+                }
+                report.dropped_duplicate_faces.extend(
+                    (0..faces.len())
+                        .filter(|&f| drop[f])
+                        .map(|f| faces.input[f] as usize),
+                );
+                faces.retain(|f| !drop[f]);
+                continue;
+            }
+        };
+        let orientation = orient(&faces, &groups, &corner_face)?;
+        let flips = orientation.flip.iter().filter(|&&f| f).count();
+        if flips == 0 {
+            break (groups, orientation, corner_face, next_corner);
+        }
+        report.faces_reoriented += flips;
+        for (f, &flip) in orientation.flip.iter().enumerate() {
+            if flip {
+                faces.reverse(f);
+            }
+        }
+    };
+    report.dropped_degenerate_faces.sort_unstable();
+    report.dropped_duplicate_faces.sort_unstable();
+
+    assemble(
+        soup,
+        faces,
+        groups,
+        orientation,
+        &corner_face,
+        &next_corner,
+        representative.as_deref(),
+        report,
+    )
+}
+
+/// Creates the halfedge arrays from oriented, manifold-edged faces, checks the vertex
+/// fans and links boundary loops.
+#[allow(clippy::too_many_arguments)]
+fn assemble(
+    soup: &PolygonSoup,
+    faces: WorkFaces,
+    groups: EdgeGroups,
+    orientation: Orientation,
+    corner_face: &[u32],
+    next_corner: &[u32],
+    representative: Option<&[u32]>,
+    mut report: BuildReport,
+) -> Result<(Mesh, BuildReport), MeshError> {
+    let nv_in = soup.vertex_count();
+    let nc = faces.indices.len();
+    let nf = faces.len();
+
+    // Compact the vertices, keeping the input's relative order.
+    let mut referenced = vec![false; nv_in];
+    for &v in &faces.indices {
+        referenced[v as usize] = true;
+    }
+    let mut new_id = vec![NO_VERTEX; nv_in];
+    let mut to_input = Vec::with_capacity(nv_in);
+    let mut positions = Vec::with_capacity(nv_in);
+    let mut unreferenced = Vec::new();
+    for i in 0..nv_in {
+        let is_merged = representative.is_some_and(|r| r[i] as usize != i);
+        if referenced[i] {
+            new_id[i] = to_input.len() as u32;
+            to_input.push(i as u32);
+            positions.push(soup.positions[i]);
+        } else if !is_merged {
+            unreferenced.push((i as u32, soup.positions[i]));
+            report.unreferenced_vertices.push(i);
+        }
+    }
+    let from_input: Vec<u32> = match representative {
+        Some(r) => (0..nv_in).map(|i| new_id[r[i] as usize]).collect(),
+        None => new_id.clone(),
+    };
+    let nv = to_input.len();
+
+    // Interior halfedges are the face corners; boundary halfedges follow them.
+    let boundary_count = groups.corner_twin.iter().filter(|&&t| t == NONE).count();
+    let nh = nc + boundary_count;
+    let mut origin = Vec::with_capacity(nh);
+    origin.extend(faces.indices.iter().map(|&v| new_id[v as usize]));
+    let mut next: Vec<u32> = next_corner.to_vec();
+    let mut prev = vec![0u32; nh];
+    for c in 0..nc {
+        prev[next[c] as usize] = c as u32;
+    }
+    let mut twin = groups.corner_twin;
+    let mut edge = groups.corner_edge;
+    let mut face_or_loop: Vec<u32> = corner_face.to_vec();
+
+    let mut out_boundary = vec![NONE; nv];
+    for c in 0..nc {
+        if twin[c] != NONE {
+            continue;
+        }
+        let b = origin.len() as u32;
+        let w = origin[next[c] as usize];
+        if out_boundary[w as usize] != NONE {
+            return Err(non_manifold_vertex(nc, &origin, &twin, &prev, &to_input, w));
+        }
+        out_boundary[w as usize] = b;
+        origin.push(w);
+        twin[c] = b;
+        twin.push(c as u32);
+        edge.push(edge[c]);
+    }
+    next.resize(nh, NONE);
+    for b in nc..nh {
+        // Boundary halfedge b runs from target(c) back to origin(c).
+        let u = origin[twin[b] as usize];
+        let nb = out_boundary[u as usize];
+        if nb == NONE {
+            return Err(non_manifold_vertex(nc, &origin, &twin, &prev, &to_input, u));
+        }
+        next[b] = nb;
+        prev[nb as usize] = b as u32;
+    }
+
+    // Outgoing halfedge per vertex: the boundary one on the boundary, so that circulating
+    // from it visits the fan of faces in order.
+    let mut vertex_halfedge = vec![NONE; nv];
+    for c in 0..nc {
+        vertex_halfedge[origin[c] as usize] = c as u32;
+    }
+    for v in 0..nv {
+        if out_boundary[v] != NONE {
+            vertex_halfedge[v] = out_boundary[v];
+        }
+    }
+
+    // One fan per vertex: circulating must visit every outgoing halfedge.
+    let mut degree = vec![0u32; nv];
+    for &o in &origin {
+        degree[o as usize] += 1;
+    }
+    for v in 0..nv {
+        let start = vertex_halfedge[v];
+        let mut h = start;
+        let mut count = 0u32;
+        loop {
+            count += 1;
+            h = twin[prev[h as usize] as usize];
+            if h == start || count > degree[v] {
+                break;
+            }
+        }
+        if count != degree[v] {
+            return Err(non_manifold_vertex(nc, &origin, &twin, &prev, &to_input, v as u32));
+        }
+    }
+
+    // Boundary loops, in order of their first boundary halfedge.
+    let mut loop_halfedge = Vec::new();
+    face_or_loop.resize(nh, NONE);
+    for b in nc..nh {
+        if face_or_loop[b] != NONE {
+            continue;
+        }
+        let id = (nf + loop_halfedge.len()) as u32;
+        loop_halfedge.push(HalfedgeId(b as u32));
+        let mut h = b;
+        loop {
+            face_or_loop[h] = id;
+            h = next[h] as usize;
+            if h == b {
+                break;
+            }
+        }
+    }
+
+    let vertex_map = VertexMap::new(to_input, from_input, unreferenced);
+    let data = MeshData {
+        positions,
+        next: into_ids(next, HalfedgeId),
+        prev: into_ids(prev, HalfedgeId),
+        twin: into_ids(twin, HalfedgeId),
+        origin: into_ids(origin, VertexId),
+        edge: into_ids(edge, EdgeId),
+        face_or_loop,
+        vertex_halfedge: into_ids(vertex_halfedge, HalfedgeId),
+        face_offsets: faces.offsets,
+        edge_count: groups.edge_count,
+        loop_halfedge,
+        face_component: into_ids(orientation.face_component, ComponentId),
+        component_count: orientation.component_count,
+        vertex_map,
+        face_to_input: faces.input,
+    };
+    Ok((Mesh::from_data(data), report))
+}
+
+fn into_ids<T>(v: Vec<u32>, f: impl Fn(u32) -> T) -> Vec<T> {
+    v.into_iter().map(f).collect()
+}
+
+/// The error for mesh vertex `v`, with the number of fans around it: the connected
+/// groups of its interior outgoing halfedges, where `h` and `twin(prev(h))` are joined
+/// when both are interior (they bound the same face pair across an edge at `v`).
+fn non_manifold_vertex(
+    interior: usize,
+    origin: &[u32],
+    twin: &[u32],
+    prev: &[u32],
+    to_input: &[u32],
+    v: u32,
+) -> MeshError {
+    let outgoing: Vec<usize> = (0..interior).filter(|&h| origin[h] == v).collect();
+    let mut group: Vec<usize> = (0..outgoing.len()).collect();
+    fn find(group: &mut [usize], mut i: usize) -> usize {
+        while group[i] != i {
+            group[i] = group[group[i]];
+            i = group[i];
+        }
+        i
+    }
+    for (i, &h) in outgoing.iter().enumerate() {
+        let t = twin[prev[h] as usize] as usize;
+        if let Some(j) = outgoing.iter().position(|&o| o == t) {
+            let (a, b) = (find(&mut group, i), find(&mut group, j));
+            group[a] = b;
+        }
+    }
+    let fans = (0..outgoing.len()).filter(|&i| find(&mut group, i) == i).count();
+    MeshError::NonManifoldVertex {
+        vertex: to_input[v as usize] as usize,
+        fans: fans.max(2),
+    }
+}

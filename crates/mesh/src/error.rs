@@ -1,0 +1,123 @@
+//! Errors raised while building a halfedge mesh from a polygon soup.
+//!
+//! Every variant names the offending element by its **input** index (0-based, in the order
+//! of the polygon soup, which for files is the file's own order), so that a user can find
+//! it in the file they gave.
+
+use thiserror::Error;
+
+/// Why a polygon soup could not become a halfedge mesh.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MeshError {
+    /// The soup has no faces at all.
+    #[error("the mesh has no faces")]
+    NoFaces,
+
+    /// A face with fewer than 3 or more than 4 vertices.
+    #[error("face {face} has {size} vertices; only triangles and quads are supported")]
+    UnsupportedFaceSize {
+        /// Input face index.
+        face: usize,
+        /// Number of vertices of that face.
+        size: usize,
+    },
+
+    /// A face refers to a vertex that does not exist.
+    #[error("face {face} refers to vertex {index}, but there are only {vertex_count} vertices")]
+    VertexIndexOutOfRange {
+        /// Input face index.
+        face: usize,
+        /// The vertex index it used (0-based).
+        index: usize,
+        /// Number of vertices in the soup.
+        vertex_count: usize,
+    },
+
+    /// A coordinate that is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate ({x}, {y}, {z})")]
+    NonFiniteCoordinate {
+        /// Input vertex index.
+        vertex: usize,
+        /// x coordinate.
+        x: f64,
+        /// y coordinate.
+        y: f64,
+        /// z coordinate.
+        z: f64,
+    },
+
+    /// A face that lists the same vertex twice.
+    #[error("face {face} uses vertex {vertex} more than once")]
+    RepeatedVertex {
+        /// Input face index.
+        face: usize,
+        /// The repeated input vertex index.
+        vertex: usize,
+    },
+
+    /// A face whose area is at most the threshold.
+    #[error(
+        "face {face} is degenerate: area {area:e} <= {threshold:e} (tolerance x squared bounding-box diagonal)"
+    )]
+    DegenerateFace {
+        /// Input face index.
+        face: usize,
+        /// Its area (norm of the polygon vector area).
+        area: f64,
+        /// The threshold used.
+        threshold: f64,
+    },
+
+    /// A face with the same vertex set as an earlier face.
+    #[error("face {face} duplicates face {first} (same vertices)")]
+    DuplicateFace {
+        /// Input index of the later face.
+        face: usize,
+        /// Input index of the earlier face with the same vertices.
+        first: usize,
+    },
+
+    /// An edge shared by more than two faces.
+    #[error("edge ({a}, {b}) is non-manifold: it is shared by faces {faces:?}")]
+    NonManifoldEdge {
+        /// One endpoint (input vertex index).
+        a: usize,
+        /// Other endpoint (input vertex index).
+        b: usize,
+        /// Input indices of all faces on the edge.
+        faces: Vec<usize>,
+    },
+
+    /// A vertex whose incident faces form more than one fan (a "bowtie" or pinch).
+    #[error(
+        "vertex {vertex} is non-manifold: its faces form {fans} separate fans (a pinch or bowtie)"
+    )]
+    NonManifoldVertex {
+        /// Input vertex index.
+        vertex: usize,
+        /// Number of fans found around it (at least 2).
+        fans: usize,
+    },
+
+    /// The faces of a component cannot be oriented consistently (a Moebius strip or Klein bottle).
+    #[error(
+        "the surface is non-orientable: faces {face} and {neighbor} cannot be oriented consistently across edge ({a}, {b})"
+    )]
+    NonOrientable {
+        /// Input face index where the conflict closed.
+        face: usize,
+        /// The neighbouring input face.
+        neighbor: usize,
+        /// Shared edge endpoint (input vertex index).
+        a: usize,
+        /// Shared edge endpoint (input vertex index).
+        b: usize,
+    },
+
+    /// More elements than a `u32` index can address.
+    #[error("the mesh is too large: {what} exceed u32::MAX")]
+    TooLarge {
+        /// Which elements overflowed.
+        what: &'static str,
+    },
+}

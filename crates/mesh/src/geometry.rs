@@ -1,0 +1,144 @@
+//! Geometry of the embedded mesh: lengths, areas, normals, angles, bounding box.
+//!
+//! Quads need not be planar. A quad `(p0, p1, p2, p3)` is the bilinear patch
+//! `X(u, v) = (1-u)(1-v) p0 + u(1-v) p1 + u v p2 + (1-u) v p3` over the unit square, the
+//! same surface the Q1 element uses; its area is integrated with the 2x2 Gauss rule,
+//! which is exact for planar quads (there `|X_u x X_v|` is affine in `u` and `v`).
+
+use nalgebra::{Point3, Vector3};
+
+use crate::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
+
+/// An axis-aligned bounding box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundingBox {
+    /// Smallest coordinates.
+    pub min: Point3<f64>,
+    /// Largest coordinates.
+    pub max: Point3<f64>,
+}
+
+impl BoundingBox {
+    /// The box around `points`; `None` if there are none.
+    pub fn around<'a>(points: impl IntoIterator<Item = &'a Point3<f64>>) -> Option<Self> {
+        let mut it = points.into_iter();
+        let first = *it.next()?;
+        Some(it.fold(
+            BoundingBox {
+                min: first,
+                max: first,
+            },
+            |b, p| BoundingBox {
+                min: b.min.inf(p),
+                max: b.max.sup(p),
+            },
+        ))
+    }
+
+    /// Length of the diagonal.
+    pub fn diagonal(&self) -> f64 {
+        (self.max - self.min).norm()
+    }
+}
+
+/// Gauss points of the 2-point rule on [0, 1]: 1/2 -+ 1/(2 sqrt 3).
+const GAUSS_2: [f64; 2] = [0.211_324_865_405_187_1, 0.788_675_134_594_812_9];
+
+impl Mesh {
+    /// Length of edge `e`.
+    pub fn edge_length(&self, e: EdgeId) -> f64 {
+        self.halfedge_vector(self.edge_halfedge(e)).norm()
+    }
+
+    /// Lengths of all edges, by edge id.
+    pub fn edge_lengths(&self) -> Vec<f64> {
+        self.edges().map(|e| self.edge_length(e)).collect()
+    }
+
+    /// Vector area of `f`: half the cross product of two sides (triangle) or of the two
+    /// diagonals (quad). Its norm is the area of a planar face; its direction is the
+    /// face normal.
+    pub fn face_vector_area(&self, f: FaceId) -> Vector3<f64> {
+        let (v, n) = self.face_vertex_array(f);
+        let p = |k: usize| self.position(v[k]);
+        if n == 3 {
+            0.5 * (p(1) - p(0)).cross(&(p(2) - p(0)))
+        } else {
+            0.5 * (p(2) - p(0)).cross(&(p(3) - p(1)))
+        }
+    }
+
+    /// Unit normal of `f` (direction of its vector area, counter-clockwise orientation).
+    pub fn face_normal(&self, f: FaceId) -> Vector3<f64> {
+        self.face_vector_area(f).normalize()
+    }
+
+    /// Area of `f`: exact for triangles; for quads the area of the bilinear patch by the
+    /// 2x2 Gauss rule (exact when the quad is planar).
+    pub fn face_area(&self, f: FaceId) -> f64 {
+        let (v, n) = self.face_vertex_array(f);
+        if n == 3 {
+            return self.face_vector_area(f).norm();
+        }
+        let p = |k: usize| self.position(v[k]);
+        let (d01, d32, d03, d12) = (p(1) - p(0), p(2) - p(3), p(3) - p(0), p(2) - p(1));
+        let mut area = 0.0;
+        for &u in &GAUSS_2 {
+            for &w in &GAUSS_2 {
+                let xu = (1.0 - w) * d01 + w * d32;
+                let xv = (1.0 - u) * d03 + u * d12;
+                area += 0.25 * xu.cross(&xv).norm();
+            }
+        }
+        area
+    }
+
+    /// Sum of all face areas.
+    pub fn total_area(&self) -> f64 {
+        self.faces().map(|f| self.face_area(f)).sum()
+    }
+
+    /// Centroid (vertex average) of `f`.
+    pub fn face_centroid(&self, f: FaceId) -> Point3<f64> {
+        let (v, n) = self.face_vertex_array(f);
+        let sum: Vector3<f64> = v[..n].iter().map(|&v| self.position(v).coords).sum();
+        Point3::from(sum / n as f64)
+    }
+
+    /// The interior angle of a face at the origin of face halfedge `h`, between `h` and
+    /// the reverse of `prev(h)`, in radians. Computed as `atan2(|a x b|, a . b)`, accurate
+    /// for angles near 0 and pi.
+    pub fn corner_angle(&self, h: HalfedgeId) -> f64 {
+        let a = self.halfedge_vector(h);
+        let b = -self.halfedge_vector(self.prev(h));
+        a.cross(&b).norm().atan2(a.dot(&b))
+    }
+
+    /// Angle-weighted vertex normal: the sum over incident faces of the corner angle at
+    /// `v` times the face normal, normalized.
+    pub fn vertex_normal(&self, v: VertexId) -> Vector3<f64> {
+        let sum: Vector3<f64> = self
+            .outgoing_halfedges(v)
+            .filter_map(|h| self.face(h).map(|f| self.corner_angle(h) * self.face_normal(f)))
+            .sum();
+        sum.normalize()
+    }
+
+    /// Angle-weighted normals of all vertices, by vertex id.
+    pub fn vertex_normals(&self) -> Vec<Vector3<f64>> {
+        let mut sum = vec![Vector3::zeros(); self.vertex_count()];
+        for f in self.faces() {
+            let n = self.face_normal(f);
+            for h in self.face_halfedges(f) {
+                sum[self.origin(h).idx()] += self.corner_angle(h) * n;
+            }
+        }
+        sum.into_iter().map(|s| s.normalize()).collect()
+    }
+
+    /// Bounding box of the mesh's vertices.
+    pub fn bounding_box(&self) -> BoundingBox {
+        // A built mesh has at least one face and so at least three vertices.
+        BoundingBox::around(self.positions()).expect("a mesh has vertices")
+    }
+}

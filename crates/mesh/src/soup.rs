@@ -1,0 +1,82 @@
+//! Polygon soups: the unvalidated input from which a [`crate::Mesh`] is built.
+
+use nalgebra::Point3;
+
+/// Vertex positions and faces as lists of vertex indices, before any validation.
+///
+/// Faces are stored flat (`indices` with `offsets`), so a soup of a million faces is three
+/// allocations, not a million. Indices are 0-based and refer to `positions`; nothing is
+/// checked until [`crate::Mesh::build`] runs.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PolygonSoup {
+    /// Vertex positions in R^3 (a planar mesh has z = 0).
+    pub positions: Vec<Point3<f64>>,
+    indices: Vec<u32>,
+    offsets: Vec<usize>,
+}
+
+impl PolygonSoup {
+    /// An empty soup with the given vertex positions.
+    pub fn new(positions: Vec<Point3<f64>>) -> Self {
+        Self {
+            positions,
+            indices: Vec::new(),
+            offsets: vec![0],
+        }
+    }
+
+    /// A soup of triangles.
+    pub fn from_triangles(positions: Vec<Point3<f64>>, triangles: &[[u32; 3]]) -> Self {
+        let mut soup = Self::new(positions);
+        soup.reserve(triangles.len(), 3 * triangles.len());
+        for t in triangles {
+            soup.push_face(t);
+        }
+        soup
+    }
+
+    /// A soup of quads.
+    pub fn from_quads(positions: Vec<Point3<f64>>, quads: &[[u32; 4]]) -> Self {
+        let mut soup = Self::new(positions);
+        soup.reserve(quads.len(), 4 * quads.len());
+        for q in quads {
+            soup.push_face(q);
+        }
+        soup
+    }
+
+    /// Reserves room for `faces` more faces with `corners` more vertex indices in total.
+    pub fn reserve(&mut self, faces: usize, corners: usize) {
+        self.offsets.reserve(faces);
+        self.indices.reserve(corners);
+    }
+
+    /// Appends a face given by its vertex indices (any count; the builder rejects sizes
+    /// other than 3 and 4 with [`crate::MeshError::UnsupportedFaceSize`]).
+    pub fn push_face(&mut self, vertices: &[u32]) {
+        self.indices.extend_from_slice(vertices);
+        self.offsets.push(self.indices.len());
+    }
+
+    /// Number of faces.
+    pub fn face_count(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Number of vertex positions.
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// The vertex indices of face `i`.
+    pub fn face(&self, i: usize) -> &[u32] {
+        &self.indices[self.offsets[i]..self.offsets[i + 1]]
+    }
+
+    /// Iterates over the faces in order.
+    pub fn faces(&self) -> impl ExactSizeIterator<Item = &[u32]> + '_ {
+        self.offsets
+            .windows(2)
+            .map(|w| &self.indices[w[0]..w[1]])
+    }
+}
