@@ -1,1 +1,329 @@
-//! Mesh IO.
+//! Reading and writing meshes: Wavefront OBJ (through `tobj`) and glTF 2.0 / GLB
+//! (through `gltf`).
+//!
+//! # Indices
+//!
+//! Vertex indices everywhere in beltrami (CLI pins, landmark files, correspondence output)
+//! are the file's own 0-based order. Readers return the file's vertices in that order;
+//! the halfedge mesh leaves out unreferenced vertices and [`crate::VertexMap`] converts.
+//! Writers restore the input order: they write the vertices in input order, unreferenced
+//! ones included, whenever no vertices were merged by a repair.
+//!
+//! # Atomic output
+//!
+//! Every writer goes through [`write_atomically`]: the file is written under a temporary
+//! name in the destination's folder and renamed over the destination only once complete,
+//! so a failed run never leaves a half-written file.
+
+mod atomic;
+pub mod gltf;
+pub mod obj;
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Point3, Vector2};
+use thiserror::Error;
+
+use crate::{BuildOptions, BuildReport, Mesh, MeshError, PolygonSoup};
+
+pub use atomic::write_atomically;
+
+/// The content of a mesh file before validation.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RawMesh {
+    /// Positions (in file order) and faces.
+    pub soup: PolygonSoup,
+    /// Texture coordinates per face corner, in the soup's face and corner order, when the
+    /// file gives one for every corner.
+    pub corner_uvs: Option<Vec<Vector2<f64>>>,
+    /// For OBJ files, the 1-based line number of every face, to name it in errors.
+    pub face_lines: Option<Vec<u32>>,
+}
+
+/// A validated mesh read from a file.
+#[derive(Debug, Clone)]
+pub struct LoadedMesh {
+    /// The halfedge mesh.
+    pub mesh: Mesh,
+    /// What the builder changed (re-oriented faces, unreferenced vertices, repairs).
+    pub report: BuildReport,
+    /// Texture coordinates per face halfedge (indexed by the [`crate::HalfedgeId`] of
+    /// the face halfedge leaving the corner's vertex), when the file has them.
+    pub corner_uvs: Option<Vec<Vector2<f64>>>,
+}
+
+impl LoadedMesh {
+    /// One texture coordinate per mesh vertex, when the file has texture coordinates and
+    /// every vertex has a single one (no texture seams); otherwise `None`.
+    pub fn vertex_uvs(&self) -> Option<Vec<Vector2<f64>>> {
+        let corner = self.corner_uvs.as_ref()?;
+        let mesh = &self.mesh;
+        let mut uv: Vec<Option<Vector2<f64>>> = vec![None; mesh.vertex_count()];
+        for f in mesh.faces() {
+            for h in mesh.face_halfedges(f) {
+                let slot = &mut uv[mesh.origin(h).idx()];
+                let value = corner[h.idx()];
+                match slot {
+                    None => *slot = Some(value),
+                    Some(old) if *old != value => return None,
+                    Some(_) => {}
+                }
+            }
+        }
+        uv.into_iter().collect()
+    }
+}
+
+/// Why a mesh file could not be read.
+#[derive(Debug, Error)]
+pub enum ReadError {
+    /// The file could not be opened or read.
+    #[error("cannot read {path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The extension is not one beltrami reads.
+    #[error("{path}: unknown mesh format (expected .obj, .gltf or .glb)")]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The file is not valid OBJ.
+    #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Obj {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number, when known.
+        line: Option<usize>,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file is not valid glTF, or has no triangles.
+    #[error("{path}: {message}")]
+    Gltf {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file parsed but its faces do not form a valid mesh.
+    #[error("{path}{}: {source}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Mesh {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number of the offending face, when known.
+        line: Option<usize>,
+        /// The validation error (input indices = the file's 0-based order).
+        source: MeshError,
+    },
+}
+
+/// Why a mesh file could not be written. The destination is left untouched.
+#[derive(Debug, Error)]
+pub enum WriteError {
+    /// Creating, writing or renaming the file failed.
+    #[error("cannot write {path}: {source}")]
+    Io {
+        /// The destination.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The extension is not one beltrami writes.
+    #[error("{path}: unknown mesh format (expected .obj, .gltf or .glb)")]
+    UnknownFormat {
+        /// The destination.
+        path: PathBuf,
+    },
+    /// A per-vertex attribute does not have one value per mesh vertex.
+    #[error("{what} has {got} values but the mesh has {expected} vertices")]
+    AttributeLength {
+        /// Which attribute.
+        what: &'static str,
+        /// Number of mesh vertices.
+        expected: usize,
+        /// Number of values given.
+        got: usize,
+    },
+    /// A value that cannot be written (NaN or infinite).
+    #[error("{what} of vertex {vertex} is not finite")]
+    NonFinite {
+        /// Which attribute.
+        what: &'static str,
+        /// Input index of the vertex.
+        vertex: usize,
+    },
+}
+
+/// Per-vertex data to write beside the connectivity. Each slice, when given, has one
+/// entry per mesh vertex ([`crate::VertexId`] order).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct VertexAttributes<'a> {
+    /// Positions to write instead of the mesh's own (e.g. a map into R^3).
+    pub positions: Option<&'a [Point3<f64>]>,
+    /// Texture coordinates (e.g. a planar map), written as `vt` / `TEXCOORD_0`.
+    pub uvs: Option<&'a [Vector2<f64>]>,
+    /// Linear RGB colors in [0, 1], written as `COLOR_0` (glTF only).
+    pub colors: Option<&'a [[f32; 3]]>,
+}
+
+impl VertexAttributes<'_> {
+    /// Checks that every given attribute has one finite value per vertex.
+    pub fn check(&self, mesh: &Mesh) -> Result<(), WriteError> {
+        let n = mesh.vertex_count();
+        let len = |what, got: usize| {
+            if got == n {
+                Ok(())
+            } else {
+                Err(WriteError::AttributeLength {
+                    what,
+                    expected: n,
+                    got,
+                })
+            }
+        };
+        let finite = |what, bad: Option<usize>| match bad {
+            Some(v) => Err(WriteError::NonFinite {
+                what,
+                vertex: mesh.vertex_map().to_input(crate::VertexId(v as u32)),
+            }),
+            None => Ok(()),
+        };
+        if let Some(p) = self.positions {
+            len("positions", p.len())?;
+            finite("position", p.iter().position(|p| !p.iter().all(|x| x.is_finite())))?;
+        }
+        if let Some(uv) = self.uvs {
+            len("uvs", uv.len())?;
+            finite("uv", uv.iter().position(|p| !p.iter().all(|x| x.is_finite())))?;
+        }
+        if let Some(c) = self.colors {
+            len("colors", c.len())?;
+            finite("color", c.iter().position(|p| !p.iter().all(|x| x.is_finite())))?;
+        }
+        Ok(())
+    }
+}
+
+/// The mesh formats beltrami reads and writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Wavefront OBJ.
+    Obj,
+    /// glTF 2.0, JSON with external or embedded buffers.
+    Gltf,
+    /// glTF 2.0 binary container.
+    Glb,
+}
+
+impl Format {
+    /// The format named by a path's extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "obj" => Some(Format::Obj),
+            "gltf" => Some(Format::Gltf),
+            "glb" => Some(Format::Glb),
+            _ => None,
+        }
+    }
+}
+
+/// Reads a mesh file's content without validating it, choosing the reader by extension.
+pub fn read_raw(path: &Path) -> Result<RawMesh, ReadError> {
+    match Format::from_path(path) {
+        Some(Format::Obj) => obj::read(path),
+        Some(Format::Gltf | Format::Glb) => gltf::read(path),
+        None => Err(ReadError::UnknownFormat {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+/// Reads and validates a mesh file (`.obj`, `.gltf`, `.glb`).
+pub fn read(path: &Path, options: &BuildOptions) -> Result<LoadedMesh, ReadError> {
+    let raw = read_raw(path)?;
+    build_raw(path, raw, options)
+}
+
+/// Validates the content of a mesh file read from `path` (named in errors).
+pub fn build_raw(path: &Path, raw: RawMesh, options: &BuildOptions) -> Result<LoadedMesh, ReadError> {
+    let (mesh, report) = Mesh::build(&raw.soup, options).map_err(|source| {
+        let line = raw
+            .face_lines
+            .as_ref()
+            .and_then(|lines| offending_face(&source).and_then(|f| lines.get(f)))
+            .map(|&l| l as usize);
+        ReadError::Mesh {
+            path: path.to_path_buf(),
+            line,
+            source,
+        }
+    })?;
+    let corner_uvs = raw.corner_uvs.map(|uv| corner_uvs_of_mesh(&mesh, &raw.soup, &uv));
+    Ok(LoadedMesh {
+        mesh,
+        report,
+        corner_uvs,
+    })
+}
+
+/// The input face an error names first, to find its line.
+fn offending_face(e: &MeshError) -> Option<usize> {
+    match e {
+        MeshError::UnsupportedFaceSize { face, .. }
+        | MeshError::VertexIndexOutOfRange { face, .. }
+        | MeshError::RepeatedVertex { face, .. }
+        | MeshError::DegenerateFace { face, .. }
+        | MeshError::DuplicateFace { face, .. }
+        | MeshError::NonOrientable { face, .. } => Some(*face),
+        MeshError::NonManifoldEdge { faces, .. } => faces.last().copied(),
+        _ => None,
+    }
+}
+
+/// Moves per-corner texture coordinates from the soup's corner order to the mesh's face
+/// halfedges. A re-oriented face keeps its first vertex and reverses the others, so each
+/// mesh corner is matched to the soup corner with the same input vertex.
+fn corner_uvs_of_mesh(mesh: &Mesh, soup: &PolygonSoup, uv: &[Vector2<f64>]) -> Vec<Vector2<f64>> {
+    let mut start = Vec::with_capacity(soup.face_count() + 1);
+    let mut acc = 0usize;
+    for face in soup.faces() {
+        start.push(acc);
+        acc += face.len();
+    }
+    let map = mesh.vertex_map();
+    let mut out = vec![Vector2::zeros(); mesh.halfedge_count()];
+    for f in mesh.faces() {
+        let input = mesh.face_to_input(f);
+        let face = soup.face(input);
+        for h in mesh.face_halfedges(f) {
+            let v = mesh.origin(h);
+            let k = face
+                .iter()
+                .position(|&i| map.from_input(i as usize) == Some(v))
+                .unwrap_or(0);
+            out[h.idx()] = uv[start[input] + k];
+        }
+    }
+    out.truncate(
+        mesh.faces()
+            .last()
+            .map_or(0, |f| mesh.face_halfedges(f).last().map_or(0, |h| h.idx() + 1)),
+    );
+    out
+}
+
+/// Writes `mesh` with the given attributes, choosing the format by extension.
+pub fn write(path: &Path, mesh: &Mesh, attributes: &VertexAttributes<'_>) -> Result<(), WriteError> {
+    match Format::from_path(path) {
+        Some(Format::Obj) => obj::write(path, mesh, attributes),
+        Some(Format::Gltf | Format::Glb) => gltf::write(path, mesh, attributes),
+        None => Err(WriteError::UnknownFormat {
+            path: path.to_path_buf(),
+        }),
+    }
+}
