@@ -78,12 +78,12 @@ impl LoadedMesh {
 #[derive(Debug, Error)]
 pub enum ReadError {
     /// The file could not be opened or read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The extension is not one beltrami reads.
     #[error("{path}: unknown mesh format (expected .obj, .gltf or .glb)")]
@@ -110,14 +110,14 @@ pub enum ReadError {
         message: String,
     },
     /// The file parsed but its faces do not form a valid mesh.
-    #[error("{path}{}: {source}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    #[error("{path}{}: {error}", line.map(|l| format!(":{l}")).unwrap_or_default())]
     Mesh {
         /// The file.
         path: PathBuf,
         /// 1-based line number of the offending face, when known.
         line: Option<usize>,
         /// The validation error (input indices = the file's 0-based order).
-        source: MeshError,
+        error: MeshError,
     },
 }
 
@@ -125,12 +125,12 @@ pub enum ReadError {
 #[derive(Debug, Error)]
 pub enum WriteError {
     /// Creating, writing or renaming the file failed.
-    #[error("cannot write {path}: {source}")]
+    #[error("cannot write {path}: {error}")]
     Io {
         /// The destination.
         path: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The extension is not one beltrami writes.
     #[error("{path}: unknown mesh format (expected .obj, .gltf or .glb)")]
@@ -251,16 +251,16 @@ pub fn read(path: &Path, options: &BuildOptions) -> Result<LoadedMesh, ReadError
 
 /// Validates the content of a mesh file read from `path` (named in errors).
 pub fn build_raw(path: &Path, raw: RawMesh, options: &BuildOptions) -> Result<LoadedMesh, ReadError> {
-    let (mesh, report) = Mesh::build(&raw.soup, options).map_err(|source| {
+    let (mesh, report) = Mesh::build(&raw.soup, options).map_err(|error| {
         let line = raw
             .face_lines
             .as_ref()
-            .and_then(|lines| offending_face(&source).and_then(|f| lines.get(f)))
+            .and_then(|lines| offending_face(&error).and_then(|f| lines.get(f)))
             .map(|&l| l as usize);
         ReadError::Mesh {
             path: path.to_path_buf(),
             line,
-            source,
+            error,
         }
     })?;
     let corner_uvs = raw.corner_uvs.map(|uv| corner_uvs_of_mesh(&mesh, &raw.soup, &uv));

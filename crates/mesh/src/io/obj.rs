@@ -1,22 +1,340 @@
-//! Wavefront OBJ reading (through `tobj`) and writing.
+//! Wavefront OBJ: reading through `tobj`, writing by hand.
+//!
+//! # Reading
+//!
+//! Only `v`, `vt` and `f` lines matter; groups, objects, materials, smoothing groups,
+//! normals, points and polylines are ignored. Faces keep their vertex count (no
+//! triangulation), so triangles and quads come through as they are and other polygons
+//! are rejected by the mesh builder with their face index and line.
+//!
+//! `tobj` numbers vertices in the order faces first use them, and starts a new index
+//! space at every `o`/`g`/`usemtl` line. To keep the file's own numbering, the reader
+//! drops those lines and puts in front of the file a single face that lists every `v` in
+//! order: first use is then file order. That face is removed from the result.
+//!
+//! Positions are read as `f64` (tobj's `use_f64` feature). Texture coordinates are kept
+//! per face corner when every face corner names one.
 
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::Path;
 
-use super::{RawMesh, ReadError, VertexAttributes, WriteError};
-use crate::Mesh;
+use nalgebra::{Point3, Vector2};
 
-/// Reads an OBJ file.
+use super::{RawMesh, ReadError, VertexAttributes, WriteError};
+use crate::{Mesh, MeshError, PolygonSoup, VertexId};
+
+/// Reads an OBJ file. See the module docs for what is kept.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
-    Err(ReadError::Obj {
+    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
         path: path.to_path_buf(),
-        line: None,
-        message: "not implemented yet".into(),
+        error,
+    })?;
+    parse(path, &bytes)
+}
+
+/// What the first pass over the file found.
+struct Prepared {
+    /// The lines tobj should see, behind the face that lists every vertex.
+    text: Vec<u8>,
+    vertex_count: usize,
+    /// 1-based line of every face.
+    face_lines: Vec<u32>,
+    /// Whether every corner of every face names a texture coordinate.
+    all_corners_have_uv: bool,
+}
+
+fn first_token(line: &[u8]) -> &[u8] {
+    let line = line.trim_ascii_start();
+    let end = line
+        .iter()
+        .position(|c| c.is_ascii_whitespace())
+        .unwrap_or(line.len());
+    &line[..end]
+}
+
+/// A face corner token `v`, `v/vt`, `v/vt/vn` or `v//vn` names a texture coordinate when
+/// its second field is present and non-empty.
+fn corner_has_uv(token: &[u8]) -> bool {
+    let mut parts = token.split(|&c| c == b'/');
+    parts.next();
+    parts.next().is_some_and(|vt| !vt.is_empty())
+}
+
+fn prepare(bytes: &[u8]) -> Prepared {
+    let vertex_count = bytes
+        .split(|&c| c == b'\n')
+        .filter(|l| first_token(l) == b"v")
+        .count();
+    let mut text = Vec::with_capacity(bytes.len() + 8 * vertex_count + 8);
+    if vertex_count > 0 {
+        text.push(b'f');
+        for i in 1..=vertex_count {
+            text.push(b' ');
+            text.extend_from_slice(i.to_string().as_bytes());
+        }
+        text.push(b'\n');
+    }
+    let mut face_lines = Vec::new();
+    let mut all_corners_have_uv = true;
+    for (i, line) in bytes.split(|&c| c == b'\n').enumerate() {
+        let keep = match first_token(line) {
+            b"v" | b"vt" => true,
+            b"f" => {
+                face_lines.push((i + 1) as u32);
+                all_corners_have_uv &= line
+                    .trim_ascii()
+                    .split(|c| c.is_ascii_whitespace())
+                    .filter(|t| !t.is_empty())
+                    .skip(1)
+                    .all(corner_has_uv);
+                true
+            }
+            _ => false,
+        };
+        if keep {
+            text.extend_from_slice(line);
+            text.push(b'\n');
+        }
+    }
+    Prepared {
+        text,
+        vertex_count,
+        face_lines,
+        all_corners_have_uv,
+    }
+}
+
+/// Parses OBJ text held in memory; `path` only names the file in errors.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
+    let prepared = prepare(bytes);
+    let options = tobj::LoadOptions {
+        single_index: false,
+        triangulate: false,
+        ignore_points: false,
+        ignore_lines: false,
+        ..Default::default()
+    };
+    let loaded = tobj::load_obj_buf(&mut prepared.text.as_slice(), &options, |_| {
+        Ok(Default::default())
+    });
+    let models = match loaded {
+        Ok((models, _)) => models,
+        Err(e) => return Err(locate_tobj_error(path, bytes, e, &prepared)),
+    };
+    let n = prepared.vertex_count;
+    let Some(model) = models.into_iter().next() else {
+        // No vertices and no faces at all.
+        return Ok(RawMesh {
+            soup: PolygonSoup::new(Vec::new()),
+            corner_uvs: None,
+            face_lines: Some(prepared.face_lines),
+        });
+    };
+    let m = model.mesh;
+    let positions: Vec<Point3<f64>> = m
+        .positions
+        .chunks_exact(3)
+        .map(|p| Point3::new(p[0], p[1], p[2]))
+        .collect();
+    if positions.len() != n {
+        return Err(ReadError::Obj {
+            path: path.to_path_buf(),
+            line: None,
+            message: format!(
+                "read {} vertex positions but the file has {n} `v` lines",
+                positions.len()
+            ),
+        });
+    }
+    // An empty arity list means every face is a triangle.
+    let arities: Vec<u32> = if m.face_arities.is_empty() {
+        vec![3; m.indices.len() / 3]
+    } else {
+        m.face_arities
+    };
+    let (&prefix, arities) = arities.split_first().unwrap_or((&0, &[]));
+    let prefix = prefix as usize;
+    let mut soup = PolygonSoup::new(positions);
+    soup.reserve(arities.len(), m.indices.len() - prefix);
+    let mut at = prefix;
+    for &k in arities {
+        let k = k as usize;
+        soup.push_face(&m.indices[at..at + k]);
+        at += k;
+    }
+    let corner_uvs = (prepared.all_corners_have_uv
+        && !m.texcoords.is_empty()
+        && m.texcoord_indices.len() == m.indices.len())
+    .then(|| {
+        m.texcoord_indices[prefix..]
+            .iter()
+            .map(|&t| {
+                let t = t as usize;
+                Vector2::new(m.texcoords[2 * t], m.texcoords[2 * t + 1])
+            })
+            .collect()
+    });
+    Ok(RawMesh {
+        soup,
+        corner_uvs,
+        face_lines: Some(prepared.face_lines),
     })
 }
 
-/// Writes an OBJ file.
+/// tobj's errors carry no line number: find the first line that explains the error.
+fn locate_tobj_error(
+    path: &Path,
+    bytes: &[u8],
+    error: tobj::LoadError,
+    prepared: &Prepared,
+) -> ReadError {
+    let path = path.to_path_buf();
+    let mut positions = 0usize;
+    let mut texcoords = 0usize;
+    let mut face = 0usize;
+    for (i, raw) in bytes.split(|&c| c == b'\n').enumerate() {
+        let line = String::from_utf8_lossy(raw);
+        let mut tokens = line.split_whitespace();
+        let kind = tokens.next().unwrap_or("");
+        let at = Some(i + 1);
+        let bad = |message: String| ReadError::Obj {
+            path: path.clone(),
+            line: at,
+            message,
+        };
+        match kind {
+            "v" => {
+                let coords: Vec<&str> = tokens.collect();
+                if coords.len() < 3 || coords[..3].iter().any(|t| t.parse::<f64>().is_err()) {
+                    return bad(format!("cannot read a vertex position from `{}`", line.trim()));
+                }
+                positions += 1;
+            }
+            "vt" => {
+                let coords: Vec<&str> = tokens.collect();
+                if coords.len() < 2 || coords[..2].iter().any(|t| t.parse::<f64>().is_err()) {
+                    return bad(format!(
+                        "cannot read a texture coordinate from `{}`",
+                        line.trim()
+                    ));
+                }
+                texcoords += 1;
+            }
+            "f" => {
+                for token in tokens {
+                    let mut fields = token.split('/');
+                    let resolve = |field: Option<&str>, count: usize| -> Result<Option<i64>, ()> {
+                        match field {
+                            None | Some("") => Ok(None),
+                            Some(s) => {
+                                let x: i64 = s.parse().map_err(|_| ())?;
+                                Ok(Some(if x < 0 { count as i64 + x } else { x - 1 }))
+                            }
+                        }
+                    };
+                    let (Ok(v), Ok(vt)) = (
+                        resolve(fields.next(), positions),
+                        resolve(fields.next(), texcoords),
+                    ) else {
+                        return bad(format!("cannot read face corner `{token}`"));
+                    };
+                    if let Some(v) = v.filter(|&v| v < 0 || v as usize >= prepared.vertex_count)
+                    {
+                        return ReadError::Mesh {
+                            path,
+                            line: at,
+                            error: MeshError::VertexIndexOutOfRange {
+                                face,
+                                index: v.max(0) as usize,
+                                vertex_count: prepared.vertex_count,
+                            },
+                        };
+                    }
+                    if vt.is_some_and(|t| t < 0 || t as usize >= texcoords) {
+                        return bad(format!(
+                            "face corner `{token}` refers to a missing texture coordinate"
+                        ));
+                    }
+                }
+                face += 1;
+            }
+            _ => {}
+        }
+    }
+    ReadError::Obj {
+        path,
+        line: None,
+        message: format!("cannot parse OBJ: {error}"),
+    }
+}
+
+/// Writes `mesh` as OBJ: `v` lines (the mesh's positions, or `attributes.positions`),
+/// one `vt` per vertex with the same indexing when `attributes.uvs` is given, then the
+/// faces. Vertices are written in input order, unreferenced ones included, whenever the
+/// mesh's vertex map preserves order (see [`crate::VertexMap::is_order_preserving`]), so
+/// vertex `k` of the output is vertex `k` of the file the mesh was read from.
 pub fn write(path: &Path, mesh: &Mesh, attributes: &VertexAttributes<'_>) -> Result<(), WriteError> {
     attributes.check(mesh)?;
-    let _ = path;
-    Ok(())
+    let map = mesh.vertex_map();
+    let order_preserving = map.is_order_preserving();
+    let slots = if order_preserving {
+        map.input_len()
+    } else {
+        mesh.vertex_count()
+    };
+    // Output slot of every mesh vertex, and the position/uv to write in every slot.
+    let slot_of = |v: VertexId| {
+        if order_preserving {
+            map.to_input(v)
+        } else {
+            v.idx()
+        }
+    };
+    let mut position = vec![Point3::origin(); slots];
+    let mut uv = vec![Vector2::zeros(); slots];
+    for v in mesh.vertices() {
+        let s = slot_of(v);
+        position[s] = attributes.positions.map_or(mesh.position(v), |p| p[v.idx()]);
+        if let Some(u) = attributes.uvs {
+            uv[s] = u[v.idx()];
+        }
+    }
+    if order_preserving {
+        for &(i, p) in map.unreferenced() {
+            position[i as usize] = p;
+        }
+    }
+    super::write_atomically(path, |w| {
+        writeln!(
+            w,
+            "# beltrami: {} vertices, {} faces",
+            slots,
+            mesh.face_count()
+        )?;
+        for p in &position {
+            writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+        }
+        if attributes.uvs.is_some() {
+            for t in &uv {
+                writeln!(w, "vt {} {}", t.x, t.y)?;
+            }
+        }
+        let mut line = String::new();
+        for f in mesh.faces() {
+            line.clear();
+            line.push('f');
+            for v in mesh.face_vertices(f) {
+                let k = slot_of(v) + 1;
+                // Writing into a String cannot fail.
+                let _ = if attributes.uvs.is_some() {
+                    write!(line, " {k}/{k}")
+                } else {
+                    write!(line, " {k}")
+                };
+            }
+            writeln!(w, "{line}")?;
+        }
+        Ok(())
+    })
 }

@@ -1,0 +1,31 @@
+//! Command-line interface: argument parsing and one module per command.
+
+mod info;
+mod load;
+
+use clap::{Parser, Subcommand};
+
+/// Quasiconformal maps of triangle and quad meshes.
+#[derive(Debug, Parser)]
+#[command(name = "beltrami", version, about, long_about = None)]
+pub struct Cli {
+    /// Print nothing but results and errors.
+    #[arg(short, long, global = true)]
+    pub quiet: bool,
+
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Load a mesh, validate it and print its size, topology and geometry.
+    Info(info::InfoArgs),
+}
+
+/// Runs the parsed command.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Info(args) => info::run(&args, cli.quiet),
+    }
+}
