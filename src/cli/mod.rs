@@ -1,5 +1,6 @@
 //! Command-line interface: argument parsing and one module per command.
 
+mod bench;
 mod info;
 mod load;
 
@@ -21,11 +22,14 @@ pub struct Cli {
 pub enum Command {
     /// Load a mesh, validate it and print its size, topology and geometry.
     Info(info::InfoArgs),
+    /// Time the library on generated and given meshes and print a table.
+    Bench(bench::BenchArgs),
 }
 
 /// Runs the parsed command.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Info(args) => info::run(&args, cli.quiet),
+        Command::Bench(args) => bench::run(&args),
     }
 }

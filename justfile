@@ -1,0 +1,26 @@
+# Short recipes for development. The README's commands never need `just`
+# (install it with `pip install rust-just` if you want it).
+
+# Run the main job on the bundled mesh.
+demo:
+    cargo run --release -- info meshes/disk_hemisphere.obj
+
+# Build everything in release mode.
+build:
+    cargo build --workspace --release
+
+# Run the whole test suite (release: numerics are ~30x slower in debug).
+test:
+    cargo test --workspace --release
+
+# What CI runs: fmt, clippy, tests.
+ci:
+    bash .ci/run
+
+# Loading benchmark: parse and build times of generated meshes.
+bench:
+    cargo run --release -- bench load
+
+# Format the workspace.
+fmt:
+    cargo fmt --all
