@@ -51,6 +51,7 @@ v 3 0 0
 v 3 1 0
 g part_b
 f 1 6 7 3
+f 5 1 3
 ";
 
 #[test]
@@ -61,8 +62,8 @@ fn vertex_indices_follow_the_file_when_faces_use_them_out_of_order() {
     let expected = v_lines(SHUFFLED);
     assert_eq!(raw.soup.positions, expected);
     let faces: Vec<Vec<u32>> = raw.soup.faces().map(<[u32]>::to_vec).collect();
-    assert_eq!(faces, vec![vec![4, 2, 3], vec![1, 4, 3], vec![0, 5, 6, 2]]);
-    assert_eq!(raw.face_lines, Some(vec![11, 12, 17]));
+    assert_eq!(faces, vec![vec![4, 2, 3], vec![1, 4, 3], vec![0, 5, 6, 2], vec![4, 0, 2]]);
+    assert_eq!(raw.face_lines, Some(vec![11, 12, 17, 18]));
 
     let loaded = load(&path);
     let mesh = &loaded.mesh;
@@ -72,11 +73,11 @@ fn vertex_indices_follow_the_file_when_faces_use_them_out_of_order() {
         assert_eq!(mesh.position(v), *p);
         assert_eq!(mesh.vertex_map().to_input(v), i);
     }
-    assert_eq!(mesh.face_count(), 3);
+    assert_eq!(mesh.face_count(), 4);
     assert_eq!(mesh.quad_count(), 1);
     assert_eq!(mesh.component_count(), 1);
     assert!(mesh.is_disk());
-    assert!((mesh.total_area() - 3.0).abs() < 1e-12);
+    assert!((mesh.total_area() - 2.5).abs() < 1e-12);
 }
 
 #[test]
