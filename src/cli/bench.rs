@@ -59,7 +59,9 @@ fn load(args: &LoadArgs) -> anyhow::Result<()> {
         cases.push((m.display().to_string(), m.clone()));
     }
     if !args.json {
-        println!("| mesh | vertices | faces | file MB | parse (tobj) s | build s | build / parse |");
+        println!(
+            "| mesh | vertices | faces | file MB | parse (tobj) s | build s | build / parse |"
+        );
         println!("|---|---|---|---|---|---|---|");
     }
     for (name, path) in &cases {

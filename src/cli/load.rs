@@ -48,7 +48,10 @@ pub fn load_mesh(path: &Path, repair: bool, quiet: bool) -> anyhow::Result<Loade
         let r = &mesh.report;
         let name = path.display();
         if r.faces_reoriented > 0 {
-            eprintln!("note: {name}: {} faces were re-oriented to match their neighbours", r.faces_reoriented);
+            eprintln!(
+                "note: {name}: {} faces were re-oriented to match their neighbours",
+                r.faces_reoriented
+            );
         }
         if !r.unreferenced_vertices.is_empty() {
             eprintln!(
@@ -57,13 +60,24 @@ pub fn load_mesh(path: &Path, repair: bool, quiet: bool) -> anyhow::Result<Loade
             );
         }
         if !r.dropped_degenerate_faces.is_empty() {
-            eprintln!("repair: {name}: dropped {} degenerate faces {:?}", r.dropped_degenerate_faces.len(), preview(&r.dropped_degenerate_faces));
+            eprintln!(
+                "repair: {name}: dropped {} degenerate faces {:?}",
+                r.dropped_degenerate_faces.len(),
+                preview(&r.dropped_degenerate_faces)
+            );
         }
         if !r.dropped_duplicate_faces.is_empty() {
-            eprintln!("repair: {name}: dropped {} duplicate faces {:?}", r.dropped_duplicate_faces.len(), preview(&r.dropped_duplicate_faces));
+            eprintln!(
+                "repair: {name}: dropped {} duplicate faces {:?}",
+                r.dropped_duplicate_faces.len(),
+                preview(&r.dropped_duplicate_faces)
+            );
         }
         if !r.merged_vertices.is_empty() {
-            eprintln!("repair: {name}: merged {} coincident vertices", r.merged_vertices.len());
+            eprintln!(
+                "repair: {name}: merged {} coincident vertices",
+                r.merged_vertices.len()
+            );
         }
     }
     Ok(Loaded { mesh, parse, build })

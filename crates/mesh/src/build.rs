@@ -498,7 +498,13 @@ pub(crate) fn build(
             .collect();
     }
 
-    let mut faces = collect_faces(soup, representative.as_deref(), threshold, repair, &mut report)?;
+    let mut faces = collect_faces(
+        soup,
+        representative.as_deref(),
+        threshold,
+        repair,
+        &mut report,
+    )?;
 
     let (groups, orientation, corner_face, next_corner) = loop {
         if faces.len() == 0 {
@@ -669,7 +675,9 @@ fn assemble(
             }
         }
         if count != degree[v] {
-            return Err(non_manifold_vertex(nc, &origin, &twin, &prev, &to_input, v as u32));
+            return Err(non_manifold_vertex(
+                nc, &origin, &twin, &prev, &to_input, v as u32,
+            ));
         }
     }
 
@@ -744,7 +752,9 @@ fn non_manifold_vertex(
             group[a] = b;
         }
     }
-    let fans = (0..outgoing.len()).filter(|&i| find(&mut group, i) == i).count();
+    let fans = (0..outgoing.len())
+        .filter(|&i| find(&mut group, i) == i)
+        .count();
     MeshError::NonManifoldVertex {
         vertex: to_input[v as usize] as usize,
         fans: fans.max(2),

@@ -119,7 +119,10 @@ impl Mesh {
     pub fn vertex_normal(&self, v: VertexId) -> Vector3<f64> {
         let sum: Vector3<f64> = self
             .outgoing_halfedges(v)
-            .filter_map(|h| self.face(h).map(|f| self.corner_angle(h) * self.face_normal(f)))
+            .filter_map(|h| {
+                self.face(h)
+                    .map(|f| self.corner_angle(h) * self.face_normal(f))
+            })
             .sum();
         sum.normalize()
     }

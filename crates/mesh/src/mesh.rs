@@ -275,10 +275,7 @@ impl Mesh {
     }
     /// The vertices of `f` in counter-clockwise order, starting at its first vertex.
     #[inline]
-    pub fn face_vertices(
-        &self,
-        f: FaceId,
-    ) -> impl ExactSizeIterator<Item = VertexId> + Clone + '_ {
+    pub fn face_vertices(&self, f: FaceId) -> impl ExactSizeIterator<Item = VertexId> + Clone + '_ {
         self.origin[self.face_range_usize(f)].iter().copied()
     }
     /// The vertices of a triangle or quad as a small array and its length.

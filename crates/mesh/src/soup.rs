@@ -75,8 +75,6 @@ impl PolygonSoup {
 
     /// Iterates over the faces in order.
     pub fn faces(&self) -> impl ExactSizeIterator<Item = &[u32]> + '_ {
-        self.offsets
-            .windows(2)
-            .map(|w| &self.indices[w[0]..w[1]])
+        self.offsets.windows(2).map(|w| &self.indices[w[0]..w[1]])
     }
 }

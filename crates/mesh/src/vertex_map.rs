@@ -74,7 +74,11 @@ impl VertexMap {
     /// True when input and mesh numberings coincide.
     pub fn is_identity(&self) -> bool {
         self.to_input.len() == self.from_input.len()
-            && self.to_input.iter().enumerate().all(|(i, &j)| i as u32 == j)
+            && self
+                .to_input
+                .iter()
+                .enumerate()
+                .all(|(i, &j)| i as u32 == j)
     }
 
     /// True when every input vertex has its own mesh vertex or is unreferenced, i.e. no

@@ -194,15 +194,24 @@ impl VertexAttributes<'_> {
         };
         if let Some(p) = self.positions {
             len("positions", p.len())?;
-            finite("position", p.iter().position(|p| !p.iter().all(|x| x.is_finite())))?;
+            finite(
+                "position",
+                p.iter().position(|p| !p.iter().all(|x| x.is_finite())),
+            )?;
         }
         if let Some(uv) = self.uvs {
             len("uvs", uv.len())?;
-            finite("uv", uv.iter().position(|p| !p.iter().all(|x| x.is_finite())))?;
+            finite(
+                "uv",
+                uv.iter().position(|p| !p.iter().all(|x| x.is_finite())),
+            )?;
         }
         if let Some(c) = self.colors {
             len("colors", c.len())?;
-            finite("color", c.iter().position(|p| !p.iter().all(|x| x.is_finite())))?;
+            finite(
+                "color",
+                c.iter().position(|p| !p.iter().all(|x| x.is_finite())),
+            )?;
         }
         Ok(())
     }
@@ -250,7 +259,11 @@ pub fn read(path: &Path, options: &BuildOptions) -> Result<LoadedMesh, ReadError
 }
 
 /// Validates the content of a mesh file read from `path` (named in errors).
-pub fn build_raw(path: &Path, raw: RawMesh, options: &BuildOptions) -> Result<LoadedMesh, ReadError> {
+pub fn build_raw(
+    path: &Path,
+    raw: RawMesh,
+    options: &BuildOptions,
+) -> Result<LoadedMesh, ReadError> {
     let (mesh, report) = Mesh::build(&raw.soup, options).map_err(|error| {
         let line = raw
             .face_lines
@@ -263,7 +276,9 @@ pub fn build_raw(path: &Path, raw: RawMesh, options: &BuildOptions) -> Result<Lo
             error,
         }
     })?;
-    let corner_uvs = raw.corner_uvs.map(|uv| corner_uvs_of_mesh(&mesh, &raw.soup, &uv));
+    let corner_uvs = raw
+        .corner_uvs
+        .map(|uv| corner_uvs_of_mesh(&mesh, &raw.soup, &uv));
     Ok(LoadedMesh {
         mesh,
         report,
@@ -309,16 +324,18 @@ fn corner_uvs_of_mesh(mesh: &Mesh, soup: &PolygonSoup, uv: &[Vector2<f64>]) -> V
             out[h.idx()] = uv[start[input] + k];
         }
     }
-    out.truncate(
-        mesh.faces()
-            .last()
-            .map_or(0, |f| mesh.face_halfedges(f).last().map_or(0, |h| h.idx() + 1)),
-    );
+    out.truncate(mesh.faces().last().map_or(0, |f| {
+        mesh.face_halfedges(f).last().map_or(0, |h| h.idx() + 1)
+    }));
     out
 }
 
 /// Writes `mesh` with the given attributes, choosing the format by extension.
-pub fn write(path: &Path, mesh: &Mesh, attributes: &VertexAttributes<'_>) -> Result<(), WriteError> {
+pub fn write(
+    path: &Path,
+    mesh: &Mesh,
+    attributes: &VertexAttributes<'_>,
+) -> Result<(), WriteError> {
     match Format::from_path(path) {
         Some(Format::Obj) => obj::write(path, mesh, attributes),
         Some(Format::Gltf | Format::Glb) => gltf::write(path, mesh, attributes),

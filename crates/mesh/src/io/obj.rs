@@ -113,7 +113,6 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
         triangulate: false,
         ignore_points: false,
         ignore_lines: false,
-        ..Default::default()
     };
     let loaded = tobj::load_obj_buf(&mut prepared.text.as_slice(), &options, |_| {
         Ok(Default::default())
@@ -207,7 +206,10 @@ fn locate_tobj_error(
             "v" => {
                 let coords: Vec<&str> = tokens.collect();
                 if coords.len() < 3 || coords[..3].iter().any(|t| t.parse::<f64>().is_err()) {
-                    return bad(format!("cannot read a vertex position from `{}`", line.trim()));
+                    return bad(format!(
+                        "cannot read a vertex position from `{}`",
+                        line.trim()
+                    ));
                 }
                 positions += 1;
             }
@@ -239,8 +241,7 @@ fn locate_tobj_error(
                     ) else {
                         return bad(format!("cannot read face corner `{token}`"));
                     };
-                    if let Some(v) = v.filter(|&v| v < 0 || v as usize >= prepared.vertex_count)
-                    {
+                    if let Some(v) = v.filter(|&v| v < 0 || v as usize >= prepared.vertex_count) {
                         return ReadError::Mesh {
                             path,
                             line: at,
@@ -274,7 +275,11 @@ fn locate_tobj_error(
 /// faces. Vertices are written in input order, unreferenced ones included, whenever the
 /// mesh's vertex map preserves order (see [`crate::VertexMap::is_order_preserving`]), so
 /// vertex `k` of the output is vertex `k` of the file the mesh was read from.
-pub fn write(path: &Path, mesh: &Mesh, attributes: &VertexAttributes<'_>) -> Result<(), WriteError> {
+pub fn write(
+    path: &Path,
+    mesh: &Mesh,
+    attributes: &VertexAttributes<'_>,
+) -> Result<(), WriteError> {
     attributes.check(mesh)?;
     let map = mesh.vertex_map();
     let order_preserving = map.is_order_preserving();
@@ -295,7 +300,9 @@ pub fn write(path: &Path, mesh: &Mesh, attributes: &VertexAttributes<'_>) -> Res
     let mut uv = vec![Vector2::zeros(); slots];
     for v in mesh.vertices() {
         let s = slot_of(v);
-        position[s] = attributes.positions.map_or(mesh.position(v), |p| p[v.idx()]);
+        position[s] = attributes
+            .positions
+            .map_or(mesh.position(v), |p| p[v.idx()]);
         if let Some(u) = attributes.uvs {
             uv[s] = u[v.idx()];
         }
