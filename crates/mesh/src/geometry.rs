@@ -2,8 +2,11 @@
 //!
 //! Quads need not be planar. A quad `(p0, p1, p2, p3)` is the bilinear patch
 //! `X(u, v) = (1-u)(1-v) p0 + u(1-v) p1 + u v p2 + (1-u) v p3` over the unit square, the
-//! same surface the Q1 element uses; its area is integrated with the 2x2 Gauss rule,
-//! which is exact for planar quads (there `|X_u x X_v|` is affine in `u` and `v`).
+//! same surface the Q1 element uses; its area is the 2x2 Gauss integral of
+//! `|X_u x X_v|`, exact for planar convex quads (there `X_u x X_v` is affine in `u` and
+//! `v`). A non-convex quad folds the bilinear map (the Jacobian changes sign), so its
+//! area is taken as the norm of its vector area instead, which is exact when it is
+//! planar.
 
 use nalgebra::{Point3, Vector3};
 
@@ -74,13 +77,24 @@ impl Mesh {
     }
 
     /// Area of `f`: exact for triangles; for quads the area of the bilinear patch by the
-    /// 2x2 Gauss rule (exact when the quad is planar).
+    /// 2x2 Gauss rule (exact for planar convex quads), or the norm of the vector area
+    /// when the patch folds (a non-convex quad; exact when planar).
     pub fn face_area(&self, f: FaceId) -> f64 {
+        let vector_area = self.face_vector_area(f);
         let (v, n) = self.face_vertex_array(f);
         if n == 3 {
-            return self.face_vector_area(f).norm();
+            return vector_area.norm();
         }
         let p = |k: usize| self.position(v[k]);
+        // The Jacobian X_u x X_v at corner k is the cross product of the corner's sides;
+        // the patch folds when one of them turns against the face normal.
+        let folded = (0..4).any(|k| {
+            let corner = (p((k + 1) % 4) - p(k)).cross(&(p((k + 3) % 4) - p(k)));
+            corner.dot(&vector_area) <= 0.0
+        });
+        if folded {
+            return vector_area.norm();
+        }
         let (d01, d32, d03, d12) = (p(1) - p(0), p(2) - p(3), p(3) - p(0), p(2) - p(1));
         let mut area = 0.0;
         for &u in &GAUSS_2 {
@@ -106,12 +120,26 @@ impl Mesh {
     }
 
     /// The interior angle of a face at the origin of face halfedge `h`, between `h` and
-    /// the reverse of `prev(h)`, in radians. Computed as `atan2(|a x b|, a . b)`, accurate
-    /// for angles near 0 and pi.
+    /// the reverse of `prev(h)`, in radians, in `(0, 2 pi)`: measured counter-clockwise
+    /// about the face normal, so a reflex corner of a non-convex quad has an angle above
+    /// pi. Computed as `atan2((a x b) . n, a . b)`, accurate for angles near 0 and pi.
     pub fn corner_angle(&self, h: HalfedgeId) -> f64 {
         let a = self.halfedge_vector(h);
         let b = -self.halfedge_vector(self.prev(h));
-        a.cross(&b).norm().atan2(a.dot(&b))
+        let cross = a.cross(&b);
+        let sin = match self.face(h) {
+            // Triangles are convex: the unsigned sine avoids a normal computation.
+            Some(f) if self.face_degree(f) == 4 => {
+                cross.dot(&self.face_vector_area(f).normalize())
+            }
+            _ => cross.norm(),
+        };
+        let angle = sin.atan2(a.dot(&b));
+        if angle < 0.0 {
+            angle + std::f64::consts::TAU
+        } else {
+            angle
+        }
     }
 
     /// Angle-weighted vertex normal: the sum over incident faces of the corner angle at

@@ -7,12 +7,19 @@ use nalgebra::Point3;
 /// Faces are stored flat (`indices` with `offsets`), so a soup of a million faces is three
 /// allocations, not a million. Indices are 0-based and refer to `positions`; nothing is
 /// checked until [`crate::Mesh::build`] runs.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PolygonSoup {
     /// Vertex positions in R^3 (a planar mesh has z = 0).
     pub positions: Vec<Point3<f64>>,
     indices: Vec<u32>,
     offsets: Vec<usize>,
+}
+
+impl Default for PolygonSoup {
+    /// An empty soup: no positions, no faces.
+    fn default() -> Self {
+        Self::new(Vec::new())
+    }
 }
 
 impl PolygonSoup {
