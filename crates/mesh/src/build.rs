@@ -489,14 +489,6 @@ pub(crate) fn build(
     let representative = repair
         .merge_coincident_vertices
         .then(|| coincident_representatives(&soup.positions));
-    if let Some(rep) = &representative {
-        report.merged_vertices = rep
-            .iter()
-            .enumerate()
-            .filter(|&(i, &r)| r as usize != i)
-            .map(|(i, &r)| (i, r as usize))
-            .collect();
-    }
 
     let mut faces = collect_faces(
         soup,
@@ -588,12 +580,18 @@ fn assemble(
     let mut positions = Vec::with_capacity(nv_in);
     let mut unreferenced = Vec::new();
     for i in 0..nv_in {
-        let is_merged = representative.is_some_and(|r| r[i] as usize != i);
+        // A vertex merged into a vertex that faces use is part of the mesh; one merged
+        // into an unreferenced vertex is just as unreferenced.
+        let merged_into = representative
+            .map(|r| r[i] as usize)
+            .filter(|&r| r != i && referenced[r]);
         if referenced[i] {
             new_id[i] = to_input.len() as u32;
             to_input.push(i as u32);
             positions.push(soup.positions[i]);
-        } else if !is_merged {
+        } else if let Some(r) = merged_into {
+            report.merged_vertices.push((i, r));
+        } else {
             unreferenced.push((i as u32, soup.positions[i]));
             report.unreferenced_vertices.push(i);
         }

@@ -129,9 +129,7 @@ impl Mesh {
         let cross = a.cross(&b);
         let sin = match self.face(h) {
             // Triangles are convex: the unsigned sine avoids a normal computation.
-            Some(f) if self.face_degree(f) == 4 => {
-                cross.dot(&self.face_vector_area(f).normalize())
-            }
+            Some(f) if self.face_degree(f) == 4 => cross.dot(&self.face_vector_area(f).normalize()),
             _ => cross.norm(),
         };
         let angle = sin.atan2(a.dot(&b));

@@ -59,7 +59,7 @@ typed_index!(
 );
 typed_index!(
     /// A directed halfedge. Interior halfedges belong to a face; boundary halfedges belong
-    /// to a [`BoundaryLoopId`] and run clockwise around holes (opposite to the faces).
+    /// to a [`BoundaryLoopId`] and have the surface on their right.
     HalfedgeId,
     "h"
 );

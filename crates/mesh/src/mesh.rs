@@ -10,8 +10,9 @@
 //!   is the face on its left.
 //! - Every edge has two halfedges. On a boundary edge the second one is an explicit
 //!   *boundary halfedge*, which belongs to a [`BoundaryLoopId`] instead of a face; boundary
-//!   halfedges come after all face halfedges and run clockwise around each hole, so a
-//!   boundary loop is walked with `next` like a face.
+//!   halfedges come after all face halfedges and have the surface on their right (seen
+//!   from the normal side, the outer boundary of a disk runs clockwise and a hole
+//!   counter-clockwise), so a boundary loop is walked with `next` like a face.
 //! - The outgoing halfedge stored for a boundary vertex is its boundary halfedge;
 //!   circulating from it with `h -> twin(prev(h))` turns counter-clockwise and visits the
 //!   incident faces as one contiguous fan.

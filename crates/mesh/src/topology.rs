@@ -11,8 +11,7 @@ use crate::{BoundaryLoopId, ComponentId, Mesh, VertexId};
 pub struct BoundaryLoop {
     /// The loop's id.
     pub id: BoundaryLoopId,
-    /// Its vertices in the order of its boundary halfedges (clockwise around the hole,
-    /// i.e. with the surface on the right).
+    /// Its vertices in the order of its boundary halfedges, with the surface on the right.
     pub vertices: Vec<VertexId>,
     /// Sum of its edge lengths.
     pub length: f64,

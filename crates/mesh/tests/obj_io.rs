@@ -62,7 +62,15 @@ fn vertex_indices_follow_the_file_when_faces_use_them_out_of_order() {
     let expected = v_lines(SHUFFLED);
     assert_eq!(raw.soup.positions, expected);
     let faces: Vec<Vec<u32>> = raw.soup.faces().map(<[u32]>::to_vec).collect();
-    assert_eq!(faces, vec![vec![4, 2, 3], vec![1, 4, 3], vec![0, 5, 6, 2], vec![4, 0, 2]]);
+    assert_eq!(
+        faces,
+        vec![
+            vec![4, 2, 3],
+            vec![1, 4, 3],
+            vec![0, 5, 6, 2],
+            vec![4, 0, 2]
+        ]
+    );
     assert_eq!(raw.face_lines, Some(vec![11, 12, 17, 18]));
 
     let loaded = load(&path);
@@ -249,7 +257,11 @@ fn round_trip_gives_the_same_mesh() {
         let back = load(&path);
         assert_eq!(back.mesh.vertex_count(), mesh.vertex_count());
         assert_eq!(back.mesh.face_count(), mesh.face_count());
-        assert_eq!(back.mesh.positions(), mesh.positions(), "positions are exact");
+        assert_eq!(
+            back.mesh.positions(),
+            mesh.positions(),
+            "positions are exact"
+        );
         for f in mesh.faces() {
             assert!(
                 back.mesh.face_vertices(f).eq(mesh.face_vertices(f)),
@@ -323,7 +335,10 @@ fn an_out_of_range_index_names_face_index_and_line() {
 #[test]
 fn an_unparsable_face_is_named_by_line() {
     let err = read_err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n");
-    assert!(matches!(err, ReadError::Obj { line: Some(4), .. }), "{err:?}");
+    assert!(
+        matches!(err, ReadError::Obj { line: Some(4), .. }),
+        "{err:?}"
+    );
 }
 
 #[test]

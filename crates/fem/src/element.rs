@@ -1,0 +1,268 @@
+//! P1 and Q1 elements on surfaces in R^3: quadrature points, tangent frames, shape
+//! functions and their gradients.
+//!
+//! # Reference elements
+//!
+//! A triangle `(p0, p1, p2)` is the image of the reference triangle `u, v >= 0,
+//! u + v <= 1` under `X = N0 p0 + N1 p1 + N2 p2` with `N0 = 1 - u - v`, `N1 = u`,
+//! `N2 = v` (P1), integrated with one point at the centroid (exact for the constant
+//! gradients of P1). A quad `(p0, p1, p2, p3)` is the image of the unit square under the
+//! bilinear map with `N0 = (1-u)(1-v)`, `N1 = u(1-v)`, `N2 = uv`, `N3 = (1-u)v` (Q1),
+//! integrated with the 2x2 Gauss rule (exact for polynomials of degree 3 in each of
+//! `u`, `v`). Non-planar quads are handled the Q1 way: the tangent vectors
+//! `X_1 = dX/du`, `X_2 = dX/dv` vary over the element and each quadrature point has its
+//! own tangent plane.
+//!
+//! # Frames
+//!
+//! Derivatives are taken in an orthonormal tangent frame `(e1, e2)` with normal
+//! `n = e1 x e2`; a point of the tangent plane has the complex coordinate `x + i y` along
+//! `(e1, e2)`.
+//!
+//! - [`Frame::Face`]: `n = X_1 x X_2 / |X_1 x X_2|` at the quadrature point and `e1` along
+//!   the face's first edge `p1 - p0` projected onto the tangent plane, so that a triangle
+//!   uses exactly its face frame ([`beltrami_mesh::FaceFrame`]) and the four points of a
+//!   quad share the direction of its first edge.
+//! - [`Frame::Global`]: for meshes in the plane z = 0, `e1 = x`, `e2 = y`, `n = z`: the
+//!   global coordinate `z = x + i y`. A face listed clockwise in the plane then has a
+//!   negative Jacobian determinant; its weight is the absolute value and its gradients
+//!   stay correct.
+//!
+//! With the tangent Jacobian `J = [X_1 . e1, X_2 . e1; X_1 . e2, X_2 . e2]`, the gradient
+//! of a shape function in the frame is `J^-T (dN/du, dN/dv)` and the quadrature weight is
+//! the reference weight times `|det J|`.
+
+use beltrami_mesh::{FaceId, Mesh, Point3, Vector2, Vector3, VertexId};
+
+use crate::FemError;
+
+/// Which tangent frame derivatives and Beltrami coefficients are expressed in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Frame {
+    /// The plane's own coordinate `z = x + i y` (meshes in the plane z = 0 only).
+    Global,
+    /// The frame of each face: origin-free, real axis along the face's first edge.
+    Face,
+}
+
+impl Frame {
+    /// The name used in file headers and reports: `global` or `face`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Frame::Global => "global",
+            Frame::Face => "face",
+        }
+    }
+}
+
+/// An orthonormal tangent frame at a quadrature point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TangentFrame {
+    /// Real axis.
+    pub e1: Vector3<f64>,
+    /// Imaginary axis, `n x e1`.
+    pub e2: Vector3<f64>,
+    /// Unit normal.
+    pub normal: Vector3<f64>,
+}
+
+impl TangentFrame {
+    /// Coordinates of `v` along `(e1, e2)` (its tangential part).
+    #[inline]
+    pub fn local(&self, v: &Vector3<f64>) -> Vector2<f64> {
+        Vector2::new(v.dot(&self.e1), v.dot(&self.e2))
+    }
+}
+
+/// One quadrature point of one element.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuadraturePoint {
+    /// The face it belongs to.
+    pub face: FaceId,
+    /// Reference weight times `|det J|`: the weights of a face sum to its area (exact for
+    /// triangles and planar convex quads).
+    pub weight: f64,
+    /// The tangent frame derivatives are expressed in.
+    pub frame: TangentFrame,
+    /// Shape function values at the point, one per face vertex (unused entries 0).
+    pub shape: [f64; 4],
+    /// Shape function gradients in the frame, one per face vertex (unused entries 0).
+    pub grad: [Vector2<f64>; 4],
+    /// Signed `det J`: negative when the element is clockwise in the frame.
+    pub det: f64,
+}
+
+/// Gauss points of the 2-point rule on [0, 1]: 1/2 -+ 1/(2 sqrt 3).
+const GAUSS_2: [f64; 2] = [0.211_324_865_405_187_1, 0.788_675_134_594_812_9];
+
+/// Shape functions and their `(d/du, d/dv)` derivatives at reference point `(u, v)`.
+fn reference_shape(n: usize, u: f64, v: f64) -> ([f64; 4], [[f64; 2]; 4]) {
+    if n == 3 {
+        (
+            [1.0 - u - v, u, v, 0.0],
+            [[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0], [0.0, 0.0]],
+        )
+    } else {
+        (
+            [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v],
+            [
+                [-(1.0 - v), -(1.0 - u)],
+                [1.0 - v, -u],
+                [v, u],
+                [-v, 1.0 - u],
+            ],
+        )
+    }
+}
+
+/// Reference points `(u, v)` and weights of the element rule.
+fn reference_rule(n: usize) -> &'static [(f64, f64, f64)] {
+    const TRI: [(f64, f64, f64); 1] = [(1.0 / 3.0, 1.0 / 3.0, 0.5)];
+    const QUAD: [(f64, f64, f64); 4] = [
+        (GAUSS_2[0], GAUSS_2[0], 0.25),
+        (GAUSS_2[1], GAUSS_2[0], 0.25),
+        (GAUSS_2[1], GAUSS_2[1], 0.25),
+        (GAUSS_2[0], GAUSS_2[1], 0.25),
+    ];
+    if n == 3 { &TRI } else { &QUAD }
+}
+
+/// Checks that every vertex has z = 0 up to `1e-12` times the bounding-box diagonal.
+pub fn check_planar(mesh: &Mesh) -> Result<(), FemError> {
+    let tol = 1e-12 * mesh.bounding_box().diagonal();
+    match mesh.vertices().find(|&v| mesh.position(v).z.abs() > tol) {
+        Some(vertex) => Err(FemError::NotPlanar {
+            vertex,
+            z: mesh.position(vertex).z,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// True if the mesh lies in the plane z = 0 (the condition of [`Frame::Global`]).
+pub fn is_planar(mesh: &Mesh) -> bool {
+    check_planar(mesh).is_ok()
+}
+
+/// The quadrature points of every face of a mesh, in face order.
+#[derive(Debug, Clone)]
+pub struct Elements {
+    points: Vec<QuadraturePoint>,
+    /// Points of face `f` are `offsets[f]..offsets[f + 1]`.
+    offsets: Vec<u32>,
+    /// Vertices of each face (unused entries repeat the first).
+    nodes: Vec<[VertexId; 4]>,
+    degree: Vec<u8>,
+    frame: Frame,
+}
+
+impl Elements {
+    /// Computes quadrature points, frames, shape values and gradients for every face.
+    ///
+    /// Fails with [`FemError::NotPlanar`] for [`Frame::Global`] on a mesh off the plane
+    /// z = 0, and with [`FemError::DegenerateElement`] where `det J` vanishes (relative to
+    /// the squared element size).
+    pub fn new(mesh: &Mesh, frame: Frame) -> Result<Self, FemError> {
+        if frame == Frame::Global {
+            check_planar(mesh)?;
+        }
+        let mut points = Vec::with_capacity(mesh.face_count() * 4);
+        let mut offsets = Vec::with_capacity(mesh.face_count() + 1);
+        let mut nodes = Vec::with_capacity(mesh.face_count());
+        let mut degree = Vec::with_capacity(mesh.face_count());
+        offsets.push(0);
+        for f in mesh.faces() {
+            let (v, n) = mesh.face_vertex_array(f);
+            let p: [Point3<f64>; 4] = std::array::from_fn(|k| mesh.position(v[k.min(n - 1)]));
+            let first_edge = p[1] - p[0];
+            let size2 = first_edge.norm_squared().max((p[2] - p[0]).norm_squared());
+            for &(u, w, ref_weight) in reference_rule(n) {
+                let (shape, dref) = reference_shape(n, u, w);
+                let (mut x1, mut x2) = (Vector3::zeros(), Vector3::zeros());
+                for k in 0..n {
+                    x1 += dref[k][0] * p[k].coords;
+                    x2 += dref[k][1] * p[k].coords;
+                }
+                let tangent = match frame {
+                    Frame::Global => TangentFrame {
+                        e1: Vector3::x(),
+                        e2: Vector3::y(),
+                        normal: Vector3::z(),
+                    },
+                    Frame::Face => {
+                        let normal = x1.cross(&x2).normalize();
+                        let e1 = (first_edge - first_edge.dot(&normal) * normal).normalize();
+                        TangentFrame {
+                            e1,
+                            e2: normal.cross(&e1),
+                            normal,
+                        }
+                    }
+                };
+                let (a, b) = (tangent.local(&x1), tangent.local(&x2));
+                let det = a.x * b.y - b.x * a.y;
+                if !det.is_finite() || det.abs() <= 1e-14 * size2 {
+                    return Err(FemError::DegenerateElement { face: f, det });
+                }
+                let mut grad = [Vector2::zeros(); 4];
+                for k in 0..n {
+                    let (du, dv) = (dref[k][0], dref[k][1]);
+                    grad[k] = Vector2::new(b.y * du - a.y * dv, -b.x * du + a.x * dv) / det;
+                }
+                points.push(QuadraturePoint {
+                    face: f,
+                    weight: ref_weight * det.abs(),
+                    frame: tangent,
+                    shape,
+                    grad,
+                    det,
+                });
+            }
+            offsets.push(points.len() as u32);
+            nodes.push(std::array::from_fn(|k| v[if k < n { k } else { 0 }]));
+            degree.push(n as u8);
+        }
+        Ok(Self {
+            points,
+            offsets,
+            nodes,
+            degree,
+            frame,
+        })
+    }
+
+    /// The frame the derivatives are expressed in.
+    pub fn frame(&self) -> Frame {
+        self.frame
+    }
+
+    /// All quadrature points, face by face.
+    pub fn points(&self) -> &[QuadraturePoint] {
+        &self.points
+    }
+
+    /// Number of quadrature points.
+    pub fn point_count(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Number of faces.
+    pub fn face_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Index range of the quadrature points of face `f` in [`Elements::points`].
+    pub fn face_points_range(&self, f: FaceId) -> std::ops::Range<usize> {
+        self.offsets[f.idx()] as usize..self.offsets[f.idx() + 1] as usize
+    }
+
+    /// The quadrature points of face `f` (1 for a triangle, 4 for a quad).
+    pub fn face_points(&self, f: FaceId) -> &[QuadraturePoint] {
+        &self.points[self.face_points_range(f)]
+    }
+
+    /// The vertices of face `f` (its nodes) in order.
+    pub fn nodes(&self, f: FaceId) -> &[VertexId] {
+        &self.nodes[f.idx()][..self.degree[f.idx()] as usize]
+    }
+}

@@ -1,0 +1,21 @@
+//! # beltrami-fem
+//!
+//! The numerical floor under every beltrami solver: P1 (triangles) and Q1 (quads)
+//! elements on surfaces in R^3, assembled operators (stiffness / cotangent Laplacian,
+//! mass, complex derivatives `D_z`, `D_zbar`), Beltrami coefficients of maps (planar,
+//! surface to plane, surface to surface, quaternionic), and sparse assembly into fixed
+//! patterns.
+//!
+//! Conventions (see `docs/conventions.md`): `f_z = (f_x - i f_y) / 2`,
+//! `f_zbar = (f_x + i f_y) / 2`, `mu = f_zbar / f_z`; derivatives are taken in the tangent
+//! frame of each quadrature point ([`Frame`]).
+
+pub mod assembly;
+pub mod beltrami;
+pub mod element;
+mod error;
+pub mod operators;
+pub mod quaternion;
+
+pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
+pub use error::FemError;
