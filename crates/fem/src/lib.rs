@@ -3,8 +3,9 @@
 //! The numerical floor under every beltrami solver: P1 (triangles) and Q1 (quads)
 //! elements on surfaces in R^3, assembled operators (stiffness / cotangent Laplacian,
 //! mass, complex derivatives `D_z`, `D_zbar`), Beltrami coefficients of maps (planar,
-//! surface to plane, surface to surface, quaternionic), and sparse assembly into fixed
-//! patterns.
+//! surface to plane, surface to surface, quaternionic), sparse assembly into fixed
+//! patterns, affine DOF maps for constraints, and constrained least-squares solves that
+//! reuse their symbolic factorization.
 //!
 //! Conventions (see `docs/conventions.md`): `f_z = (f_x - i f_y) / 2`,
 //! `f_zbar = (f_x + i f_y) / 2`, `mu = f_zbar / f_z`; derivatives are taken in the tangent
@@ -12,10 +13,14 @@
 
 pub mod assembly;
 pub mod beltrami;
+pub mod dof;
 pub mod element;
 mod error;
 pub mod operators;
 pub mod quaternion;
+pub mod solve;
 
+pub use dof::{DofConstraints, DofError, DofMap, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
+pub use solve::{LeastSquaresSolver, SolveError, SolveOptions};
