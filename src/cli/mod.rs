@@ -1,6 +1,7 @@
 //! Command-line interface: argument parsing and one module per command.
 
 mod bench;
+mod distortion;
 mod info;
 mod load;
 
@@ -22,6 +23,9 @@ pub struct Cli {
 pub enum Command {
     /// Load a mesh, validate it and print its size, topology and geometry.
     Info(info::InfoArgs),
+    /// Measure the distortion of a map given as a mesh: per-face Beltrami coefficients,
+    /// their statistics and the flipped faces.
+    Distortion(distortion::DistortionArgs),
     /// Time the library on generated and given meshes and print a table.
     Bench(bench::BenchArgs),
 }
@@ -30,6 +34,7 @@ pub enum Command {
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Info(args) => info::run(&args, cli.quiet),
+        Command::Distortion(args) => distortion::run(&args, cli.quiet),
         Command::Bench(args) => bench::run(&args),
     }
 }

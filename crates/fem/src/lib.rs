@@ -13,14 +13,18 @@
 
 pub mod assembly;
 pub mod beltrami;
+pub mod distortion;
 pub mod dof;
 pub mod element;
 mod error;
+pub mod field;
 pub mod operators;
 pub mod quaternion;
 pub mod solve;
 
+pub use distortion::{Distortion, DistortionStats, Histogram};
 pub use dof::{DofConstraints, DofError, DofMap, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
+pub use field::{BeltramiField, FieldError};
 pub use solve::{LeastSquaresSolver, SolveError, SolveOptions};

@@ -169,6 +169,11 @@ pub fn default_singularity_tolerance(n: usize) -> f64 {
 /// Options shared by the solvers.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveOptions {
+    /// Threads for the least-squares and SPD solves (sparse products, Cholesky); 0 and 1
+    /// mean sequential; the saddle-point LU is always sequential. On the
+    /// 2-core machines measured in `docs/benchmarks.md` a second thread did not pay off,
+    /// so the default is sequential.
+    pub threads: usize,
     /// Smallest accepted `min_k pivot_k / diagonal_k` of a Cholesky factorization, and
     /// smallest accepted reciprocal condition estimate of a saddle-point system; below
     /// it the system is singular. `None`: [`default_singularity_tolerance`] of the
@@ -178,6 +183,15 @@ pub struct SolveOptions {
 }
 
 impl SolveOptions {
+    /// faer's parallelism for [`SolveOptions::threads`].
+    pub fn par(&self) -> Par {
+        if self.threads <= 1 {
+            Par::Seq
+        } else {
+            Par::rayon(self.threads)
+        }
+    }
+
     fn tolerance(&self, n: usize) -> f64 {
         self.singularity_tolerance
             .unwrap_or_else(|| default_singularity_tolerance(n))
@@ -329,13 +343,16 @@ impl<T: Scalar> LeastSquaresSolver<T> {
         let (normal_pattern, normal_info) =
             sparse_sparse_matmul_symbolic(bt_pattern.as_ref(), b_pattern.as_ref())?;
         let cholesky = if n > 0 {
-            Some(Cholesky::new(normal_pattern.as_ref())?)
+            Some(Cholesky::new(normal_pattern.as_ref(), options.par())?)
         } else {
             None
         };
         let scratch =
-            sparse_sparse_matmul_numeric_scratch::<usize, T>(b_pattern.as_ref(), Par::Seq).or(
-                sparse_sparse_matmul_numeric_scratch::<usize, T>(normal_pattern.as_ref(), Par::Seq),
+            sparse_sparse_matmul_numeric_scratch::<usize, T>(b_pattern.as_ref(), options.par()).or(
+                sparse_sparse_matmul_numeric_scratch::<usize, T>(
+                    normal_pattern.as_ref(),
+                    options.par(),
+                ),
             );
         buffer = MemBuffer::try_new(scratch).map_err(FaerError::from)?;
 
@@ -397,6 +414,7 @@ impl<T: Scalar> LeastSquaresSolver<T> {
         self.check_inputs(a, weights, b)?;
         check_len("the length of x", self.dofs.full_len(), x.len())?;
         let one = T::from_f64(1.0);
+        let par = self.options.par();
 
         // B = A K.
         sparse_sparse_matmul_numeric(
@@ -406,7 +424,7 @@ impl<T: Scalar> LeastSquaresSolver<T> {
             self.dofs.k(),
             one,
             &self.b_info,
-            Par::Seq,
+            par,
             MemStack::new(&mut self.buffer),
         );
         // B^H W: column i of B^H is row i of B, scaled by w_i.
@@ -427,7 +445,7 @@ impl<T: Scalar> LeastSquaresSolver<T> {
             bmat,
             one,
             &self.normal_info,
-            Par::Seq,
+            par,
             MemStack::new(&mut self.buffer),
         );
         // Right-hand side B^H W (b - A x0).
@@ -438,7 +456,7 @@ impl<T: Scalar> LeastSquaresSolver<T> {
             a,
             column(self.dofs.x0()),
             -one,
-            Par::Seq,
+            par,
         );
         sparse_dense_matmul(
             column_mut(&mut self.y),
@@ -446,7 +464,7 @@ impl<T: Scalar> LeastSquaresSolver<T> {
             bt,
             column(&self.residual),
             one,
-            Par::Seq,
+            par,
         );
 
         if let Some(cholesky) = &mut self.cholesky {
@@ -545,7 +563,7 @@ pub fn solve_spd<T: Scalar>(
     if n == 0 {
         return Ok(x);
     }
-    let mut cholesky = Cholesky::<T>::new(matrix.symbolic())?;
+    let mut cholesky = Cholesky::<T>::new(matrix.symbolic(), options.par())?;
     cholesky
         .factorize(matrix, options.tolerance(n))
         .map_err(|failure| match failure {

@@ -11,15 +11,8 @@ use beltrami_mesh::{Mesh, Point3, PolygonSoup, Vector3};
 use nalgebra::{Rotation3, Unit};
 use num_complex::Complex64;
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+mod common;
+use common::Rng;
 
 /// Unit-square grid, interior vertices moved by up to `amount` cells, mapped by `warp`.
 fn planar_mesh(n: usize, cells: Cells, amount: f64, warp: impl Fn(f64, f64) -> (f64, f64)) -> Mesh {

@@ -14,31 +14,8 @@ use faer::Side;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
-/// A tiny deterministic generator (xorshift64*), values in [0, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// The unit-square grid with interior vertices moved randomly by up to `amount` cells.
-fn jittered(n: usize, cells: Cells, amount: f64, seed: u64) -> Mesh {
-    let mut soup = grid(n, n, cells);
-    let mut rng = Rng(seed);
-    let h = 1.0 / n as f64;
-    for p in &mut soup.positions {
-        let interior = p.x > 1e-9 && p.x < 1.0 - 1e-9 && p.y > 1e-9 && p.y < 1.0 - 1e-9;
-        if interior {
-            p.x += (rng.next() - 0.5) * 2.0 * amount * h;
-            p.y += (rng.next() - 0.5) * 2.0 * amount * h;
-        }
-    }
-    Mesh::from_soup(&soup).unwrap()
-}
+mod common;
+use common::{Rng, jittered};
 
 fn dense_mul(m: &SparseColMat<usize, f64>, x: &[f64]) -> Vec<f64> {
     let mut y = vec![0.0; m.nrows()];

@@ -12,34 +12,15 @@ use faer::{Mat, MatRef};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
+mod common;
+use common::Rng;
+
 fn c(re: f64, im: f64) -> Complex64 {
     Complex64::new(re, im)
 }
 
 fn v(i: u32) -> VertexId {
     VertexId(i)
-}
-
-/// splitmix64: a reproducible generator (no dev-dependency needed).
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [-1, 1).
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
-    }
 }
 
 /// A random value of the scalar type.
@@ -568,6 +549,7 @@ fn pivot_test_reads_simplicial_and_supernodal_factors() {
         let rhs = Mat::<f64>::from_fn(n, 1, |i, _| (i as f64).cos());
         let strict = SolveOptions {
             singularity_tolerance: Some(1e-2),
+            ..SolveOptions::default()
         };
         match solve_spd(grounded.as_ref(), rhs.as_ref(), strict) {
             Err(SolveError::Singular { ratio, .. }) => {

@@ -37,6 +37,7 @@ pub mod io;
 mod mesh;
 pub mod primitives;
 mod soup;
+pub mod subdivision;
 mod topology;
 mod vertex_map;
 

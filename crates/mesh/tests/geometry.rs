@@ -759,3 +759,26 @@ fn nonconvex_planar_quad_corner_angles() {
     assert!(close(angles[2], TAU - unsigned, 1e-12), "{angles:?}");
     assert!(close(angles[1], angles[3], 1e-14), "{angles:?}");
 }
+
+#[test]
+fn subdivision_keeps_topology_and_area_and_quarters_faces() {
+    use beltrami_mesh::subdivision::subdivide;
+    for soup in [
+        primitives::icosphere(1),
+        primitives::grid(3, 2, Cells::Quads),
+        primitives::torus(6, 5, 2.0, 0.5, Cells::Triangles),
+    ] {
+        let mesh = Mesh::from_soup(&soup).unwrap();
+        let fine = Mesh::from_soup(&subdivide(&mesh)).unwrap();
+        assert_eq!(fine.face_count(), 4 * mesh.face_count());
+        assert_eq!(fine.euler_characteristic(), mesh.euler_characteristic());
+        assert_eq!(fine.boundary_loop_count(), mesh.boundary_loop_count());
+        assert!((fine.total_area() - mesh.total_area()).abs() < 1e-12 * mesh.total_area());
+        for f in mesh.faces() {
+            for k in 0..4 {
+                let child = beltrami_mesh::FaceId((4 * f.idx() + k) as u32);
+                assert!(fine.face_normal(child).dot(&mesh.face_normal(f)) > 0.999);
+            }
+        }
+    }
+}

@@ -35,12 +35,16 @@ pub(super) struct Cholesky<T: Scalar> {
     buffer: MemBuffer,
     /// Right-hand-side columns the buffer holds room for.
     buffer_columns: usize,
+    par: Par,
 }
 
 impl<T: Scalar> Cholesky<T> {
     /// Symbolic analysis (AMD ordering, elimination tree, supernodes) of `pattern`
     /// (square; only its lower triangle matters).
-    pub(super) fn new(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, SolveError> {
+    pub(super) fn new(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        par: Par,
+    ) -> Result<Self, SolveError> {
         let symbolic = factorize_symbolic_cholesky(
             pattern,
             Side::Lower,
@@ -48,20 +52,21 @@ impl<T: Scalar> Cholesky<T> {
             Default::default(),
         )?;
         let n = symbolic.nrows();
-        let req = Self::scratch(&symbolic, 1);
+        let req = Self::scratch(&symbolic, 1, par);
         Ok(Self {
             values: vec![T::from_f64(0.0); symbolic.len_val()],
             diagonal: vec![0.0; n],
             buffer: MemBuffer::try_new(req).map_err(|_| FaerError::OutOfMemory)?,
             buffer_columns: 1,
+            par,
             symbolic,
         })
     }
 
-    fn scratch(symbolic: &SymbolicCholesky<usize>, rhs_columns: usize) -> StackReq {
+    fn scratch(symbolic: &SymbolicCholesky<usize>, rhs_columns: usize, par: Par) -> StackReq {
         symbolic
-            .factorize_numeric_llt_scratch::<T>(Par::Seq, Default::default())
-            .or(symbolic.solve_in_place_scratch::<T>(rhs_columns, Par::Seq))
+            .factorize_numeric_llt_scratch::<T>(par, Default::default())
+            .or(symbolic.solve_in_place_scratch::<T>(rhs_columns, par))
     }
 
     /// Numeric factorization of `matrix` (same pattern as at construction, lower
@@ -92,7 +97,7 @@ impl<T: Scalar> Cholesky<T> {
             matrix,
             Side::Lower,
             Default::default(),
-            Par::Seq,
+            self.par,
             MemStack::new(&mut self.buffer),
             Default::default(),
         );
@@ -150,14 +155,14 @@ impl<T: Scalar> Cholesky<T> {
     pub(super) fn solve_in_place(&mut self, rhs: MatMut<'_, T>) -> Result<(), SolveError> {
         if rhs.ncols() > self.buffer_columns {
             // Grows only for more right-hand sides than ever before.
-            self.buffer = MemBuffer::try_new(Self::scratch(&self.symbolic, rhs.ncols()))
+            self.buffer = MemBuffer::try_new(Self::scratch(&self.symbolic, rhs.ncols(), self.par))
                 .map_err(|_| FaerError::OutOfMemory)?;
             self.buffer_columns = rhs.ncols();
         }
         LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             rhs,
-            Par::Seq,
+            self.par,
             MemStack::new(&mut self.buffer),
         );
         Ok(())

@@ -1,4 +1,4 @@
-//! `beltrami bench`: timings printed as a table (figures go to docs/benchmarks.md).
+//! `beltrami bench load`: OBJ parse time against halfedge build time.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -7,20 +7,8 @@ use anyhow::Context;
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_mesh::primitives::{Cells, grid};
 use beltrami_mesh::{BuildOptions, Mesh};
-use clap::{Args, Subcommand};
+use clap::Args;
 use serde_json::json;
-
-#[derive(Debug, Args)]
-pub struct BenchArgs {
-    #[command(subcommand)]
-    pub what: BenchKind,
-}
-
-#[derive(Debug, Subcommand)]
-pub enum BenchKind {
-    /// OBJ parse time against halfedge build time, on generated grids and given meshes.
-    Load(LoadArgs),
-}
 
 #[derive(Debug, Args)]
 pub struct LoadArgs {
@@ -38,13 +26,7 @@ pub struct LoadArgs {
     pub json: bool,
 }
 
-pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
-    match &args.what {
-        BenchKind::Load(a) => load(a),
-    }
-}
-
-fn load(args: &LoadArgs) -> anyhow::Result<()> {
+pub fn run(args: &LoadArgs) -> anyhow::Result<()> {
     let dir = tempfile::tempdir().context("cannot create a temporary folder")?;
     let mut cases: Vec<(String, PathBuf)> = Vec::new();
     for &t in &args.triangles {

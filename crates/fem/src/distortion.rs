@@ -1,0 +1,221 @@
+//! Distortion of a map: per-face Beltrami coefficients, flipped faces and `|mu|`
+//! statistics.
+//!
+//! For faces `f = 1..F` with coefficients `mu_f`, areas `A_f` (of the source face) and
+//! flip flags, [`DistortionStats`] holds
+//!
+//! ```text
+//! mu_mean = (1/F) sum_f |mu_f|
+//! mu_max  = max_f |mu_f|
+//! mu_std  = sqrt((1/F) sum_f (|mu_f| - mu_mean)^2)          (population std)
+//! mu_l2   = sqrt(sum_f A_f |mu_f|^2 / sum_f A_f)            (area-weighted L2 norm)
+//! ```
+//!
+//! and a [`Histogram`] of `|mu_f|` over `[0, 1)` plus the count of faces with
+//! `|mu_f| >= 1`. A conformal map has all of them 0; an affine map `z + k conj(z)` has
+//! `|mu| = |k|` on every face. `|mu|` does not depend on the frame (a frame rotation
+//! multiplies `mu` by a unit number), so the statistics do not either.
+//!
+//! [`measure_planar`] and [`measure_surface`] go from a mesh and the images of its
+//! vertices to a [`Distortion`]: the field, the flags and the statistics.
+
+use beltrami_mesh::{FaceId, Mesh, Point3, Vector3};
+use num_complex::Complex64;
+
+use crate::beltrami::{self, PointDerivatives};
+use crate::{BeltramiField, Elements, FemError, Frame};
+
+/// A histogram of `|mu|` over faces: [`Histogram::BINS`] bins of width
+/// [`Histogram::WIDTH`] over `[0, 1)`, and the faces beyond.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Histogram {
+    /// `bins[k]` counts the faces with `floor(|mu| / WIDTH) = k` (evaluated in floating
+    /// point), i.e. `k WIDTH <= |mu| < (k + 1) WIDTH`.
+    pub bins: [usize; Histogram::BINS],
+    /// Faces with `|mu| >= 1` (flipped or collapsed, see [`crate::beltrami`]).
+    pub at_least_one: usize,
+}
+
+impl Histogram {
+    /// Number of bins over `[0, 1)`.
+    pub const BINS: usize = 10;
+    /// Width of a bin, `1 / BINS`.
+    pub const WIDTH: f64 = 1.0 / Self::BINS as f64;
+
+    /// Counts one value `|mu| >= 0`.
+    fn add(&mut self, modulus: f64) {
+        if modulus >= 1.0 {
+            self.at_least_one += 1;
+        } else {
+            let k = (modulus * Self::BINS as f64) as usize;
+            self.bins[k.min(Self::BINS - 1)] += 1;
+        }
+    }
+}
+
+/// Statistics of `|mu|` over the faces of a map; the formulas are in the module docs.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DistortionStats {
+    /// Number of faces `F`.
+    pub faces: usize,
+    /// Number of flipped faces (a quadrature point with Jacobian `<= 0`).
+    pub flipped: usize,
+    /// Mean of `|mu|` over faces (unweighted).
+    pub mu_mean: f64,
+    /// Largest `|mu|`.
+    pub mu_max: f64,
+    /// Population standard deviation of `|mu|` over faces (unweighted).
+    pub mu_std: f64,
+    /// Area-weighted L2 norm `sqrt(sum A_f |mu_f|^2 / sum A_f)`.
+    pub mu_l2: f64,
+    /// Histogram of `|mu|`.
+    pub histogram: Histogram,
+}
+
+impl DistortionStats {
+    /// The statistics of per-face values `mu`, source face areas `areas` and flip flags
+    /// `flipped` (all of the same length). With no faces every statistic is 0.
+    ///
+    /// Fails with [`FemError::Length`] if the lengths differ and with
+    /// [`FemError::NonFinite`] for a non-finite `mu`, or an area that is non-finite or
+    /// negative. If every area is 0, `mu_l2` is the unweighted root mean square.
+    pub fn new(mu: &[Complex64], areas: &[f64], flipped: &[bool]) -> Result<Self, FemError> {
+        let faces = mu.len();
+        for (what, got) in [("face areas", areas.len()), ("flip flags", flipped.len())] {
+            if got != faces {
+                return Err(FemError::Length {
+                    what,
+                    expected: faces,
+                    got,
+                });
+            }
+        }
+        if let Some(index) = mu
+            .iter()
+            .position(|m| !(m.re.is_finite() && m.im.is_finite()))
+        {
+            return Err(FemError::NonFinite {
+                what: "Beltrami coefficient",
+                index,
+            });
+        }
+        if let Some(index) = areas.iter().position(|a| !(a.is_finite() && *a >= 0.0)) {
+            return Err(FemError::NonFinite {
+                what: "face area",
+                index,
+            });
+        }
+        if faces == 0 {
+            return Ok(Self::default());
+        }
+        let modulus: Vec<f64> = mu.iter().map(|m| m.norm()).collect();
+        let n = faces as f64;
+        let mu_mean = modulus.iter().sum::<f64>() / n;
+        let mu_max = modulus.iter().copied().fold(0.0, f64::max);
+        let mu_std = (modulus.iter().map(|m| (m - mu_mean).powi(2)).sum::<f64>() / n).sqrt();
+        let total_area: f64 = areas.iter().sum();
+        let mu_l2 = if total_area > 0.0 {
+            let weighted: f64 = modulus.iter().zip(areas).map(|(m, a)| a * m * m).sum();
+            (weighted / total_area).sqrt()
+        } else {
+            (modulus.iter().map(|m| m * m).sum::<f64>() / n).sqrt()
+        };
+        let mut histogram = Histogram::default();
+        for &m in &modulus {
+            histogram.add(m);
+        }
+        Ok(Self {
+            faces,
+            flipped: flipped.iter().filter(|&&f| f).count(),
+            mu_mean,
+            mu_max,
+            mu_std,
+            mu_l2,
+            histogram,
+        })
+    }
+}
+
+/// The distortion of a map: its per-face Beltrami field, the flipped faces and the
+/// statistics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distortion {
+    /// `mu` per face ([`beltrami::face_mu`]: the value at the centroid of a triangle, the
+    /// weighted mean over the four Gauss points of a quad), in the frame of the elements.
+    pub field: BeltramiField,
+    /// Per face: true if the Jacobian of the map is `<= 0` at one of its quadrature points
+    /// ([`beltrami::flipped_faces`]).
+    pub flipped: Vec<bool>,
+    /// Statistics of `|mu|`, weighted by the source face areas (the sums of the
+    /// quadrature weights of each face).
+    pub stats: DistortionStats,
+}
+
+impl Distortion {
+    /// The distortion of a map from its derivatives at every quadrature point of
+    /// `elements` (from [`beltrami::planar_map`] or [`beltrami::surface_map`]).
+    pub fn from_derivatives(
+        elements: &Elements,
+        derivatives: &[PointDerivatives],
+    ) -> Result<Self, FemError> {
+        if derivatives.len() != elements.point_count() {
+            return Err(FemError::Length {
+                what: "derivatives",
+                expected: elements.point_count(),
+                got: derivatives.len(),
+            });
+        }
+        let mu = beltrami::face_mu(elements, &beltrami::point_mu(derivatives));
+        let flipped = beltrami::flipped_faces(elements, derivatives);
+        let areas: Vec<f64> = (0..elements.face_count())
+            .map(|f| {
+                elements
+                    .face_points(FaceId(f as u32))
+                    .iter()
+                    .map(|q| q.weight)
+                    .sum()
+            })
+            .collect();
+        let stats = DistortionStats::new(&mu, &areas, &flipped)?;
+        Ok(Self {
+            field: BeltramiField::new(elements.frame(), mu),
+            flipped,
+            stats,
+        })
+    }
+}
+
+/// The distortion of a map into the plane, `map[v]` the image of vertex `v`, measured in
+/// `frame` ([`Frame::Global`] for a mesh in the plane z = 0, [`Frame::Face`] for a
+/// surface).
+///
+/// Fails like [`Elements::new`] (non-planar mesh for the global frame, degenerate face)
+/// and [`beltrami::planar_map`] (wrong length, non-finite image).
+pub fn measure_planar(
+    mesh: &Mesh,
+    map: &[Complex64],
+    frame: Frame,
+) -> Result<Distortion, FemError> {
+    let elements = Elements::new(mesh, frame)?;
+    let derivatives = beltrami::planar_map(&elements, mesh.vertex_count(), map)?;
+    Distortion::from_derivatives(&elements, &derivatives)
+}
+
+/// The distortion of a map of a surface into R^3, `image[v]` the image of vertex `v`,
+/// measured intrinsically in the face frames ([`beltrami::surface_map`]).
+///
+/// `reference_normals`, one per face, are the normals the image's orientation is judged
+/// against (the target surface's normal at the image of each face); `None` judges it
+/// against the source normals, which suits images close to the source. Fails like
+/// [`Elements::new`] (degenerate face) and [`beltrami::surface_map`] (wrong length,
+/// non-finite image).
+pub fn measure_surface(
+    mesh: &Mesh,
+    image: &[Point3<f64>],
+    reference_normals: Option<&[Vector3<f64>]>,
+) -> Result<Distortion, FemError> {
+    let elements = Elements::new(mesh, Frame::Face)?;
+    let derivatives =
+        beltrami::surface_map(&elements, mesh.vertex_count(), image, reference_normals)?;
+    Distortion::from_derivatives(&elements, &derivatives)
+}

@@ -1,0 +1,58 @@
+//! Helpers shared by the integration tests of beltrami-fem: a reproducible random
+//! generator (no dev-dependency needed) and jittered planar meshes.
+// Each test binary compiles this module and uses only part of it.
+#![allow(dead_code)]
+
+use beltrami_mesh::Mesh;
+use beltrami_mesh::primitives::{Cells, grid};
+use num_complex::Complex64;
+
+/// splitmix64: a reproducible stream of random numbers.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn next(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in [-1, 1).
+    pub fn uniform(&mut self) -> f64 {
+        2.0 * self.next() - 1.0
+    }
+
+    /// Uniform in `0..n`.
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
+
+    /// A Beltrami coefficient with `|mu| < 0.9`.
+    pub fn mu(&mut self) -> Complex64 {
+        Complex64::from_polar(0.9 * self.next(), std::f64::consts::TAU * self.next())
+    }
+}
+
+/// The unit-square grid of `n x n` cells with interior vertices moved randomly by up to
+/// `amount` cells in x and y.
+pub fn jittered(n: usize, cells: Cells, amount: f64, seed: u64) -> Mesh {
+    let mut soup = grid(n, n, cells);
+    let mut rng = Rng(seed);
+    let h = 1.0 / n as f64;
+    for p in &mut soup.positions {
+        let interior = p.x > 1e-9 && p.x < 1.0 - 1e-9 && p.y > 1e-9 && p.y < 1.0 - 1e-9;
+        if interior {
+            p.x += rng.uniform() * amount * h;
+            p.y += rng.uniform() * amount * h;
+        }
+    }
+    Mesh::from_soup(&soup).expect("a jittered grid is a valid mesh")
+}

@@ -1,0 +1,29 @@
+//! `beltrami bench`: timings printed as tables (the figures go to docs/benchmarks.md).
+
+mod fem;
+mod load;
+
+use clap::{Args, Subcommand};
+
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    pub what: BenchKind,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum BenchKind {
+    /// OBJ parse time against halfedge build time, on generated grids and given meshes.
+    Load(load::LoadArgs),
+    /// Assembly, symbolic and numeric factorization and solve of the Laplacian and of
+    /// the LSCM system (complex N form and real 2N form), against faer on the same
+    /// matrices.
+    Fem(fem::FemArgs),
+}
+
+pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    match &args.what {
+        BenchKind::Load(a) => load::run(a),
+        BenchKind::Fem(a) => fem::run(a),
+    }
+}
