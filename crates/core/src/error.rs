@@ -1,0 +1,55 @@
+//! Errors of solvers.
+
+use beltrami_fem::{DofError, FemError, FieldError, SolveError};
+use beltrami_mesh::MeshError;
+use thiserror::Error;
+
+/// Why a solve could not be done.
+#[derive(Debug, Error)]
+pub enum SolverError {
+    /// The solver cannot take this problem; the message says why and what to do instead
+    /// (e.g. "lscm maps disk-topology meshes; this mesh has genus 1 and no boundary: run
+    /// `beltrami cut` first or use beltrami-flow").
+    #[error("{solver}: {message}")]
+    Unsupported {
+        /// The solver's name.
+        solver: &'static str,
+        /// Why, in plain words, with the way out.
+        message: String,
+    },
+    /// An input of the problem is invalid (a pin on a missing vertex, a field of the
+    /// wrong length, ...); the message names the element.
+    #[error("{solver}: {message}")]
+    InvalidInput {
+        /// The solver's name.
+        solver: &'static str,
+        /// What is wrong, naming the element.
+        message: String,
+    },
+    /// No solver of that name is registered.
+    #[error("no solver named `{name}`; available: {available}")]
+    UnknownSolver {
+        /// The name asked for.
+        name: String,
+        /// The registered names, comma-separated.
+        available: String,
+    },
+    /// The solve was cancelled.
+    #[error("cancelled")]
+    Cancelled,
+    /// A mesh operation failed.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// An element computation failed.
+    #[error(transparent)]
+    Fem(#[from] FemError),
+    /// A Beltrami field is invalid.
+    #[error(transparent)]
+    Field(#[from] FieldError),
+    /// The constraints could not be turned into a DOF map.
+    #[error(transparent)]
+    Dof(#[from] DofError),
+    /// A linear solve failed.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+}
