@@ -1,6 +1,7 @@
 //! Command-line interface: argument parsing and one module per command.
 
 mod bench;
+mod cut;
 mod distortion;
 mod info;
 mod load;
@@ -28,6 +29,9 @@ pub enum Command {
     Distortion(distortion::DistortionArgs),
     /// Time the library on generated and given meshes and print a table.
     Bench(bench::BenchArgs),
+    /// Cut a surface of genus >= 1 (or with several boundary loops) into a disk along a
+    /// greedy shortest system of loops and write it as OBJ.
+    Cut(cut::CutArgs),
 }
 
 /// Runs the parsed command.
@@ -36,5 +40,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info(args) => info::run(&args, cli.quiet),
         Command::Distortion(args) => distortion::run(&args, cli.quiet),
         Command::Bench(args) => bench::run(&args),
+        Command::Cut(args) => cut::run(&args, cli.quiet),
     }
 }

@@ -45,9 +45,12 @@ pub struct Progress {
     pub energy: Option<f64>,
 }
 
+/// A progress callback.
+type ProgressFn<'a> = Box<dyn FnMut(&Progress) + 'a>;
+
 /// What a solve may use beside the problem: a progress callback and a cancellation flag.
 pub struct Context<'a> {
-    progress: Option<Box<dyn FnMut(&Progress) + 'a>>,
+    progress: Option<ProgressFn<'a>>,
     cancel: Arc<AtomicBool>,
 }
 

@@ -29,6 +29,7 @@
 
 mod build;
 pub mod circulators;
+pub mod cut;
 mod error;
 pub mod frame;
 mod geometry;
@@ -42,6 +43,9 @@ mod topology;
 mod vertex_map;
 
 pub use build::{BuildOptions, BuildReport, Repair};
+pub use cut::{
+    CutError, CutGraph, CutMesh, Generator, GeneratorKind, TorusSides, cut_graph, cut_to_disk,
+};
 pub use error::MeshError;
 pub use frame::FaceFrame;
 pub use geometry::BoundingBox;
