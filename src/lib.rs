@@ -10,8 +10,22 @@
 //!   Beltrami fields (per-face `mu` in a stated frame, with their file format) and
 //!   distortion statistics.
 //!
+//! - [`core`]: the `Solver` trait, problems, solutions, reports and the registry.
+//! - [`init`]: the initialization solvers (tutte, harmonic, lscm).
+//!
+//! [`registry`] returns every solver shipped with this package.
+//!
 //! The `beltrami` binary built from this package is the command-line front end; see the
 //! README for its commands.
 
+pub use beltrami_core as core;
 pub use beltrami_fem as fem;
+pub use beltrami_init as init;
 pub use beltrami_mesh as mesh;
+
+/// Every solver shipped with beltrami, by name.
+pub fn registry() -> beltrami_core::Registry {
+    let mut registry = beltrami_core::Registry::new();
+    beltrami_init::register(&mut registry);
+    registry
+}

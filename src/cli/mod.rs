@@ -1,10 +1,14 @@
 //! Command-line interface: argument parsing and one module per command.
 
 mod bench;
+mod colormap;
 mod cut;
 mod distortion;
 mod info;
 mod load;
+mod param;
+mod pins;
+mod solvers;
 
 use clap::{Parser, Subcommand};
 
@@ -27,6 +31,11 @@ pub enum Command {
     /// Measure the distortion of a map given as a mesh: per-face Beltrami coefficients,
     /// their statistics and the flipped faces.
     Distortion(distortion::DistortionArgs),
+    /// Parameterize a mesh with a registered solver (tutte, harmonic, lscm) and write
+    /// the map as texture coordinates.
+    Param(param::ParamArgs),
+    /// List the registered solvers and what each accepts.
+    Solvers(solvers::SolversArgs),
     /// Time the library on generated and given meshes and print a table.
     Bench(bench::BenchArgs),
     /// Cut a surface of genus >= 1 (or with several boundary loops) into a disk along a
@@ -39,6 +48,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Info(args) => info::run(&args, cli.quiet),
         Command::Distortion(args) => distortion::run(&args, cli.quiet),
+        Command::Param(args) => param::run(&args, cli.quiet),
+        Command::Solvers(args) => solvers::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Cut(args) => cut::run(&args, cli.quiet),
     }

@@ -17,9 +17,13 @@
 //!
 //! solved by a sparse Cholesky factorization (`B^H W B` is Hermitian positive
 //! semidefinite; it is definite exactly when the constraints determine the minimizer).
-//! The pattern of `B`, of `B^H`, of the normal matrix and the symbolic factorization are
-//! computed once, at construction; [`LeastSquaresSolver::solve`] only refills values
-//! (iterative solvers call it every step with new values in the same pattern).
+//! The patterns of `B` and of the normal matrix (lower triangle), the maps that scatter
+//! the values of `A` into them, and the symbolic factorization are computed once, at
+//! construction; [`LeastSquaresSolver::solve`] only refills values (iterative solvers
+//! call it every step with new values in the same pattern). No sparse-sparse product
+//! is formed: every row of `K` has at most one nonzero, so `B` is a remap of the entries
+//! of `A`, and `B^H W B` is summed row by row of `B` into precomputed positions
+//! (`normal` module: formulas and construction of the maps).
 //!
 //! The normal equations square the condition number of `W^(1/2) A K`; they are the
 //! right tool here because finite-element energies are well scaled, and the factor is
@@ -33,6 +37,7 @@
 //! solution is checked for non-finite values.
 
 mod cholesky;
+mod normal;
 mod saddle;
 
 pub use saddle::{SaddlePointSolution, solve_saddle_point};
@@ -40,16 +45,9 @@ pub use saddle::{SaddlePointSolution, solve_saddle_point};
 use crate::dof::{DofMap, Scalar};
 use beltrami_mesh::VertexId;
 use cholesky::{Cholesky, FactorFailure};
-use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::matmul::{
-    SparseMatMulInfo, sparse_dense_matmul, sparse_sparse_matmul_numeric,
-    sparse_sparse_matmul_numeric_scratch, sparse_sparse_matmul_symbolic,
-};
-use faer::sparse::utils::{transpose, transpose_scratch};
-use faer::sparse::{
-    FaerError, SparseColMatMut, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef,
-};
-use faer::{Accum, Mat, MatMut, MatRef, Par};
+use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::{Mat, MatMut, MatRef, Par};
+use normal::NormalEquations;
 use std::fmt;
 use thiserror::Error;
 
@@ -169,10 +167,11 @@ pub fn default_singularity_tolerance(n: usize) -> f64 {
 /// Options shared by the solvers.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveOptions {
-    /// Threads for the least-squares and SPD solves (sparse products, Cholesky); 0 and 1
-    /// mean sequential; the saddle-point LU is always sequential. On the
-    /// 2-core machines measured in `docs/benchmarks.md` a second thread did not pay off,
-    /// so the default is sequential.
+    /// Threads for the Cholesky factorizations of the least-squares and SPD solves; 0
+    /// and 1 mean sequential; the assembly of the normal equations and the saddle-point
+    /// LU are always sequential. On the 2-core machines measured in
+    /// `docs/benchmarks.md` a second thread did not pay off, so the default is
+    /// sequential.
     pub threads: usize,
     /// Smallest accepted `min_k pivot_k / diagonal_k` of a Cholesky factorization, and
     /// smallest accepted reciprocal condition estimate of a saddle-point system; below
@@ -238,10 +237,6 @@ fn check_finite_solution<T: Scalar>(v: &[T]) -> Result<(), SolveError> {
     }
 }
 
-fn column<T>(v: &[T]) -> MatRef<'_, T> {
-    MatRef::from_column_major_slice(v, v.len(), 1)
-}
-
 fn column_mut<T>(v: &mut [T]) -> MatMut<'_, T> {
     let n = v.len();
     MatMut::from_column_major_slice_mut(v, n, 1)
@@ -262,27 +257,14 @@ pub struct LeastSquaresSolver<T: Scalar> {
     options: SolveOptions,
     /// Pattern of `A` (`m x N`) the solver was built for.
     a_pattern: SymbolicSparseColMat<usize>,
-    /// `B = A K` (`m x n`).
-    b_pattern: SymbolicSparseColMat<usize>,
-    b_info: SparseMatMulInfo,
-    b_values: Vec<T>,
-    /// `B^H W` (`n x m`): its pattern, and for each of its entries the position of the
-    /// matching entry of `B`, so that refilling it is a gather (no transposition).
-    bt_pattern: SymbolicSparseColMat<usize>,
-    bt_source: Vec<usize>,
-    bt_values: Vec<T>,
-    /// `B^H W B` (`n x n`, both triangles; the factorization reads the lower one).
-    normal_pattern: SymbolicSparseColMat<usize>,
-    normal_info: SparseMatMulInfo,
-    normal_values: Vec<T>,
+    /// `B = A K`, `B^H W B` (lower triangle) and the maps filling them.
+    normal: NormalEquations<T>,
     /// `None` when every unknown is fixed (`n = 0`): then `x = x0`.
     cholesky: Option<Cholesky<T>>,
     /// `b - A x0` (`m`).
     residual: Vec<T>,
     /// Right-hand side, then solution, of the normal equations (`n`).
     y: Vec<T>,
-    /// Scratch of the two sparse products.
-    buffer: MemBuffer,
 }
 
 impl<T: Scalar> fmt::Debug for LeastSquaresSolver<T> {
@@ -291,7 +273,7 @@ impl<T: Scalar> fmt::Debug for LeastSquaresSolver<T> {
             .field("rows", &self.a_pattern.nrows())
             .field("full_len", &self.a_pattern.ncols())
             .field("reduced_len", &self.y.len())
-            .field("normal_nnz", &self.normal_values.len())
+            .field("normal_nnz", &self.normal.pattern().row_idx().len())
             .field("options", &self.options)
             .finish_non_exhaustive()
     }
@@ -299,8 +281,9 @@ impl<T: Scalar> fmt::Debug for LeastSquaresSolver<T> {
 
 impl<T: Scalar> LeastSquaresSolver<T> {
     /// Symbolic phase for matrices `A` with the pattern `a_pattern`
-    /// (`m x dofs.full_len()`): the patterns of `B = A K`, `B^H` and `B^H W B`, and the
-    /// symbolic Cholesky factorization (AMD ordering) of the latter.
+    /// (`m x dofs.full_len()`): the patterns of `B = A K` and of the lower triangle of
+    /// `B^H W B`, the maps scattering `A` into them, and the symbolic Cholesky
+    /// factorization (AMD ordering) of the latter.
     ///
     /// Errors: [`SolveError::Length`] if `A` has not `dofs.full_len()` columns,
     /// [`SolveError::Unconstrained`] if a reduced unknown appears in no row of `A`.
@@ -313,67 +296,21 @@ impl<T: Scalar> LeastSquaresSolver<T> {
         let m = a_pattern.nrows();
         let n = dofs.reduced_len();
         let a_pattern = a_pattern.to_owned()?;
-        let (b_pattern, b_info) =
-            sparse_sparse_matmul_symbolic(a_pattern.as_ref(), dofs.k().symbolic())?;
-        if let Some(index) = (0..n).find(|&j| b_pattern.col_range(j).is_empty()) {
-            return Err(SolveError::Unconstrained {
-                index,
-                node: dofs.dof_node(index),
-            });
-        }
-
-        // Transpose a copy of B whose values are their own positions: the result's
-        // values say where each entry of B^H comes from.
-        let nnz = b_pattern.row_idx().len();
-        let positions: Vec<usize> = (0..nnz).collect();
-        let mut bt_col_ptr = vec![0usize; m + 1];
-        let mut bt_row_idx = vec![0usize; nnz];
-        let mut bt_source = vec![0usize; nnz];
-        let mut buffer =
-            MemBuffer::try_new(transpose_scratch::<usize>(m, n)).map_err(FaerError::from)?;
-        transpose(
-            &mut bt_source,
-            &mut bt_col_ptr,
-            &mut bt_row_idx,
-            SparseColMatRef::new(b_pattern.as_ref(), &positions),
-            MemStack::new(&mut buffer),
-        );
-        let bt_pattern = SymbolicSparseColMat::new_checked(n, m, bt_col_ptr, None, bt_row_idx);
-
-        let (normal_pattern, normal_info) =
-            sparse_sparse_matmul_symbolic(bt_pattern.as_ref(), b_pattern.as_ref())?;
+        let normal = NormalEquations::new(a_pattern.as_ref(), dofs)?;
         let cholesky = if n > 0 {
-            Some(Cholesky::new(normal_pattern.as_ref(), options.par())?)
+            Some(Cholesky::new(normal.pattern(), options.par())?)
         } else {
             None
         };
-        let scratch =
-            sparse_sparse_matmul_numeric_scratch::<usize, T>(b_pattern.as_ref(), options.par()).or(
-                sparse_sparse_matmul_numeric_scratch::<usize, T>(
-                    normal_pattern.as_ref(),
-                    options.par(),
-                ),
-            );
-        buffer = MemBuffer::try_new(scratch).map_err(FaerError::from)?;
-
         let zero = T::from_f64(0.0);
         Ok(Self {
             dofs: dofs.clone(),
             options,
-            b_values: vec![zero; nnz],
-            bt_values: vec![zero; nnz],
-            normal_values: vec![zero; normal_pattern.row_idx().len()],
+            a_pattern,
+            normal,
+            cholesky,
             residual: vec![zero; m],
             y: vec![zero; n],
-            a_pattern,
-            b_pattern,
-            b_info,
-            bt_pattern,
-            bt_source,
-            normal_pattern,
-            normal_info,
-            cholesky,
-            buffer,
         })
     }
 
@@ -413,65 +350,26 @@ impl<T: Scalar> LeastSquaresSolver<T> {
     ) -> Result<(), SolveError> {
         self.check_inputs(a, weights, b)?;
         check_len("the length of x", self.dofs.full_len(), x.len())?;
-        let one = T::from_f64(1.0);
-        let par = self.options.par();
 
-        // B = A K.
-        sparse_sparse_matmul_numeric(
-            SparseColMatMut::new(self.b_pattern.as_ref(), &mut self.b_values),
-            Accum::Replace,
-            a,
-            self.dofs.k(),
-            one,
-            &self.b_info,
-            par,
-            MemStack::new(&mut self.buffer),
-        );
-        // B^H W: column i of B^H is row i of B, scaled by w_i.
-        let bt_col_ptr = self.bt_pattern.col_ptr();
-        for i in 0..self.residual.len() {
-            let w = T::from_f64(weights.map_or(1.0, |w| w[i]));
-            for q in bt_col_ptr[i]..bt_col_ptr[i + 1] {
-                self.bt_values[q] = self.b_values[self.bt_source[q]].conjugate() * w;
+        // Right-hand side of the problem in y: b - A x0 (only the columns with a
+        // nonzero x0, the fixed and sliding node unknowns, contribute).
+        self.residual.copy_from_slice(b);
+        let zero = T::from_f64(0.0);
+        for (l, &x0) in self.dofs.x0().iter().enumerate() {
+            if x0 != zero {
+                let minus_x0 = -x0;
+                for (i, &a_il) in a.row_idx_of_col(l).zip(a.val_of_col(l)) {
+                    self.residual[i] += a_il * minus_x0;
+                }
             }
         }
-        let bt = SparseColMatRef::new(self.bt_pattern.as_ref(), &self.bt_values);
-        let bmat = SparseColMatRef::new(self.b_pattern.as_ref(), &self.b_values);
-        // Normal matrix B^H W B.
-        sparse_sparse_matmul_numeric(
-            SparseColMatMut::new(self.normal_pattern.as_ref(), &mut self.normal_values),
-            Accum::Replace,
-            bt,
-            bmat,
-            one,
-            &self.normal_info,
-            par,
-            MemStack::new(&mut self.buffer),
-        );
-        // Right-hand side B^H W (b - A x0).
-        self.residual.copy_from_slice(b);
-        sparse_dense_matmul(
-            column_mut(&mut self.residual),
-            Accum::Add,
-            a,
-            column(self.dofs.x0()),
-            -one,
-            par,
-        );
-        sparse_dense_matmul(
-            column_mut(&mut self.y),
-            Accum::Replace,
-            bt,
-            column(&self.residual),
-            one,
-            par,
-        );
+        self.normal
+            .assemble(a, weights, &self.residual, &mut self.y);
 
         if let Some(cholesky) = &mut self.cholesky {
-            let normal = SparseColMatRef::new(self.normal_pattern.as_ref(), &self.normal_values);
             let tolerance = self.options.tolerance(self.y.len());
             cholesky
-                .factorize(normal, tolerance)
+                .factorize(self.normal.matrix(), tolerance)
                 .map_err(|failure| match failure {
                     // B^H W B is semidefinite by construction: a non-positive pivot can
                     // only be a zero one perturbed by rounding.

@@ -1,0 +1,145 @@
+//! # beltrami-init
+//!
+//! The first solvers of beltrami: linear parameterizations of disk-topology meshes
+//! (triangles, quads or both) into the plane. They are ends in themselves and the
+//! initial maps of every iterative solver.
+//!
+//! - [`Tutte`] (`tutte`): the boundary goes onto a convex curve (circle, unit square,
+//!   convex polygon; [`boundary`]) and every interior vertex is a weighted mean of its
+//!   neighbours, `sum_j w_ij (x_i - x_j) = 0`, with uniform weights `w_ij = 1`
+//!   (W. T. Tutte, "How to draw a graph", Proc. London Math. Soc. 13, 1963) or Floater's
+//!   mean-value weights `w_ij = (tan(a/2) + tan(b/2)) / |p_i - p_j|` (M. S. Floater,
+//!   "Mean value coordinates", CAGD 20, 2003). With a convex boundary and positive
+//!   weights the map is bijective (Tutte's theorem, extended by Floater, "One-to-one
+//!   piecewise linear mappings over triangulations", Math. Comp. 72, 2003).
+//! - [`Harmonic`] (`harmonic`): the same boundaries, cotangent weights
+//!   `w_ij = (cot a_ij + cot b_ij) / 2` (U. Pinkall and K. Polthier, "Computing discrete
+//!   minimal surfaces and their conjugates", Experimental Math. 2, 1993), i.e. the
+//!   minimizer of the Dirichlet energy `(1/2) integral |grad f|^2` of the P1/Q1 map. With
+//!   the boundary fixed, `E_D = A + 2 integral |f_zbar|^2` (`A` the image area, fixed by
+//!   the boundary), so it is also the most conformal map in the least-squares sense.
+//!   Cotangent weights are negative on obtuse triangles, and then faces may flip.
+//! - [`Lscm`] (`lscm`): the least-squares conformal map with a free boundary
+//!   (B. Levy, S. Petitjean, N. Ray, J. Maillot, "Least squares conformal maps for
+//!   automatic texture atlas generation", SIGGRAPH 2002): minimize
+//!   `E_C(f) = sum_q w_q |f_zbar(q)|^2` over the quadrature points `q` of all faces (one
+//!   per triangle, four per quad) in the face frames, with two vertices pinned (by
+//!   default two boundary vertices far apart, at `(0, 0)` and `(1, 0)`).
+//!
+//! All three need a single topological disk; a mesh of another topology gets
+//! [`beltrami_core::SolverError::Unsupported`] saying what it is and what to do instead.
+//! Their reports carry the timings of each stage, the per-face Beltrami coefficient and
+//! its statistics (flipped faces included), and notes on flips.
+//!
+//! ```
+//! use beltrami_core::{Context, PlanarBoundary, Problem, Solver, Target};
+//! use beltrami_init::Tutte;
+//! use beltrami_mesh::{Mesh, primitives::{grid, Cells}};
+//!
+//! let mesh = Mesh::from_soup(&grid(8, 8, Cells::Triangles)).unwrap();
+//! let problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Circle));
+//! let solution = Tutte.solve(&problem, &mut Context::new()).unwrap();
+//! assert_eq!(solution.report.flipped(), Some(0));
+//! ```
+
+pub mod boundary;
+pub mod harmonic;
+pub mod lscm;
+pub mod tutte;
+pub mod weights;
+
+pub use harmonic::Harmonic;
+pub use lscm::Lscm;
+pub use tutte::Tutte;
+
+use beltrami_core::{Context, Goal, Problem, Progress, Report, SolverError};
+use beltrami_fem::distortion::measure_planar;
+use beltrami_fem::{Frame, SolveOptions};
+use beltrami_mesh::Mesh;
+use num_complex::Complex64;
+
+/// Adds [`Tutte`], [`Harmonic`] and [`Lscm`] to `registry`.
+pub fn register(registry: &mut beltrami_core::Registry) {
+    registry.register(Box::new(Tutte));
+    registry.register(Box::new(Harmonic));
+    registry.register(Box::new(Lscm));
+}
+
+/// The advice of the topology check: what to do with a mesh that is not a disk.
+const NOT_A_DISK: &str = "run `beltrami cut` first or use beltrami-flow";
+
+/// Rejects goals other than least-squares conformality and curve constraints, which
+/// none of these linear solvers can honour.
+fn check_goal_and_curves(solver: &'static str, problem: &Problem<'_>) -> Result<(), SolverError> {
+    let unsupported = |message: String| Err(SolverError::Unsupported { solver, message });
+    match &problem.goal {
+        Goal::Conformal { p } if *p == 2.0 => {}
+        Goal::Conformal { p } => {
+            return unsupported(format!(
+                "{solver} minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu; use an iterative solver for p > 2"
+            ));
+        }
+        Goal::Prescribed(_) => {
+            return unsupported(format!(
+                "{solver} computes a map of its own and cannot follow a prescribed Beltrami coefficient; use lsqc"
+            ));
+        }
+        Goal::Extremal => {
+            return unsupported(format!(
+                "{solver} does not compute extremal (Teichmueller) maps; use teichmuller"
+            ));
+        }
+    }
+    if !problem.constraints.curves.is_empty() {
+        return unsupported(format!(
+            "{solver} cannot make vertices follow curves; use lsqc or beltrami-flow"
+        ));
+    }
+    Ok(())
+}
+
+/// The solve options of the problem's parameters.
+fn solve_options(problem: &Problem<'_>) -> SolveOptions {
+    SolveOptions {
+        threads: problem.params.threads,
+        ..SolveOptions::default()
+    }
+}
+
+/// Runs one stage of a solve: checks for cancellation, reports the stage's start and end
+/// to the context and records its duration in the report under `name`.
+fn stage<T>(
+    name: &'static str,
+    context: &mut Context<'_>,
+    report: &mut Report,
+    f: impl FnOnce() -> Result<T, SolverError>,
+) -> Result<T, SolverError> {
+    context.check_cancelled()?;
+    let progress = |done| Progress {
+        stage: name,
+        done,
+        total: Some(1),
+        energy: None,
+    };
+    context.report(&progress(0));
+    let out = report.time(name, f)?;
+    context.report(&progress(1));
+    Ok(out)
+}
+
+/// Measures the distortion of a planar map in the face frames into `report.mu` and
+/// `report.distortion` (a "distortion" stage), and returns the number of flipped faces.
+fn measure(
+    mesh: &Mesh,
+    map: &[Complex64],
+    context: &mut Context<'_>,
+    report: &mut Report,
+) -> Result<usize, SolverError> {
+    let distortion = stage("distortion", context, report, || {
+        Ok(measure_planar(mesh, map, Frame::Face)?)
+    })?;
+    let flipped = distortion.stats.flipped;
+    report.mu = Some(distortion.field);
+    report.distortion = Some(distortion.stats);
+    Ok(flipped)
+}

@@ -1,0 +1,250 @@
+//! The least-squares conformal map (Levy, Petitjean, Ray, Maillot 2002) of a disk mesh
+//! with a free boundary.
+//!
+//! A map `f` given by its vertex images `x` (complex, `f = sum_i x_i N_i` on every face)
+//! is conformal where `f_zbar = 0`. LSCM minimizes the conformal energy
+//!
+//! ```text
+//! E_C(x) = sum_q w_q |f_zbar(q)|^2 = | W^(1/2) D_zbar x |^2
+//! ```
+//!
+//! over the quadrature points `q` of all faces (one per triangle, the 2x2 Gauss points
+//! of a quad, so Q1 quads are handled the same way), with `w_q` the quadrature weights
+//! and `f_zbar = (f_x + i f_y) / 2` taken in the face frames
+//! ([`beltrami_fem::operators::complex_derivatives`] on [`Frame::Face`] elements). The
+//! energy is invariant under similarities `x -> a x + b`, so two vertices are pinned;
+//! then (on a disk) the minimizer is unique. It is a complex-linear least-squares
+//! problem, solved in `N` complex unknowns through the normal equations
+//! ([`LeastSquaresSolver`], sparse Cholesky).
+//!
+//! On a planar mesh the identity has `f_zbar = 0`, so pinning two vertices at their own
+//! positions reproduces the mesh exactly. On a curved surface no map is exactly
+//! conformal and the residual `E_C` measures the distortion; LSCM does not guarantee a
+//! bijection, so the report counts flipped faces.
+
+use beltrami_core::{
+    Context, Map, PlanarBoundary, Position, Problem, Report, Solution, Solver, SolverError, Target,
+    topology,
+};
+use beltrami_fem::operators::{apply, complex_derivatives};
+use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
+use beltrami_mesh::{Mesh, VertexId};
+use num_complex::Complex64;
+
+use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options, stage};
+
+/// The least-squares conformal map (module docs).
+///
+/// Reads: `target` (`Plane(Free)` only), `constraints.pins` and `params.threads`.
+/// Pins: none (two boundary vertices far apart are pinned at `(0, 0)` and `(1, 0)`: the
+/// boundary vertex farthest from the loop's first vertex, then the one farthest from
+/// that), or exactly two (without positions: at `(0, 0)` and `(1, 0)` in order; with
+/// planar positions: there), or more than two, all with planar positions. The report's
+/// energy is the final `E_C`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Lscm;
+
+const NAME: &str = "lscm";
+
+impl Solver for Lscm {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn description(&self) -> &'static str {
+        "least-squares conformal map (LSCM): disk into the plane with a free boundary and two pinned vertices"
+    }
+
+    fn accepts(&self) -> &'static str {
+        "disk meshes (triangles, quads); target: plane with a free boundary; pins: none, two, or more with positions"
+    }
+
+    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+        pins(problem).map(|_| ())
+    }
+
+    fn solve(
+        &self,
+        problem: &Problem<'_>,
+        context: &mut Context<'_>,
+    ) -> Result<Solution, SolverError> {
+        let mesh = problem.source;
+        let mut report = Report::new(NAME);
+        let pinned = pins(problem)?;
+        if problem.constraints.pins.is_empty() {
+            let input = |v: VertexId| mesh.vertex_map().to_input(v);
+            report.notes.push(format!(
+                "pinned the boundary vertices {} (input index) at (0, 0) and {} at (1, 0), far apart",
+                input(pinned[0].0),
+                input(pinned[1].0)
+            ));
+        }
+        let (derivatives, mut solver) = stage("assembly", context, &mut report, || {
+            let elements = Elements::new(mesh, Frame::Face)?;
+            let derivatives = complex_derivatives(mesh, &elements)?;
+            let mut constraints = DofConstraints::new();
+            for &(v, z) in &pinned {
+                constraints.fix(v, z);
+            }
+            let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
+            let solver = LeastSquaresSolver::new(
+                derivatives.dzbar.symbolic(),
+                &dofs,
+                solve_options(problem),
+            )?;
+            Ok((derivatives, solver))
+        })?;
+        let map = stage("solve", context, &mut report, || {
+            let zero = vec![Complex64::new(0.0, 0.0); derivatives.dzbar.nrows()];
+            Ok(solver.solve(
+                derivatives.dzbar.as_ref(),
+                Some(&derivatives.weights),
+                &zero,
+            )?)
+        })?;
+        let residual = apply(&derivatives.dzbar, &map);
+        let energy = residual
+            .iter()
+            .zip(&derivatives.weights)
+            .map(|(r, w)| w * r.norm_sqr())
+            .sum();
+        report.energy_history.push(energy);
+        let flipped = measure(mesh, &map, context, &mut report)?;
+        if flipped > 0 {
+            report.notes.push(format!(
+                "{flipped} of {} faces are flipped: LSCM does not guarantee a bijection; tutte always gives one",
+                mesh.face_count()
+            ));
+        }
+        Ok(Solution {
+            map: Map::Planar(map),
+            report,
+        })
+    }
+}
+
+/// The capability check, returning the pinned vertices and their images.
+fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError> {
+    let mesh = problem.source;
+    let unsupported = |message: String| SolverError::Unsupported {
+        solver: NAME,
+        message,
+    };
+    let invalid = |message: String| SolverError::InvalidInput {
+        solver: NAME,
+        message,
+    };
+    topology::require_disk(NAME, mesh, NOT_A_DISK)?;
+    check_goal_and_curves(NAME, problem)?;
+    match &problem.target {
+        Target::Plane(PlanarBoundary::Free) => {}
+        Target::Plane(_) | Target::Disk => {
+            return Err(unsupported(
+                "lscm leaves the boundary free; for a fixed boundary use harmonic or tutte"
+                    .to_string(),
+            ));
+        }
+        _ => {
+            return Err(unsupported(
+                "lscm maps into the plane with a free boundary; for other targets use beltrami-flow, lsqc or qcmc"
+                    .to_string(),
+            ));
+        }
+    }
+    let given = &problem.constraints.pins;
+    for pin in given {
+        if pin.vertex.idx() >= mesh.vertex_count() {
+            return Err(invalid(format!(
+                "a pin is on vertex {}, but the mesh has {} vertices",
+                pin.vertex,
+                mesh.vertex_count()
+            )));
+        }
+    }
+    let positions: Vec<Option<Complex64>> = given
+        .iter()
+        .map(|pin| match pin.position {
+            None => Ok(None),
+            Some(Position::Planar(z)) if z.is_finite() => Ok(Some(z)),
+            Some(Position::Planar(_)) => Err(invalid(format!(
+                "the position of the pin on vertex {} is not finite",
+                pin.vertex
+            ))),
+            Some(Position::Spatial(_)) => Err(unsupported(format!(
+                "lscm maps into the plane, but the pin on vertex {} has a position in space",
+                pin.vertex
+            ))),
+        })
+        .collect::<Result<_, _>>()?;
+    let zero = Complex64::new(0.0, 0.0);
+    let one = Complex64::new(1.0, 0.0);
+    let pinned: Vec<(VertexId, Complex64)> = match given.len() {
+        0 => {
+            let (a, b) = far_boundary_pair(mesh);
+            vec![(a, zero), (b, one)]
+        }
+        1 => {
+            return Err(unsupported(format!(
+                "lscm needs two pinned vertices (or none, to pin two boundary vertices far apart), but only vertex {} was pinned",
+                given[0].vertex
+            )));
+        }
+        2 => match (positions[0], positions[1]) {
+            (None, None) => vec![(given[0].vertex, zero), (given[1].vertex, one)],
+            (Some(p), Some(q)) => vec![(given[0].vertex, p), (given[1].vertex, q)],
+            _ => {
+                return Err(unsupported(
+                    "give positions to both pins or to neither (then they go to (0, 0) and (1, 0))"
+                        .to_string(),
+                ));
+            }
+        },
+        n => given
+            .iter()
+            .zip(&positions)
+            .map(|(pin, z)| {
+                z.map(|z| (pin.vertex, z)).ok_or_else(|| {
+                    unsupported(format!(
+                        "with {n} pins every pin needs a position, but the pin on vertex {} has none",
+                        pin.vertex
+                    ))
+                })
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    // Pins that all coincide let the whole mesh collapse onto one point (zero energy).
+    if pinned.iter().all(|&(_, z)| z == pinned[0].1) {
+        return Err(invalid(format!(
+            "all pins are at the same position {}: the map would collapse to a point",
+            pinned[0].1
+        )));
+    }
+    Ok(pinned)
+}
+
+/// Two boundary vertices far apart: the boundary vertex farthest from the first vertex
+/// of the longest loop, and the boundary vertex farthest from that one (the two-sweep
+/// approximation of the boundary's diameter). The mesh is a disk, so it has a loop.
+fn far_boundary_pair(mesh: &Mesh) -> (VertexId, VertexId) {
+    let vertices = mesh
+        .boundary_loop_list()
+        .into_iter()
+        .reduce(|best, l| if l.length > best.length { l } else { best })
+        .map(|l| l.vertices)
+        .unwrap_or_default();
+    let farthest = |from: VertexId| {
+        let p = mesh.position(from);
+        vertices
+            .iter()
+            .copied()
+            .max_by(|&u, &v| {
+                let du = (mesh.position(u) - p).norm_squared();
+                let dv = (mesh.position(v) - p).norm_squared();
+                du.total_cmp(&dv)
+            })
+            .unwrap_or(from)
+    };
+    let first = vertices.first().copied().unwrap_or(VertexId(0));
+    let a = farthest(first);
+    (a, farthest(a))
+}

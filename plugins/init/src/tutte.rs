@@ -1,0 +1,450 @@
+//! Tutte's embedding: a disk mesh onto a convex boundary with every interior vertex at a
+//! weighted mean of its neighbours.
+//!
+//! With the boundary vertices fixed at positions `x_b` (a [`BoundaryMap`]), the interior
+//! vertices solve
+//!
+//! ```text
+//! sum_j w_ij (x_i - x_j) = 0            for every interior vertex i,
+//! ```
+//!
+//! a sparse system `L_II x_I = L_IB x_B` with `(L_II)_ii = sum_j w_ij`,
+//! `(L_II)_ij = -w_ij` and right-hand side `sum_{j fixed} w_ij x_j`, solved once for the
+//! real and once for the imaginary parts. Symmetric weights (uniform, cotangent) make
+//! `L_II` symmetric positive definite (a Laplacian with Dirichlet rows removed), solved
+//! by sparse Cholesky ([`solve_spd`]); mean-value weights are not symmetric and go
+//! through a sparse LU with partial pivoting (faer). For positive weights `L_II` is an
+//! irreducibly diagonally dominant M-matrix, so the system is nonsingular.
+//!
+//! Tutte (1963) for uniform weights and Floater (2003) for any positive weights: if the
+//! boundary goes onto a convex polygon, in order, the map is a bijection onto its interior
+//! (no flipped faces), except for faces whose vertices all land on one straight side,
+//! which collapse ([`crate::boundary`]: collapsed faces). [`Tutte`] accepts uniform
+//! (default) and mean-value weights; the cotangent weights belong to
+//! [`crate::Harmonic`], which shares this module's machinery.
+
+use beltrami_core::{
+    Context, Map, PlanarBoundary, Problem, Report, Solution, Solver, SolverError, Target, Weights,
+    topology,
+};
+use beltrami_fem::SolveError;
+use beltrami_fem::solve::solve_spd;
+use beltrami_mesh::VertexId;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::LuError;
+use faer::sparse::linalg::lu::{NumericLu, factorize_symbolic_lu};
+use faer::sparse::{FaerError, SparseColMat, Triplet};
+use faer::{Conj, Mat, Par};
+use num_complex::Complex64;
+
+use crate::boundary::{self, BoundaryError, BoundaryMap};
+use crate::weights::{EdgeWeights, WeightError};
+use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options, stage};
+
+/// The weighted-mean system of a fixed boundary (module docs): `L_II x_I = b`, with one
+/// right-hand side column for the real and one for the imaginary parts.
+#[derive(Debug, Clone)]
+pub struct WeightedMeanSystem {
+    /// `L_II` (rows and columns in the order of `interior`).
+    matrix: SparseColMat<usize, f64>,
+    /// `sum_{j fixed} w_ij x_j`, real parts in column 0, imaginary parts in column 1.
+    rhs: Mat<f64>,
+    /// The unknown vertices, in unknown order.
+    interior: Vec<VertexId>,
+    /// The map so far: the fixed values, zero elsewhere.
+    map: Vec<Complex64>,
+    symmetric: bool,
+}
+
+impl WeightedMeanSystem {
+    /// Assembles the system of `weights` with the vertices of `boundary` fixed; every
+    /// other vertex is an unknown.
+    ///
+    /// Errors: [`SolveError::Length`] if the weights are not of a mesh with a vertex for
+    /// every boundary vertex, [`SolveError::Faer`] if the matrix cannot be built.
+    pub fn new(weights: &EdgeWeights, boundary: &BoundaryMap) -> Result<Self, SolveError> {
+        let n = weights.vertex_count();
+        let mut slot = vec![usize::MAX; n];
+        let mut map = vec![Complex64::new(0.0, 0.0); n];
+        let mut fixed = vec![false; n];
+        for (&v, &z) in boundary.vertices.iter().zip(&boundary.positions) {
+            if v.idx() >= n {
+                return Err(SolveError::Length {
+                    what: "the vertex count of the weights",
+                    expected: v.idx() + 1,
+                    got: n,
+                });
+            }
+            fixed[v.idx()] = true;
+            map[v.idx()] = z;
+        }
+        let interior: Vec<VertexId> = (0..n)
+            .filter(|&i| !fixed[i])
+            .map(VertexId::from_usize)
+            .collect();
+        for (k, v) in interior.iter().enumerate() {
+            slot[v.idx()] = k;
+        }
+        let mut triplets = Vec::new();
+        let mut rhs = Mat::<f64>::zeros(interior.len(), 2);
+        for (k, &v) in interior.iter().enumerate() {
+            let mut diagonal = 0.0;
+            for (j, w) in weights.row(v) {
+                diagonal += w;
+                if fixed[j.idx()] {
+                    rhs[(k, 0)] += w * map[j.idx()].re;
+                    rhs[(k, 1)] += w * map[j.idx()].im;
+                } else {
+                    triplets.push(Triplet::new(k, slot[j.idx()], -w));
+                }
+            }
+            triplets.push(Triplet::new(k, k, diagonal));
+        }
+        let matrix = SparseColMat::try_new_from_triplets(interior.len(), interior.len(), &triplets)
+            .map_err(|e| match e {
+                faer::sparse::CreationError::Generic(e) => SolveError::Faer(e),
+                // Indices are below the interior count by construction.
+                faer::sparse::CreationError::OutOfBounds { .. } => {
+                    SolveError::Faer(FaerError::IndexOverflow)
+                }
+            })?;
+        Ok(Self {
+            matrix,
+            rhs,
+            interior,
+            map,
+            symmetric: weights.is_symmetric(),
+        })
+    }
+
+    /// The unknown (interior) vertices, in unknown order.
+    pub fn interior(&self) -> &[VertexId] {
+        &self.interior
+    }
+
+    /// Solves the system: sparse Cholesky for symmetric weights, sparse LU otherwise.
+    /// Returns the image of every vertex (the fixed boundary values included).
+    ///
+    /// Errors: [`SolveError::NotPositiveDefinite`] or [`SolveError::Singular`] (naming
+    /// the vertex where the LU broke down) for a singular system,
+    /// [`SolveError::NonFiniteSolution`].
+    pub fn solve(&self, options: beltrami_fem::SolveOptions) -> Result<Vec<Complex64>, SolveError> {
+        let x = if self.symmetric {
+            solve_spd(self.matrix.as_ref(), self.rhs.as_ref(), options)?
+        } else {
+            self.solve_lu()?
+        };
+        let mut map = self.map.clone();
+        for (k, v) in self.interior.iter().enumerate() {
+            map[v.idx()] = Complex64::new(x[(k, 0)], x[(k, 1)]);
+        }
+        Ok(map)
+    }
+
+    /// Sparse LU with partial pivoting (faer), both right-hand sides at once.
+    fn solve_lu(&self) -> Result<Mat<f64>, SolveError> {
+        let size = self.interior.len();
+        let mut x = self.rhs.clone();
+        if size == 0 {
+            return Ok(x);
+        }
+        let symbolic = factorize_symbolic_lu(self.matrix.symbolic(), Default::default())?;
+        let scratch = symbolic
+            .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(2, Par::Seq));
+        let mut buffer = MemBuffer::try_new(scratch).map_err(FaerError::from)?;
+        let mut numeric = NumericLu::new();
+        let lu = symbolic
+            .factorize_numeric_lu(
+                &mut numeric,
+                self.matrix.as_ref(),
+                Par::Seq,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .map_err(|e| match e {
+                // The index counts columns in the fill-reducing column order.
+                LuError::SymbolicSingular { index } => {
+                    let index = symbolic.col_perm().arrays().0[index.min(size - 1)];
+                    SolveError::Singular {
+                        index,
+                        node: Some(self.interior[index]),
+                        ratio: 0.0,
+                    }
+                }
+                LuError::Generic(e) => SolveError::Faer(e),
+            })?;
+        lu.solve_in_place_with_conj(Conj::No, x.as_mut(), Par::Seq, MemStack::new(&mut buffer));
+        for j in 0..2 {
+            if let Some(i) = (0..size).find(|&i| !x[(i, j)].is_finite()) {
+                return Err(SolveError::NonFiniteSolution {
+                    index: i + j * size,
+                });
+            }
+        }
+        Ok(x)
+    }
+}
+
+/// Tutte's embedding (module docs): a disk mesh onto a fixed convex boundary, interior
+/// vertices at weighted means of their neighbours, uniform (default) or mean-value
+/// weights.
+///
+/// Reads: `target` (`Plane(Circle | Square | Polygon | Keep | Given)` or `Disk`, which
+/// is the circle fixed by arc length), `params.weights` (`Uniform`, `MeanValue`),
+/// `params.threads`, and at most one pin without a position, on the boundary, which
+/// chooses the vertex that goes to `(1, 0)` on the circle or to the first corner of a
+/// polygon. The report's energy is `E = (1/2) sum_{edges ij} w_ij |x_i - x_j|^2` for
+/// uniform weights (none for the non-symmetric mean-value weights).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Tutte;
+
+impl Solver for Tutte {
+    fn name(&self) -> &'static str {
+        "tutte"
+    }
+
+    fn description(&self) -> &'static str {
+        "Tutte embedding: disk onto a convex boundary, interior vertices at weighted means (uniform or mean-value weights); bijective for a convex boundary"
+    }
+
+    fn accepts(&self) -> &'static str {
+        "disk meshes (triangles, quads); targets: circle, square, convex polygon, disk, keep, given boundary; weights: uniform, mean-value; one boundary pin to choose the start"
+    }
+
+    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+        FIXED_TUTTE.check(problem)
+    }
+
+    fn solve(
+        &self,
+        problem: &Problem<'_>,
+        context: &mut Context<'_>,
+    ) -> Result<Solution, SolverError> {
+        FIXED_TUTTE.solve(problem, context)
+    }
+}
+
+const FIXED_TUTTE: FixedBoundary = FixedBoundary {
+    solver: "tutte",
+    default_weights: Weights::Uniform,
+    accepted_weights: &[Weights::Uniform, Weights::MeanValue],
+};
+
+/// A linear map with a fixed boundary: the shared machinery of [`Tutte`] and
+/// [`crate::Harmonic`], which differ in their name and weights.
+pub(crate) struct FixedBoundary {
+    /// The solver's name.
+    pub(crate) solver: &'static str,
+    /// The weights without `params.weights`.
+    pub(crate) default_weights: Weights,
+    /// The weights `params.weights` may choose.
+    pub(crate) accepted_weights: &'static [Weights],
+}
+
+/// Words for a weight kind in messages.
+fn weight_name(w: Weights) -> &'static str {
+    match w {
+        Weights::Uniform => "uniform",
+        Weights::MeanValue => "mean-value",
+        Weights::Cotan => "cotangent",
+    }
+}
+
+impl FixedBoundary {
+    fn unsupported(&self, message: String) -> SolverError {
+        SolverError::Unsupported {
+            solver: self.solver,
+            message,
+        }
+    }
+
+    /// The weights the problem asks for.
+    fn weights(&self, problem: &Problem<'_>) -> Weights {
+        problem.params.weights.unwrap_or(self.default_weights)
+    }
+
+    /// The capability check of the solver.
+    pub(crate) fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+        self.prepare(problem).map(|_| ())
+    }
+
+    /// The capability check, which also builds the boundary map (cheap, and it holds the
+    /// checks of the polygon and of the corner vertices).
+    fn prepare(&self, problem: &Problem<'_>) -> Result<BoundaryMap, SolverError> {
+        let solver = self.solver;
+        let mesh = problem.source;
+        topology::require_disk(solver, mesh, NOT_A_DISK)?;
+        check_goal_and_curves(solver, problem)?;
+        let weights = self.weights(problem);
+        if !self.accepted_weights.contains(&weights) {
+            let accepted: Vec<&str> = self
+                .accepted_weights
+                .iter()
+                .map(|&w| weight_name(w))
+                .collect();
+            return Err(self.unsupported(format!(
+                "{solver} takes {} weights, not {}{}",
+                accepted.join(" or "),
+                weight_name(weights),
+                if weights == Weights::Cotan {
+                    "; cotangent weights are the harmonic solver's"
+                } else {
+                    ""
+                }
+            )));
+        }
+        let start = self.start_vertex(problem)?;
+        let invalid = |e: BoundaryError| SolverError::InvalidInput {
+            solver,
+            message: e.to_string(),
+        };
+        match &problem.target {
+            Target::Disk | Target::Plane(PlanarBoundary::Circle) => boundary::circle(mesh, start),
+            Target::Plane(PlanarBoundary::Square { corners }) => {
+                boundary::square(mesh, *corners, start)
+            }
+            Target::Plane(PlanarBoundary::Polygon(corners)) => {
+                boundary::polygon(mesh, corners, start)
+            }
+            Target::Plane(PlanarBoundary::Keep) => match boundary::keep(mesh) {
+                Err(BoundaryError::NotPlanar { vertex, z }) => {
+                    return Err(self.unsupported(format!(
+                        "keeping the boundary needs a source in the plane z = 0, but vertex {vertex} has z = {z:e}; map it onto a circle, square or polygon instead"
+                    )));
+                }
+                other => other,
+            },
+            Target::Plane(PlanarBoundary::Given(values)) => boundary::given(mesh, values),
+            Target::Plane(PlanarBoundary::Free) => {
+                return Err(self.unsupported(format!(
+                    "{solver} needs a fixed boundary (circle, square, polygon); for a free boundary use lscm"
+                )));
+            }
+            Target::Annulus { .. } | Target::CircleDomain => {
+                return Err(self.unsupported(format!(
+                    "{solver} maps onto a disk or a convex polygon; annuli and circle domains need a multiply-connected mesh and qcmc"
+                )));
+            }
+            Target::Sphere => {
+                return Err(self.unsupported(format!(
+                    "{solver} maps into the plane; for the sphere use beltrami-flow"
+                )));
+            }
+            Target::Mesh(_) | Target::Surface => {
+                return Err(self.unsupported(format!(
+                    "{solver} maps into the plane; for maps onto a surface use beltrami-flow or lsqc"
+                )));
+            }
+        }
+        .map_err(invalid)
+    }
+
+    /// The start vertex chosen by a pin, if any: at most one pin, without a position, and
+    /// only for targets that have a free start (circle, disk, automatic square, polygon).
+    fn start_vertex(&self, problem: &Problem<'_>) -> Result<Option<VertexId>, SolverError> {
+        let solver = self.solver;
+        let pins = &problem.constraints.pins;
+        let Some(pin) = pins.first() else {
+            return Ok(None);
+        };
+        if pins.len() > 1 {
+            return Err(self.unsupported(format!(
+                "{solver} fixes the whole boundary and takes at most one pin (the vertex that starts the boundary), {} were given; for several pins use lscm",
+                pins.len()
+            )));
+        }
+        if pin.position.is_some() {
+            return Err(self.unsupported(format!(
+                "{solver} places the boundary itself; the pin on vertex {} may choose where it starts but cannot have a position",
+                pin.vertex
+            )));
+        }
+        let start_is_free = matches!(
+            problem.target,
+            Target::Disk
+                | Target::Plane(
+                    PlanarBoundary::Circle
+                        | PlanarBoundary::Square { corners: None }
+                        | PlanarBoundary::Polygon(_)
+                )
+        );
+        if !start_is_free {
+            return Err(self.unsupported(format!(
+                "the target fixes where the boundary starts, so {solver} takes no pin"
+            )));
+        }
+        Ok(Some(pin.vertex))
+    }
+
+    /// Builds the boundary, the weights and the system, solves it, measures the
+    /// distortion and explains flips in the notes.
+    pub(crate) fn solve(
+        &self,
+        problem: &Problem<'_>,
+        context: &mut Context<'_>,
+    ) -> Result<Solution, SolverError> {
+        let solver = self.solver;
+        let mesh = problem.source;
+        let mut report = Report::new(solver);
+        let boundary = stage("boundary", context, &mut report, || self.prepare(problem))?;
+        let kind = self.weights(problem);
+        let (weights, system) = stage("assembly", context, &mut report, || {
+            let weights = EdgeWeights::new(mesh, kind).map_err(|e| match e {
+                WeightError::Fem(e) => SolverError::Fem(e),
+                e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
+                    solver,
+                    message: e.to_string(),
+                },
+            })?;
+            let system = WeightedMeanSystem::new(&weights, &boundary)?;
+            Ok((weights, system))
+        })?;
+        let options = solve_options(problem);
+        let map = stage("solve", context, &mut report, || Ok(system.solve(options)?))?;
+        if weights.is_symmetric() {
+            report.energy_history.push(spring_energy(&weights, &map));
+        }
+        let flipped = measure(mesh, &map, context, &mut report)?;
+        let negative = weights.negative_count(system.interior().iter().copied());
+        if negative > 0 {
+            report.notes.push(format!(
+                "{negative} {} weights of interior vertices are negative{}",
+                weight_name(kind),
+                match kind {
+                    Weights::Cotan => " (obtuse triangles); use tutte for a map that never flips",
+                    _ => " (reflex quad corners); the bijectivity theorem needs positive weights",
+                }
+            ));
+        }
+        if flipped > 0 {
+            report.notes.push(format!(
+                "{flipped} of {} faces are flipped or collapsed (Jacobian <= 0)",
+                mesh.face_count()
+            ));
+        }
+        let collapsed = boundary::collapsed_faces(mesh, &boundary).len();
+        if collapsed > 0 {
+            report.notes.push(format!(
+                "{collapsed} faces have all their vertices on one straight side of the boundary and collapse to segments: give corners at those vertices or map onto the circle"
+            ));
+        }
+        Ok(Solution {
+            map: Map::Planar(map),
+            report,
+        })
+    }
+}
+
+/// `E = (1/2) sum_{edges ij} w_ij |x_i - x_j|^2 = (1/4) sum_i sum_j w_ij |x_i - x_j|^2`
+/// for symmetric weights: the energy whose minimizer the weighted-mean map is (the
+/// Dirichlet energy for cotangent weights).
+fn spring_energy(weights: &EdgeWeights, map: &[Complex64]) -> f64 {
+    let mut energy = 0.0;
+    for (i, &xi) in map.iter().enumerate() {
+        for (j, w) in weights.row(VertexId::from_usize(i)) {
+            energy += w * (xi - map[j.idx()]).norm_sqr();
+        }
+    }
+    energy / 4.0
+}

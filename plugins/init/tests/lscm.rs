@@ -1,0 +1,214 @@
+//! LSCM: exact on planar meshes (the identity is conformal), close to conformal on the
+//! hemisphere, pins honoured exactly, and clear errors for other topologies and pins.
+
+mod common;
+
+use beltrami_core::{Context, Pin, PlanarBoundary, Position, Problem, Solver, SolverError, Target};
+use beltrami_init::Lscm;
+use beltrami_mesh::primitives::{Cells, icosphere, torus};
+use beltrami_mesh::{Mesh, Point3};
+use common::{
+    boundary_vertices, flipped_faces, hemisphere, identity_error, jittered, planar, shared_disks,
+    summary,
+};
+use num_complex::Complex64;
+
+fn free(mesh: &Mesh) -> Problem<'_> {
+    Problem::new(mesh, Target::Plane(PlanarBoundary::Free))
+}
+
+fn own_position(mesh: &Mesh, v: beltrami_mesh::VertexId) -> Complex64 {
+    let p = mesh.position(v);
+    Complex64::new(p.x, p.y)
+}
+
+#[test]
+fn reproduces_a_planar_mesh_pinned_at_its_own_positions() {
+    for (cells, seed) in [(Cells::Triangles, 21), (Cells::Quads, 22)] {
+        let mesh = jittered(16, cells, 0.35, seed);
+        let b = boundary_vertices(&mesh);
+        let mut problem = free(&mesh);
+        problem.constraints.pins = [b[0], b[b.len() / 3]]
+            .iter()
+            .map(|&v| Pin {
+                vertex: v,
+                position: Some(Position::Planar(own_position(&mesh, v))),
+            })
+            .collect();
+        let solution = Lscm.solve(&problem, &mut Context::new()).unwrap();
+        let err = identity_error(&mesh, planar(&solution.map));
+        assert!(err < 1e-9, "{cells:?}: {err:e}");
+        assert!(solution.report.energy_history[0] < 1e-20);
+    }
+}
+
+#[test]
+fn default_pins_give_a_similarity_of_a_planar_mesh() {
+    let mesh = jittered(12, Cells::Triangles, 0.3, 23);
+    let solution = Lscm.solve(&free(&mesh), &mut Context::new()).unwrap();
+    let map = planar(&solution.map);
+    // The pinned vertices are exactly at 0 and 1; the map is z -> a z + b through them.
+    let a_vertex = mesh
+        .vertices()
+        .find(|v| map[v.idx()] == Complex64::new(0.0, 0.0));
+    let b_vertex = mesh
+        .vertices()
+        .find(|v| map[v.idx()] == Complex64::new(1.0, 0.0));
+    let (Some(p), Some(q)) = (a_vertex, b_vertex) else {
+        panic!("no vertex exactly at (0, 0) and (1, 0)");
+    };
+    assert!(mesh.is_boundary_vertex(p) && mesh.is_boundary_vertex(q));
+    let (zp, zq) = (own_position(&mesh, p), own_position(&mesh, q));
+    let a = 1.0 / (zq - zp);
+    let worst = mesh
+        .vertices()
+        .map(|v| (map[v.idx()] - a * (own_position(&mesh, v) - zp)).norm())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-9, "{worst:e}");
+    // Far apart: the diagonal of the unit square.
+    assert!(((zq - zp).norm() - 2f64.sqrt()).abs() < 1e-12);
+    assert!(solution.report.notes.iter().any(|n| n.contains("pinned")));
+}
+
+#[test]
+fn hemisphere_is_nearly_conformal() {
+    let mesh = hemisphere();
+    let solution = Lscm.solve(&free(&mesh), &mut Context::new()).unwrap();
+    let map = planar(&solution.map);
+    println!("hemisphere lscm: {}", summary(&solution.report));
+    let stats = solution.report.distortion.unwrap();
+    assert_eq!(stats.flipped, 0);
+    assert_eq!(flipped_faces(&mesh, map).len(), 0);
+    // Measured: mu mean 0.0095, max 0.0234 (3600 triangles); asserted with a margin.
+    assert!(stats.mu_mean < 0.02, "mu mean {}", stats.mu_mean);
+    assert!(stats.mu_max < 0.05, "mu max {}", stats.mu_max);
+    let at = |z: Complex64| map.iter().filter(|&&w| w == z).count();
+    assert_eq!(at(Complex64::new(0.0, 0.0)), 1);
+    assert_eq!(at(Complex64::new(1.0, 0.0)), 1);
+}
+
+#[test]
+fn pins_without_positions_go_to_zero_and_one() {
+    let mesh = hemisphere();
+    let b = boundary_vertices(&mesh);
+    let mut problem = free(&mesh);
+    problem.constraints.pins = vec![
+        Pin {
+            vertex: b[7],
+            position: None,
+        },
+        Pin {
+            vertex: b[70],
+            position: None,
+        },
+    ];
+    let solution = Lscm.solve(&problem, &mut Context::new()).unwrap();
+    let map = planar(&solution.map);
+    assert_eq!(map[b[7].idx()], Complex64::new(0.0, 0.0));
+    assert_eq!(map[b[70].idx()], Complex64::new(1.0, 0.0));
+    assert!(solution.report.notes.iter().all(|n| !n.contains("pinned")));
+}
+
+#[test]
+fn runs_on_the_shared_disks() {
+    let Some(meshes) = shared_disks("lscm runs_on_the_shared_disks") else {
+        return;
+    };
+    for (name, mesh) in &meshes {
+        let solution = Lscm.solve(&free(mesh), &mut Context::new()).unwrap();
+        let map = planar(&solution.map);
+        println!("{name} lscm: {}", summary(&solution.report));
+        assert!(map.iter().all(|z| z.is_finite()), "{name}");
+        assert_eq!(
+            solution.report.flipped(),
+            Some(flipped_faces(mesh, map).len()),
+            "{name}"
+        );
+    }
+}
+
+fn unsupported(result: Result<(), SolverError>) -> String {
+    match result {
+        Err(SolverError::Unsupported { solver, message }) => {
+            assert_eq!(solver, "lscm");
+            message
+        }
+        other => panic!("expected Unsupported, got {other:?}"),
+    }
+}
+
+#[test]
+fn other_topologies_are_unsupported() {
+    let torus = Mesh::from_soup(&torus(16, 8, 2.0, 0.6, Cells::Triangles)).unwrap();
+    let message = unsupported(Lscm.check(&free(&torus)));
+    assert!(message.contains("genus 1"), "{message}");
+    assert!(message.contains("beltrami cut"), "{message}");
+    let sphere = Mesh::from_soup(&icosphere(2)).unwrap();
+    let message = unsupported(Lscm.check(&free(&sphere)));
+    assert!(message.contains("genus 0 and no boundary"), "{message}");
+    // solve checks too.
+    assert!(matches!(
+        Lscm.solve(&free(&sphere), &mut Context::new()),
+        Err(SolverError::Unsupported { .. })
+    ));
+}
+
+#[test]
+fn pin_counts_and_targets_are_checked() {
+    let mesh = jittered(6, Cells::Quads, 0.2, 24);
+    let b = boundary_vertices(&mesh);
+    let pin = |k: usize, position: Option<Complex64>| Pin {
+        vertex: b[k],
+        position: position.map(Position::Planar),
+    };
+    let mut problem = free(&mesh);
+    problem.constraints.pins = vec![pin(0, None)];
+    assert!(unsupported(Lscm.check(&problem)).contains("two"));
+    problem.constraints.pins = vec![pin(0, None), pin(3, Some(Complex64::new(1.0, 1.0)))];
+    unsupported(Lscm.check(&problem));
+    problem.constraints.pins = vec![pin(0, None), pin(3, None), pin(6, None)];
+    unsupported(Lscm.check(&problem));
+    problem.constraints.pins = vec![
+        Pin {
+            vertex: b[0],
+            position: Some(Position::Spatial(Point3::new(0.0, 0.0, 1.0))),
+        },
+        pin(3, Some(Complex64::new(1.0, 0.0))),
+    ];
+    unsupported(Lscm.check(&problem));
+    // Three pins with positions: all honoured.
+    let z = [
+        Complex64::new(0.0, 0.0),
+        Complex64::new(2.0, 0.0),
+        Complex64::new(1.0, 1.5),
+    ];
+    problem.constraints.pins = vec![pin(0, Some(z[0])), pin(8, Some(z[1])), pin(16, Some(z[2]))];
+    let solution = Lscm.solve(&problem, &mut Context::new()).unwrap();
+    let map = planar(&solution.map);
+    for (k, zk) in [0, 8, 16].iter().zip(z) {
+        assert_eq!(map[b[*k].idx()], zk);
+    }
+    // Coinciding pins would collapse the map.
+    problem.constraints.pins = vec![pin(0, Some(z[1])), pin(8, Some(z[1]))];
+    assert!(matches!(
+        Lscm.check(&problem),
+        Err(SolverError::InvalidInput { .. })
+    ));
+    // A pin beyond the mesh.
+    problem.constraints.pins = vec![
+        pin(0, None),
+        Pin {
+            vertex: beltrami_mesh::VertexId(10_000),
+            position: None,
+        },
+    ];
+    match Lscm.check(&problem) {
+        Err(SolverError::InvalidInput { message, .. }) => {
+            assert!(message.contains("v10000"), "{message}")
+        }
+        other => panic!("expected InvalidInput, got {other:?}"),
+    }
+    problem.constraints.pins.clear();
+    problem.target = Target::Disk;
+    assert!(unsupported(Lscm.check(&problem)).contains("harmonic"));
+}
