@@ -149,3 +149,33 @@ pub fn icosphere(subdivisions: usize) -> PolygonSoup {
     }
     PolygonSoup::from_triangles(positions, &triangles)
 }
+
+/// [`grid`] with every vertex off the square's boundary moved by independent uniform
+/// offsets of up to `amount` cells in x and in y (`amount < 0.5` keeps every face
+/// counter-clockwise). The offsets come from a SplitMix64 stream seeded with `seed`, so
+/// the same arguments give the same mesh on every machine: irregular meshes for tests and
+/// benchmarks.
+pub fn jittered_grid(nx: usize, ny: usize, cells: Cells, amount: f64, seed: u64) -> PolygonSoup {
+    let mut soup = grid(nx, ny, cells);
+    let mut state = seed;
+    let mut uniform = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        2.0 * ((z >> 11) as f64 / (1u64 << 53) as f64) - 1.0
+    };
+    let (hx, hy) = (1.0 / nx as f64, 1.0 / ny as f64);
+    for p in &mut soup.positions {
+        let interior = p.x > 0.5 * hx * 1e-6
+            && p.x < 1.0 - 0.5 * hx * 1e-6
+            && p.y > 0.5 * hy * 1e-6
+            && p.y < 1.0 - 0.5 * hy * 1e-6;
+        if interior {
+            p.x += uniform() * amount * hx;
+            p.y += uniform() * amount * hy;
+        }
+    }
+    soup
+}

@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use beltrami_mesh::Mesh;
-use beltrami_mesh::primitives::{Cells, grid};
+use beltrami_mesh::primitives::{Cells, jittered_grid};
 use num_complex::Complex64;
 
 /// splitmix64: a reproducible stream of random numbers.
@@ -44,15 +44,6 @@ impl Rng {
 /// The unit-square grid of `n x n` cells with interior vertices moved randomly by up to
 /// `amount` cells in x and y.
 pub fn jittered(n: usize, cells: Cells, amount: f64, seed: u64) -> Mesh {
-    let mut soup = grid(n, n, cells);
-    let mut rng = Rng(seed);
-    let h = 1.0 / n as f64;
-    for p in &mut soup.positions {
-        let interior = p.x > 1e-9 && p.x < 1.0 - 1e-9 && p.y > 1e-9 && p.y < 1.0 - 1e-9;
-        if interior {
-            p.x += rng.uniform() * amount * h;
-            p.y += rng.uniform() * amount * h;
-        }
-    }
-    Mesh::from_soup(&soup).expect("a jittered grid is a valid mesh")
+    Mesh::from_soup(&jittered_grid(n, n, cells, amount, seed))
+        .expect("a jittered grid is a valid mesh")
 }

@@ -45,6 +45,7 @@ use base64::engine::{DecodePaddingMode, GeneralPurpose, GeneralPurposeConfig};
 use nalgebra::{Matrix3, Matrix4, Point3, Vector2, Vector3};
 use serde_json::{Value, json};
 
+use super::slots::OutputSlots;
 use super::{RawMesh, ReadError, VertexAttributes, WriteError};
 use crate::{Mesh, PolygonSoup};
 
@@ -616,52 +617,31 @@ struct OutputVertices {
 
 impl OutputVertices {
     fn new(mesh: &Mesh, attributes: &VertexAttributes<'_>) -> Result<Self, WriteError> {
-        let map = mesh.vertex_map();
-        let restore_input_order = map.is_order_preserving();
-        let (len, slot): (usize, Vec<usize>) = if restore_input_order {
-            (
-                map.input_len(),
-                mesh.vertices().map(|v| map.to_input(v)).collect(),
-            )
-        } else {
-            (mesh.vertex_count(), (0..mesh.vertex_count()).collect())
-        };
-
-        let mut positions = vec![[0.0f32; 3]; len];
-        for v in mesh.vertices() {
-            let p = attributes
-                .positions
-                .map_or_else(|| mesh.position(v), |p| p[v.idx()]);
-            positions[slot[v.idx()]] = to_f32(p.coords.into(), "position", map.to_input(v))?;
-        }
-        if restore_input_order {
-            for &(i, p) in map.unreferenced() {
-                positions[i as usize] = to_f32(p.coords.into(), "position", i as usize)?;
-            }
-        }
+        let slots = OutputSlots::new(mesh);
+        let positions = slots
+            .positions(mesh, attributes)
+            .iter()
+            .enumerate()
+            .map(|(s, p)| to_f32(p.coords.into(), "position", slots.input_index(mesh, s)))
+            .collect::<Result<Vec<_>, _>>()?;
         let uvs = match attributes.uvs {
-            Some(uvs) => {
-                let mut out = vec![[0.0f32; 2]; len];
-                for v in mesh.vertices() {
-                    out[slot[v.idx()]] = to_f32(uvs[v.idx()].into(), "uv", map.to_input(v))?;
-                }
-                Some(out)
-            }
+            Some(uvs) => Some(
+                slots
+                    .scatter(uvs)
+                    .iter()
+                    .enumerate()
+                    .map(|(s, uv)| to_f32((*uv).into(), "uv", slots.input_index(mesh, s)))
+                    .collect::<Result<Vec<_>, _>>()?,
+            ),
             None => None,
         };
-        let colors = attributes.colors.map(|colors| {
-            let mut out = vec![[0.0f32; 3]; len];
-            for v in mesh.vertices() {
-                out[slot[v.idx()]] = colors[v.idx()];
-            }
-            out
-        });
+        let colors = attributes.colors.map(|colors| slots.scatter(colors));
 
         let mut triangles = Vec::with_capacity(3 * (mesh.face_count() + mesh.quad_count()));
         for f in mesh.faces() {
             let (vs, n) = mesh.face_vertex_array(f);
             // Slots are input indices or mesh indices, both below u32::MAX.
-            let s = |k: usize| slot[vs[k].idx()] as u32;
+            let s = |k: usize| slots.slot(vs[k]) as u32;
             if n == 4 {
                 triangles.extend([s(0), s(1), s(2), s(0), s(2), s(3)]);
             } else {

@@ -18,6 +18,7 @@
 mod atomic;
 pub mod gltf;
 pub mod obj;
+mod slots;
 
 use std::path::{Path, PathBuf};
 

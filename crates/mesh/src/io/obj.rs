@@ -22,7 +22,7 @@ use std::path::Path;
 use nalgebra::{Point3, Vector2};
 
 use super::{RawMesh, ReadError, VertexAttributes, WriteError};
-use crate::{Mesh, MeshError, PolygonSoup, VertexId};
+use crate::{Mesh, MeshError, PolygonSoup};
 
 /// Reads an OBJ file. See the module docs for what is kept.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
@@ -281,49 +281,21 @@ pub fn write(
     attributes: &VertexAttributes<'_>,
 ) -> Result<(), WriteError> {
     attributes.check(mesh)?;
-    let map = mesh.vertex_map();
-    let order_preserving = map.is_order_preserving();
-    let slots = if order_preserving {
-        map.input_len()
-    } else {
-        mesh.vertex_count()
-    };
-    // Output slot of every mesh vertex, and the position/uv to write in every slot.
-    let slot_of = |v: VertexId| {
-        if order_preserving {
-            map.to_input(v)
-        } else {
-            v.idx()
-        }
-    };
-    let mut position = vec![Point3::origin(); slots];
-    let mut uv = vec![Vector2::zeros(); slots];
-    for v in mesh.vertices() {
-        let s = slot_of(v);
-        position[s] = attributes
-            .positions
-            .map_or(mesh.position(v), |p| p[v.idx()]);
-        if let Some(u) = attributes.uvs {
-            uv[s] = u[v.idx()];
-        }
-    }
-    if order_preserving {
-        for &(i, p) in map.unreferenced() {
-            position[i as usize] = p;
-        }
-    }
+    let slots = super::slots::OutputSlots::new(mesh);
+    let position = slots.positions(mesh, attributes);
+    let uv = attributes.uvs.map(|u| slots.scatter(u));
     super::write_atomically(path, |w| {
         writeln!(
             w,
             "# beltrami: {} vertices, {} faces",
-            slots,
+            slots.len(),
             mesh.face_count()
         )?;
         for p in &position {
             writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
         }
-        if attributes.uvs.is_some() {
-            for t in &uv {
+        if let Some(uv) = &uv {
+            for t in uv {
                 writeln!(w, "vt {} {}", t.x, t.y)?;
             }
         }
@@ -332,9 +304,9 @@ pub fn write(
             line.clear();
             line.push('f');
             for v in mesh.face_vertices(f) {
-                let k = slot_of(v) + 1;
+                let k = slots.slot(v) + 1;
                 // Writing into a String cannot fail.
-                let _ = if attributes.uvs.is_some() {
+                let _ = if uv.is_some() {
                     write!(line, " {k}/{k}")
                 } else {
                     write!(line, " {k}")

@@ -1,6 +1,6 @@
-//! Helpers shared by the integration tests of beltrami-init: a reproducible random
-//! generator, jittered planar grids, the bundled and shared meshes, and checks of maps
-//! that do not go through the code under test.
+//! Helpers shared by the integration tests of beltrami-init: jittered planar grids, the
+//! bundled and shared meshes, and checks of maps that do not go through the code under
+//! test.
 // Each test binary compiles this module and uses only part of it.
 #![allow(dead_code)]
 
@@ -8,43 +8,15 @@ use std::path::{Path, PathBuf};
 
 use beltrami_core::{Map, Report};
 use beltrami_mesh::io::read;
-use beltrami_mesh::primitives::{Cells, grid};
+use beltrami_mesh::primitives::{Cells, jittered_grid};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, VertexId};
 use num_complex::Complex64;
-
-/// splitmix64: a reproducible stream of random numbers.
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// The next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [-1, 1).
-    pub fn uniform(&mut self) -> f64 {
-        2.0 * ((self.next_u64() >> 11) as f64 / (1u64 << 53) as f64) - 1.0
-    }
-}
 
 /// The unit-square grid of `n x n` cells with interior vertices moved randomly by up to
 /// `amount` cells in x and y.
 pub fn jittered(n: usize, cells: Cells, amount: f64, seed: u64) -> Mesh {
-    let mut soup = grid(n, n, cells);
-    let mut rng = Rng(seed);
-    let h = 1.0 / n as f64;
-    for p in &mut soup.positions {
-        let interior = p.x > 1e-9 && p.x < 1.0 - 1e-9 && p.y > 1e-9 && p.y < 1.0 - 1e-9;
-        if interior {
-            p.x += rng.uniform() * amount * h;
-            p.y += rng.uniform() * amount * h;
-        }
-    }
-    Mesh::from_soup(&soup).expect("a jittered grid is a valid mesh")
+    Mesh::from_soup(&jittered_grid(n, n, cells, amount, seed))
+        .expect("a jittered grid is a valid mesh")
 }
 
 /// The bundled hemisphere (a cap of the unit sphere, 3600 triangles).
