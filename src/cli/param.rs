@@ -136,6 +136,12 @@ fn target_of(args: &ParamArgs) -> anyhow::Result<Target<'static>> {
 }
 
 pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
+    if Format::from_path(&args.output).is_none() {
+        bail!(
+            "{}: unknown output format (expected .obj, .gltf or .glb)",
+            args.output.display()
+        );
+    }
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
@@ -152,12 +158,6 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
             vertex: spec.resolve(mesh)?,
             position: None,
         });
-    }
-    if Format::from_path(&args.output).is_none() {
-        bail!(
-            "{}: unknown output format (expected .obj, .gltf or .glb)",
-            args.output.display()
-        );
     }
     solver.check(&problem)?;
 
