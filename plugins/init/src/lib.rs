@@ -1,8 +1,8 @@
 //! # beltrami-init
 //!
 //! The first solvers of beltrami: linear parameterizations of disk-topology meshes
-//! (triangles, quads or both) into the plane. They are ends in themselves and the
-//! initial maps of every iterative solver.
+//! (triangles, quads or both) into the plane, and of closed genus-0 meshes onto the
+//! sphere. They are ends in themselves and the initial maps of every iterative solver.
 //!
 //! - [`Tutte`] (`tutte`): the boundary goes onto a convex curve (circle, unit square,
 //!   convex polygon; [`boundary`]) and every interior vertex is a weighted mean of its
@@ -25,9 +25,16 @@
 //!   `E_C(f) = sum_q w_q |f_zbar(q)|^2` over the quadrature points `q` of all faces (one
 //!   per triangle, four per quad) in the face frames, with two vertices pinned (by
 //!   default two boundary vertices far apart, at `(0, 0)` and `(1, 0)`).
+//! - [`Sphere`] (`sphere`): a closed genus-0 mesh onto the unit sphere, as an initial
+//!   bijection (T. W. Wong and H. Zhao, SIAM J. Imaging Sci. 7, 2014, section 4.1):
+//!   Tutte's embedding of the mesh minus one face onto a regular polygon, the inverse
+//!   stereographic projection `s(z) = (2x, 2y, |z|^2 - 1) / (|z|^2 + 1)`, and Moebius
+//!   centering of the area (A. Baden, K. Crane, M. Kazhdan, "Moebius registration",
+//!   SGP 2018).
 //!
-//! All three need a single topological disk; a mesh of another topology gets
-//! [`beltrami_core::SolverError::Unsupported`] saying what it is and what to do instead.
+//! The first three need a single topological disk, [`Sphere`] a closed genus-0 surface;
+//! a mesh of another topology gets [`beltrami_core::SolverError::Unsupported`] saying
+//! what it is and what to do instead.
 //! Their reports carry the timings of each stage, the per-face Beltrami coefficient and
 //! its statistics (flipped faces included), and notes on flips.
 //!
@@ -45,24 +52,28 @@
 pub mod boundary;
 pub mod harmonic;
 pub mod lscm;
+pub mod sphere;
 pub mod tutte;
 pub mod weights;
 
 pub use harmonic::Harmonic;
 pub use lscm::Lscm;
+pub use sphere::Sphere;
 pub use tutte::Tutte;
 
 use beltrami_core::{Context, Goal, Problem, Progress, Report, SolverError};
-use beltrami_fem::distortion::measure_planar;
-use beltrami_fem::{Frame, SolveOptions};
+use beltrami_fem::beltrami::planar_map;
+use beltrami_fem::distortion::{Distortion, measure_planar};
+use beltrami_fem::{Elements, Frame, SolveOptions};
 use beltrami_mesh::Mesh;
 use num_complex::Complex64;
 
-/// Adds [`Tutte`], [`Harmonic`] and [`Lscm`] to `registry`.
+/// Adds [`Tutte`], [`Harmonic`], [`Lscm`] and [`Sphere`] to `registry`.
 pub fn register(registry: &mut beltrami_core::Registry) {
     registry.register(Box::new(Tutte));
     registry.register(Box::new(Harmonic));
     registry.register(Box::new(Lscm));
+    registry.register(Box::new(Sphere));
 }
 
 /// The advice of the topology check: what to do with a mesh that is not a disk.
@@ -129,14 +140,21 @@ fn stage<T>(
 
 /// Measures the distortion of a planar map in the face frames into `report.mu` and
 /// `report.distortion` (a "distortion" stage), and returns the number of flipped faces.
+/// `elements` are the solver's own face-frame elements when it has them (reused), else
+/// they are computed.
 fn measure(
     mesh: &Mesh,
+    elements: Option<&Elements>,
     map: &[Complex64],
     context: &mut Context<'_>,
     report: &mut Report,
 ) -> Result<usize, SolverError> {
-    let distortion = stage("distortion", context, report, || {
-        Ok(measure_planar(mesh, map, Frame::Face)?)
+    let distortion = stage("distortion", context, report, || match elements {
+        Some(elements) => {
+            let derivatives = planar_map(elements, mesh.vertex_count(), map)?;
+            Ok(Distortion::from_derivatives(elements, &derivatives)?)
+        }
+        None => Ok(measure_planar(mesh, map, Frame::Face)?),
     })?;
     let flipped = distortion.stats.flipped;
     report.mu = Some(distortion.field);

@@ -79,7 +79,7 @@ impl Solver for Lscm {
                 input(pinned[1].0)
             ));
         }
-        let (derivatives, mut solver) = stage("assembly", context, &mut report, || {
+        let (elements, derivatives, mut solver) = stage("assembly", context, &mut report, || {
             let elements = Elements::new(mesh, Frame::Face)?;
             let derivatives = complex_derivatives(mesh, &elements)?;
             let mut constraints = DofConstraints::new();
@@ -92,7 +92,7 @@ impl Solver for Lscm {
                 &dofs,
                 solve_options(problem),
             )?;
-            Ok((derivatives, solver))
+            Ok((elements, derivatives, solver))
         })?;
         let map = stage("solve", context, &mut report, || {
             let zero = vec![Complex64::new(0.0, 0.0); derivatives.dzbar.nrows()];
@@ -109,7 +109,7 @@ impl Solver for Lscm {
             .map(|(r, w)| w * r.norm_sqr())
             .sum();
         report.energy_history.push(energy);
-        let flipped = measure(mesh, &map, context, &mut report)?;
+        let flipped = measure(mesh, Some(&elements), &map, context, &mut report)?;
         if flipped > 0 {
             report.notes.push(format!(
                 "{flipped} of {} faces are flipped: LSCM does not guarantee a bijection; tutte always gives one",

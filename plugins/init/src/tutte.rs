@@ -405,7 +405,7 @@ impl FixedBoundary {
         if weights.is_symmetric() {
             report.energy_history.push(spring_energy(&weights, &map));
         }
-        let flipped = measure(mesh, &map, context, &mut report)?;
+        let flipped = measure(mesh, None, &map, context, &mut report)?;
         let negative = weights.negative_count(system.interior().iter().copied());
         if negative > 0 {
             report.notes.push(format!(

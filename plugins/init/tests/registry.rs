@@ -1,15 +1,16 @@
-//! The plugin registers its three solvers under their stable names.
+//! The plugin registers its solvers under their stable names.
 
 use beltrami_core::Registry;
 
 #[test]
-fn registers_tutte_harmonic_and_lscm() {
+fn registers_tutte_harmonic_lscm_and_sphere() {
     let mut registry = Registry::new();
     beltrami_init::register(&mut registry);
-    assert_eq!(registry.names(), ["tutte", "harmonic", "lscm"]);
-    for name in ["tutte", "harmonic", "lscm"] {
+    assert_eq!(registry.names(), ["tutte", "harmonic", "lscm", "sphere"]);
+    for name in ["tutte", "harmonic", "lscm", "sphere"] {
         let solver = registry.get(name).unwrap();
         assert_eq!(solver.name(), name);
         assert!(!solver.description().is_empty() && !solver.accepts().is_empty());
     }
+    assert!(registry.get("nope").is_err());
 }

@@ -1,0 +1,562 @@
+//! A closed genus-0 mesh onto the unit sphere: the initial bijection of spherical
+//! solvers (T. W. Wong and H. Zhao, "Computation of quasiconformal surface maps using
+//! discrete Beltrami flow", SIAM J. Imaging Sci. 7, 2014, section 4.1: "remove a
+//! triangle ..., apply Tutte embedding ..., then map onto a sphere by stereographic
+//! projection, with the triangle put back to fill the hole").
+//!
+//! # Stages
+//!
+//! 1. **Puncture.** Remove one face `r`: the one with the largest `A_f q_f`, its area
+//!    times its shape quality `q_f = 4 tan(pi / n) A_f / sum_k l_k^2` (`n` = 3 or 4
+//!    sides of lengths `l_k`; `q = 1` for the equilateral triangle and the square, so the
+//!    removed face is large and close to the regular polygon it is mapped onto). The rest
+//!    is a disk whose single boundary loop is the outline of `r`; it keeps every vertex,
+//!    so vertex ids do not change.
+//! 2. **Tutte.** The disk goes into the plane with every interior vertex at a weighted
+//!    mean of its neighbours ([`crate::tutte::WeightedMeanSystem`]; mean-value weights by
+//!    default, uniform on request) and the `n` boundary vertices on the corners of a
+//!    regular `n`-gon (equilateral triangle or square) inscribed in the circle of radius
+//!    `R`. The corners are placed counter-clockwise in loop order, the mirror of the
+//!    usual clockwise placement of [`crate::boundary`], so the faces run clockwise in the
+//!    plane: seen from below, as the projection below needs. Tutte's theorem (Floater's
+//!    for mean-value weights) makes this a bijection onto the polygon for triangles.
+//! 3. **Projection.** The inverse stereographic projection from the north pole,
+//!
+//!    ```text
+//!    s(x + i y) = (2x, 2y, |z|^2 - 1) / (|z|^2 + 1),
+//!    ```
+//!
+//!    conformal, with `s(0)` the south pole and `s(infinity)` the north pole; the plane
+//!    outside the polygon, i.e. the removed face, goes to a cap around the north pole.
+//!    Near the south pole `s(z) ~ (2x, 2y, -1)`, where the outward normal is `-e_z`, so
+//!    `s` maps the plane *seen from below* onto the sphere seen from outside: clockwise
+//!    faces in the plane become outward-facing faces on the sphere. `R` gives the cap
+//!    `|z| > R`, whose boundary circle passes through the removed face's vertices, the
+//!    removed face's share `a = A_r / A` of the surface area: the cap has area
+//!    `2 pi (1 - h)` with `h = (R^2 - 1) / (R^2 + 1)`, so `4 pi a = 4 pi / (R^2 + 1)` and
+//!    `R = sqrt(1/a - 1)`.
+//! 4. **Normalization.** Moebius centering (A. Baden, K. Crane, M. Kazhdan, "Moebius
+//!    registration", Computer Graphics Forum 37(5), SGP 2018): with source face areas
+//!    `A_f` and `x_f` the centroid of face `f`'s image projected onto the sphere, the
+//!    centre of mass `c = sum_f A_f x_f / sum_f A_f` of the pushed-forward area lies in
+//!    the open unit ball. The conformal automorphism of the ball that moves `c` to the
+//!    origin (L. V. Ahlfors, "Moebius transformations in several dimensions", 1981),
+//!
+//!    ```text
+//!    phi_c(x) = ((1 - |c|^2)(x - c) - |x - c|^2 c) / (1 - 2 <x, c> + |c|^2 |x|^2),
+//!    ```
+//!
+//!    is on the sphere `phi_c(x) = (1 - |c|^2)(x - c) / |x - c|^2 - c`, an
+//!    orientation-preserving Moebius transformation of the sphere. Baden, Crane and
+//!    Kazhdan iterate `x <- phi_c(x)` (vertex images projected back to unit length) with
+//!    `c` recomputed each time. For small `b`, `phi_b(x) ~ x - 2b + 2 <x, b> x`, so the
+//!    step `phi_b` moves the centre of mass to `c - 2 (I - M) b`, with the second moment
+//!    `M = sum_f A_f x_f x_f^T / sum_f A_f`: the plain step `b = c` gives `(2M - I) c`
+//!    (`-c/3` for a uniform spread, but slow where `M` is far from `I/3`), the Newton
+//!    step `b = (2 (I - M))^{-1} c` gives 0 to first order. Each step takes the first of
+//!    `b =` Newton (when inside the ball), `c`, `c/2`, `c/4`, ... that brings the centre of
+//!    mass closer to the origin, until `|c| <= 1e-6` or after 100 steps. The area of the
+//!    source is then spread around the sphere instead of crowding one side: the usual
+//!    normalization of the Moebius freedom of spherical maps.
+//!
+//! # Flips
+//!
+//! The image of a face is the flat polygon through its vertex images. It faces outward
+//! when its normal points away from the centre: a triangle `p0 p1 p2` is *inward* (a
+//! flip) when `((p1 - p0) x (p2 - p0)) . m <= 0`, `m` the mean of its vertex images. A
+//! quad's image is not planar; it is inward when any triangle of either diagonal split
+//! (`012`, `023`, `013`, `123`) is. Those four triangles give the Jacobian of the
+//! bilinear patch at its corners, and the Jacobian's component along the fixed direction
+//! `m` is bilinear on the patch, so a quad that passes has a positive Jacobian at every
+//! point, the Gauss points of the distortion measure included.
+//!
+//! A planar triangle's circumdisk goes to a spherical cap through the vertex images, and
+//! the flat image faces outward exactly when that cap is the smaller of the two the
+//! circle bounds. Tutte's map has no flips in the plane, but a very obtuse face has a
+//! circumdisk far larger than itself, which the projection and the centering may blow up
+//! beyond a hemisphere: such faces are the flips that remain (a handful in 10^5 on
+//! meshes with slivers).
+//!
+//! The image always has the combinatorial orientation of the source: when the source's
+//! faces face inward (negative signed volume), the image's faces still face outward, and
+//! the report notes that the map reverses orientation in space.
+//!
+//! # Distortion
+//!
+//! The report's `mu` is measured intrinsically
+//! ([`beltrami_fem::distortion::measure_surface`]) with the radial direction `m / |m|` at
+//! each image face as the reference normal; its flipped count is that of the inward
+//! faces above (together with any Gauss point the measure finds flipped). The map is an
+//! initialization, bijective up to the rare flips above but not conformal. The stretch is
+//! largest near the removed face's corners (a full turn around them is squeezed into the
+//! polygon's corner angle) and on long protrusions, which Tutte embeddings shrink
+//! geometrically.
+
+use std::f64::consts::{PI, TAU};
+
+use beltrami_core::{
+    Context, Goal, Map, Problem, Progress, Report, Solution, Solver, SolverError, Target, Weights,
+    topology,
+};
+use beltrami_fem::distortion::measure_surface;
+use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
+use nalgebra::Matrix3;
+use num_complex::Complex64;
+
+use crate::boundary::BoundaryMap;
+use crate::tutte::WeightedMeanSystem;
+use crate::weights::{EdgeWeights, WeightError};
+use crate::{solve_options, stage};
+
+/// The Tutte embedding of the mesh minus one face, inverse stereographic projection and
+/// Moebius centering (module docs): an initial map of a closed genus-0 mesh onto the
+/// unit sphere, bijective up to rare flips of very obtuse faces.
+///
+/// Reads: `target` (`Sphere` only), `goal` (`Conformal { p: 2 }` only: the map is an
+/// initialization), `params.weights` (`MeanValue`, the default, or `Uniform`) and
+/// `params.threads` (uniform weights). Takes no pins and no curves. The report holds the
+/// timings of the stages (`puncture`, `tutte`, `projection`, `normalization`,
+/// `distortion`), the number of normalization steps as its iterations, the distance of
+/// the centre of mass from the origin after each step as its energy history, and notes
+/// naming the removed face (input index) and counting flipped faces.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Sphere;
+
+const NAME: &str = "sphere";
+
+/// The advice of the topology check, after "sphere maps closed genus-0 meshes; this
+/// mesh has ...".
+const NOT_A_SPHERE: &str = "use lscm/tutte for disks, or `beltrami cut` for higher genus";
+
+/// The normalization stops once the centre of mass is this close to the origin.
+const CENTER_TOLERANCE: f64 = 1e-6;
+
+/// The normalization stops after this many Moebius steps.
+const MAX_STEPS: usize = 100;
+
+/// A normalization step halves its candidate this many times at most.
+const MAX_HALVINGS: u32 = 20;
+
+impl Solver for Sphere {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn description(&self) -> &'static str {
+        "closed genus-0 mesh onto the unit sphere: Tutte embedding of the mesh minus one face, inverse stereographic projection, Moebius centering; a bijective initialization, not a conformal map"
+    }
+
+    fn accepts(&self) -> &'static str {
+        "closed genus-0 meshes (triangles, quads); target: sphere; goal: conformal (p = 2) initialization; weights: mean-value (default), uniform; no pins or curves"
+    }
+
+    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+        weights(problem).map(|_| ())
+    }
+
+    fn solve(
+        &self,
+        problem: &Problem<'_>,
+        context: &mut Context<'_>,
+    ) -> Result<Solution, SolverError> {
+        let mesh = problem.source;
+        let kind = weights(problem)?;
+        let mut report = Report::new(NAME);
+
+        let removed = removed_face(mesh);
+        let punctured = stage("puncture", context, &mut report, || puncture(mesh, removed))?;
+        let share = mesh.face_area(removed) / mesh.total_area();
+        let radius = cap_radius(share);
+        report.notes.push(format!(
+            "removed face {} (input index, a {}) covering {:.3e} of the area; its vertices go to a circle of radius {radius:.4} before the projection",
+            mesh.face_to_input(removed),
+            if mesh.face_degree(removed) == 3 {
+                "triangle"
+            } else {
+                "quad"
+            },
+            share
+        ));
+
+        let (planar, negative) = stage("tutte", context, &mut report, || {
+            let weights = EdgeWeights::new(&punctured, kind).map_err(|e| match e {
+                WeightError::Fem(e) => SolverError::Fem(e),
+                e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
+                    solver: NAME,
+                    message: e.to_string(),
+                },
+            })?;
+            let boundary = hole_boundary(&punctured, radius);
+            let system = WeightedMeanSystem::new(&weights, &boundary)?;
+            let negative = weights.negative_count(system.interior().iter().copied());
+            Ok((system.solve(solve_options(problem))?, negative))
+        })?;
+        if negative > 0 {
+            report.notes.push(format!(
+                "{negative} mean-value weights of interior vertices are negative (reflex quad corners); the bijectivity theorem needs positive weights"
+            ));
+        }
+
+        let mut image: Vec<Point3<f64>> = stage("projection", context, &mut report, || {
+            Ok(planar.iter().map(|&z| inverse_stereographic(z)).collect())
+        })?;
+
+        normalize(mesh, &mut image, context, &mut report)?;
+
+        let (inward, distortion) = stage("distortion", context, &mut report, || {
+            let inward = inward_faces(mesh, &image);
+            let radial: Vec<Vector3<f64>> = mesh
+                .faces()
+                .map(|f| radial_direction(mesh, &image, f))
+                .collect();
+            Ok((inward, measure_surface(mesh, &image, Some(&radial))?))
+        })?;
+        let flipped = inward
+            .iter()
+            .zip(&distortion.flipped)
+            .filter(|&(&a, &b)| a || b)
+            .count();
+        let mut stats = distortion.stats;
+        stats.flipped = flipped;
+        report.mu = Some(distortion.field);
+        report.distortion = Some(stats);
+        if flipped > 0 {
+            report.notes.push(format!(
+                "{flipped} of {} faces are flipped: their images face the centre of the sphere (very obtuse faces, whose circumcircles the projection blows up)",
+                mesh.face_count()
+            ));
+        }
+        if signed_volume(mesh) < 0.0 {
+            report.notes.push(
+                "the source's faces face inward (negative signed volume); the image faces face outward, so the map reverses orientation in space"
+                    .to_string(),
+            );
+        }
+        Ok(Solution {
+            map: Map::Spatial(image),
+            report,
+        })
+    }
+}
+
+/// The capability check, returning the weights to use.
+fn weights(problem: &Problem<'_>) -> Result<Weights, SolverError> {
+    let unsupported = |message: String| {
+        Err(SolverError::Unsupported {
+            solver: NAME,
+            message,
+        })
+    };
+    topology::require_sphere(NAME, problem.source, NOT_A_SPHERE)?;
+    match &problem.target {
+        Target::Sphere => {}
+        Target::Plane(_) | Target::Disk | Target::Annulus { .. } | Target::CircleDomain => {
+            return unsupported(
+                "sphere maps onto the unit sphere; for planar targets cut the mesh into a disk (or remove a face) and use tutte, harmonic or lscm"
+                    .to_string(),
+            );
+        }
+        Target::Mesh(_) | Target::Surface => {
+            return unsupported(
+                "sphere maps onto the unit sphere; for maps onto a surface use beltrami-flow or lsqc"
+                    .to_string(),
+            );
+        }
+    }
+    match &problem.goal {
+        Goal::Conformal { p } if *p == 2.0 => {}
+        Goal::Conformal { p } => {
+            return unsupported(format!(
+                "sphere computes a fixed initial map and minimizes no norm of mu, so it cannot aim at p = {p}; start beltrami-flow from its map"
+            ));
+        }
+        Goal::Prescribed(_) => {
+            return unsupported(
+                "sphere computes a fixed initial map and cannot follow a prescribed Beltrami coefficient; start beltrami-flow from its map"
+                    .to_string(),
+            );
+        }
+        Goal::Extremal => {
+            return unsupported(
+                "sphere computes a fixed initial map, not an extremal (Teichmueller) map; use teichmuller"
+                    .to_string(),
+            );
+        }
+    }
+    let constraints = &problem.constraints;
+    if let Some(pin) = constraints.pins.first() {
+        return unsupported(format!(
+            "sphere places every vertex itself and takes no pins (given: {}, the first on vertex {}); pin landmarks in beltrami-flow, starting from this map",
+            constraints.pins.len(),
+            pin.vertex
+        ));
+    }
+    if !constraints.curves.is_empty() {
+        return unsupported(format!(
+            "sphere cannot make vertices follow curves (given: {}); use beltrami-flow",
+            constraints.curves.len()
+        ));
+    }
+    match problem.params.weights.unwrap_or(Weights::MeanValue) {
+        Weights::Cotan => unsupported(
+            "sphere takes mean-value or uniform weights, not cotangent: cotangent weights are negative on obtuse triangles and may fold the map"
+                .to_string(),
+        ),
+        w => Ok(w),
+    }
+}
+
+/// The face to remove: the largest area times shape quality `q_f` (module docs). The
+/// mesh is closed, so it has faces; ties go to the first face.
+fn removed_face(mesh: &Mesh) -> FaceId {
+    let score = |f: FaceId| {
+        let area = mesh.face_area(f);
+        let squares: f64 = mesh
+            .face_halfedges(f)
+            .map(|h| mesh.halfedge_vector(h).norm_squared())
+            .sum();
+        let n = mesh.face_degree(f) as f64;
+        let quality = 4.0 * (PI / n).tan() * area / squares;
+        let score = area * quality;
+        if score.is_finite() { score } else { 0.0 }
+    };
+    mesh.faces()
+        .map(|f| (f, score(f)))
+        .fold((FaceId(0), f64::NEG_INFINITY), |best, (f, s)| {
+            if s > best.1 { (f, s) } else { best }
+        })
+        .0
+}
+
+/// The mesh without face `removed`, with the same vertex ids.
+fn puncture(mesh: &Mesh, removed: FaceId) -> Result<Mesh, SolverError> {
+    let mut soup = PolygonSoup::new(mesh.positions().to_vec());
+    soup.reserve(mesh.face_count() - 1, 4 * mesh.face_count());
+    let mut corners = Vec::with_capacity(4);
+    for f in mesh.faces().filter(|&f| f != removed) {
+        corners.clear();
+        corners.extend(mesh.face_vertices(f).map(|v| v.0));
+        soup.push_face(&corners);
+    }
+    // The source mesh was validated already; accept any face it accepted.
+    let options = BuildOptions {
+        degenerate_area_tolerance: 0.0,
+        ..BuildOptions::default()
+    };
+    let (punctured, _) = Mesh::build(&soup, &options)?;
+    let map = punctured.vertex_map();
+    if let Some(v) = mesh
+        .vertices()
+        .find(|&v| map.from_input(v.idx()) != Some(v))
+    {
+        return Err(SolverError::InvalidInput {
+            solver: NAME,
+            message: format!(
+                "removing face {} (input index) left vertex {} (input index) without faces",
+                mesh.face_to_input(removed),
+                mesh.vertex_map().to_input(v)
+            ),
+        });
+    }
+    if !punctured.is_disk() {
+        return Err(SolverError::InvalidInput {
+            solver: NAME,
+            message: format!(
+                "removing face {} (input index) left {} instead of a disk",
+                mesh.face_to_input(removed),
+                topology::describe(&punctured)
+            ),
+        });
+    }
+    Ok(punctured)
+}
+
+/// `R = sqrt(1/a - 1)` for the removed face's area share `a` (module docs); 1 if `a` is
+/// not in `(0, 1)`.
+fn cap_radius(share: f64) -> f64 {
+    let radius = (1.0 / share - 1.0).sqrt();
+    if radius.is_finite() && radius > 0.0 {
+        radius
+    } else {
+        1.0
+    }
+}
+
+/// The boundary loop of the punctured mesh (the removed face's outline, `n` vertices) on
+/// the corners `R exp(2 pi i k / n)` of a regular polygon, counter-clockwise in loop
+/// order (module docs).
+fn hole_boundary(punctured: &Mesh, radius: f64) -> BoundaryMap {
+    let vertices: Vec<VertexId> = punctured
+        .boundary_loops()
+        .flat_map(|b| punctured.loop_vertices(b))
+        .collect();
+    let n = vertices.len() as f64;
+    let positions = (0..vertices.len())
+        .map(|k| Complex64::from_polar(radius, TAU * k as f64 / n))
+        .collect();
+    BoundaryMap {
+        vertices,
+        positions,
+    }
+}
+
+/// `s(z) = (2x, 2y, |z|^2 - 1) / (|z|^2 + 1)`, the inverse stereographic projection from
+/// the north pole.
+fn inverse_stereographic(z: Complex64) -> Point3<f64> {
+    let r2 = z.norm_sqr();
+    let d = r2 + 1.0;
+    Point3::new(2.0 * z.re / d, 2.0 * z.im / d, (r2 - 1.0) / d)
+}
+
+/// The mean of the images of `f`'s vertices.
+fn image_mean(mesh: &Mesh, image: &[Point3<f64>], f: FaceId) -> Vector3<f64> {
+    let (vertices, n) = mesh.face_vertex_array(f);
+    vertices[..n]
+        .iter()
+        .map(|v| image[v.idx()].coords)
+        .sum::<Vector3<f64>>()
+        / n as f64
+}
+
+/// The unit radial direction at the image of `f` (zero if the image's mean is the
+/// origin).
+fn radial_direction(mesh: &Mesh, image: &[Point3<f64>], f: FaceId) -> Vector3<f64> {
+    let m = image_mean(mesh, image, f);
+    let norm = m.norm();
+    if norm > 0.0 { m / norm } else { m }
+}
+
+/// The centre of mass `c = sum_f A_f x_f / sum_f A_f` of the source area carried to the
+/// sphere and the second moment `M = sum_f A_f x_f x_f^T / sum_f A_f`, `x_f` the radial
+/// direction at the image of face `f`.
+fn moments(mesh: &Mesh, areas: &[f64], image: &[Point3<f64>]) -> (Vector3<f64>, Matrix3<f64>) {
+    let total: f64 = areas.iter().sum();
+    let (mut c, mut m) = (Vector3::zeros(), Matrix3::zeros());
+    for (f, &a) in mesh.faces().zip(areas) {
+        let x = radial_direction(mesh, image, f);
+        c += a * x;
+        m += a * x * x.transpose();
+    }
+    (c / total, m / total)
+}
+
+/// `phi_b` (module docs) on the unit sphere, the result projected back to unit length.
+fn moebius(b: Vector3<f64>, source: &[Point3<f64>], target: &mut Vec<Point3<f64>>) {
+    let shrink = 1.0 - b.norm_squared();
+    target.clear();
+    target.extend(source.iter().map(|p| {
+        let d = p.coords - b;
+        let q = shrink / d.norm_squared() * d - b;
+        Point3::from(q / q.norm())
+    }));
+}
+
+/// Moebius centering (module docs): applies `phi_b` to every image point until the
+/// centre of mass `c` is within [`CENTER_TOLERANCE`] of the origin or after
+/// [`MAX_STEPS`] steps, recording each step in the report; the "normalization" timing.
+///
+/// Each step tries, in order, the Newton step of the linearization,
+/// `b = (2 (I - M))^{-1} c` (when it is inside the ball), then `b = c` (Baden, Crane and
+/// Kazhdan's iteration) and `c/2, c/4, ...`, and takes the first that moves the centre of
+/// mass closer to the origin; the Newton step converges in a few steps where the
+/// linearization holds, the others keep the far steps safe.
+fn normalize(
+    mesh: &Mesh,
+    image: &mut Vec<Point3<f64>>,
+    context: &mut Context<'_>,
+    report: &mut Report,
+) -> Result<(), SolverError> {
+    context.check_cancelled()?;
+    let start = std::time::Instant::now();
+    let areas: Vec<f64> = mesh.faces().map(|f| mesh.face_area(f)).collect();
+    let (mut c, mut m) = moments(mesh, &areas, image);
+    let initial = c.norm();
+    let mut trial = Vec::with_capacity(image.len());
+    let mut steps = 0;
+    // An average of unit vectors lies in the closed ball; on its boundary (all mass at
+    // one point) no Moebius transformation can spread it.
+    while c.norm() > CENTER_TOLERANCE && c.norm() < 1.0 && steps < MAX_STEPS {
+        context.check_cancelled()?;
+        let newton = (2.0 * (Matrix3::identity() - m))
+            .try_inverse()
+            .map(|inverse| inverse * c)
+            .filter(|b| b.norm() < 1.0);
+        let halvings = (0..MAX_HALVINGS).map(|k| c / f64::from(1u32 << k));
+        let mut improved = None;
+        for b in newton.into_iter().chain(halvings) {
+            moebius(b, image, &mut trial);
+            let (c_trial, m_trial) = moments(mesh, &areas, &trial);
+            if c_trial.norm() < c.norm() {
+                improved = Some((c_trial, m_trial));
+                break;
+            }
+        }
+        let Some((c_new, m_new)) = improved else {
+            break;
+        };
+        std::mem::swap(image, &mut trial);
+        (c, m) = (c_new, m_new);
+        steps += 1;
+        report.energy_history.push(c.norm());
+        context.report(&Progress {
+            stage: "normalization",
+            done: steps,
+            total: Some(MAX_STEPS),
+            energy: Some(c.norm()),
+        });
+    }
+    // Unit length to the last bit, also where no step was taken.
+    for p in image.iter_mut() {
+        *p = Point3::from(p.coords / p.coords.norm());
+    }
+    report.iterations = steps;
+    report
+        .timings
+        .push(("normalization".to_string(), start.elapsed().as_secs_f64()));
+    if c.norm() <= CENTER_TOLERANCE {
+        report.notes.push(format!(
+            "Moebius centering moved the centre of mass of the area from {initial:.3e} to {:.1e} from the origin in {steps} steps",
+            c.norm()
+        ));
+    } else {
+        report.notes.push(format!(
+            "Moebius centering stopped after {steps} steps with the centre of mass of the area {:.3e} from the origin (started at {initial:.3e})",
+            c.norm()
+        ));
+    }
+    Ok(())
+}
+
+/// Per face: true if its image faces the centre (module docs: a triangle whose normal
+/// points inward, a quad with such a triangle in either diagonal split).
+fn inward_faces(mesh: &Mesh, image: &[Point3<f64>]) -> Vec<bool> {
+    const TRIANGLES: [[usize; 3]; 1] = [[0, 1, 2]];
+    const QUAD_SPLITS: [[usize; 3]; 4] = [[0, 1, 2], [0, 2, 3], [0, 1, 3], [1, 2, 3]];
+    mesh.faces()
+        .map(|f| {
+            let (vertices, n) = mesh.face_vertex_array(f);
+            let p = |k: usize| image[vertices[k].idx()];
+            let m = image_mean(mesh, image, f);
+            let triangles: &[[usize; 3]] = if n == 3 { &TRIANGLES } else { &QUAD_SPLITS };
+            triangles.iter().any(|&[a, b, c]| {
+                let normal = (p(b) - p(a)).cross(&(p(c) - p(a)));
+                normal.dot(&m) <= 0.0
+            })
+        })
+        .collect()
+}
+
+/// The signed volume `sum_f (1/6) p0 . (p1 x p2)` enclosed by the source (quads split
+/// along `v0 v2`); positive when the faces face outward.
+fn signed_volume(mesh: &Mesh) -> f64 {
+    mesh.faces()
+        .map(|f| {
+            let (vertices, n) = mesh.face_vertex_array(f);
+            let p = |k: usize| mesh.position(vertices[k]).coords;
+            (1..n - 1)
+                .map(|k| p(0).dot(&p(k).cross(&p(k + 1))))
+                .sum::<f64>()
+                / 6.0
+        })
+        .sum()
+}
