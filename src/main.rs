@@ -1,6 +1,12 @@
 //! The `beltrami` command-line program.
 
 mod cli;
+#[cfg(target_os = "linux")]
+mod huge_pages;
+
+#[cfg(target_os = "linux")]
+#[global_allocator]
+static ALLOCATOR: huge_pages::HugePages = huge_pages::HugePages;
 
 use std::process::ExitCode;
 
