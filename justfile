@@ -3,7 +3,7 @@
 
 # Run the main job on the bundled mesh.
 demo:
-    cargo run --release -- info meshes/disk_hemisphere.obj
+    cargo run --release -- param meshes/disk_hemisphere.obj --solver lscm -o hemisphere_lscm.obj
 
 # Build everything in release mode.
 build:

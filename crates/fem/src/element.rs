@@ -90,6 +90,10 @@ pub struct QuadraturePoint {
     pub grad: [Vector2<f64>; 4],
     /// Signed `det J`: negative when the element is clockwise in the frame.
     pub det: f64,
+    /// The metric of the reference coordinates, `g_ij = X_i . X_j` with `X_1 = dX/du`,
+    /// `X_2 = dX/dv` (the tangent vectors in R^3, before any projection to the frame);
+    /// `sqrt(det g)` is the area element of the surface patch.
+    pub metric: [[f64; 2]; 2],
 }
 
 /// Gauss points of the 2-point rule on [0, 1]: 1/2 -+ 1/(2 sqrt 3).
@@ -209,6 +213,7 @@ impl Elements {
                     let (du, dv) = (dref[k][0], dref[k][1]);
                     grad[k] = Vector2::new(b.y * du - a.y * dv, -b.x * du + a.x * dv) / det;
                 }
+                let g12 = x1.dot(&x2);
                 points.push(QuadraturePoint {
                     face: f,
                     weight: ref_weight * det.abs(),
@@ -216,6 +221,7 @@ impl Elements {
                     shape,
                     grad,
                     det,
+                    metric: [[x1.norm_squared(), g12], [g12, x2.norm_squared()]],
                 });
             }
             offsets.push(points.len() as u32);

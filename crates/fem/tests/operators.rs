@@ -297,3 +297,36 @@ fn global_frame_needs_a_mesh_in_the_plane() {
         16
     );
 }
+
+#[test]
+fn the_metric_gives_the_area_element_of_the_patch() {
+    // Each point's frame spans the patch's tangent plane there (for planar meshes in the
+    // global frame, the plane itself), so |det J| = |X_1 x X_2| = sqrt(det g) and the
+    // weight is sqrt(det g) times the reference weight, non-planar quads included.
+    let soup = beltrami_mesh::primitives::torus(10, 6, 2.0, 0.7, Cells::Quads);
+    let torus = Mesh::from_soup(&soup).unwrap();
+    for (mesh, frame) in [
+        (jittered(5, Cells::Triangles, 0.3, 4), Frame::Global),
+        (jittered(5, Cells::Quads, 0.3, 4), Frame::Face),
+        (torus, Frame::Face),
+    ] {
+        let elements = Elements::new(&mesh, frame).unwrap();
+        for q in elements.points() {
+            let g = q.metric;
+            assert!((g[0][1] - g[1][0]).abs() == 0.0);
+            let area_element = (g[0][0] * g[1][1] - g[0][1] * g[1][0]).sqrt();
+            let reference_weight = if elements.nodes(q.face).len() == 3 {
+                0.5
+            } else {
+                0.25
+            };
+            assert!(
+                (area_element * reference_weight - q.weight).abs() < 1e-12 * (1.0 + q.weight),
+                "face {}: {} vs {}",
+                q.face,
+                area_element * reference_weight,
+                q.weight
+            );
+        }
+    }
+}
