@@ -3,27 +3,13 @@
 
 use std::f64::consts::TAU;
 use std::path::Path;
-use std::process::{Command, Output};
 
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_mesh::primitives::{Cells, icosphere, torus};
 use beltrami_mesh::{BuildOptions, Mesh, PolygonSoup};
 
-fn beltrami(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_beltrami"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the beltrami binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+mod common;
+use common::{beltrami, s, text};
 
 fn write_soup(path: &Path, soup: &PolygonSoup) -> Mesh {
     let mesh = Mesh::from_soup(soup).unwrap();

@@ -2,7 +2,6 @@
 //! similarities of surfaces, flips judged against a target, and bad input.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_mesh::primitives::{Cells, grid, icosphere, torus};
@@ -10,21 +9,8 @@ use beltrami_mesh::{BuildOptions, Mesh, Point3, Vector2, Vector3};
 use num_complex::Complex64;
 use serde_json::Value;
 
-fn beltrami(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_beltrami"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the beltrami binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+mod common;
+use common::{beltrami, s, text};
 
 /// Runs `distortion ... --json` and returns the report.
 fn report(args: &[&str]) -> Value {

@@ -1,19 +1,9 @@
 //! End-to-end runs of `beltrami info` on the bundled mesh and on bad input.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn beltrami(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_beltrami"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the beltrami binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+mod common;
+use common::{beltrami, text};
 
 fn write(dir: &Path, name: &str, content: &str) -> PathBuf {
     let p = dir.join(name);

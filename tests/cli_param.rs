@@ -3,29 +3,16 @@
 
 use std::collections::HashMap;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use beltrami_mesh::Mesh;
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_mesh::primitives::{Cells, torus};
 
+mod common;
+use common::{beltrami, s, text};
+
 const HEMISPHERE: &str = "meshes/disk_hemisphere.obj";
-
-fn beltrami(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_beltrami"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("the beltrami binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// Runs `beltrami param` and fails the test (with its stderr) unless it succeeds.
 fn param(args: &[&str]) -> Output {
