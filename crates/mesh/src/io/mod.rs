@@ -174,47 +174,43 @@ pub struct VertexAttributes<'a> {
 impl VertexAttributes<'_> {
     /// Checks that every given attribute has one finite value per vertex.
     pub fn check(&self, mesh: &Mesh) -> Result<(), WriteError> {
-        let n = mesh.vertex_count();
-        let len = |what, got: usize| {
-            if got == n {
-                Ok(())
-            } else {
-                Err(WriteError::AttributeLength {
-                    what,
-                    expected: n,
-                    got,
-                })
-            }
-        };
-        let finite = |what, bad: Option<usize>| match bad {
-            Some(v) => Err(WriteError::NonFinite {
-                what,
-                vertex: mesh.vertex_map().to_input(crate::VertexId(v as u32)),
-            }),
-            None => Ok(()),
-        };
-        if let Some(p) = self.positions {
-            len("positions", p.len())?;
-            finite(
-                "position",
-                p.iter().position(|p| !p.iter().all(|x| x.is_finite())),
-            )?;
-        }
-        if let Some(uv) = self.uvs {
-            len("uvs", uv.len())?;
-            finite(
-                "uv",
-                uv.iter().position(|p| !p.iter().all(|x| x.is_finite())),
-            )?;
-        }
-        if let Some(c) = self.colors {
-            len("colors", c.len())?;
-            finite(
-                "color",
-                c.iter().position(|p| !p.iter().all(|x| x.is_finite())),
-            )?;
-        }
-        Ok(())
+        check_attribute(mesh, ["positions", "position"], self.positions, |p| {
+            p.iter().all(|x| x.is_finite())
+        })?;
+        check_attribute(mesh, ["uvs", "uv"], self.uvs, |t| {
+            t.iter().all(|x| x.is_finite())
+        })?;
+        check_attribute(mesh, ["colors", "color"], self.colors, |c| {
+            c.iter().all(|x| x.is_finite())
+        })
+    }
+}
+
+/// Checks that an attribute, when given, has one value per mesh vertex and that
+/// `finite` holds for each, naming the first bad vertex by its input index. `names` are
+/// the attribute's plural (for the length) and singular (for a value) names.
+fn check_attribute<T>(
+    mesh: &Mesh,
+    [plural, singular]: [&'static str; 2],
+    values: Option<&[T]>,
+    finite: impl Fn(&T) -> bool,
+) -> Result<(), WriteError> {
+    let Some(values) = values else {
+        return Ok(());
+    };
+    if values.len() != mesh.vertex_count() {
+        return Err(WriteError::AttributeLength {
+            what: plural,
+            expected: mesh.vertex_count(),
+            got: values.len(),
+        });
+    }
+    match values.iter().position(|v| !finite(v)) {
+        Some(v) => Err(WriteError::NonFinite {
+            what: singular,
+            vertex: mesh.vertex_map().to_input(crate::VertexId(v as u32)),
+        }),
+        None => Ok(()),
     }
 }
 
