@@ -98,6 +98,27 @@ impl<'a> Context<'a> {
         self.cancel.load(Ordering::Relaxed)
     }
 
+    /// Runs one stage of a solve: checks for cancellation, reports the stage's start and
+    /// end (`done` 0 then 1 of 1) and records its duration in `report` under `name`.
+    pub fn stage<T>(
+        &mut self,
+        name: &'static str,
+        report: &mut Report,
+        f: impl FnOnce() -> Result<T, SolverError>,
+    ) -> Result<T, SolverError> {
+        self.check_cancelled()?;
+        let progress = |done| Progress {
+            stage: name,
+            done,
+            total: Some(1),
+            energy: None,
+        };
+        self.report(&progress(0));
+        let out = report.time(name, f)?;
+        self.report(&progress(1));
+        Ok(out)
+    }
+
     /// `Err(SolverError::Cancelled)` once cancellation was requested; iterative solvers
     /// call it between steps (and return their best map so far instead, when they can).
     pub fn check_cancelled(&self) -> Result<(), SolverError> {

@@ -61,7 +61,7 @@ pub use lscm::Lscm;
 pub use sphere::Sphere;
 pub use tutte::Tutte;
 
-use beltrami_core::{Context, Goal, Problem, Progress, Report, SolverError};
+use beltrami_core::{Context, Goal, Problem, Report, SolverError};
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::distortion::{Distortion, measure_planar};
 use beltrami_fem::{Elements, Frame, SolveOptions};
@@ -117,27 +117,6 @@ fn solve_options(problem: &Problem<'_>) -> SolveOptions {
     }
 }
 
-/// Runs one stage of a solve: checks for cancellation, reports the stage's start and end
-/// to the context and records its duration in the report under `name`.
-fn stage<T>(
-    name: &'static str,
-    context: &mut Context<'_>,
-    report: &mut Report,
-    f: impl FnOnce() -> Result<T, SolverError>,
-) -> Result<T, SolverError> {
-    context.check_cancelled()?;
-    let progress = |done| Progress {
-        stage: name,
-        done,
-        total: Some(1),
-        energy: None,
-    };
-    context.report(&progress(0));
-    let out = report.time(name, f)?;
-    context.report(&progress(1));
-    Ok(out)
-}
-
 /// Measures the distortion of a planar map in the face frames into `report.mu` and
 /// `report.distortion` (a "distortion" stage), and returns the number of flipped faces.
 /// `elements` are the solver's own face-frame elements when it has them (reused), else
@@ -149,7 +128,7 @@ fn measure(
     context: &mut Context<'_>,
     report: &mut Report,
 ) -> Result<usize, SolverError> {
-    let distortion = stage("distortion", context, report, || match elements {
+    let distortion = context.stage("distortion", report, || match elements {
         Some(elements) => {
             let derivatives = planar_map(elements, mesh.vertex_count(), map)?;
             Ok(Distortion::from_derivatives(elements, &derivatives)?)

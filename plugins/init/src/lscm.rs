@@ -31,7 +31,7 @@ use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::{Mesh, VertexId};
 use num_complex::Complex64;
 
-use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options, stage};
+use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
 
 /// The least-squares conformal map (module docs).
 ///
@@ -79,7 +79,7 @@ impl Solver for Lscm {
                 input(pinned[1].0)
             ));
         }
-        let (elements, derivatives, mut solver) = stage("assembly", context, &mut report, || {
+        let (elements, derivatives, mut solver) = context.stage("assembly", &mut report, || {
             let elements = Elements::new(mesh, Frame::Face)?;
             let derivatives = complex_derivatives(mesh, &elements)?;
             let mut constraints = DofConstraints::new();
@@ -94,7 +94,7 @@ impl Solver for Lscm {
             )?;
             Ok((elements, derivatives, solver))
         })?;
-        let map = stage("solve", context, &mut report, || {
+        let map = context.stage("solve", &mut report, || {
             let zero = vec![Complex64::new(0.0, 0.0); derivatives.dzbar.nrows()];
             Ok(solver.solve(
                 derivatives.dzbar.as_ref(),

@@ -104,9 +104,9 @@ use nalgebra::Matrix3;
 use num_complex::Complex64;
 
 use crate::boundary::BoundaryMap;
+use crate::solve_options;
 use crate::tutte::WeightedMeanSystem;
 use crate::weights::{EdgeWeights, WeightError};
-use crate::{solve_options, stage};
 
 /// The Tutte embedding of the mesh minus one face, inverse stereographic projection and
 /// Moebius centering (module docs): an initial map of a closed genus-0 mesh onto the
@@ -164,7 +164,7 @@ impl Solver for Sphere {
         let mut report = Report::new(NAME);
 
         let removed = removed_face(mesh);
-        let punctured = stage("puncture", context, &mut report, || puncture(mesh, removed))?;
+        let punctured = context.stage("puncture", &mut report, || puncture(mesh, removed))?;
         let share = mesh.face_area(removed) / mesh.total_area();
         let radius = cap_radius(share);
         report.notes.push(format!(
@@ -178,7 +178,7 @@ impl Solver for Sphere {
             share
         ));
 
-        let (planar, negative) = stage("tutte", context, &mut report, || {
+        let (planar, negative) = context.stage("tutte", &mut report, || {
             let weights = EdgeWeights::new(&punctured, kind).map_err(|e| match e {
                 WeightError::Fem(e) => SolverError::Fem(e),
                 e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
@@ -197,13 +197,13 @@ impl Solver for Sphere {
             ));
         }
 
-        let mut image: Vec<Point3<f64>> = stage("projection", context, &mut report, || {
+        let mut image: Vec<Point3<f64>> = context.stage("projection", &mut report, || {
             Ok(planar.iter().map(|&z| inverse_stereographic(z)).collect())
         })?;
 
         normalize(mesh, &mut image, context, &mut report)?;
 
-        let (inward, distortion) = stage("distortion", context, &mut report, || {
+        let (inward, distortion) = context.stage("distortion", &mut report, || {
             let inward = inward_faces(mesh, &image);
             let radial: Vec<Vector3<f64>> = mesh
                 .faces()

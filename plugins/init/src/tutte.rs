@@ -39,7 +39,7 @@ use num_complex::Complex64;
 
 use crate::boundary::{self, BoundaryError, BoundaryMap};
 use crate::weights::{EdgeWeights, WeightError};
-use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options, stage};
+use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
 
 /// The weighted-mean system of a fixed boundary (module docs): `L_II x_I = b`, with one
 /// right-hand side column for the real and one for the imaginary parts.
@@ -387,9 +387,9 @@ impl FixedBoundary {
         let solver = self.solver;
         let mesh = problem.source;
         let mut report = Report::new(solver);
-        let boundary = stage("boundary", context, &mut report, || self.prepare(problem))?;
+        let boundary = context.stage("boundary", &mut report, || self.prepare(problem))?;
         let kind = self.weights(problem);
-        let (weights, system) = stage("assembly", context, &mut report, || {
+        let (weights, system) = context.stage("assembly", &mut report, || {
             let weights = EdgeWeights::new(mesh, kind).map_err(|e| match e {
                 WeightError::Fem(e) => SolverError::Fem(e),
                 e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
@@ -401,7 +401,7 @@ impl FixedBoundary {
             Ok((weights, system))
         })?;
         let options = solve_options(problem);
-        let map = stage("solve", context, &mut report, || Ok(system.solve(options)?))?;
+        let map = context.stage("solve", &mut report, || Ok(system.solve(options)?))?;
         if weights.is_symmetric() {
             report.energy_history.push(spring_energy(&weights, &map));
         }
