@@ -12,6 +12,8 @@
 //!
 //! - [`core`]: the `Solver` trait, problems, solutions, reports and the registry.
 //! - [`init`]: the initialization solvers (tutte, harmonic, lscm).
+//! - [`lsqc`]: the least-squares quasiconformal map for a prescribed Beltrami
+//!   coefficient (lsqc).
 //!
 //! [`registry`] returns every solver shipped with this package.
 //!
@@ -21,11 +23,13 @@
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;
 pub use beltrami_init as init;
+pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
 
 /// Every solver shipped with beltrami, by name.
 pub fn registry() -> beltrami_core::Registry {
     let mut registry = beltrami_core::Registry::new();
     beltrami_init::register(&mut registry);
+    beltrami_lsqc::register(&mut registry);
     registry
 }

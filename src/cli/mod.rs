@@ -8,6 +8,7 @@ mod info;
 mod load;
 mod param;
 mod pins;
+mod qc;
 mod solvers;
 
 use clap::{Parser, Subcommand};
@@ -34,6 +35,9 @@ pub enum Command {
     /// Parameterize a mesh with a registered solver (tutte, harmonic, lscm) and write
     /// the map as texture coordinates.
     Param(param::ParamArgs),
+    /// A quasiconformal map with a prescribed Beltrami coefficient (lsqc), written as
+    /// texture coordinates.
+    Qc(qc::QcArgs),
     /// List the registered solvers and what each accepts.
     Solvers(solvers::SolversArgs),
     /// Time the library on generated and given meshes and print a table.
@@ -49,6 +53,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info(args) => info::run(&args, cli.quiet),
         Command::Distortion(args) => distortion::run(&args, cli.quiet),
         Command::Param(args) => param::run(&args, cli.quiet),
+        Command::Qc(args) => qc::run(&args, cli.quiet),
         Command::Solvers(args) => solvers::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Cut(args) => cut::run(&args, cli.quiet),

@@ -531,3 +531,31 @@ pub(crate) fn collapsed_faces(mesh: &Mesh, map: &BoundaryMap) -> Vec<FaceId> {
         })
         .collect()
 }
+
+/// Two boundary vertices far apart: the boundary vertex farthest from the first vertex
+/// of the longest loop, and the boundary vertex farthest from that one (the two-sweep
+/// approximation of the boundary's diameter): the default pins of lscm and lsqc. A mesh
+/// without boundary gives vertex 0 twice.
+pub fn far_boundary_pair(mesh: &Mesh) -> (VertexId, VertexId) {
+    let vertices = mesh
+        .boundary_loop_list()
+        .into_iter()
+        .reduce(|best, l| if l.length > best.length { l } else { best })
+        .map(|l| l.vertices)
+        .unwrap_or_default();
+    let farthest = |from: VertexId| {
+        let p = mesh.position(from);
+        vertices
+            .iter()
+            .copied()
+            .max_by(|&u, &v| {
+                let du = (mesh.position(u) - p).norm_squared();
+                let dv = (mesh.position(v) - p).norm_squared();
+                du.total_cmp(&dv)
+            })
+            .unwrap_or(from)
+    };
+    let first = vertices.first().copied().unwrap_or(VertexId(0));
+    let a = farthest(first);
+    (a, farthest(a))
+}

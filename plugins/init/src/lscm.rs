@@ -28,7 +28,7 @@ use beltrami_core::{
 };
 use beltrami_fem::operators::{apply, complex_derivatives};
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
-use beltrami_mesh::{Mesh, VertexId};
+use beltrami_mesh::VertexId;
 use num_complex::Complex64;
 
 use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
@@ -180,7 +180,7 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
     let one = Complex64::new(1.0, 0.0);
     let pinned: Vec<(VertexId, Complex64)> = match given.len() {
         0 => {
-            let (a, b) = far_boundary_pair(mesh);
+            let (a, b) = crate::boundary::far_boundary_pair(mesh);
             vec![(a, zero), (b, one)]
         }
         1 => {
@@ -220,31 +220,4 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
         )));
     }
     Ok(pinned)
-}
-
-/// Two boundary vertices far apart: the boundary vertex farthest from the first vertex
-/// of the longest loop, and the boundary vertex farthest from that one (the two-sweep
-/// approximation of the boundary's diameter). The mesh is a disk, so it has a loop.
-fn far_boundary_pair(mesh: &Mesh) -> (VertexId, VertexId) {
-    let vertices = mesh
-        .boundary_loop_list()
-        .into_iter()
-        .reduce(|best, l| if l.length > best.length { l } else { best })
-        .map(|l| l.vertices)
-        .unwrap_or_default();
-    let farthest = |from: VertexId| {
-        let p = mesh.position(from);
-        vertices
-            .iter()
-            .copied()
-            .max_by(|&u, &v| {
-                let du = (mesh.position(u) - p).norm_squared();
-                let dv = (mesh.position(v) - p).norm_squared();
-                du.total_cmp(&dv)
-            })
-            .unwrap_or(from)
-    };
-    let first = vertices.first().copied().unwrap_or(VertexId(0));
-    let a = farthest(first);
-    (a, farthest(a))
 }

@@ -1,0 +1,585 @@
+//! Beltrami coefficients given as expressions of `z`, e.g. `0.6*z`, `0.6*z^3`,
+//! `0.3+0.3i`, `conj(z)*z/4`, `0.5*exp(i*z)`.
+//!
+//! # Grammar
+//!
+//! ```text
+//! expr    = term { ("+" | "-") term }
+//! term    = unary { ("*" | "/") unary }
+//! unary   = ("-" | "+") unary | power
+//! power   = primary [ "^" unary ]          exponent: a constant integer (may be negative)
+//! primary = number | "i" | "z" | name "(" expr ")" | "(" expr ")"
+//! number  = digits [ "." digits ] [ ("e" | "E") [sign] digits ] [ "i" ]
+//! name    = "conj" | "abs" | "exp"
+//! ```
+//!
+//! So `-z^2 = -(z^2)`, `2*z^3 = 2 (z^3)`, `2^3^2 = 2^9`, `z^-2 = 1 / z^2`, `2i` is the
+//! number `2 i`, and there is no implicit multiplication (`2z` is an error). Values are
+//! complex: `abs(w) = |w|` (real), `conj(w) = re w - i im w`, `exp(w) = e^w`.
+//! Whitespace is ignored. Errors ([`ExprError`]) give the 1-based column (in
+//! characters) of the problem.
+
+use beltrami_fem::element::check_planar;
+use beltrami_fem::{BeltramiField, FemError, Frame};
+use beltrami_mesh::Mesh;
+use num_complex::Complex64;
+use thiserror::Error;
+
+/// Why an expression could not be parsed. Columns are 1-based, in characters.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum ExprError {
+    /// The expression is empty (or only whitespace).
+    #[error("the expression is empty")]
+    Empty,
+    /// A character that starts no token.
+    #[error("column {column}: unexpected character `{character}`")]
+    UnexpectedCharacter {
+        /// Where.
+        column: usize,
+        /// The character.
+        character: char,
+    },
+    /// A token (or the end) where something else was expected.
+    #[error("column {column}: expected {expected}, found {found}")]
+    UnexpectedToken {
+        /// Where (one past the last character for the end of the expression).
+        column: usize,
+        /// What was expected.
+        expected: &'static str,
+        /// What was found (`end of expression` at the end).
+        found: String,
+    },
+    /// A `(` never closed (column of the `(`), or a `)` never opened.
+    #[error("column {column}: unbalanced parenthesis")]
+    UnbalancedParenthesis {
+        /// The unmatched parenthesis.
+        column: usize,
+    },
+    /// An exponent that is not a constant integer (`z^0.5`, `z^z`).
+    #[error("column {column}: the power must be a constant integer, found {found}")]
+    NonIntegerPower {
+        /// Where the exponent starts.
+        column: usize,
+        /// The exponent found (its value, or `an expression of z`).
+        found: String,
+    },
+    /// A name followed by `(` that is not a known function.
+    #[error("column {column}: unknown function `{name}` (known: conj, abs, exp)")]
+    UnknownFunction {
+        /// Where the name starts.
+        column: usize,
+        /// The name.
+        name: String,
+    },
+    /// A name that is neither `z` nor `i` nor a function call.
+    #[error("column {column}: unknown name `{name}` (the variable is `z`, the imaginary unit `i`)")]
+    UnknownName {
+        /// Where the name starts.
+        column: usize,
+        /// The name.
+        name: String,
+    },
+}
+
+/// A function of one complex argument.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Function {
+    Conj,
+    Abs,
+    Exp,
+}
+
+/// A parsed expression of `z` (module docs); evaluate it with [`Expr::eval`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum Expr {
+    /// A complex constant.
+    Number(Complex64),
+    /// The variable `z`.
+    Z,
+    /// `-a`.
+    Neg(Box<Expr>),
+    /// `a + b`.
+    Add(Box<Expr>, Box<Expr>),
+    /// `a - b`.
+    Sub(Box<Expr>, Box<Expr>),
+    /// `a * b`.
+    Mul(Box<Expr>, Box<Expr>),
+    /// `a / b`.
+    Div(Box<Expr>, Box<Expr>),
+    /// `a ^ n`, `n` an integer.
+    Pow(Box<Expr>, i32),
+    /// `conj(a)`.
+    Conj(Box<Expr>),
+    /// `abs(a)`.
+    Abs(Box<Expr>),
+    /// `exp(a)`.
+    Exp(Box<Expr>),
+}
+
+impl Expr {
+    /// Parses `text` (module docs).
+    pub fn parse(text: &str) -> Result<Self, ExprError> {
+        let tokens = tokenize(text)?;
+        if tokens.len() == 1 {
+            return Err(ExprError::Empty);
+        }
+        let mut parser = Parser { tokens, next: 0 };
+        let expr = parser.expr()?;
+        let token = parser.peek();
+        match token.kind {
+            Kind::End => Ok(expr),
+            Kind::Close => Err(ExprError::UnbalancedParenthesis {
+                column: token.column,
+            }),
+            _ => Err(parser.unexpected("an operator or the end of the expression")),
+        }
+    }
+
+    /// The value at `z`. Division by zero and negative powers of zero give infinities
+    /// or NaN, as in floating point.
+    pub fn eval(&self, z: Complex64) -> Complex64 {
+        match self {
+            Expr::Number(c) => *c,
+            Expr::Z => z,
+            Expr::Neg(a) => -a.eval(z),
+            Expr::Add(a, b) => a.eval(z) + b.eval(z),
+            Expr::Sub(a, b) => a.eval(z) - b.eval(z),
+            Expr::Mul(a, b) => a.eval(z) * b.eval(z),
+            Expr::Div(a, b) => a.eval(z) / b.eval(z),
+            Expr::Pow(a, n) => a.eval(z).powi(*n),
+            Expr::Conj(a) => a.eval(z).conj(),
+            Expr::Abs(a) => Complex64::new(a.eval(z).norm(), 0.0),
+            Expr::Exp(a) => a.eval(z).exp(),
+        }
+    }
+
+    /// True if the expression does not involve `z`.
+    fn is_constant(&self) -> bool {
+        match self {
+            Expr::Number(_) => true,
+            Expr::Z => false,
+            Expr::Neg(a) | Expr::Pow(a, _) | Expr::Conj(a) | Expr::Abs(a) | Expr::Exp(a) => {
+                a.is_constant()
+            }
+            Expr::Add(a, b) | Expr::Sub(a, b) | Expr::Mul(a, b) | Expr::Div(a, b) => {
+                a.is_constant() && b.is_constant()
+            }
+        }
+    }
+
+    /// The field `mu_f = expr(z_f)` in [`Frame::Global`], `z_f = x + i y` the centroid
+    /// of face `f` of a mesh in the plane z = 0 (the mean of its vertices).
+    ///
+    /// Fails with [`FemError::NotPlanar`] for a mesh off the plane. The values are not
+    /// checked; [`BeltramiField::check`] names a face with `|mu| >= 1` or a non-finite
+    /// value.
+    pub fn field(&self, mesh: &Mesh) -> Result<BeltramiField, FemError> {
+        check_planar(mesh)?;
+        let mu = mesh
+            .faces()
+            .map(|f| {
+                let c = mesh.face_centroid(f);
+                self.eval(Complex64::new(c.x, c.y))
+            })
+            .collect();
+        Ok(BeltramiField::new(Frame::Global, mu))
+    }
+}
+
+impl std::str::FromStr for Expr {
+    type Err = ExprError;
+
+    fn from_str(text: &str) -> Result<Self, ExprError> {
+        Self::parse(text)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Kind {
+    Number(Complex64),
+    Name(String),
+    Plus,
+    Minus,
+    Star,
+    Slash,
+    Caret,
+    Open,
+    Close,
+    End,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Token {
+    kind: Kind,
+    /// 1-based column of the first character.
+    column: usize,
+}
+
+impl Token {
+    fn describe(&self) -> String {
+        match &self.kind {
+            Kind::Number(c) if c.im == 0.0 => format!("`{}`", c.re),
+            Kind::Number(c) => format!("`{}i`", c.im),
+            Kind::Name(n) => format!("`{n}`"),
+            Kind::Plus => "`+`".into(),
+            Kind::Minus => "`-`".into(),
+            Kind::Star => "`*`".into(),
+            Kind::Slash => "`/`".into(),
+            Kind::Caret => "`^`".into(),
+            Kind::Open => "`(`".into(),
+            Kind::Close => "`)`".into(),
+            Kind::End => "end of expression".into(),
+        }
+    }
+}
+
+/// Splits `text` into tokens, ending with [`Kind::End`].
+fn tokenize(text: &str) -> Result<Vec<Token>, ExprError> {
+    let chars: Vec<char> = text.chars().collect();
+    let mut tokens = Vec::new();
+    let mut k = 0;
+    while k < chars.len() {
+        let c = chars[k];
+        let column = k + 1;
+        let simple = match c {
+            '+' => Some(Kind::Plus),
+            '-' => Some(Kind::Minus),
+            '*' => Some(Kind::Star),
+            '/' => Some(Kind::Slash),
+            '^' => Some(Kind::Caret),
+            '(' => Some(Kind::Open),
+            ')' => Some(Kind::Close),
+            _ => None,
+        };
+        if let Some(kind) = simple {
+            tokens.push(Token { kind, column });
+            k += 1;
+        } else if c.is_whitespace() {
+            k += 1;
+        } else if c.is_ascii_digit() || c == '.' {
+            let start = k;
+            while k < chars.len() && (chars[k].is_ascii_digit() || chars[k] == '.') {
+                k += 1;
+            }
+            // An exponent: e or E followed by digits, with an optional sign.
+            if k < chars.len() && (chars[k] == 'e' || chars[k] == 'E') {
+                let mut j = k + 1;
+                if j < chars.len() && (chars[j] == '+' || chars[j] == '-') {
+                    j += 1;
+                }
+                if j < chars.len() && chars[j].is_ascii_digit() {
+                    k = j;
+                    while k < chars.len() && chars[k].is_ascii_digit() {
+                        k += 1;
+                    }
+                }
+            }
+            let literal: String = chars[start..k].iter().collect();
+            let value: f64 = literal
+                .parse()
+                .map_err(|_| ExprError::UnexpectedCharacter {
+                    column,
+                    character: c,
+                })?;
+            let imaginary = k < chars.len()
+                && chars[k] == 'i'
+                && !chars
+                    .get(k + 1)
+                    .is_some_and(|&n| n.is_alphanumeric() || n == '_');
+            let kind = if imaginary {
+                k += 1;
+                Kind::Number(Complex64::new(0.0, value))
+            } else {
+                Kind::Number(Complex64::new(value, 0.0))
+            };
+            tokens.push(Token { kind, column });
+        } else if c.is_alphabetic() || c == '_' {
+            let start = k;
+            while k < chars.len() && (chars[k].is_alphanumeric() || chars[k] == '_') {
+                k += 1;
+            }
+            let name = chars[start..k].iter().collect();
+            tokens.push(Token {
+                kind: Kind::Name(name),
+                column,
+            });
+        } else {
+            return Err(ExprError::UnexpectedCharacter {
+                column,
+                character: c,
+            });
+        }
+    }
+    tokens.push(Token {
+        kind: Kind::End,
+        column: chars.len() + 1,
+    });
+    Ok(tokens)
+}
+
+/// Recursive descent over the tokens (module docs).
+struct Parser {
+    tokens: Vec<Token>,
+    next: usize,
+}
+
+impl Parser {
+    fn peek(&self) -> &Token {
+        // The last token is End, which is never consumed.
+        &self.tokens[self.next.min(self.tokens.len() - 1)]
+    }
+
+    fn bump(&mut self) -> Token {
+        let token = self.peek().clone();
+        if token.kind != Kind::End {
+            self.next += 1;
+        }
+        token
+    }
+
+    fn unexpected(&self, expected: &'static str) -> ExprError {
+        let token = self.peek();
+        ExprError::UnexpectedToken {
+            column: token.column,
+            expected,
+            found: token.describe(),
+        }
+    }
+
+    fn expr(&mut self) -> Result<Expr, ExprError> {
+        let mut left = self.term()?;
+        loop {
+            match self.peek().kind {
+                Kind::Plus => {
+                    self.bump();
+                    left = Expr::Add(Box::new(left), Box::new(self.term()?));
+                }
+                Kind::Minus => {
+                    self.bump();
+                    left = Expr::Sub(Box::new(left), Box::new(self.term()?));
+                }
+                _ => return Ok(left),
+            }
+        }
+    }
+
+    fn term(&mut self) -> Result<Expr, ExprError> {
+        let mut left = self.unary()?;
+        loop {
+            match self.peek().kind {
+                Kind::Star => {
+                    self.bump();
+                    left = Expr::Mul(Box::new(left), Box::new(self.unary()?));
+                }
+                Kind::Slash => {
+                    self.bump();
+                    left = Expr::Div(Box::new(left), Box::new(self.unary()?));
+                }
+                _ => return Ok(left),
+            }
+        }
+    }
+
+    fn unary(&mut self) -> Result<Expr, ExprError> {
+        match self.peek().kind {
+            Kind::Minus => {
+                self.bump();
+                Ok(Expr::Neg(Box::new(self.unary()?)))
+            }
+            Kind::Plus => {
+                self.bump();
+                self.unary()
+            }
+            _ => self.power(),
+        }
+    }
+
+    fn power(&mut self) -> Result<Expr, ExprError> {
+        let base = self.primary()?;
+        if self.peek().kind != Kind::Caret {
+            return Ok(base);
+        }
+        self.bump();
+        let column = self.peek().column;
+        let exponent = self.unary()?;
+        let non_integer = |found: String| ExprError::NonIntegerPower { column, found };
+        if !exponent.is_constant() {
+            return Err(non_integer("an expression of z".into()));
+        }
+        let n = exponent.eval(Complex64::new(0.0, 0.0));
+        let integral = n.im == 0.0 && n.re.fract() == 0.0 && n.re.abs() <= f64::from(i32::MAX);
+        if !integral {
+            return Err(non_integer(if n.im == 0.0 {
+                n.re.to_string()
+            } else {
+                n.to_string()
+            }));
+        }
+        Ok(Expr::Pow(Box::new(base), n.re as i32))
+    }
+
+    fn primary(&mut self) -> Result<Expr, ExprError> {
+        let token = self.peek().clone();
+        match token.kind {
+            Kind::Number(c) => {
+                self.bump();
+                Ok(Expr::Number(c))
+            }
+            Kind::Open => {
+                self.bump();
+                let inner = self.expr()?;
+                self.close(token.column)?;
+                Ok(inner)
+            }
+            Kind::Name(name) => {
+                self.bump();
+                if self.peek().kind == Kind::Open {
+                    let function = match name.as_str() {
+                        "conj" => Function::Conj,
+                        "abs" => Function::Abs,
+                        "exp" => Function::Exp,
+                        _ => {
+                            return Err(ExprError::UnknownFunction {
+                                column: token.column,
+                                name,
+                            });
+                        }
+                    };
+                    let open = self.bump().column;
+                    let argument = Box::new(self.expr()?);
+                    self.close(open)?;
+                    return Ok(match function {
+                        Function::Conj => Expr::Conj(argument),
+                        Function::Abs => Expr::Abs(argument),
+                        Function::Exp => Expr::Exp(argument),
+                    });
+                }
+                match name.as_str() {
+                    "z" => Ok(Expr::Z),
+                    "i" => Ok(Expr::Number(Complex64::new(0.0, 1.0))),
+                    _ => Err(ExprError::UnknownName {
+                        column: token.column,
+                        name,
+                    }),
+                }
+            }
+            Kind::Close => Err(ExprError::UnbalancedParenthesis {
+                column: token.column,
+            }),
+            _ => Err(self.unexpected("a number, `z`, `i`, a function or `(`")),
+        }
+    }
+
+    /// Consumes the `)` closing the `(` at column `open`.
+    fn close(&mut self, open: usize) -> Result<(), ExprError> {
+        match self.peek().kind {
+            Kind::Close => {
+                self.bump();
+                Ok(())
+            }
+            Kind::End => Err(ExprError::UnbalancedParenthesis { column: open }),
+            _ => Err(self.unexpected("`)` or an operator")),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c(re: f64, im: f64) -> Complex64 {
+        Complex64::new(re, im)
+    }
+
+    fn value(text: &str, z: Complex64) -> Complex64 {
+        Expr::parse(text).unwrap().eval(z)
+    }
+
+    fn close(a: Complex64, b: Complex64) -> bool {
+        (a - b).norm() <= 1e-14 * (1.0 + b.norm())
+    }
+
+    #[test]
+    fn numbers() {
+        let z = c(0.0, 0.0);
+        assert_eq!(value("0.6", z), c(0.6, 0.0));
+        assert_eq!(value("i", z), c(0.0, 1.0));
+        assert_eq!(value("2i", z), c(0.0, 2.0));
+        assert_eq!(value("0.3+0.3i", z), c(0.3, 0.3));
+        assert_eq!(value(" 1e-1 ", z), c(0.1, 0.0));
+        assert_eq!(value("2.5E+1i", z), c(0.0, 25.0));
+        assert_eq!(value(".5", z), c(0.5, 0.0));
+    }
+
+    #[test]
+    fn precedence() {
+        let z = c(0.3, -0.7);
+        assert!(close(value("-z^2", z), -(z * z)));
+        assert!(close(value("2*z^3", z), 2.0 * z * z * z));
+        assert!(close(value("0.6*z", z), 0.6 * z));
+        assert!(close(value("conj(z)*z", z), c(z.norm_sqr(), 0.0)));
+        assert!(close(value("exp(i*z)", z), (c(0.0, 1.0) * z).exp()));
+        assert!(close(value("1 + 2 * 3", z), c(7.0, 0.0)));
+        assert!(close(value("(1 + 2) * 3", z), c(9.0, 0.0)));
+        assert!(close(value("8 / 2 / 2", z), c(2.0, 0.0)));
+        assert!(close(value("1 - 2 - 3", z), c(-4.0, 0.0)));
+        assert!(close(value("2^3^2", z), c(512.0, 0.0)));
+        assert!(close(value("z^-2", z), 1.0 / (z * z)));
+        assert!(close(value("z^(1-3)", z), 1.0 / (z * z)));
+        assert!(close(value("2*-z", z), -2.0 * z));
+        assert!(close(value("abs(z)", z), c(z.norm(), 0.0)));
+        assert!(close(value("abs(-3)/4", z), c(0.75, 0.0)));
+        assert!(close(value("z^0", z), c(1.0, 0.0)));
+    }
+
+    #[test]
+    fn errors_give_the_column() {
+        let err = |text: &str| Expr::parse(text).unwrap_err();
+        assert_eq!(
+            err("0.6*z$"),
+            ExprError::UnexpectedCharacter {
+                column: 6,
+                character: '$'
+            }
+        );
+        assert_eq!(err("(z+1"), ExprError::UnbalancedParenthesis { column: 1 });
+        assert_eq!(err("z+1)"), ExprError::UnbalancedParenthesis { column: 4 });
+        assert_eq!(err("exp(z"), ExprError::UnbalancedParenthesis { column: 4 });
+        assert_eq!(
+            err("z^0.5"),
+            ExprError::NonIntegerPower {
+                column: 3,
+                found: "0.5".into()
+            }
+        );
+        assert!(matches!(
+            err("z^z"),
+            ExprError::NonIntegerPower { column: 3, .. }
+        ));
+        assert_eq!(
+            err("0.5*sin(z)"),
+            ExprError::UnknownFunction {
+                column: 5,
+                name: "sin".into()
+            }
+        );
+        assert_eq!(
+            err("w"),
+            ExprError::UnknownName {
+                column: 1,
+                name: "w".into()
+            }
+        );
+        assert!(matches!(
+            err("2z"),
+            ExprError::UnexpectedToken { column: 2, .. }
+        ));
+        assert!(matches!(
+            err("z +"),
+            ExprError::UnexpectedToken { column: 4, .. }
+        ));
+        assert_eq!(err("  "), ExprError::Empty);
+        // The message names the column.
+        assert!(err("z^0.5").to_string().contains("column 3"));
+    }
+}

@@ -1,0 +1,393 @@
+//! The least-squares quasiconformal map of a disk mesh into the plane for a prescribed
+//! Beltrami coefficient (module docs of the crate).
+
+use beltrami_core::{
+    Context, Goal, Map, PlanarBoundary, Position, Problem, Report, Solution, Solver, SolverError,
+    Target, topology,
+};
+use beltrami_fem::assembly::Pattern;
+use beltrami_fem::beltrami::planar_map;
+use beltrami_fem::element::check_planar;
+use beltrami_fem::operators::apply;
+use beltrami_fem::{
+    BeltramiField, Distortion, DofConstraints, DofMap, Elements, FemError, Frame,
+    LeastSquaresSolver, SolveOptions,
+};
+use beltrami_init::boundary::{self, BoundaryError};
+use beltrami_mesh::{FaceId, Mesh, VertexId};
+use faer::sparse::SparseColMat;
+use num_complex::Complex64;
+
+/// The least-squares quasiconformal map (crate docs).
+///
+/// Reads: `goal` (`Prescribed(field)`, or `Conformal { p: 2 }` for `mu = 0`), `target`
+/// (`Plane(Keep | Given | Free)`), `constraints.pins` and `params.threads`. With a fixed
+/// boundary (`Keep`, `Given`) pins add further fixed vertices; with a free boundary it
+/// needs two or more pins, or none (two boundary vertices far apart are pinned at
+/// `(0, 0)` and `(1, 0)`, as in lscm). A pin without a position stays where it is on a
+/// planar source; on a curved source two such pins go to `(0, 0)` and `(1, 0)`. The
+/// report's energy is the final `E_mu`; its notes give `|mu - target|` ([`MuError`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Lsqc;
+
+const NAME: &str = "lsqc";
+
+/// What to do with a mesh that is not a disk.
+const NOT_A_DISK: &str = "run `beltrami cut` first or use beltrami-flow";
+
+impl Solver for Lsqc {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn description(&self) -> &'static str {
+        "least-squares quasiconformal map for a prescribed Beltrami coefficient (one linear solve)"
+    }
+
+    fn accepts(&self) -> &'static str {
+        "disk meshes (triangles, quads); goal: prescribed mu (global or face frame); target: plane with the boundary kept, given, or free with pins"
+    }
+
+    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+        setup(problem).map(|_| ())
+    }
+
+    fn solve(
+        &self,
+        problem: &Problem<'_>,
+        context: &mut Context<'_>,
+    ) -> Result<Solution, SolverError> {
+        let mesh = problem.source;
+        let mut report = Report::new(NAME);
+        let Setup {
+            field,
+            fixed,
+            default_pins,
+        } = setup(problem)?;
+        if let Some((a, b)) = default_pins {
+            let input = |v: VertexId| mesh.vertex_map().to_input(v);
+            report.notes.push(format!(
+                "pinned the boundary vertices {} (input index) at (0, 0) and {} at (1, 0), far apart",
+                input(a),
+                input(b)
+            ));
+        }
+        let (elements, operator, mut solver) = context.stage("assembly", &mut report, || {
+            let elements = Elements::new(mesh, field.frame)?;
+            let operator = beltrami_operator(mesh, &elements, &field.mu)?;
+            let mut constraints = DofConstraints::new();
+            for &(v, z) in &fixed {
+                constraints.fix(v, z);
+            }
+            let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
+            let options = SolveOptions {
+                threads: problem.params.threads,
+                ..SolveOptions::default()
+            };
+            let solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, options)?;
+            Ok((elements, operator, solver))
+        })?;
+        let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
+        let map = context.stage("solve", &mut report, || {
+            let zero = vec![Complex64::new(0.0, 0.0); operator.nrows()];
+            Ok(solver.solve(operator.as_ref(), Some(&weights), &zero)?)
+        })?;
+        let energy = apply(&operator, &map)
+            .iter()
+            .zip(&weights)
+            .map(|(r, w)| w * r.norm_sqr())
+            .sum();
+        report.energy_history.push(energy);
+
+        let distortion = context.stage("distortion", &mut report, || {
+            let derivatives = planar_map(&elements, mesh.vertex_count(), &map)?;
+            Ok(Distortion::from_derivatives(&elements, &derivatives)?)
+        })?;
+        let error = MuError::new(&elements, &distortion.field.mu, &field.mu)?;
+        report.notes.push(format!(
+            "|mu - target| per face ({} frame): L2 (area-weighted RMS) = {:.4e}, sup = {:.4e} at face {}",
+            field.frame.name(),
+            error.rms,
+            error.sup,
+            error.sup_face
+        ));
+        let flipped = distortion.stats.flipped;
+        if flipped > 0 {
+            report.notes.push(format!(
+                "{flipped} of {} faces are flipped: the least-squares map is not guaranteed to be a bijection; beltrami-flow keeps faces unflipped",
+                mesh.face_count()
+            ));
+        }
+        report.mu = Some(distortion.field);
+        report.distortion = Some(distortion.stats);
+        Ok(Solution {
+            map: Map::Planar(map),
+            report,
+        })
+    }
+}
+
+/// `|mu - target|` over the faces, weighted by the face areas (the sums of the
+/// quadrature weights of each face).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MuError {
+    /// The area-weighted RMS `sqrt(sum_f A_f |mu_f - target_f|^2 / sum_f A_f)`.
+    pub rms: f64,
+    /// `sum_f A_f |mu_f - target_f|^2`, the squared "L2" column of Wong-Zhao's tables
+    /// (not normalized by the area).
+    pub l2_squared: f64,
+    /// `max_f |mu_f - target_f|`.
+    pub sup: f64,
+    /// The face where the sup is reached (the first of equal ones).
+    pub sup_face: FaceId,
+}
+
+impl MuError {
+    /// The error of `measured` against `target` (one value per face of `elements`, in
+    /// the same frame). Fails with [`FemError::Length`] for a wrong length.
+    pub fn new(
+        elements: &Elements,
+        measured: &[Complex64],
+        target: &[Complex64],
+    ) -> Result<Self, FemError> {
+        let faces = elements.face_count();
+        for (what, values) in [("measured mu", measured), ("target mu", target)] {
+            if values.len() != faces {
+                return Err(FemError::Length {
+                    what,
+                    expected: faces,
+                    got: values.len(),
+                });
+            }
+        }
+        let (mut area, mut l2_squared, mut sup, mut sup_face) = (0.0, 0.0, 0.0, FaceId(0));
+        for (f, (m, t)) in measured.iter().zip(target).enumerate() {
+            let face = FaceId(f as u32);
+            let a: f64 = elements.face_points(face).iter().map(|q| q.weight).sum();
+            let d = (m - t).norm();
+            area += a;
+            l2_squared += a * d * d;
+            if d > sup {
+                (sup, sup_face) = (d, face);
+            }
+        }
+        let rms = if area > 0.0 {
+            (l2_squared / area).sqrt()
+        } else {
+            0.0
+        };
+        Ok(Self {
+            rms,
+            l2_squared,
+            sup,
+            sup_face,
+        })
+    }
+}
+
+/// The operator `A = D_zbar - diag(mu_q) D_z` (quadrature points x vertices) of the
+/// elements, `mu_q = mu[f]` at every quadrature point of face `f`: `(A x)_q` is
+/// `f_zbar(q) - mu_f f_z(q)` of the map with vertex values `x`, in the elements' frame.
+pub fn beltrami_operator(
+    mesh: &Mesh,
+    elements: &Elements,
+    mu: &[Complex64],
+) -> Result<SparseColMat<usize, Complex64>, FemError> {
+    if mu.len() != elements.face_count() {
+        return Err(FemError::Length {
+            what: "Beltrami coefficient",
+            expected: elements.face_count(),
+            got: mu.len(),
+        });
+    }
+    let mut positions = Vec::with_capacity(elements.point_count() * 4);
+    let mut values = Vec::with_capacity(elements.point_count() * 4);
+    for (row, q) in elements.points().iter().enumerate() {
+        let m = mu[q.face.idx()];
+        for (k, v) in elements.nodes(q.face).iter().enumerate() {
+            let g = q.grad[k];
+            let dz = Complex64::new(0.5 * g.x, -0.5 * g.y);
+            let dzbar = Complex64::new(0.5 * g.x, 0.5 * g.y);
+            positions.push((row, v.idx()));
+            values.push(dzbar - m * dz);
+        }
+    }
+    Pattern::new(elements.point_count(), mesh.vertex_count(), &positions)?.assemble(&values)
+}
+
+/// What the capability check finds: the field in the frame the elements use, the fixed
+/// vertices with their images, and the default pins if they were chosen.
+struct Setup {
+    field: BeltramiField,
+    fixed: Vec<(VertexId, Complex64)>,
+    default_pins: Option<(VertexId, VertexId)>,
+}
+
+fn unsupported(message: String) -> SolverError {
+    SolverError::Unsupported {
+        solver: NAME,
+        message,
+    }
+}
+
+fn invalid(message: String) -> SolverError {
+    SolverError::InvalidInput {
+        solver: NAME,
+        message,
+    }
+}
+
+/// The capability check: topology, goal, curves, boundary and pins.
+fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
+    let mesh = problem.source;
+    topology::require_disk(NAME, mesh, NOT_A_DISK)?;
+    let planar = check_planar(mesh);
+    let field = match &problem.goal {
+        Goal::Prescribed(field) => {
+            // Names the first face with |mu| >= 1 or a non-finite value.
+            field.check(mesh.face_count())?;
+            if field.frame == Frame::Global
+                && let Err(FemError::NotPlanar { vertex, z }) = planar
+            {
+                return Err(unsupported(format!(
+                    "the Beltrami field is in the global frame, which needs a mesh in the plane z = 0, but vertex {vertex} has z = {z:e}; give the field in the face frame"
+                )));
+            }
+            field.clone()
+        }
+        Goal::Conformal { p } if *p == 2.0 => BeltramiField::zero(Frame::Face, mesh.face_count()),
+        Goal::Conformal { p } => {
+            return Err(unsupported(format!(
+                "lsqc minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu; use beltrami-flow for p > 2"
+            )));
+        }
+        Goal::Extremal => {
+            return Err(unsupported(
+                "lsqc follows a prescribed Beltrami coefficient; for extremal (Teichmueller) maps use teichmuller"
+                    .to_string(),
+            ));
+        }
+    };
+    if !problem.constraints.curves.is_empty() {
+        return Err(unsupported(
+            "lsqc does not make vertices follow curves yet; use beltrami-flow".to_string(),
+        ));
+    }
+    let pins = pins(problem, planar.is_ok())?;
+    let boundary_map = match &problem.target {
+        Target::Plane(PlanarBoundary::Free) => None,
+        Target::Plane(PlanarBoundary::Keep) => {
+            Some(boundary::keep(mesh).map_err(|e| match e {
+                BoundaryError::NotPlanar { vertex, z } => unsupported(format!(
+                    "keeping the boundary needs a source in the plane z = 0, but vertex {vertex} has z = {z:e}; give the boundary (a map) or leave it free"
+                )),
+                e => invalid(e.to_string()),
+            })?)
+        }
+        Target::Plane(PlanarBoundary::Given(values)) => {
+            Some(boundary::given(mesh, values).map_err(|e| invalid(e.to_string()))?)
+        }
+        Target::Plane(_) => {
+            return Err(unsupported(
+                "lsqc keeps the source's boundary, takes a given boundary map or leaves the boundary free; map the boundary first (tutte, harmonic) and pass it as a given boundary"
+                    .to_string(),
+            ));
+        }
+        _ => {
+            return Err(unsupported(
+                "lsqc maps into the plane; for the disk, annulus, sphere or a target mesh use beltrami-flow"
+                    .to_string(),
+            ));
+        }
+    };
+    let zero = Complex64::new(0.0, 0.0);
+    let one = Complex64::new(1.0, 0.0);
+    let (fixed, default_pins) = match boundary_map {
+        Some(map) => {
+            let mut fixed: Vec<(VertexId, Complex64)> =
+                map.vertices.into_iter().zip(map.positions).collect();
+            for (v, z) in &pins {
+                let z = z.ok_or_else(|| {
+                    unsupported(format!(
+                        "the pin on vertex {v} has no position and the source is not planar; give it a position"
+                    ))
+                })?;
+                fixed.push((*v, z));
+            }
+            (fixed, None)
+        }
+        None => match pins.as_slice() {
+            [] => {
+                let (a, b) = beltrami_init::boundary::far_boundary_pair(mesh);
+                (vec![(a, zero), (b, one)], Some((a, b)))
+            }
+            [(v, _)] => {
+                return Err(unsupported(format!(
+                    "with a free boundary lsqc needs two pinned vertices (or none, to pin two boundary vertices far apart), but only vertex {v} was pinned"
+                )));
+            }
+            [(a, None), (b, None)] => (vec![(*a, zero), (*b, one)], None),
+            pins => {
+                let fixed = pins
+                    .iter()
+                    .map(|&(v, z)| {
+                        z.map(|z| (v, z)).ok_or_else(|| {
+                            unsupported(format!(
+                                "the pin on vertex {v} has no position; give every pin a position, or none of two pins (then they go to (0, 0) and (1, 0))"
+                            ))
+                        })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                if fixed.iter().all(|&(_, z)| z == fixed[0].1) {
+                    return Err(invalid(format!(
+                        "all pins are at the same position {}: the map would collapse to a point",
+                        fixed[0].1
+                    )));
+                }
+                (fixed, None)
+            }
+        },
+    };
+    Ok(Setup {
+        field,
+        fixed,
+        default_pins,
+    })
+}
+
+/// The pins with their planar positions: given ones, the vertex's own position for a
+/// pin without one on a planar source, `None` otherwise.
+fn pins(
+    problem: &Problem<'_>,
+    planar: bool,
+) -> Result<Vec<(VertexId, Option<Complex64>)>, SolverError> {
+    let mesh = problem.source;
+    problem
+        .constraints
+        .pins
+        .iter()
+        .map(|pin| {
+            let v = pin.vertex;
+            if v.idx() >= mesh.vertex_count() {
+                return Err(invalid(format!(
+                    "a pin is on vertex {v}, but the mesh has {} vertices",
+                    mesh.vertex_count()
+                )));
+            }
+            match pin.position {
+                Some(Position::Planar(z)) if z.is_finite() => Ok((v, Some(z))),
+                Some(Position::Planar(_)) => Err(invalid(format!(
+                    "the position of the pin on vertex {v} is not finite"
+                ))),
+                Some(Position::Spatial(_)) => Err(unsupported(format!(
+                    "lsqc maps into the plane, but the pin on vertex {v} has a position in space"
+                ))),
+                None if planar => {
+                    let p = mesh.position(v);
+                    Ok((v, Some(Complex64::new(p.x, p.y))))
+                }
+                None => Ok((v, None)),
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,121 @@
+//! End-to-end runs of `beltrami qc`: a constant `mu` from an expression is met exactly
+//! with a free boundary, the written OBJ has one `vt` per vertex, the report has the
+//! `|mu - target|` errors, and bad coefficients fail with the column, line or face.
+
+use std::path::{Path, PathBuf};
+
+use beltrami_mesh::Mesh;
+use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_mesh::primitives::{Cells, jittered_grid};
+
+mod common;
+use common::{beltrami, s, text};
+
+/// Writes a jittered planar grid of the unit square as OBJ into `dir`.
+fn planar_grid(dir: &Path, cells: Cells) -> (PathBuf, Mesh) {
+    let mesh = Mesh::from_soup(&jittered_grid(8, 8, cells, 0.3, 71)).unwrap();
+    let path = dir.join("grid.obj");
+    io::write(&path, &mesh, &VertexAttributes::default()).unwrap();
+    (path, mesh)
+}
+
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn constant_mu_expression_is_met_exactly_with_a_free_boundary() {
+    let dir = tempfile::tempdir().unwrap();
+    for cells in [Cells::Triangles, Cells::Quads] {
+        let (mesh_path, mesh) = planar_grid(dir.path(), cells);
+        let out_path = dir.path().join("out.obj");
+        let report_path = dir.path().join("report.json");
+        let out = beltrami(&[
+            "qc",
+            s(&mesh_path),
+            "--solver",
+            "lsqc",
+            "--mu-expr",
+            "0.2+0.1i",
+            "--pin",
+            "0,0",
+            "--pin",
+            "1,1",
+            "-o",
+            s(&out_path),
+            "--report",
+            s(&report_path),
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert!(text(&out.stdout).contains("|mu - target|"));
+        let obj = std::fs::read_to_string(&out_path).unwrap();
+        let vt = obj.lines().filter(|l| l.starts_with("vt ")).count();
+        assert_eq!(vt, mesh.vertex_count());
+        let report = read_json(&report_path);
+        assert_eq!(report["solver"], "lsqc");
+        assert_eq!(report["flipped"], 0);
+        let l2 = report["mu_error_l2"].as_f64().unwrap();
+        let sup = report["mu_error_sup"].as_f64().unwrap();
+        assert!(l2 < 1e-10 && sup < 1e-10, "{cells:?}: {l2:e} {sup:e}");
+    }
+}
+
+#[test]
+fn varying_mu_prints_a_json_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh_path, _) = planar_grid(dir.path(), Cells::Triangles);
+    let out_path = dir.path().join("out.obj");
+    let out = beltrami(&[
+        "qc",
+        s(&mesh_path),
+        "--mu-expr",
+        "0.6*(z - 0.5 - 0.5i)",
+        "-o",
+        s(&out_path),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let report: serde_json::Value = serde_json::from_str(&text(&out.stdout)).unwrap();
+    let l2 = report["mu_error_l2"].as_f64().unwrap();
+    assert!(l2 > 0.0 && l2 < 0.05, "{l2:e}");
+    assert!(out_path.exists());
+}
+
+#[test]
+fn bad_coefficients_fail_with_the_column_the_line_or_the_face() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh_path, mesh) = planar_grid(dir.path(), Cells::Triangles);
+    let out_path = dir.path().join("out.obj");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["qc", s(&mesh_path), "-o", s(&out_path)];
+        args.extend_from_slice(extra);
+        beltrami(&args)
+    };
+    // A parse error gives the column.
+    let out = run(&["--mu-expr", "0.6*z^0.5"]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("column 7"),
+        "{}",
+        text(&out.stderr)
+    );
+    // |mu| >= 1 from an expression names the face.
+    let out = run(&["--mu-expr", "2*z"]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains(">= 1"), "{}", text(&out.stderr));
+    // |mu| >= 1 in a file names the line and the face.
+    let field = dir.path().join("mu.txt");
+    let mut lines = vec![format!("# mu frame=global faces={}", mesh.face_count())];
+    lines.extend((0..mesh.face_count()).map(|f| if f == 3 { "1.5 0" } else { "0.1 0" }.into()));
+    std::fs::write(&field, lines.join("\n")).unwrap();
+    let out = run(&["--mu", s(&field)]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains(":5:") && stderr.contains(">= 1"),
+        "{stderr}"
+    );
+    // Neither or both of --mu and --mu-expr.
+    assert!(!run(&[]).status.success());
+    assert!(!out_path.exists());
+}
