@@ -2,6 +2,7 @@
 //! typed errors of the dirty ones. Skipped, with a message, when `../shared` is absent
 //! (a user's fresh clone); CI has it.
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use beltrami::mesh::io::{self, ReadError};
@@ -12,7 +13,8 @@ fn shared_meshes() -> Option<PathBuf> {
     if dir.is_dir() {
         Some(dir)
     } else {
-        eprintln!(
+        let _ = writeln!(
+            std::io::stderr(),
             "SKIPPED: {} not found; the shared-mesh tests need ../shared beside the repo",
             dir.display()
         );

@@ -4,6 +4,7 @@
 //! errors. The shared meshes (`../shared/meshes`) are skipped with a message when absent.
 
 use std::f64::consts::TAU;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use beltrami_mesh::primitives::{self, Cells};
@@ -21,7 +22,8 @@ fn shared_meshes() -> Option<PathBuf> {
     if dir.is_dir() {
         Some(dir)
     } else {
-        eprintln!(
+        let _ = writeln!(
+            std::io::stderr(),
             "SKIPPED: {} not found; the shared-mesh cut tests need ../shared beside the repo",
             dir.display()
         );

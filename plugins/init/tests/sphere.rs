@@ -7,6 +7,7 @@
 mod common;
 
 use std::f64::consts::PI;
+use std::io::Write as _;
 use std::path::PathBuf;
 
 use beltrami_core::{
@@ -306,7 +307,11 @@ fn shared(name: &str) -> Option<Mesh> {
     ))
     .join(name);
     if !path.exists() {
-        println!("SKIPPED {name}: {} is absent", path.display());
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED {name}: {} is absent",
+            path.display()
+        );
         return None;
     }
     Some(

@@ -4,6 +4,7 @@
 // Each test binary compiles this module and uses only part of it.
 #![allow(dead_code)]
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use beltrami_core::{Map, Report};
@@ -38,7 +39,11 @@ pub fn shared_disks(test: &str) -> Option<Vec<(String, Mesh)>> {
         "/../../../shared/meshes"
     ));
     let Ok(entries) = std::fs::read_dir(&dir) else {
-        println!("SKIPPED {test}: {} is absent", dir.display());
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED {test}: {} is absent",
+            dir.display()
+        );
         return None;
     };
     let mut names: Vec<String> = entries
