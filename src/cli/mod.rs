@@ -6,6 +6,7 @@ mod cut;
 mod distortion;
 mod info;
 mod load;
+mod mapping;
 mod param;
 mod pins;
 mod qc;

@@ -3,18 +3,17 @@
 //! `z = x + i y` evaluated at the face centroids (`--mu-expr "0.6*z"`, global frame).
 
 use std::path::PathBuf;
-use std::time::Instant;
 
 use anyhow::{Context as _, bail};
-use beltrami_core::{Context, Goal, Map, Pin, PlanarBoundary, Problem, Solution, Target};
+use beltrami_core::{Goal, Map, PlanarBoundary, Problem, Target};
 use beltrami_fem::{BeltramiField, Elements};
 use beltrami_lsqc::{Expr, MuError};
-use beltrami_mesh::io::{self, Format, VertexAttributes};
-use beltrami_mesh::{Mesh, Vector2};
+use beltrami_mesh::Mesh;
 use clap::{ArgGroup, Args, ValueEnum};
 use serde_json::json;
 
 use super::load::load_mesh;
+use super::mapping;
 use super::pins::PinSpec;
 
 /// Boundary conditions of `--boundary`.
@@ -78,12 +77,7 @@ fn field_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<BeltramiField> {
 }
 
 pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
-    if Format::from_path(&args.output).is_none() {
-        bail!(
-            "{}: unknown output format (expected .obj, .gltf or .glb)",
-            args.output.display()
-        );
-    }
+    mapping::check_output_format(&args.output)?;
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
@@ -96,17 +90,9 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     };
     let mut problem = Problem::new(mesh, Target::Plane(boundary));
     problem.goal = Goal::Prescribed(field.clone());
-    for spec in &args.pins {
-        problem.constraints.pins.push(Pin {
-            vertex: spec.resolve(mesh)?,
-            position: None,
-        });
-    }
-    solver.check(&problem)?;
+    problem.constraints.pins = mapping::resolve_pins(&args.pins, mesh)?;
 
-    let start = Instant::now();
-    let solution = solver.solve(&problem, &mut Context::new())?;
-    let seconds = start.elapsed().as_secs_f64();
+    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.json)?;
     let error = match &solution.report.mu {
         Some(measured) if measured.frame == field.frame => {
             let elements = Elements::new(mesh, field.frame)?;
@@ -114,82 +100,37 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         }
         _ => None,
     };
-
-    let Map::Planar(z) = &solution.map else {
+    if !matches!(solution.map, Map::Planar(_)) {
         bail!("this command writes planar maps only");
-    };
-    let uv: Vec<Vector2<f64>> = z.iter().map(|z| Vector2::new(z.re, z.im)).collect();
-    io::write(
-        &args.output,
-        mesh,
-        &VertexAttributes {
-            uvs: Some(&uv),
-            ..Default::default()
-        },
-    )?;
-
-    let report = report_json(args, &solution, error.as_ref(), seconds);
-    if let Some(path) = &args.report {
-        let text = serde_json::to_string_pretty(&report)?;
-        io::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
-            .with_context(|| format!("cannot write the report {}", path.display()))?;
     }
-    if args.json {
-        println!("{report}");
-    } else if !quiet {
-        print_summary(args, &solution, error.as_ref(), seconds);
-    }
-    Ok(())
-}
+    mapping::write_map(&args.output, mesh, &solution)?;
 
-fn report_json(
-    args: &QcArgs,
-    solution: &Solution,
-    error: Option<&MuError>,
-    seconds: f64,
-) -> serde_json::Value {
-    let r = &solution.report;
-    let d = r.distortion.as_ref();
-    json!({
-        "solver": r.solver,
-        "mesh": args.mesh.display().to_string(),
-        "output": args.output.display().to_string(),
-        "seconds": seconds,
-        "iterations": r.iterations,
-        "flipped": d.map(|d| d.flipped),
-        "mu_mean": d.map(|d| d.mu_mean),
-        "mu_max": d.map(|d| d.mu_max),
-        "mu_error_l2": error.map(|e| e.rms),
-        "mu_error_l2_squared": error.map(|e| e.l2_squared),
-        "mu_error_sup": error.map(|e| e.sup),
-        "mu_error_sup_face": error.map(|e| e.sup_face.idx()),
-        "energy_history": r.energy_history,
-        "timings": r.timings.iter().map(|(k, v)| json!({"stage": k, "seconds": v})).collect::<Vec<_>>(),
-        "notes": r.notes,
-    })
-}
-
-fn print_summary(args: &QcArgs, solution: &Solution, error: Option<&MuError>, seconds: f64) {
-    let r = &solution.report;
-    println!(
-        "{} -> {} ({}, {seconds:.3} s)",
-        args.mesh.display(),
-        args.output.display(),
-        r.solver
+    let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
+    report.insert("mu_error_l2".into(), json!(error.as_ref().map(|e| e.rms)));
+    report.insert(
+        "mu_error_l2_squared".into(),
+        json!(error.as_ref().map(|e| e.l2_squared)),
     );
-    if let Some(d) = &r.distortion {
-        println!("  flipped faces   {}", d.flipped);
-    }
-    if let Some(e) = error {
-        println!(
-            "  |mu - target|   L2 (RMS) {:.4e}  sup {:.4e} (face {})",
-            e.rms, e.sup, e.sup_face
-        );
-    }
-    for (stage, s) in &r.timings {
-        println!("  {stage:<15} {s:.3} s");
-    }
-    for note in &r.notes {
-        println!("  note: {note}");
-    }
+    report.insert("mu_error_sup".into(), json!(error.as_ref().map(|e| e.sup)));
+    report.insert(
+        "mu_error_sup_face".into(),
+        json!(error.as_ref().map(|e| e.sup_face.idx())),
+    );
+    let extra: Vec<String> = error
+        .iter()
+        .map(|e| {
+            format!(
+                "|mu - target|   L2 (RMS) {:.4e}  sup {:.4e} (face {})",
+                e.rms, e.sup, e.sup_face
+            )
+        })
+        .collect();
+    mapping::finish(
+        report,
+        args.report.as_deref(),
+        args.json,
+        quiet,
+        (&args.mesh, &args.output, &solution, seconds),
+        &extra,
+    )
 }

@@ -1,0 +1,218 @@
+//! What every mapping command shares: the output-format check, pins, the solve with a
+//! late progress bar, writing the map, the JSON report and the summary.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context as _, bail};
+use beltrami_core::{Context, Map, Pin, Problem, Progress, Solution, Solver};
+use beltrami_mesh::io::{self, Format, VertexAttributes};
+use beltrami_mesh::{Mesh, Vector2};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde_json::{Map as JsonMap, Value, json};
+
+use super::colormap::viridis;
+use super::pins::PinSpec;
+
+/// Fails, before any work, when `output` is not a mesh format beltrami writes.
+pub fn check_output_format(output: &Path) -> anyhow::Result<()> {
+    if Format::from_path(output).is_none() {
+        bail!(
+            "{}: unknown output format (expected .obj, .gltf or .glb)",
+            output.display()
+        );
+    }
+    Ok(())
+}
+
+/// The pins of `--pin` flags, without positions (the solver places them).
+pub fn resolve_pins(specs: &[PinSpec], mesh: &Mesh) -> anyhow::Result<Vec<Pin>> {
+    specs
+        .iter()
+        .map(|spec| {
+            Ok(Pin {
+                vertex: spec.resolve(mesh)?,
+                position: None,
+            })
+        })
+        .collect()
+}
+
+/// A progress bar that appears only once a run has lasted a second.
+struct LateBar {
+    bar: ProgressBar,
+    start: Instant,
+    shown: bool,
+    enabled: bool,
+}
+
+impl LateBar {
+    fn new(enabled: bool) -> Self {
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {msg} [{elapsed}]")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        Self {
+            bar,
+            start: Instant::now(),
+            shown: false,
+            enabled,
+        }
+    }
+
+    fn update(&mut self, p: &Progress) {
+        if !self.enabled {
+            return;
+        }
+        if !self.shown && self.start.elapsed() > Duration::from_secs(1) {
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+            self.bar.enable_steady_tick(Duration::from_millis(120));
+            self.shown = true;
+        }
+        let mut msg = p.stage.to_string();
+        if let Some(total) = p.total {
+            msg.push_str(&format!(" {}/{total}", p.done));
+        }
+        if let Some(e) = p.energy {
+            msg.push_str(&format!(" energy {e:.3e}"));
+        }
+        self.bar.set_message(msg);
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// Checks and solves `problem`, with a progress bar on stderr for runs over a second
+/// when `show_progress`; returns the solution and the wall-clock seconds of the solve.
+pub fn solve(
+    solver: &dyn Solver,
+    problem: &Problem<'_>,
+    show_progress: bool,
+) -> anyhow::Result<(Solution, f64)> {
+    solver.check(problem)?;
+    let mut bar = LateBar::new(show_progress);
+    let start = Instant::now();
+    let solution = {
+        let mut context = Context::new().with_progress(|p: &Progress| bar.update(p));
+        solver.solve(problem, &mut context)
+    };
+    bar.finish();
+    Ok((solution?, start.elapsed().as_secs_f64()))
+}
+
+/// Writes the map of `solution` on `mesh`'s connectivity: a planar map as one texture
+/// coordinate per vertex, a spatial map as the positions; glTF output also gets the
+/// per-vertex |mu| (mean over the incident faces) as viridis colors.
+pub fn write_map(output: &Path, mesh: &Mesh, solution: &Solution) -> anyhow::Result<()> {
+    let glb = matches!(Format::from_path(output), Some(Format::Glb | Format::Gltf));
+    let colors: Option<Vec<[f32; 3]>> = match (&solution.report.mu, glb) {
+        (Some(field), true) => Some(
+            mesh.vertices()
+                .map(|v| {
+                    let (sum, n) = mesh.vertex_faces(v).fold((0.0, 0usize), |(s, n), f| {
+                        (s + field.mu[f.idx()].norm(), n + 1)
+                    });
+                    viridis(if n > 0 { sum / n as f64 } else { 0.0 })
+                })
+                .collect(),
+        ),
+        _ => None,
+    };
+    let uv: Vec<Vector2<f64>>;
+    let mut attributes = VertexAttributes {
+        colors: colors.as_deref(),
+        ..Default::default()
+    };
+    match &solution.map {
+        Map::Planar(z) => {
+            uv = z.iter().map(|z| Vector2::new(z.re, z.im)).collect();
+            attributes.uvs = Some(&uv);
+        }
+        Map::Spatial(p) => attributes.positions = Some(p),
+        Map::OnMesh(_) => bail!("this command writes planar and spatial maps only"),
+    }
+    io::write(output, mesh, &attributes)?;
+    Ok(())
+}
+
+/// The JSON report keys every mapping command writes: solver, files, seconds,
+/// iterations, flipped faces and |mu| statistics, energy history, timings, notes.
+pub fn report_json(
+    mesh: &Path,
+    output: &Path,
+    solution: &Solution,
+    seconds: f64,
+) -> JsonMap<String, Value> {
+    let r = &solution.report;
+    let d = r.distortion.as_ref();
+    let value = json!({
+        "solver": r.solver,
+        "mesh": mesh.display().to_string(),
+        "output": output.display().to_string(),
+        "seconds": seconds,
+        "iterations": r.iterations,
+        "flipped": d.map(|d| d.flipped),
+        "mu_mean": d.map(|d| d.mu_mean),
+        "mu_max": d.map(|d| d.mu_max),
+        "mu_std": d.map(|d| d.mu_std),
+        "mu_l2": d.map(|d| d.mu_l2),
+        "energy_history": r.energy_history,
+        "timings": r.timings.iter().map(|(k, v)| json!({"stage": k, "seconds": v})).collect::<Vec<_>>(),
+        "notes": r.notes,
+    });
+    match value {
+        Value::Object(map) => map,
+        _ => JsonMap::new(),
+    }
+}
+
+/// Writes the report to `--report` (atomically) and prints it with `--json`; otherwise
+/// prints the summary unless `quiet`. `extra` lines go into the summary after the |mu|
+/// statistics.
+pub fn finish(
+    report: JsonMap<String, Value>,
+    report_path: Option<&Path>,
+    json: bool,
+    quiet: bool,
+    summary: (&Path, &Path, &Solution, f64),
+    extra: &[String],
+) -> anyhow::Result<()> {
+    let report = Value::Object(report);
+    if let Some(path) = report_path {
+        let text = serde_json::to_string_pretty(&report)?;
+        io::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
+            .with_context(|| format!("cannot write the report {}", path.display()))?;
+    }
+    if json {
+        println!("{report}");
+    } else if !quiet {
+        let (mesh, output, solution, seconds) = summary;
+        let r = &solution.report;
+        println!(
+            "{} -> {} ({}, {seconds:.3} s)",
+            mesh.display(),
+            output.display(),
+            r.solver
+        );
+        if let Some(d) = &r.distortion {
+            println!("  flipped faces   {}", d.flipped);
+            println!(
+                "  |mu|            mean {:.4e}  max {:.4e}  std {:.4e}",
+                d.mu_mean, d.mu_max, d.mu_std
+            );
+        }
+        for line in extra {
+            println!("  {line}");
+        }
+        for (stage, s) in &r.timings {
+            println!("  {stage:<15} {s:.3} s");
+        }
+        for note in &r.notes {
+            println!("  note: {note}");
+        }
+    }
+    Ok(())
+}
