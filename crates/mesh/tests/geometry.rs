@@ -6,33 +6,8 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use beltrami_mesh::primitives::{self, Cells};
 use beltrami_mesh::{BoundingBox, FaceId, Mesh, Point3, PolygonSoup, Vector2, Vector3, VertexId};
 
-/// Deterministic xorshift64* generator (no dependencies).
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Self {
-        Rng((seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03) | 1)
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        let mut x = self.0;
-        x ^= x >> 12;
-        x ^= x << 25;
-        x ^= x >> 27;
-        self.0 = x;
-        x.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [lo, hi).
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.unit()
-    }
-}
+mod common;
+use common::Rng;
 
 fn mesh(soup: &PolygonSoup) -> Mesh {
     Mesh::from_soup(soup).expect("valid mesh")
