@@ -22,6 +22,7 @@
 
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;
+pub use beltrami_flow as flow;
 pub use beltrami_init as init;
 pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
@@ -31,5 +32,6 @@ pub fn registry() -> beltrami_core::Registry {
     let mut registry = beltrami_core::Registry::new();
     beltrami_init::register(&mut registry);
     beltrami_lsqc::register(&mut registry);
+    beltrami_flow::register(&mut registry);
     registry
 }

@@ -139,6 +139,9 @@ pub struct Report {
     pub iterations: usize,
     /// Energy or error after each iteration (direct solvers: the final energy, if any).
     pub energy_history: Vec<f64>,
+    /// The step size taken at each iteration of an iterative solver (empty for direct
+    /// solvers).
+    pub step_sizes: Vec<f64>,
     /// Beltrami coefficient of the result per face, when measured.
     pub mu: Option<BeltramiField>,
     /// Statistics of `|mu|` and the flipped-face count, when measured.

@@ -219,3 +219,62 @@ pub fn measure_surface(
         beltrami::surface_map(&elements, mesh.vertex_count(), image, reference_normals)?;
     Distortion::from_derivatives(&elements, &derivatives)
 }
+
+/// `|mu - target|` over the faces, weighted by the face areas (the sums of the
+/// quadrature weights of each face): how far a map is from a prescribed Beltrami
+/// coefficient, in the measures of Wong-Zhao's tables 5.1-5.3.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MuError {
+    /// The area-weighted RMS `sqrt(sum_f A_f |mu_f - target_f|^2 / sum_f A_f)`.
+    pub rms: f64,
+    /// `sum_f A_f |mu_f - target_f|^2`, the squared "L2" column of Wong-Zhao's tables
+    /// (not normalized by the area).
+    pub l2_squared: f64,
+    /// `max_f |mu_f - target_f|`.
+    pub sup: f64,
+    /// The face where the sup is reached (the first of equal ones).
+    pub sup_face: FaceId,
+}
+
+impl MuError {
+    /// The error of `measured` against `target` (one value per face of `elements`, in
+    /// the same frame). Fails with [`FemError::Length`] for a wrong length.
+    pub fn new(
+        elements: &Elements,
+        measured: &[Complex64],
+        target: &[Complex64],
+    ) -> Result<Self, FemError> {
+        let faces = elements.face_count();
+        for (what, values) in [("measured mu", measured), ("target mu", target)] {
+            if values.len() != faces {
+                return Err(FemError::Length {
+                    what,
+                    expected: faces,
+                    got: values.len(),
+                });
+            }
+        }
+        let (mut area, mut l2_squared, mut sup, mut sup_face) = (0.0, 0.0, 0.0, FaceId(0));
+        for (f, (m, t)) in measured.iter().zip(target).enumerate() {
+            let face = FaceId(f as u32);
+            let a: f64 = elements.face_points(face).iter().map(|q| q.weight).sum();
+            let d = (m - t).norm();
+            area += a;
+            l2_squared += a * d * d;
+            if d > sup {
+                (sup, sup_face) = (d, face);
+            }
+        }
+        let rms = if area > 0.0 {
+            (l2_squared / area).sqrt()
+        } else {
+            0.0
+        };
+        Ok(Self {
+            rms,
+            l2_squared,
+            sup,
+            sup_face,
+        })
+    }
+}

@@ -22,9 +22,9 @@ pub mod operators;
 pub mod quaternion;
 pub mod solve;
 
-pub use distortion::{Distortion, DistortionStats, Histogram};
+pub use distortion::{Distortion, DistortionStats, Histogram, MuError};
 pub use dof::{DofConstraints, DofError, DofMap, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
 pub use field::{BeltramiField, FieldError};
-pub use solve::{LeastSquaresSolver, SolveError, SolveOptions};
+pub use solve::{LeastSquaresSolver, SolveError, SolveOptions, SpdSolver};

@@ -142,6 +142,9 @@ pub enum SolveError {
         /// The largest accepted.
         limit: f64,
     },
+    /// [`SpdSolver::solve_in_place`] was called without a successful factorization.
+    #[error("no factorization to solve with: factorize a matrix first")]
+    NotFactored,
     /// The solution has a NaN or infinite entry.
     #[error("the solution is not finite at index {index}: the system is singular or overflows")]
     NonFiniteSolution {
@@ -461,24 +464,134 @@ pub fn solve_spd<T: Scalar>(
     if n == 0 {
         return Ok(x);
     }
-    let mut cholesky = Cholesky::<T>::new(matrix.symbolic(), options.par())?;
-    cholesky
-        .factorize(matrix, options.tolerance(n))
-        .map_err(|failure| match failure {
-            FactorFailure::NonPositivePivot { index } => SolveError::NotPositiveDefinite { index },
-            FactorFailure::SmallPivot { index, ratio } => SolveError::Singular {
-                index,
-                node: None,
-                ratio,
-            },
-        })?;
-    cholesky.solve_in_place(x.as_mut())?;
-    for j in 0..x.ncols() {
-        for i in 0..n {
-            if !x[(i, j)].finite() {
-                return Err(SolveError::NonFiniteSolution { index: i + j * n });
+    let mut solver = SpdSolver::<T>::new(matrix.symbolic(), options)?;
+    solver.factorize(matrix)?;
+    solver.solve_in_place(x.as_mut())?;
+    Ok(x)
+}
+
+/// Repeated solves `M x = r` with Hermitian positive definite matrices `M` of one fixed
+/// sparsity pattern (iterative solvers that assemble their own normal equations every
+/// step): the symbolic Cholesky factorization (AMD ordering, supernodes) is done once by
+/// [`SpdSolver::new`]; [`SpdSolver::factorize`] refactors the values of each new matrix
+/// and [`SpdSolver::solve_in_place`] solves with the last factorization, as often as
+/// needed.
+///
+/// Errors are those of [`solve_spd`]: [`SolveError::NotPositiveDefinite`] for a pivot
+/// `<= 0`, [`SolveError::Singular`] for a pivot tiny relative to its diagonal (the test of
+/// [`SolveOptions::singularity_tolerance`]), [`SolveError::NonFiniteSolution`].
+pub struct SpdSolver<T: Scalar> {
+    pattern: SymbolicSparseColMat<usize>,
+    cholesky: Cholesky<T>,
+    options: SolveOptions,
+    /// Whether the last factorization succeeded.
+    factored: bool,
+}
+
+impl<T: Scalar> fmt::Debug for SpdSolver<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SpdSolver")
+            .field("n", &self.pattern.nrows())
+            .field("nnz", &self.pattern.row_idx().len())
+            .field("options", &self.options)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<T: Scalar> SpdSolver<T> {
+    /// Symbolic phase for matrices with the pattern `pattern` (square; only its lower
+    /// triangle is read).
+    pub fn new(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        options: SolveOptions,
+    ) -> Result<Self, SolveError> {
+        check_len(
+            "the column count of the pattern",
+            pattern.nrows(),
+            pattern.ncols(),
+        )?;
+        Ok(Self {
+            pattern: pattern.to_owned()?,
+            cholesky: Cholesky::new(pattern, options.par())?,
+            options,
+            factored: false,
+        })
+    }
+
+    /// The number of unknowns.
+    pub fn len(&self) -> usize {
+        self.pattern.nrows()
+    }
+
+    /// True when there are no unknowns.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Numeric factorization of `matrix` (the pattern given to [`SpdSolver::new`], lower
+    /// triangle read), kept for [`SpdSolver::solve_in_place`].
+    pub fn factorize(&mut self, matrix: SparseColMatRef<'_, usize, T>) -> Result<(), SolveError> {
+        self.factored = false;
+        let n = self.len();
+        check_len("the row count of the matrix", n, matrix.nrows())?;
+        check_len("the column count of the matrix", n, matrix.ncols())?;
+        if let Some(col) = (0..n)
+            .find(|&j| matrix.row_idx_of_col_raw(j) != self.pattern.as_ref().row_idx_of_col_raw(j))
+        {
+            return Err(SolveError::PatternMismatch { col });
+        }
+        check_finite_matrix("the matrix", matrix)?;
+        self.cholesky
+            .factorize(matrix, self.options.tolerance(n))
+            .map_err(|failure| match failure {
+                FactorFailure::NonPositivePivot { index } => {
+                    SolveError::NotPositiveDefinite { index }
+                }
+                FactorFailure::SmallPivot { index, ratio } => SolveError::Singular {
+                    index,
+                    node: None,
+                    ratio,
+                },
+            })?;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Overwrites the columns of `rhs` with the solutions of `matrix x = rhs` for the
+    /// matrix of the last successful [`SpdSolver::factorize`] (error
+    /// [`SolveError::NotFactored`] if there is none).
+    pub fn solve_in_place(&mut self, mut rhs: MatMut<'_, T>) -> Result<(), SolveError> {
+        check_len(
+            "the row count of the right-hand side",
+            self.len(),
+            rhs.nrows(),
+        )?;
+        for j in 0..rhs.ncols() {
+            for i in 0..rhs.nrows() {
+                if !rhs[(i, j)].finite() {
+                    return Err(SolveError::NonFinite {
+                        what: "the right-hand side",
+                        index: i + j * rhs.nrows(),
+                    });
+                }
             }
         }
+        if self.is_empty() {
+            return Ok(());
+        }
+        if !self.factored {
+            return Err(SolveError::NotFactored);
+        }
+        self.cholesky.solve_in_place(rhs.as_mut())?;
+        for j in 0..rhs.ncols() {
+            for i in 0..rhs.nrows() {
+                if !rhs[(i, j)].finite() {
+                    return Err(SolveError::NonFiniteSolution {
+                        index: i + j * rhs.nrows(),
+                    });
+                }
+            }
+        }
+        Ok(())
     }
-    Ok(x)
 }

@@ -1,4 +1,5 @@
-//! Generated meshes for tests, examples and benchmarks: grids, spheres, tori.
+//! Generated meshes for tests, examples and benchmarks: grids, disks, annuli, spheres,
+//! tori (among them the refinement families of Wong-Zhao 2014, section 5.1).
 //!
 //! Each returns a [`PolygonSoup`] (so callers can permute or corrupt it before building)
 //! with counter-clockwise faces seen from outside (or from +z for planar grids).
@@ -130,22 +131,9 @@ pub fn icosphere(subdivisions: usize) -> PolygonSoup {
         [9, 8, 1],
     ];
     for _ in 0..subdivisions {
-        let mut midpoint = std::collections::HashMap::new();
-        let mut mid = |a: u32, b: u32, positions: &mut Vec<Point3<f64>>| -> u32 {
-            *midpoint.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let m = (positions[a as usize].coords + positions[b as usize].coords).normalize();
-                positions.push(Point3::from(m));
-                (positions.len() - 1) as u32
-            })
-        };
-        let mut next = Vec::with_capacity(4 * triangles.len());
-        for &[a, b, c] in &triangles {
-            let ab = mid(a, b, &mut positions);
-            let bc = mid(b, c, &mut positions);
-            let ca = mid(c, a, &mut positions);
-            next.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        triangles = next;
+        triangles = split_triangles(&mut positions, &triangles, |m, _| {
+            Point3::from(m.coords.normalize())
+        });
     }
     PolygonSoup::from_triangles(positions, &triangles)
 }
@@ -175,6 +163,129 @@ pub fn jittered_grid(nx: usize, ny: usize, cells: Cells, amount: f64, seed: u64)
         if interior {
             p.x += uniform() * amount * hx;
             p.y += uniform() * amount * hy;
+        }
+    }
+    soup
+}
+
+/// One 1-to-4 split of `triangles` by their edge midpoints, new vertices appended to
+/// `positions` at `place(midpoint, on_boundary)` (`on_boundary`: the edge belongs to one
+/// triangle only). Children of triangle `t` are `4t .. 4t + 3`, with its orientation.
+fn split_triangles(
+    positions: &mut Vec<Point3<f64>>,
+    triangles: &[[u32; 3]],
+    place: impl Fn(Point3<f64>, bool) -> Point3<f64>,
+) -> Vec<[u32; 3]> {
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let mut uses = std::collections::HashMap::new();
+    for t in triangles {
+        for k in 0..3 {
+            *uses.entry(key(t[k], t[(k + 1) % 3])).or_insert(0u32) += 1;
+        }
+    }
+    let mut midpoint = std::collections::HashMap::new();
+    let mut mid = |a: u32, b: u32, positions: &mut Vec<Point3<f64>>| -> u32 {
+        *midpoint.entry(key(a, b)).or_insert_with(|| {
+            let m = nalgebra::center(&positions[a as usize], &positions[b as usize]);
+            positions.push(place(m, uses[&key(a, b)] == 1));
+            (positions.len() - 1) as u32
+        })
+    };
+    let mut next = Vec::with_capacity(4 * triangles.len());
+    for &[a, b, c] in triangles {
+        let ab = mid(a, b, positions);
+        let bc = mid(b, c, positions);
+        let ca = mid(c, a, positions);
+        next.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+    }
+    next
+}
+
+/// The unit disk of Wong-Zhao's Table 5.1: level 0 is the square with corners
+/// `1, i, -1, -i` split into four triangles at the centre; each level splits every
+/// triangle 1-to-4 by its edge midpoints, boundary midpoints projected radially onto the
+/// unit circle (interior midpoints stay on their edges). Level `l` has `4^(l+1)` faces;
+/// vertex 0 is the centre and vertex 1 the point `1`.
+pub fn disk(level: usize) -> PolygonSoup {
+    let mut positions = vec![
+        Point3::origin(),
+        Point3::new(1.0, 0.0, 0.0),
+        Point3::new(0.0, 1.0, 0.0),
+        Point3::new(-1.0, 0.0, 0.0),
+        Point3::new(0.0, -1.0, 0.0),
+    ];
+    let mut triangles = vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 1]];
+    for _ in 0..level {
+        triangles = split_triangles(&mut positions, &triangles, |m, boundary| {
+            if boundary {
+                Point3::from(m.coords.normalize())
+            } else {
+                m
+            }
+        });
+    }
+    PolygonSoup::from_triangles(positions, &triangles)
+}
+
+/// The unit sphere of Wong-Zhao's Table 5.2: level 0 is the octahedron with vertices
+/// `+-e_x, +-e_y, +-e_z`; each level splits every triangle 1-to-4, midpoints projected
+/// onto the sphere. Level `l` has `8 * 4^l` faces; vertex 0 is `(0, 0, -1)`, vertex 1 is
+/// `(1, 0, 0)` and vertex 5 is `(0, 0, 1)` — the points `0`, `1` and `infinity` of the
+/// stereographic coordinate from the north pole.
+pub fn octahedral_sphere(level: usize) -> PolygonSoup {
+    let mut positions = vec![
+        Point3::new(0.0, 0.0, -1.0),
+        Point3::new(1.0, 0.0, 0.0),
+        Point3::new(0.0, 1.0, 0.0),
+        Point3::new(-1.0, 0.0, 0.0),
+        Point3::new(0.0, -1.0, 0.0),
+        Point3::new(0.0, 0.0, 1.0),
+    ];
+    let mut triangles = vec![
+        [0, 2, 1],
+        [0, 3, 2],
+        [0, 4, 3],
+        [0, 1, 4],
+        [5, 1, 2],
+        [5, 2, 3],
+        [5, 3, 4],
+        [5, 4, 1],
+    ];
+    for _ in 0..level {
+        triangles = split_triangles(&mut positions, &triangles, |m, _| {
+            Point3::from(m.coords.normalize())
+        });
+    }
+    PolygonSoup::from_triangles(positions, &triangles)
+}
+
+/// The annulus `inner <= |z| <= 1` in the plane z = 0: `rings` layers of cells between
+/// the two circles (radii spaced geometrically, so cells stay close to squares) and
+/// `sectors` cells around, each cell split into two triangles along alternating
+/// diagonals. Vertex `s + sectors * r` is at radius `inner^(1 - r / rings)`, angle
+/// `2 pi s / sectors`; vertex `sectors * rings` is the point `1`.
+pub fn annulus(inner: f64, rings: usize, sectors: usize) -> PolygonSoup {
+    let mut positions = Vec::with_capacity((rings + 1) * sectors);
+    for r in 0..=rings {
+        let radius = inner.powf(1.0 - r as f64 / rings as f64);
+        for s in 0..sectors {
+            let angle = TAU * s as f64 / sectors as f64;
+            positions.push(Point3::new(radius * angle.cos(), radius * angle.sin(), 0.0));
+        }
+    }
+    let mut soup = PolygonSoup::new(positions);
+    soup.reserve(2 * rings * sectors, 6 * rings * sectors);
+    let id = |s: usize, r: usize| (s % sectors + sectors * r) as u32;
+    for r in 0..rings {
+        for s in 0..sectors {
+            let (a, b, c, d) = (id(s, r), id(s + 1, r), id(s + 1, r + 1), id(s, r + 1));
+            if (r + s) % 2 == 0 {
+                soup.push_face(&[a, b, c]);
+                soup.push_face(&[a, c, d]);
+            } else {
+                soup.push_face(&[a, b, d]);
+                soup.push_face(&[b, c, d]);
+            }
         }
     }
     soup

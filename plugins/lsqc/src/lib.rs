@@ -40,7 +40,7 @@
 //! Faces with `|mu| >= 1` are rejected before any work, naming the face. The report has
 //! the stage timings, the measured per-face `mu` and its statistics (flipped faces
 //! included) in the field's frame, the final `E_mu`, and a note with `|mu - target|`
-//! (area-weighted RMS and sup, [`MuError`]).
+//! (area-weighted RMS and sup, [`beltrami_fem::MuError`]).
 //!
 //! [`expr`] parses coefficients given as expressions of `z` (`0.6*z`, `0.3+0.3i`).
 //!
@@ -63,7 +63,7 @@ pub mod expr;
 mod lsqc;
 
 pub use expr::{Expr, ExprError};
-pub use lsqc::{Lsqc, MuError, beltrami_operator};
+pub use lsqc::{Lsqc, beltrami_operator};
 
 /// Adds [`Lsqc`] to `registry`.
 pub fn register(registry: &mut beltrami_core::Registry) {

@@ -11,10 +11,10 @@ use beltrami_fem::element::check_planar;
 use beltrami_fem::operators::apply;
 use beltrami_fem::{
     BeltramiField, Distortion, DofConstraints, DofMap, Elements, FemError, Frame,
-    LeastSquaresSolver, SolveOptions,
+    LeastSquaresSolver, MuError, SolveOptions,
 };
 use beltrami_init::boundary::{self, BoundaryError};
-use beltrami_mesh::{FaceId, Mesh, VertexId};
+use beltrami_mesh::{Mesh, VertexId};
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
@@ -26,7 +26,7 @@ use num_complex::Complex64;
 /// needs two or more pins, or none (two boundary vertices far apart are pinned at
 /// `(0, 0)` and `(1, 0)`, as in lscm). A pin without a position stays where it is on a
 /// planar source; on a curved source two such pins go to `(0, 0)` and `(1, 0)`. The
-/// report's energy is the final `E_mu`; its notes give `|mu - target|` ([`MuError`]).
+/// report's energy is the final `E_mu`; its notes give `|mu - target|` ([`beltrami_fem::MuError`]).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Lsqc;
 
@@ -123,64 +123,6 @@ impl Solver for Lsqc {
         Ok(Solution {
             map: Map::Planar(map),
             report,
-        })
-    }
-}
-
-/// `|mu - target|` over the faces, weighted by the face areas (the sums of the
-/// quadrature weights of each face).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MuError {
-    /// The area-weighted RMS `sqrt(sum_f A_f |mu_f - target_f|^2 / sum_f A_f)`.
-    pub rms: f64,
-    /// `sum_f A_f |mu_f - target_f|^2`, the squared "L2" column of Wong-Zhao's tables
-    /// (not normalized by the area).
-    pub l2_squared: f64,
-    /// `max_f |mu_f - target_f|`.
-    pub sup: f64,
-    /// The face where the sup is reached (the first of equal ones).
-    pub sup_face: FaceId,
-}
-
-impl MuError {
-    /// The error of `measured` against `target` (one value per face of `elements`, in
-    /// the same frame). Fails with [`FemError::Length`] for a wrong length.
-    pub fn new(
-        elements: &Elements,
-        measured: &[Complex64],
-        target: &[Complex64],
-    ) -> Result<Self, FemError> {
-        let faces = elements.face_count();
-        for (what, values) in [("measured mu", measured), ("target mu", target)] {
-            if values.len() != faces {
-                return Err(FemError::Length {
-                    what,
-                    expected: faces,
-                    got: values.len(),
-                });
-            }
-        }
-        let (mut area, mut l2_squared, mut sup, mut sup_face) = (0.0, 0.0, 0.0, FaceId(0));
-        for (f, (m, t)) in measured.iter().zip(target).enumerate() {
-            let face = FaceId(f as u32);
-            let a: f64 = elements.face_points(face).iter().map(|q| q.weight).sum();
-            let d = (m - t).norm();
-            area += a;
-            l2_squared += a * d * d;
-            if d > sup {
-                (sup, sup_face) = (d, face);
-            }
-        }
-        let rms = if area > 0.0 {
-            (l2_squared / area).sqrt()
-        } else {
-            0.0
-        };
-        Ok(Self {
-            rms,
-            l2_squared,
-            sup,
-            sup_face,
         })
     }
 }

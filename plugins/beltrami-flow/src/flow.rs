@@ -1,0 +1,265 @@
+//! The flow iteration: measure, transport the adjustment to the target, solve for the
+//! flow, step, project.
+//!
+//! Step `k` starts from the image `Y` of the source vertices on the target, with
+//! Beltrami coefficient `mu_T` and `f_z` per face (in the image frame of
+//! [`crate::measure`]), and the objective `E = sum_T A_T |mu_T - sigma_T|^p`.
+//!
+//! 1. Composition (Wong-Zhao 2014, eq. 3.5, 3.16-3.17). Composing the map with a
+//!    homeomorphism `g` of the target with coefficient `tau` gives, to first order in
+//!    `tau`,
+//!    ```text
+//!    mu(g o f) = mu + (1 - |mu|^2) theta tau,    theta = conj(f_z) / f_z,
+//!    ```
+//!    so the error `e_T = mu_T - sigma_T` is cancelled by
+//!    `rho_T = (sigma_T - mu_T) / ((1 - |mu_T|^2) theta_T)` (eq. 3.17), on the image face.
+//! 2. Flow (eq. 4.4, 6.1-6.9). `g = id + t V` has `tau = t V_zbar + O(t^2)`
+//!    (Theorem 3.2), and [`FlowSystem`] finds the tangent field `V` minimizing
+//!    `sum_T w_T |V_zbar - rho_T|^2` with
+//!    ```text
+//!    w_T = A_T (1 - |mu_T|^2)^2 max(|mu_T|, 1e-3)^(p - 2).
+//!    ```
+//!    These weights make the flow a Gauss-Newton step for `E`: `w_T |V_zbar - rho_T|^2`
+//!    is `A_T |mu_T|^(p-2) |e_T + (1 - |mu_T|^2) theta_T V_zbar|^2`, the linearized
+//!    error, reweighted for `p > 2` (the gradient of `sum A |mu|^p` is that of the
+//!    reweighted `p = 2` sum at the current map). The paper weights by the image area;
+//!    both have the same continuous limit, and these make the flow a descent direction
+//!    for the error it is judged by.
+//! 3. Step (section 4.4). The largest `t` in `{1, 1/2, 1/4, ...}` for which
+//!    `Y' = P(Y + t V)` (each vertex projected back onto the target by its role) has no
+//!    more flipped faces than `Y` and a smaller `E`.
+//! 4. Stop when the largest vertex update `t max_i |V_i|` is below the tolerance, or no
+//!    step above it decreases `E`, or the iteration limit is reached, or the solve is
+//!    cancelled (the map so far is returned; every accepted step decreased `E`, so it is
+//!    the best one seen).
+
+use beltrami_core::{Context, Progress, SolverError};
+use beltrami_fem::{Elements, SolveOptions};
+use beltrami_mesh::{FaceId, Point3, Vector3};
+use num_complex::Complex64;
+
+use crate::extension::HarmonicExtension;
+use crate::measure::{ImageFace, Objective, image_faces, triangle};
+use crate::system::{Flow, FlowSystem};
+use crate::target::{Role, TargetGeometry};
+
+/// Smallest `|mu|` used in the `L^p` reweighting (`p > 2`), so that faces that are
+/// already conformal keep a positive weight.
+const MU_FLOOR: f64 = 1e-3;
+
+/// How the iteration ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    /// The largest vertex update fell below the tolerance.
+    Converged,
+    /// No step above the tolerance decreased the error.
+    Stalled,
+    /// The iteration limit was reached.
+    IterationLimit,
+    /// Cancellation was requested.
+    Cancelled,
+}
+
+/// Parameters of [`run`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlowOptions {
+    /// Stop when the largest vertex update is below this (target units).
+    pub tolerance: f64,
+    /// Most iterations.
+    pub max_iterations: usize,
+    /// Options of the sparse factorizations.
+    pub solve: SolveOptions,
+}
+
+/// The result of [`run`].
+#[derive(Debug, Clone)]
+pub struct FlowRun<G> {
+    /// Final images of the source vertices.
+    pub image: Vec<Point3<f64>>,
+    /// The target after the flow (a free annulus radius has moved).
+    pub target: G,
+    /// Final image faces (their `mu` and flips).
+    pub faces: Vec<ImageFace>,
+    /// `E` before the first step and after each accepted step.
+    pub energy_history: Vec<f64>,
+    /// The step size `t` of each accepted step.
+    pub step_sizes: Vec<f64>,
+    /// The largest vertex update `t max_i |V_i|` of each accepted step.
+    pub updates: Vec<f64>,
+    /// Why it stopped.
+    pub stop: Stop,
+}
+
+impl<G> FlowRun<G> {
+    /// Accepted steps.
+    pub fn iterations(&self) -> usize {
+        self.step_sizes.len()
+    }
+}
+
+/// Gauss-Newton weights and targets of the flow (module docs, items 1-2).
+fn weights_and_targets(
+    objective: &Objective,
+    faces: &[ImageFace],
+    weights: &mut Vec<f64>,
+    rho: &mut Vec<Complex64>,
+) {
+    weights.clear();
+    rho.clear();
+    for (f, face) in faces.iter().enumerate() {
+        let mu = face.mu();
+        let fz = face.derivatives.fz;
+        let shrink = 1.0 - mu.norm_sqr();
+        if fz.norm_sqr() == 0.0 || shrink.abs() < 1e-12 || !mu.is_finite() {
+            weights.push(0.0);
+            rho.push(Complex64::default());
+            continue;
+        }
+        let error = mu - objective.sigma(f);
+        let reweight = if objective.p == 2.0 {
+            1.0
+        } else {
+            mu.norm().max(MU_FLOOR).powf(objective.p - 2.0)
+        };
+        weights.push(objective.areas[f] * shrink * shrink * reweight);
+        // 1 / theta = f_z / conj(f_z).
+        rho.push(-error * fz / (shrink * fz.conj()));
+    }
+}
+
+/// `P(Y + t V)`: the stepped images, projected by role onto `target` moved by the
+/// offsets `t delta`, the boundary's projection spread into the interior
+/// ([`HarmonicExtension`]) before the interior is projected.
+#[allow(clippy::too_many_arguments)]
+fn step<G: TargetGeometry>(
+    target: &G,
+    roles: &[Role],
+    image: &[Point3<f64>],
+    flow: &Flow,
+    t: f64,
+    extension: Option<&mut HarmonicExtension>,
+    delta: &mut Vec<Vector3<f64>>,
+    out: &mut Vec<Point3<f64>>,
+) -> Result<G, SolverError> {
+    let mut moved = target.clone();
+    for (c, &d) in flow.offset.iter().enumerate() {
+        if d != 0.0 {
+            moved.offset_curve(c, t * d);
+        }
+    }
+    out.clear();
+    out.extend(image.iter().zip(&flow.vertex).map(|(p, v)| p + t * v));
+    delta.clear();
+    delta.resize(out.len(), Vector3::zeros());
+    for ((p, d), &role) in out.iter_mut().zip(delta.iter_mut()).zip(roles) {
+        if let Role::Curve(_) = role {
+            let q = moved.project(role, p);
+            *d = q - *p;
+            *p = q;
+        }
+    }
+    if let Some(extension) = extension {
+        extension.apply(delta, out)?;
+    }
+    for (p, &role) in out.iter_mut().zip(roles) {
+        if role == Role::Free {
+            *p = moved.project(role, p);
+        }
+    }
+    Ok(moved)
+}
+
+/// Runs the flow from `image` (one point per source vertex, on `target`) with the
+/// unknowns of `system`, for `objective` measured on the source `elements`.
+pub fn run<G: TargetGeometry>(
+    elements: &Elements,
+    mut target: G,
+    system: &mut FlowSystem,
+    mut image: Vec<Point3<f64>>,
+    objective: &Objective,
+    options: FlowOptions,
+    context: &mut Context<'_>,
+) -> Result<FlowRun<G>, SolverError> {
+    let triangles: Vec<[usize; 3]> = (0..elements.face_count())
+        .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
+        .collect();
+    let mut extension = HarmonicExtension::new(&triangles, system.roles(), options.solve)?;
+    let mut delta = Vec::new();
+    let mut faces = Vec::with_capacity(elements.face_count());
+    image_faces(elements, &target, &image, &mut faces);
+    let (mut energy, mut flipped) = objective.evaluate(&faces);
+    let mut energy_history = vec![energy];
+    let (mut step_sizes, mut updates) = (Vec::new(), Vec::new());
+    let (mut weights, mut rho) = (Vec::new(), Vec::new());
+    let (mut trial, mut trial_faces) = (Vec::new(), Vec::new());
+    let report = |context: &mut Context<'_>, done: usize, energy: f64| {
+        context.report(&Progress {
+            stage: "flow",
+            done,
+            total: Some(options.max_iterations),
+            energy: Some(energy),
+        });
+    };
+    report(context, 0, energy);
+    let mut stop = Stop::IterationLimit;
+    for iteration in 0..options.max_iterations {
+        if context.is_cancelled() {
+            stop = Stop::Cancelled;
+            break;
+        }
+        weights_and_targets(objective, &faces, &mut weights, &mut rho);
+        let flow = system.solve(&target, &image, &faces, &weights, &rho)?;
+        let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let mut t = 1.0;
+        let accepted = loop {
+            if t * largest < options.tolerance {
+                break None;
+            }
+            let moved = step(
+                &target,
+                system.roles(),
+                &image,
+                &flow,
+                t,
+                extension.as_mut(),
+                &mut delta,
+                &mut trial,
+            )?;
+            image_faces(elements, &moved, &trial, &mut trial_faces);
+            let (e, flips) = objective.evaluate(&trial_faces);
+            if flips <= flipped && e < energy {
+                break Some((moved, e, flips));
+            }
+            t *= 0.5;
+        };
+        let Some((moved, e, flips)) = accepted else {
+            stop = if largest < options.tolerance {
+                Stop::Converged
+            } else {
+                Stop::Stalled
+            };
+            break;
+        };
+        target = moved;
+        std::mem::swap(&mut image, &mut trial);
+        std::mem::swap(&mut faces, &mut trial_faces);
+        (energy, flipped) = (e, flips);
+        energy_history.push(energy);
+        step_sizes.push(t);
+        updates.push(t * largest);
+        report(context, iteration + 1, energy);
+        if t * largest < options.tolerance {
+            stop = Stop::Converged;
+            break;
+        }
+    }
+    Ok(FlowRun {
+        image,
+        target,
+        faces,
+        energy_history,
+        step_sizes,
+        updates,
+        stop,
+    })
+}

@@ -1,0 +1,149 @@
+//! The current map, face by face: its derivatives in the frame of each image face, its
+//! Beltrami coefficient, flips and the error the flow decreases.
+//!
+//! For a P1 face `T` of the source (one quadrature point, tangent frame `(e1, e2)` of
+//! the source elements) and its image triangle `Y_0 Y_1 Y_2` on the target, the image
+//! frame is `(r, s, n)`: `r` along `Y_1 - Y_0`, `n` the triangle's normal turned to the
+//! side of the target's normal at its centroid, `s = n x r` (Wong-Zhao 2014, Appendix:
+//! "local isometric coordinates (r, s) on each image face"). With
+//! `f_x = sum_k Y_k d_x N_k` and `f_y = sum_k Y_k d_y N_k` in R^3,
+//!
+//! ```text
+//! F_x = f_x . r + i f_x . s,   F_y = f_y . r + i f_y . s,
+//! f_z = (F_x - i F_y) / 2,     f_zbar = (F_x + i F_y) / 2,     mu = f_zbar / f_z,
+//! ```
+//!
+//! and the face is flipped when `|f_z|^2 - |f_zbar|^2 <= 0` (the image triangle turns
+//! against the target's normal, or is degenerate). `mu` does not depend on the choice of
+//! `r` (a rotation of the image frame multiplies `f_z` and `f_zbar` by one unit number);
+//! `f_z` does, and the flow uses it in the same image frame as its own unknowns.
+
+use beltrami_fem::Elements;
+use beltrami_fem::beltrami::PointDerivatives;
+use beltrami_mesh::{FaceId, Point3, Vector2, Vector3, VertexId};
+use num_complex::Complex64;
+
+use crate::target::TargetGeometry;
+
+/// One image face of the current map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageFace {
+    /// `f_z` and `f_zbar` in the source frame and the image frame.
+    pub derivatives: PointDerivatives,
+    /// The image frame's real axis `r`.
+    pub r: Vector3<f64>,
+    /// The image frame's imaginary axis `s`.
+    pub s: Vector3<f64>,
+    /// The image triangle's vertices in `(r, s)` coordinates (the first at the origin).
+    pub local: [Vector2<f64>; 3],
+}
+
+impl ImageFace {
+    /// `mu = f_zbar / f_z`.
+    pub fn mu(&self) -> Complex64 {
+        self.derivatives.mu()
+    }
+
+    /// Whether the image is flipped or degenerate.
+    pub fn flipped(&self) -> bool {
+        self.derivatives.jacobian() <= 0.0
+    }
+}
+
+/// The vertices of P1 face `f` of `elements`.
+pub(crate) fn triangle(elements: &Elements, f: FaceId) -> [VertexId; 3] {
+    let n = elements.nodes(f);
+    [n[0], n[1], n[2]]
+}
+
+/// The image face of `f` under the map `image`.
+pub fn image_face<G: TargetGeometry>(
+    elements: &Elements,
+    target: &G,
+    image: &[Point3<f64>],
+    f: FaceId,
+) -> ImageFace {
+    let q = &elements.face_points(f)[0];
+    let [a, b, c] = triangle(elements, f).map(|v| image[v.idx()]);
+    let (e1, e2) = (b - a, c - a);
+    let centroid = Point3::from((a.coords + b.coords + c.coords) / 3.0);
+    let reference = target.normal(&centroid);
+    let m = e1.cross(&e2);
+    let n = if m.norm_squared() > 0.0 {
+        let m = m.normalize();
+        if m.dot(&reference) >= 0.0 { m } else { -m }
+    } else {
+        reference
+    };
+    let r = {
+        let t = e1 - n * n.dot(&e1);
+        if t.norm_squared() > 0.0 {
+            t.normalize()
+        } else {
+            crate::target::orthonormal_basis(&n)[0]
+        }
+    };
+    let s = n.cross(&r);
+    let nodes = triangle(elements, f);
+    let (mut fx, mut fy) = (Vector3::zeros(), Vector3::zeros());
+    for (k, v) in nodes.iter().enumerate() {
+        fx += image[v.idx()].coords * q.grad[k].x;
+        fy += image[v.idx()].coords * q.grad[k].y;
+    }
+    let along = |v: &Vector3<f64>| Complex64::new(v.dot(&r), v.dot(&s));
+    ImageFace {
+        derivatives: PointDerivatives::from_xy(along(&fx), along(&fy)),
+        r,
+        s,
+        local: [
+            Vector2::zeros(),
+            Vector2::new(e1.dot(&r), e1.dot(&s)),
+            Vector2::new(e2.dot(&r), e2.dot(&s)),
+        ],
+    }
+}
+
+/// Every image face of the map `image`, into `out` (cleared first).
+pub fn image_faces<G: TargetGeometry>(
+    elements: &Elements,
+    target: &G,
+    image: &[Point3<f64>],
+    out: &mut Vec<ImageFace>,
+) {
+    out.clear();
+    out.extend(
+        (0..elements.face_count()).map(|f| image_face(elements, target, image, FaceId(f as u32))),
+    );
+}
+
+/// What the flow decreases: `E = sum_T A_T |mu_T - sigma_T|^p` over the source faces
+/// (areas `A_T`), with `sigma = 0` for the conformal goals.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Objective {
+    /// Source face areas.
+    pub areas: Vec<f64>,
+    /// The target coefficient per face, in the source elements' frame (`None`: zero).
+    pub sigma: Option<Vec<Complex64>>,
+    /// The exponent `p >= 2`.
+    pub p: f64,
+}
+
+impl Objective {
+    /// The target coefficient of face `f`.
+    #[inline]
+    pub fn sigma(&self, f: usize) -> Complex64 {
+        self.sigma.as_ref().map_or(Complex64::default(), |s| s[f])
+    }
+
+    /// `E` and the number of flipped faces of `faces`.
+    pub fn evaluate(&self, faces: &[ImageFace]) -> (f64, usize) {
+        let mut energy = 0.0;
+        let mut flipped = 0;
+        for (f, face) in faces.iter().enumerate() {
+            let d = (face.mu() - self.sigma(f)).norm();
+            energy += self.areas[f] * if self.p == 2.0 { d * d } else { d.powf(self.p) };
+            flipped += usize::from(face.flipped());
+        }
+        (energy, flipped)
+    }
+}

@@ -1,0 +1,290 @@
+//! The geometry of a fixed target domain, as the flow sees it.
+//!
+//! The flow moves the image `Y_i` of every source vertex by a tangent vector of the
+//! target (Wong-Zhao 2014, section 4.5): a vertex with [`Role::Free`] moves in the
+//! target's tangent plane at `Y_i` (two unknowns), a vertex with [`Role::Curve`] along
+//! the tangent of a boundary curve (one unknown), a [`Role::Fixed`] vertex not at all.
+//! After each step [`TargetGeometry::project`] puts every image back onto the target
+//! (the surface, or its boundary curve). A curve may have a free normal offset (the
+//! inner circle of an annulus whose radius is an unknown): one more unknown shared by the
+//! vertices on it, moving them along [`TargetGeometry::curve_offset_direction`].
+//!
+//! Orientation: [`TargetGeometry::normal`] is the side a counter-clockwise source face
+//! must face once mapped; an image face turning the other way is flipped.
+
+use beltrami_mesh::{Point3, Vector3};
+
+/// How a vertex may move on the target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// Anywhere on the target surface (two tangent unknowns).
+    Free,
+    /// Along boundary curve `c` of the target (one unknown).
+    Curve(usize),
+    /// Held where it is (a pin or a polygon corner).
+    Fixed,
+}
+
+/// A target domain of the flow: its normals, tangents, boundary curves and projections.
+pub trait TargetGeometry: Clone {
+    /// The unit normal at `p` (the orientation reference).
+    fn normal(&self, p: &Point3<f64>) -> Vector3<f64>;
+
+    /// A positively oriented orthonormal tangent basis `(u, v)` at `p`
+    /// (`u x v = normal(p)`).
+    fn tangent_basis(&self, p: &Point3<f64>) -> [Vector3<f64>; 2] {
+        orthonormal_basis(&self.normal(p))
+    }
+
+    /// The unit tangent of boundary curve `curve` at `p`.
+    fn curve_tangent(&self, curve: usize, p: &Point3<f64>) -> Vector3<f64>;
+
+    /// The direction a free offset of `curve` moves its points at `p`, or `None` when
+    /// the curve is fixed (the default).
+    fn curve_offset_direction(&self, _curve: usize, _p: &Point3<f64>) -> Option<Vector3<f64>> {
+        None
+    }
+
+    /// Moves `curve` by `delta` along its offset direction (curves with a free offset
+    /// only; others ignore it).
+    fn offset_curve(&mut self, _curve: usize, _delta: f64) {}
+
+    /// The number of boundary curves.
+    fn curve_count(&self) -> usize;
+
+    /// The point of the target (for [`Role::Free`]) or of its curve (for
+    /// [`Role::Curve`]) nearest to `p`; [`Role::Fixed`] points are returned unchanged.
+    fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64>;
+}
+
+/// A positively oriented orthonormal basis `(u, v)` of the plane orthogonal to the unit
+/// vector `n` (`u x v = n`), continuous away from `n = -e_z`.
+pub fn orthonormal_basis(n: &Vector3<f64>) -> [Vector3<f64>; 2] {
+    // Frisvad's construction with the branch at the south pole (Duff et al. 2017).
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    [
+        Vector3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        Vector3::new(b, sign + n.y * n.y * a, -n.y),
+    ]
+}
+
+/// A straight side of a planar region, from corner `a` to corner `b`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Side {
+    /// Start corner.
+    pub a: Point3<f64>,
+    /// End corner.
+    pub b: Point3<f64>,
+}
+
+impl Side {
+    fn closest(&self, p: &Point3<f64>) -> Point3<f64> {
+        let d = self.b - self.a;
+        let t = ((p - self.a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+        self.a + t * d
+    }
+}
+
+/// A polygonal region of the plane z = 0 (possibly with holes): its boundary is a set of
+/// straight [`Side`]s between corners. Boundary points slide along their side; corners
+/// stay. Curve `c` is side `c`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaneRegion {
+    /// The sides, one curve each.
+    pub sides: Vec<Side>,
+}
+
+impl TargetGeometry for PlaneRegion {
+    fn normal(&self, _p: &Point3<f64>) -> Vector3<f64> {
+        Vector3::z()
+    }
+
+    fn tangent_basis(&self, _p: &Point3<f64>) -> [Vector3<f64>; 2] {
+        [Vector3::x(), Vector3::y()]
+    }
+
+    fn curve_tangent(&self, curve: usize, _p: &Point3<f64>) -> Vector3<f64> {
+        let s = &self.sides[curve];
+        (s.b - s.a).normalize()
+    }
+
+    fn curve_count(&self) -> usize {
+        self.sides.len()
+    }
+
+    fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64> {
+        match role {
+            Role::Free => Point3::new(p.x, p.y, 0.0),
+            Role::Curve(c) => self.sides[c].closest(p),
+            Role::Fixed => *p,
+        }
+    }
+}
+
+/// Circles centred at the origin of the plane z = 0, as boundary curves.
+fn circle_tangent(p: &Point3<f64>) -> Vector3<f64> {
+    Vector3::new(-p.y, p.x, 0.0).normalize()
+}
+
+fn onto_circle(p: &Point3<f64>, radius: f64) -> Point3<f64> {
+    let r = p.x.hypot(p.y);
+    if r > 0.0 {
+        Point3::new(p.x * radius / r, p.y * radius / r, 0.0)
+    } else {
+        Point3::new(radius, 0.0, 0.0)
+    }
+}
+
+/// The unit disk `|z| <= 1`; curve 0 is the unit circle, traversed counter-clockwise.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct UnitDisk;
+
+impl TargetGeometry for UnitDisk {
+    fn normal(&self, _p: &Point3<f64>) -> Vector3<f64> {
+        Vector3::z()
+    }
+
+    fn tangent_basis(&self, _p: &Point3<f64>) -> [Vector3<f64>; 2] {
+        [Vector3::x(), Vector3::y()]
+    }
+
+    fn curve_tangent(&self, _curve: usize, p: &Point3<f64>) -> Vector3<f64> {
+        circle_tangent(p)
+    }
+
+    fn curve_count(&self) -> usize {
+        1
+    }
+
+    fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64> {
+        match role {
+            Role::Free => Point3::new(p.x, p.y, 0.0),
+            Role::Curve(_) => onto_circle(p, 1.0),
+            Role::Fixed => *p,
+        }
+    }
+}
+
+/// The annulus `r <= |z| <= 1`: curve 0 is the unit circle, curve 1 the inner circle.
+/// With `free_inner`, `r` is an unknown of the flow (the conformal modulus
+/// `log(1/r) / 2 pi` is then found, not imposed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Annulus {
+    /// The inner radius `0 < r < 1`.
+    pub inner_radius: f64,
+    /// Whether the inner radius moves with the flow.
+    pub free_inner: bool,
+}
+
+/// The outer circle of an [`Annulus`].
+pub const OUTER: usize = 0;
+/// The inner circle of an [`Annulus`].
+pub const INNER: usize = 1;
+
+impl TargetGeometry for Annulus {
+    fn normal(&self, _p: &Point3<f64>) -> Vector3<f64> {
+        Vector3::z()
+    }
+
+    fn tangent_basis(&self, _p: &Point3<f64>) -> [Vector3<f64>; 2] {
+        [Vector3::x(), Vector3::y()]
+    }
+
+    fn curve_tangent(&self, _curve: usize, p: &Point3<f64>) -> Vector3<f64> {
+        circle_tangent(p)
+    }
+
+    fn curve_offset_direction(&self, curve: usize, p: &Point3<f64>) -> Option<Vector3<f64>> {
+        (curve == INNER && self.free_inner).then(|| Vector3::new(p.x, p.y, 0.0).normalize())
+    }
+
+    fn offset_curve(&mut self, curve: usize, delta: f64) {
+        if curve == INNER && self.free_inner {
+            self.inner_radius += delta;
+        }
+    }
+
+    fn curve_count(&self) -> usize {
+        2
+    }
+
+    fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64> {
+        match role {
+            Role::Free => Point3::new(p.x, p.y, 0.0),
+            Role::Curve(OUTER) => onto_circle(p, 1.0),
+            Role::Curve(_) => onto_circle(p, self.inner_radius),
+            Role::Fixed => *p,
+        }
+    }
+}
+
+/// The unit sphere centred at the origin, outward normal; no boundary curves.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct UnitSphere;
+
+impl TargetGeometry for UnitSphere {
+    fn normal(&self, p: &Point3<f64>) -> Vector3<f64> {
+        p.coords.normalize()
+    }
+
+    fn curve_tangent(&self, _curve: usize, p: &Point3<f64>) -> Vector3<f64> {
+        orthonormal_basis(&self.normal(p))[0]
+    }
+
+    fn curve_count(&self) -> usize {
+        0
+    }
+
+    fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64> {
+        match role {
+            Role::Fixed => *p,
+            _ => Point3::from(p.coords.normalize()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_is_orthonormal_and_positive() {
+        for n in [
+            Vector3::new(0.0, 0.0, 1.0),
+            Vector3::new(0.0, 0.0, -1.0),
+            Vector3::new(0.3, -0.4, 0.2).normalize(),
+            Vector3::new(-0.1, 0.2, -0.9).normalize(),
+        ] {
+            let [u, v] = orthonormal_basis(&n);
+            assert!((u.norm() - 1.0).abs() < 1e-14 && (v.norm() - 1.0).abs() < 1e-14);
+            assert!(u.dot(&v).abs() < 1e-14 && u.dot(&n).abs() < 1e-14);
+            assert!((u.cross(&v) - n).norm() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn projections_land_on_the_target() {
+        let p = Point3::new(0.3, -1.7, 0.2);
+        assert!((UnitDisk.project(Role::Curve(0), &p).coords.norm() - 1.0).abs() < 1e-15);
+        let annulus = Annulus {
+            inner_radius: 0.4,
+            free_inner: false,
+        };
+        let q = annulus.project(Role::Curve(INNER), &p);
+        assert!((q.coords.norm() - 0.4).abs() < 1e-15 && q.z == 0.0);
+        assert!((UnitSphere.project(Role::Free, &p).coords.norm() - 1.0).abs() < 1e-15);
+        let square = PlaneRegion {
+            sides: vec![Side {
+                a: Point3::new(0.0, 0.0, 0.0),
+                b: Point3::new(1.0, 0.0, 0.0),
+            }],
+        };
+        assert_eq!(
+            square.project(Role::Curve(0), &p),
+            Point3::new(0.3, 0.0, 0.0)
+        );
+        assert_eq!(square.project(Role::Fixed, &p), p);
+    }
+}
