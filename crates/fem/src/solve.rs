@@ -142,6 +142,13 @@ pub enum SolveError {
         /// The largest accepted.
         limit: f64,
     },
+    /// An elimination order that is not a permutation: entry `index` is out of range or
+    /// repeated.
+    #[error("the elimination order is not a permutation (entry {index})")]
+    InvalidOrder {
+        /// The offending entry.
+        index: usize,
+    },
     /// [`SpdSolver::solve_in_place`] was called without a successful factorization.
     #[error("no factorization to solve with: factorize a matrix first")]
     NotFactored,
@@ -518,6 +525,34 @@ impl<T: Scalar> SpdSolver<T> {
         })
     }
 
+    /// [`SpdSolver::new`] eliminating the unknowns in the order `order` (`order[k]` is
+    /// the unknown eliminated k-th; a permutation of `0..n`) instead of AMD's. Unknowns
+    /// that come in groups (two per mesh vertex) factor faster, and order far faster,
+    /// with the AMD order of the groups' graph expanded group by group
+    /// ([`amd_order`]).
+    pub fn with_order(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: &[usize],
+        options: SolveOptions,
+    ) -> Result<Self, SolveError> {
+        let n = pattern.nrows();
+        check_len("the column count of the pattern", n, pattern.ncols())?;
+        check_len("the length of the order", n, order.len())?;
+        let mut inverse = vec![usize::MAX; n];
+        for (k, &i) in order.iter().enumerate() {
+            if i >= n || inverse[i] != usize::MAX {
+                return Err(SolveError::InvalidOrder { index: k });
+            }
+            inverse[i] = k;
+        }
+        Ok(Self {
+            pattern: pattern.to_owned()?,
+            cholesky: Cholesky::with_ordering(pattern, Some((order, &inverse)), options.par())?,
+            options,
+            factored: false,
+        })
+    }
+
     /// The number of unknowns.
     pub fn len(&self) -> usize {
         self.pattern.nrows()
@@ -594,4 +629,25 @@ impl<T: Scalar> SpdSolver<T> {
         }
         Ok(())
     }
+}
+
+/// The approximate minimum degree order of the symmetric pattern `pattern + pattern^T`
+/// (faer's AMD): `order[k]` is the row to eliminate k-th.
+pub fn amd_order(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Vec<usize>, SolveError> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::amd;
+    let n = pattern.nrows();
+    check_len("the column count of the pattern", n, pattern.ncols())?;
+    let (mut forward, mut inverse) = (vec![0usize; n], vec![0usize; n]);
+    let nnz = pattern.row_idx().len();
+    let mut buffer = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<usize>(n, nnz))
+        .map_err(|_| FaerError::OutOfMemory)?;
+    amd::order_maybe_unsorted(
+        &mut forward,
+        &mut inverse,
+        pattern,
+        Default::default(),
+        MemStack::new(&mut buffer),
+    )?;
+    Ok(forward)
 }

@@ -33,6 +33,8 @@
 //!    cancelled (the map so far is returned; every accepted step decreased `E`, so it is
 //!    the best one seen).
 
+use std::time::Instant;
+
 use beltrami_core::{Context, Progress, SolverError};
 use beltrami_fem::{Elements, SolveOptions};
 use beltrami_mesh::{FaceId, Point3, Vector3};
@@ -88,6 +90,10 @@ pub struct FlowRun<G> {
     pub updates: Vec<f64>,
     /// Why it stopped.
     pub stop: Stop,
+    /// Seconds spent assembling and solving the flow systems.
+    pub solve_seconds: f64,
+    /// Seconds spent stepping, projecting and measuring (the step-size search).
+    pub step_seconds: f64,
 }
 
 impl<G> FlowRun<G> {
@@ -183,7 +189,11 @@ pub fn run<G: TargetGeometry>(
     let triangles: Vec<[usize; 3]> = (0..elements.face_count())
         .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
         .collect();
-    let mut extension = HarmonicExtension::new(&triangles, system.roles(), options.solve)?;
+    let mut extension = if target.curved() {
+        HarmonicExtension::new(&triangles, system.roles(), options.solve)?
+    } else {
+        None
+    };
     let mut delta = Vec::new();
     let mut faces = Vec::with_capacity(elements.face_count());
     image_faces(elements, &target, &image, &mut faces);
@@ -202,13 +212,17 @@ pub fn run<G: TargetGeometry>(
     };
     report(context, 0, energy);
     let mut stop = Stop::IterationLimit;
+    let (mut solve_seconds, mut step_seconds) = (0.0, 0.0);
     for iteration in 0..options.max_iterations {
         if context.is_cancelled() {
             stop = Stop::Cancelled;
             break;
         }
+        let clock = Instant::now();
         weights_and_targets(objective, &faces, &mut weights, &mut rho);
         let flow = system.solve(&target, &image, &faces, &weights, &rho)?;
+        solve_seconds += clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
         let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
         let mut t = 1.0;
         let accepted = loop {
@@ -232,6 +246,7 @@ pub fn run<G: TargetGeometry>(
             }
             t *= 0.5;
         };
+        step_seconds += clock.elapsed().as_secs_f64();
         let Some((moved, e, flips)) = accepted else {
             stop = if largest < options.tolerance {
                 Stop::Converged
@@ -261,5 +276,7 @@ pub fn run<G: TargetGeometry>(
         step_sizes,
         updates,
         stop,
+        solve_seconds,
+        step_seconds,
     })
 }

@@ -666,6 +666,12 @@ fn run<G: TargetGeometry>(
         ),
         e => e,
     })?;
+    report
+        .timings
+        .push(("flow: solves".into(), run.solve_seconds));
+    report
+        .timings
+        .push(("flow: steps".into(), run.step_seconds));
     report.iterations = run.iterations();
     report.energy_history = run.energy_history.clone();
     report.step_sizes = run.step_sizes.clone();

@@ -26,6 +26,7 @@
 
 use beltrami_core::SolverError;
 use beltrami_fem::assembly::Pattern;
+use beltrami_fem::solve::amd_order;
 use beltrami_fem::{Elements, SolveOptions, SpdSolver};
 use beltrami_mesh::{FaceId, Point3, Vector3};
 use faer::MatMut;
@@ -159,7 +160,8 @@ impl FlowSystem {
             });
         }
         let pattern = Pattern::new(n, n, &positions)?;
-        let solver = SpdSolver::new(pattern.symbolic().as_ref(), options)?;
+        let order = block_order(&faces, &roles, &first, n)?;
+        let solver = SpdSolver::with_order(pattern.symbolic().as_ref(), &order, options)?;
         Ok(Self {
             roles,
             first,
@@ -259,6 +261,36 @@ impl FlowSystem {
         }
         Ok(flow)
     }
+}
+
+/// An elimination order of the unknowns: AMD on the graph of the vertices (an edge per
+/// triangle side), each vertex's unknowns together, the shared offsets last (they couple
+/// to a whole curve). Ordering the vertex graph is about four times cheaper than the
+/// unknowns' graph, and keeps each vertex's pair in one supernode.
+fn block_order(
+    faces: &[[usize; 3]],
+    roles: &[Role],
+    first: &[usize],
+    n: usize,
+) -> Result<Vec<usize>, SolverError> {
+    let nv = roles.len();
+    let mut positions = Vec::with_capacity(nv + 3 * faces.len());
+    positions.extend((0..nv).map(|v| (v, v)));
+    for f in faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            positions.push((a.max(b), a.min(b)));
+        }
+    }
+    let graph = Pattern::new(nv, nv, &positions)?;
+    let vertices = amd_order(graph.symbolic().as_ref())?;
+    let mut order = Vec::with_capacity(n);
+    for v in vertices {
+        order.extend(first[v]..first[v] + unknowns_of(roles[v]));
+    }
+    let vertex_unknowns = order.len();
+    order.extend(vertex_unknowns..n);
+    Ok(order)
 }
 
 /// The unknown direction `index` of a vertex with `role` at `p`.

@@ -52,6 +52,13 @@ pub trait TargetGeometry: Clone {
     /// The number of boundary curves.
     fn curve_count(&self) -> usize;
 
+    /// Whether a point moved along a curve's tangent can leave the curve (a circle), so
+    /// that its projection back must be spread into the interior; false for straight
+    /// curves.
+    fn curved(&self) -> bool {
+        true
+    }
+
     /// The point of the target (for [`Role::Free`]) or of its curve (for
     /// [`Role::Curve`]) nearest to `p`; [`Role::Fixed`] points are returned unchanged.
     fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64>;
@@ -112,6 +119,10 @@ impl TargetGeometry for PlaneRegion {
 
     fn curve_count(&self) -> usize {
         self.sides.len()
+    }
+
+    fn curved(&self) -> bool {
+        false
     }
 
     fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64> {

@@ -9,6 +9,7 @@ use super::SolveError;
 use crate::dof::Scalar;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
+use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
 use faer::sparse::linalg::cholesky::{
     LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
@@ -45,12 +46,24 @@ impl<T: Scalar> Cholesky<T> {
         pattern: SymbolicSparseColMatRef<'_, usize>,
         par: Par,
     ) -> Result<Self, SolveError> {
-        let symbolic = factorize_symbolic_cholesky(
-            pattern,
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            Default::default(),
-        )?;
+        Self::with_ordering(pattern, None, par)
+    }
+
+    /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
+    /// eliminated k-th) instead of AMD, when given.
+    pub(super) fn with_ordering(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: Option<(&[usize], &[usize])>,
+        par: Par,
+    ) -> Result<Self, SolveError> {
+        let ordering = match order {
+            Some((forward, inverse)) => {
+                SymmetricOrdering::Custom(PermRef::new_checked(forward, inverse, pattern.nrows()))
+            }
+            None => SymmetricOrdering::Amd,
+        };
+        let symbolic =
+            factorize_symbolic_cholesky(pattern, Side::Lower, ordering, Default::default())?;
         let n = symbolic.nrows();
         let req = Self::scratch(&symbolic, 1, par);
         Ok(Self {

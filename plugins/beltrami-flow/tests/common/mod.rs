@@ -1,0 +1,105 @@
+//! Shared pieces of the flow tests: running a problem, error measures, the paper's
+//! diffeomorphism of the square.
+
+#![allow(dead_code)]
+
+use beltrami_core::{Context, Map, Pin, Problem, Solution, Solver};
+use beltrami_fem::MuError;
+use beltrami_fem::{Elements, Frame};
+use beltrami_flow::BeltramiFlow;
+use beltrami_mesh::{Mesh, Point3, VertexId};
+use num_complex::Complex64;
+
+/// Pins without positions at `vertices`.
+pub fn pins(vertices: &[u32]) -> Vec<Pin> {
+    vertices
+        .iter()
+        .map(|&v| Pin {
+            vertex: VertexId(v),
+            position: None,
+        })
+        .collect()
+}
+
+/// Solves `problem` with the flow.
+pub fn flow(problem: &Problem<'_>) -> Solution {
+    BeltramiFlow
+        .solve(problem, &mut Context::new())
+        .expect("the flow runs")
+}
+
+/// `|mu - target|` of a solution (measured in `frame`).
+pub fn mu_error(mesh: &Mesh, solution: &Solution, target: &[Complex64], frame: Frame) -> MuError {
+    let elements = Elements::new(mesh, frame).unwrap();
+    let measured = solution.report.mu.as_ref().expect("mu is reported");
+    assert_eq!(measured.frame, frame);
+    MuError::new(&elements, &measured.mu, target).unwrap()
+}
+
+/// The planar images of a solution.
+pub fn planar(solution: &Solution) -> &[Complex64] {
+    match &solution.map {
+        Map::Planar(z) => z,
+        other => panic!("expected a planar map, got {other:?}"),
+    }
+}
+
+/// The spatial images of a solution.
+pub fn spatial(solution: &Solution) -> &[Point3<f64>] {
+    match &solution.map {
+        Map::Spatial(p) => p,
+        other => panic!("expected a spatial map, got {other:?}"),
+    }
+}
+
+/// `z = x + i y` of a point.
+pub fn complex(p: &Point3<f64>) -> Complex64 {
+    Complex64::new(p.x, p.y)
+}
+
+/// `mu` at the face centroids of a planar mesh.
+pub fn sample(mesh: &Mesh, mu: impl Fn(Complex64) -> Complex64) -> Vec<Complex64> {
+    mesh.faces()
+        .map(|f| mu(complex(&mesh.face_centroid(f))))
+        .collect()
+}
+
+/// A strongly distorted diffeomorphism of the square `[-1, 1]^2` onto itself, fixing the
+/// corners and moving points along the top and left sides (Wong-Zhao 2014, Table 5.3
+/// uses one such map; the paper does not give its formula, this one is ours): a shear
+/// `S` sliding the boundary, then a swirl rotating the circle of radius `r <= 1` by
+/// `2 (1 - r^2)^3` radians.
+pub fn square_diffeomorphism(p: Complex64) -> Complex64 {
+    use std::f64::consts::PI;
+    let (x, y) = (p.re, p.im);
+    let s = Complex64::new(
+        x + 0.1 * (PI * x).sin() * (1.0 + y),
+        y + 0.1 * (PI * y).sin() * (1.0 - x),
+    );
+    let r2 = s.norm_sqr();
+    if r2 >= 1.0 {
+        return s;
+    }
+    s * Complex64::from_polar(1.0, 2.0 * (1.0 - r2).powi(3))
+}
+
+/// The Beltrami coefficient of `f` at `p` from central differences (step `1e-5`, error
+/// about `1e-10`).
+pub fn beltrami_of(f: impl Fn(Complex64) -> Complex64, p: Complex64) -> Complex64 {
+    let h = 1e-5;
+    let i = Complex64::i();
+    let fx = (f(p + h) - f(p - h)) / (2.0 * h);
+    let fy = (f(p + i * h) - f(p - i * h)) / (2.0 * h);
+    (fx + i * fy) / (fx - i * fy)
+}
+
+/// The square `[-1, 1]^2` with `n` by `n` cells split into triangles.
+pub fn square(n: usize) -> Mesh {
+    let mut soup =
+        beltrami_mesh::primitives::grid(n, n, beltrami_mesh::primitives::Cells::Triangles);
+    for p in &mut soup.positions {
+        p.x = 2.0 * p.x - 1.0;
+        p.y = 2.0 * p.y - 1.0;
+    }
+    Mesh::from_soup(&soup).unwrap()
+}
