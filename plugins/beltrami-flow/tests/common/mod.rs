@@ -103,3 +103,23 @@ pub fn square(n: usize) -> Mesh {
     }
     Mesh::from_soup(&soup).unwrap()
 }
+
+/// The bundled hemisphere (a cap of the unit sphere, 3600 triangles).
+pub fn hemisphere() -> Mesh {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../meshes/disk_hemisphere.obj"
+    );
+    beltrami_mesh::io::read(std::path::Path::new(path), &Default::default())
+        .expect("the bundled hemisphere reads")
+        .mesh
+}
+
+/// A deterministic pseudo-random number in `[-1, 1)` for index `i` (SplitMix64).
+pub fn noise(seed: u64, i: usize) -> f64 {
+    let mut z = seed.wrapping_add((i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    2.0 * ((z >> 11) as f64 / (1u64 << 53) as f64) - 1.0
+}
