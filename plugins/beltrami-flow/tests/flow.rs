@@ -290,7 +290,7 @@ fn bad_problems_are_typed_errors() {
     mu[7] = Complex64::new(0.0, 1.0);
     p.goal = Goal::Prescribed(BeltramiField::new(Frame::Global, mu));
     let message = rejected(&p);
-    assert!(message.contains("face 7 "), "{message}");
+    assert!(message.contains("face f7 "), "{message}");
 
     let mut p = Problem::new(&disk, Target::Disk);
     p.goal = Goal::Conformal { p: 1.5 };
