@@ -86,7 +86,8 @@ impl LateBar {
 }
 
 /// Checks and solves `problem`, with a progress bar on stderr for runs over a second
-/// when `show_progress`; returns the solution and the wall-clock seconds of the solve.
+/// when `show_progress`, Ctrl-C asking the solver to stop ([`super::interrupt`]);
+/// returns the solution and the wall-clock seconds of the solve.
 pub fn solve(
     solver: &dyn Solver,
     problem: &Problem<'_>,
@@ -96,7 +97,9 @@ pub fn solve(
     let mut bar = LateBar::new(show_progress);
     let start = Instant::now();
     let solution = {
-        let mut context = Context::new().with_progress(|p: &Progress| bar.update(p));
+        let mut context = Context::new()
+            .with_progress(|p: &Progress| bar.update(p))
+            .with_cancel_flag(super::interrupt::cancel_flag());
         solver.solve(problem, &mut context)
     };
     bar.finish();
@@ -160,6 +163,7 @@ pub fn report_json(
         "mu_std": d.map(|d| d.mu_std),
         "mu_l2": d.map(|d| d.mu_l2),
         "energy_history": r.energy_history,
+        "step_sizes": r.step_sizes,
         "timings": r.timings.iter().map(|(k, v)| json!({"stage": k, "seconds": v})).collect::<Vec<_>>(),
         "notes": r.notes,
     });
@@ -213,6 +217,14 @@ pub fn finish(
         for note in &r.notes {
             println!("  note: {note}");
         }
+    }
+    if super::interrupt::interrupted() {
+        let (_, output, solution, _) = summary;
+        bail!(
+            "interrupted after {} iterations: the map so far was written to {}",
+            solution.report.iterations,
+            output.display()
+        );
     }
     Ok(())
 }

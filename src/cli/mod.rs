@@ -5,6 +5,7 @@ mod colormap;
 mod cut;
 mod distortion;
 mod info;
+mod interrupt;
 mod load;
 mod mapping;
 mod param;
@@ -36,8 +37,8 @@ pub enum Command {
     /// Parameterize a mesh with a registered solver (tutte, harmonic, lscm) and write
     /// the map as texture coordinates.
     Param(param::ParamArgs),
-    /// A quasiconformal map with a prescribed Beltrami coefficient (lsqc), written as
-    /// texture coordinates.
+    /// A quasiconformal map with a prescribed Beltrami coefficient or the most conformal
+    /// one (lsqc, beltrami-flow) onto the plane, a disk, an annulus or the sphere.
     Qc(qc::QcArgs),
     /// List the registered solvers and what each accepts.
     Solvers(solvers::SolversArgs),

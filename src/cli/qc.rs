@@ -1,54 +1,106 @@
-//! `beltrami qc`: a quasiconformal map with a prescribed Beltrami coefficient, given
-//! per face (`--mu FILE`, the `distortion` field format) or as an expression of
-//! `z = x + i y` evaluated at the face centroids (`--mu-expr "0.6*z"`, global frame).
+//! `beltrami qc`: a quasiconformal map with a prescribed Beltrami coefficient — per face
+//! (`--mu FILE`, the `distortion` field format) or as an expression of `z`
+//! (`--mu-expr "0.6*z"`) — or the most conformal one (`--conformal [--p P]`), by lsqc
+//! (one linear solve into the plane) or beltrami-flow (onto the input's own planar
+//! region, the unit disk, an annulus or the unit sphere).
+//!
+//! `z` in `--mu-expr` is `x + i y` of the face centroids for planar targets (a mesh in
+//! the plane z = 0), and the stereographic coordinate from the north pole,
+//! `z = (x + i y) / (1 - z3)`, of the centroids for the sphere.
 
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use beltrami_core::{Goal, Map, PlanarBoundary, Problem, Target};
-use beltrami_fem::{BeltramiField, Elements};
-use beltrami_lsqc::{Expr, MuError};
-use beltrami_mesh::Mesh;
+use beltrami_fem::{BeltramiField, Elements, MuError};
+use beltrami_lsqc::Expr;
+use beltrami_mesh::io::read;
+use beltrami_mesh::{BuildOptions, Mesh};
 use clap::{ArgGroup, Args, ValueEnum};
+use num_complex::Complex64;
 use serde_json::json;
 
 use super::load::load_mesh;
 use super::mapping;
 use super::pins::PinSpec;
 
-/// Boundary conditions of `--boundary`.
+/// Where `--target` maps to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TargetArg {
+    /// The plane: lsqc with the boundary of `--boundary`; beltrami-flow onto the input's
+    /// own planar region (boundary sliding along its straight sides, corners fixed).
+    Plane,
+    /// The unit disk (boundary sliding on the circle).
+    Disk,
+    /// The annulus `r <= |z| <= 1` (the input must be such an annulus; see
+    /// `--free-radius`).
+    Annulus,
+    /// The unit sphere (closed genus-0 meshes).
+    Sphere,
+}
+
+/// Boundary conditions of `--boundary` (lsqc, plane target).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum QcBoundaryArg {
     /// Keep the input's own boundary positions (a mesh in the plane z = 0).
     Keep,
     /// Free boundary with pins (two boundary vertices far apart by default).
     Free,
+    /// The boundary of the map in `--boundary-map`.
+    Given,
 }
 
 #[derive(Debug, Args)]
-#[command(group(ArgGroup::new("coefficient").required(true).args(["mu", "mu_expr"])))]
+#[command(group(ArgGroup::new("goal").required(true).args(["mu", "mu_expr", "conformal"])))]
 pub struct QcArgs {
     /// Mesh file (.obj, .gltf, .glb).
     pub mesh: PathBuf,
-    /// Solver name: lsqc.
+    /// Solver name: lsqc or beltrami-flow.
     #[arg(long, default_value = "lsqc")]
     pub solver: String,
     /// The Beltrami coefficient per face, in the field format (`# mu frame=... faces=N`).
     #[arg(long)]
     pub mu: Option<PathBuf>,
-    /// The Beltrami coefficient as an expression of z (e.g. "0.6*z", "0.3+0.3i"),
-    /// evaluated at the face centroids of a mesh in the plane z = 0.
+    /// The Beltrami coefficient as an expression of z (e.g. "0.6*z", "0.3+0.3i"), at the
+    /// face centroids (module docs: z on the sphere is stereographic).
     #[arg(long = "mu-expr")]
     pub mu_expr: Option<String>,
-    /// Boundary condition.
+    /// The most conformal map instead: the smallest L^p norm of mu.
+    #[arg(long)]
+    pub conformal: bool,
+    /// The exponent of `--conformal` (beltrami-flow: p >= 2; lsqc: 2 only) [default: 2].
+    #[arg(long)]
+    pub p: Option<f64>,
+    /// Where the map goes.
+    #[arg(long, value_enum, default_value = "plane")]
+    pub target: TargetArg,
+    /// lsqc's boundary condition on the plane.
     #[arg(long, value_enum, default_value = "free")]
     pub boundary: QcBoundaryArg,
+    /// With `--boundary given`: a mesh of the same vertices whose texture coordinates
+    /// (or, without them, x and y) give the boundary positions.
+    #[arg(long = "boundary-map")]
+    pub boundary_map: Option<PathBuf>,
+    /// Annulus target: let the inner radius move (the prescribed mu fixes the conformal
+    /// modulus); by default the input's inner radius is kept.
+    #[arg(long = "free-radius")]
+    pub free_radius: bool,
     /// Pin a vertex where it is: `v12` by its 0-based index, or `x,y[,z]` for the
     /// nearest vertex; repeatable.
     #[arg(long = "pin")]
     pub pins: Vec<PinSpec>,
+    /// beltrami-flow: stop when the largest vertex update is below this (relative to
+    /// the target's size).
+    #[arg(long, default_value_t = 1e-6)]
+    pub tolerance: f64,
+    /// beltrami-flow: most iterations.
+    #[arg(long = "max-iters", default_value_t = 200)]
+    pub max_iters: usize,
+    /// Threads for the sparse factorizations.
+    #[arg(long, default_value_t = 1)]
+    pub threads: usize,
     /// Output mesh: .obj (the input's vertices and faces, one `vt` per vertex with its
-    /// image) or .glb/.gltf.
+    /// planar image, or the image positions for the sphere) or .glb/.gltf.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Write the JSON report here.
@@ -62,17 +114,95 @@ pub struct QcArgs {
     pub repair: bool,
 }
 
-/// The prescribed field from `--mu` or `--mu-expr`.
-fn field_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<BeltramiField> {
-    if let Some(path) = &args.mu {
-        return Ok(BeltramiField::read(path, mesh.face_count())?);
+/// The goal of `--mu`, `--mu-expr` or `--conformal`, and the field it prescribes (zero
+/// for the conformal goal, in the frame the error is measured in).
+fn goal_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<(Goal, Option<BeltramiField>)> {
+    if args.conformal {
+        return Ok((
+            Goal::Conformal {
+                p: args.p.unwrap_or(2.0),
+            },
+            None,
+        ));
     }
-    let Some(text) = &args.mu_expr else {
-        bail!("give the Beltrami coefficient with --mu FILE or --mu-expr EXPR");
+    if args.p.is_some() {
+        bail!("--p is the exponent of --conformal; a prescribed mu has no exponent");
+    }
+    let field = if let Some(path) = &args.mu {
+        BeltramiField::read(path, mesh.face_count())?
+    } else {
+        let Some(text) = &args.mu_expr else {
+            bail!("give the goal with --mu FILE, --mu-expr EXPR or --conformal");
+        };
+        let expr = Expr::parse(text).with_context(|| format!("--mu-expr `{text}`"))?;
+        if args.target == TargetArg::Sphere {
+            beltrami_flow::stereographic::field(mesh, |z| expr.eval(z))
+                .with_context(|| format!("--mu-expr `{text}` on the sphere"))?
+        } else {
+            expr.field(mesh).with_context(|| {
+                "--mu-expr evaluates mu at z = x + i y and needs a mesh in the plane z = 0; give a per-face field with --mu"
+            })?
+        }
     };
-    let expr = Expr::parse(text).with_context(|| format!("--mu-expr `{text}`"))?;
-    expr.field(mesh).with_context(|| {
-        "--mu-expr evaluates mu at z = x + i y and needs a mesh in the plane z = 0; give a per-face field with --mu"
+    Ok((Goal::Prescribed(field.clone()), Some(field)))
+}
+
+/// The planar map of `--boundary-map`: its texture coordinates, or its x and y.
+fn boundary_map(path: &std::path::Path, mesh: &Mesh) -> anyhow::Result<Vec<Complex64>> {
+    let loaded = read(path, &BuildOptions::default())
+        .with_context(|| format!("--boundary-map {}", path.display()))?;
+    let other = &loaded.mesh;
+    if other.vertex_count() != mesh.vertex_count() {
+        bail!(
+            "--boundary-map {} has {} vertices, the mesh {}",
+            path.display(),
+            other.vertex_count(),
+            mesh.vertex_count()
+        );
+    }
+    Ok(match loaded.vertex_uvs() {
+        Some(uv) => uv.iter().map(|t| Complex64::new(t.x, t.y)).collect(),
+        None => other
+            .positions()
+            .iter()
+            .map(|p| Complex64::new(p.x, p.y))
+            .collect(),
+    })
+}
+
+/// The target of `--target` (and `--boundary`, `--free-radius`).
+fn target_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<Target<'static>> {
+    Ok(match args.target {
+        TargetArg::Plane if args.solver == "lsqc" => Target::Plane(match args.boundary {
+            QcBoundaryArg::Keep => PlanarBoundary::Keep,
+            QcBoundaryArg::Free => PlanarBoundary::Free,
+            QcBoundaryArg::Given => {
+                let Some(path) = &args.boundary_map else {
+                    bail!("--boundary given needs --boundary-map FILE");
+                };
+                PlanarBoundary::Given(boundary_map(path, mesh)?)
+            }
+        }),
+        TargetArg::Plane => Target::Plane(PlanarBoundary::Keep),
+        TargetArg::Disk => Target::Disk,
+        TargetArg::Annulus => Target::Annulus {
+            inner_radius: if args.free_radius {
+                None
+            } else {
+                let loops = mesh.boundary_loop_list();
+                loops
+                    .iter()
+                    .map(|l| {
+                        l.vertices
+                            .iter()
+                            .map(|&v| mesh.position(v).coords.xy().norm())
+                            .sum::<f64>()
+                            / l.vertices.len() as f64
+                    })
+                    .min_by(f64::total_cmp)
+            },
+        },
+        TargetArg::Sphere => Target::Sphere,
     })
 }
 
@@ -82,30 +212,46 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     let solver = registry.get(&args.solver)?;
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
     let mesh = &loaded.mesh.mesh;
-    let field = field_of(args, mesh)?;
+    let (goal, field) = goal_of(args, mesh)?;
 
-    let boundary = match args.boundary {
-        QcBoundaryArg::Keep => PlanarBoundary::Keep,
-        QcBoundaryArg::Free => PlanarBoundary::Free,
-    };
-    let mut problem = Problem::new(mesh, Target::Plane(boundary));
-    problem.goal = Goal::Prescribed(field.clone());
+    let mut problem = Problem::new(mesh, target_of(args, mesh)?);
+    problem.goal = goal;
     problem.constraints.pins = mapping::resolve_pins(&args.pins, mesh)?;
+    problem.params.tolerance = args.tolerance;
+    problem.params.max_iterations = args.max_iters;
+    problem.params.threads = args.threads;
 
     let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.json)?;
-    let error = match &solution.report.mu {
-        Some(measured) if measured.frame == field.frame => {
+    let error = match (&solution.report.mu, &field) {
+        (Some(measured), Some(field)) if measured.frame == field.frame => {
             let elements = Elements::new(mesh, field.frame)?;
             Some(MuError::new(&elements, &measured.mu, &field.mu)?)
         }
+        (Some(measured), None) => {
+            let elements = Elements::new(mesh, measured.frame)?;
+            let zero = vec![Complex64::default(); measured.mu.len()];
+            Some(MuError::new(&elements, &measured.mu, &zero)?)
+        }
         _ => None,
     };
-    if !matches!(solution.map, Map::Planar(_)) {
-        bail!("this command writes planar maps only");
+    if let (Map::Spatial(_), false) = (&solution.map, args.target == TargetArg::Sphere) {
+        bail!("{} gave points in space for a planar target", solver.name());
     }
     mapping::write_map(&args.output, mesh, &solution)?;
 
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
+    report.insert(
+        "target".into(),
+        json!(format!("{:?}", args.target).to_lowercase()),
+    );
+    report.insert(
+        "goal".into(),
+        json!(if args.conformal {
+            format!("conformal L^{}", args.p.unwrap_or(2.0))
+        } else {
+            "prescribed mu".into()
+        }),
+    );
     report.insert("mu_error_l2".into(), json!(error.as_ref().map(|e| e.rms)));
     report.insert(
         "mu_error_l2_squared".into(),
@@ -116,7 +262,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         "mu_error_sup_face".into(),
         json!(error.as_ref().map(|e| e.sup_face.idx())),
     );
-    let extra: Vec<String> = error
+    let mut extra: Vec<String> = error
         .iter()
         .map(|e| {
             format!(
@@ -125,6 +271,24 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             )
         })
         .collect();
+    if solution.report.iterations > 0 {
+        extra.push(format!(
+            "iterations      {} (error {:.4e} -> {:.4e})",
+            solution.report.iterations,
+            solution
+                .report
+                .energy_history
+                .first()
+                .copied()
+                .unwrap_or(0.0),
+            solution
+                .report
+                .energy_history
+                .last()
+                .copied()
+                .unwrap_or(0.0)
+        ));
+    }
     mapping::finish(
         report,
         args.report.as_deref(),

@@ -49,6 +49,9 @@ use crate::target::{Role, TargetGeometry};
 /// already conformal keep a positive weight.
 const MU_FLOOR: f64 = 1e-3;
 
+/// The smallest step size tried (`2^-50`): below it the step is lost in rounding.
+const MIN_STEP: f64 = 8.881_784_197_001_252e-16;
+
 /// How the iteration ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stop {
@@ -226,7 +229,7 @@ pub fn run<G: TargetGeometry>(
         let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
         let mut t = 1.0;
         let accepted = loop {
-            if t * largest < options.tolerance {
+            if t * largest < options.tolerance || t < MIN_STEP {
                 break None;
             }
             let moved = step(

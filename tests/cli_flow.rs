@@ -1,0 +1,231 @@
+//! End-to-end runs of `beltrami qc --solver beltrami-flow`: each target, the report's
+//! iteration history and errors, Ctrl-C writing the map so far, and the errors of bad
+//! requests.
+
+use std::path::{Path, PathBuf};
+
+use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_mesh::{BuildOptions, Mesh, primitives};
+
+mod common;
+use common::{beltrami, s, text};
+
+fn write(dir: &Path, name: &str, mesh: &Mesh) -> PathBuf {
+    let path = dir.join(name);
+    io::write(&path, mesh, &VertexAttributes::default()).unwrap();
+    path
+}
+
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn vt_lines(path: &Path) -> Vec<(f64, f64)> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("vt "))
+        .map(|l| {
+            let mut it = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
+            (it.next().unwrap(), it.next().unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn conformal_flow_onto_the_disk_writes_the_map_and_its_history() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("disk.obj");
+    let report = dir.path().join("report.json");
+    let run = beltrami(&[
+        "qc",
+        "meshes/disk_hemisphere.obj",
+        "--solver",
+        "beltrami-flow",
+        "--target",
+        "disk",
+        "--conformal",
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let r = read_json(&report);
+    assert_eq!(r["solver"], "beltrami-flow");
+    assert_eq!(r["flipped"], 0);
+    let iterations = r["iterations"].as_u64().unwrap() as usize;
+    assert!(iterations > 0);
+    assert_eq!(r["step_sizes"].as_array().unwrap().len(), iterations);
+    let history = r["energy_history"].as_array().unwrap();
+    assert_eq!(history.len(), iterations + 1);
+    assert!(history.last().unwrap().as_f64().unwrap() < history[0].as_f64().unwrap());
+    assert!(r["mu_error_sup"].as_f64().unwrap() < 0.05);
+    let uv = vt_lines(&out);
+    let mesh = io::read(
+        Path::new("meshes/disk_hemisphere.obj"),
+        &BuildOptions::default(),
+    )
+    .unwrap()
+    .mesh;
+    assert_eq!(uv.len(), mesh.vertex_count());
+    for l in mesh.boundary_loop_list() {
+        for v in l.vertices {
+            let (x, y) = uv[v.idx()];
+            assert!((x.hypot(y) - 1.0).abs() < 1e-9);
+        }
+    }
+}
+
+#[test]
+fn sphere_target_takes_a_stereographic_expression() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = Mesh::from_soup(&primitives::octahedral_sphere(3)).unwrap();
+    let input = write(dir.path(), "sphere.obj", &sphere);
+    let out = dir.path().join("image.obj");
+    let report = dir.path().join("report.json");
+    let run = beltrami(&[
+        "qc",
+        s(&input),
+        "--solver",
+        "beltrami-flow",
+        "--target",
+        "sphere",
+        "--mu-expr",
+        "0.3+0.3i",
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let image = io::read(&out, &BuildOptions::default()).unwrap().mesh;
+    for p in image.positions() {
+        assert!((p.coords.norm() - 1.0).abs() < 1e-9);
+    }
+    let r = read_json(&report);
+    assert_eq!(r["flipped"], 0);
+    // Table 5.2, level 3: the paper's squared L2 error is 0.1145.
+    assert!(r["mu_error_l2_squared"].as_f64().unwrap() < 0.1145);
+    let notes = r["notes"].as_array().unwrap();
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.as_str().unwrap().contains("pinned vertices 0, 1, 5"))
+    );
+}
+
+#[test]
+fn annulus_with_a_free_radius_reports_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let annulus = Mesh::from_soup(&primitives::annulus(0.4, 6, 48)).unwrap();
+    let input = write(dir.path(), "annulus.obj", &annulus);
+    let out = dir.path().join("image.obj");
+    let run = beltrami(&[
+        "qc",
+        s(&input),
+        "--solver",
+        "beltrami-flow",
+        "--target",
+        "annulus",
+        "--free-radius",
+        "--mu-expr",
+        "0.6*z^3",
+        "--pin",
+        "1,0",
+        "-o",
+        s(&out),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let summary = text(&run.stdout);
+    assert!(summary.contains("inner radius 0.4"), "{summary}");
+    assert!(summary.contains("flipped faces   0"), "{summary}");
+}
+
+#[test]
+fn ctrl_c_writes_the_map_so_far() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = Mesh::from_soup(&primitives::octahedral_sphere(7)).unwrap();
+    let input = write(dir.path(), "sphere.obj", &sphere);
+    let out = dir.path().join("image.obj");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_beltrami"))
+        .args([
+            "qc",
+            s(&input),
+            "--solver",
+            "beltrami-flow",
+            "--target",
+            "sphere",
+            "--mu-expr",
+            "0.3+0.3i",
+            "--tolerance",
+            "1e-12",
+            "-o",
+            s(&out),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_secs(3));
+    // SAFETY: signalling our own child process.
+    unsafe {
+        libc::kill(child.id() as libc::pid_t, libc::SIGINT);
+    }
+    let run = child.wait_with_output().unwrap();
+    let stderr = text(&run.stderr);
+    assert!(!run.status.success());
+    assert!(stderr.contains("interrupted after"), "{stderr}");
+    assert!(stderr.contains("the map so far was written"), "{stderr}");
+    let image = io::read(&out, &BuildOptions::default()).unwrap().mesh;
+    assert_eq!(image.vertex_count(), sphere.vertex_count());
+}
+
+#[test]
+fn bad_requests_fail_with_a_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let run = beltrami(&[
+        "qc",
+        "meshes/disk_hemisphere.obj",
+        "--solver",
+        "beltrami-flow",
+        "--target",
+        "sphere",
+        "--conformal",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("closed genus-0"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!out.exists(), "nothing written");
+
+    let run = beltrami(&[
+        "qc",
+        "meshes/disk_hemisphere.obj",
+        "--boundary",
+        "given",
+        "--conformal",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(text(&run.stderr).contains("--boundary-map"));
+
+    let run = beltrami(&[
+        "qc",
+        "meshes/disk_hemisphere.obj",
+        "--mu-expr",
+        "0",
+        "--p",
+        "3",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(text(&run.stderr).contains("--conformal"));
+}
