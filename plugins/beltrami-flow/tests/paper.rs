@@ -1,37 +1,29 @@
 //! Wong-Zhao 2014, section 5: Tables 5.1-5.3 and Fig. 5.9 reproduced.
 //!
-//! The paper's "sup" column is `max_T |mu_T - target(centroid_T)|` and its "L2" column is
-//! `sum_T A_T |mu_T - target_T|^2` (squared, not normalized): it falls by about 4 per
-//! level while the area-weighted RMS error falls by about 2 (first order in `h`). Table
-//! 5.1's levels 6 and 7 look misprinted by a factor of 10 (the other levels and the
-//! first-order rate give 3.4e-4 and 8.6e-5). Our tables next to the paper's are in
-//! `docs/flow.md`.
+//! What the paper's columns measure: [`beltrami_flow::paper`]. Our tables next to the
+//! paper's are in `docs/flow.md` (`beltrami bench flow` prints them).
 
 mod common;
 
 use beltrami_core::{PlanarBoundary, Problem, Target};
 use beltrami_fem::{BeltramiField, Frame};
+use beltrami_flow::paper::*;
 use beltrami_flow::stereographic::{self, inverse_stereographic, stereographic};
 use beltrami_mesh::{Mesh, Point3, primitives};
 use common::*;
 use num_complex::Complex64;
 
-/// Table 5.1: level, faces, steps, sup, L2 (squared).
-const TABLE_5_1: [(usize, usize, usize, f64, f64); 8] = [
-    (0, 4, 4, 0.2000, 0.0800),
-    (1, 16, 12, 0.2795, 0.0813),
-    (2, 64, 12, 0.2251, 0.0458),
-    (3, 256, 13, 0.1767, 0.0176),
-    (4, 1024, 12, 0.1060, 0.0052),
-    (5, 4096, 10, 0.0582, 0.0013),
-    (6, 16384, 9, 0.0306, 0.341e-4),
-    (7, 65536, 9, 0.0157, 0.855e-5),
-];
-
 #[test]
 fn table_5_1_disk_with_mu_0_6_z() {
     let mut rows = Vec::new();
-    for &(level, faces, paper_steps, paper_sup, _) in &TABLE_5_1 {
+    for &DiskRow {
+        level,
+        faces,
+        steps: paper_steps,
+        sup: paper_sup,
+        ..
+    } in &TABLE_5_1
+    {
         let mesh = Mesh::from_soup(&primitives::disk(level)).unwrap();
         assert_eq!(mesh.face_count(), faces);
         let sigma = sample(&mesh, |z| 0.6 * z);
@@ -92,17 +84,6 @@ fn table_5_1_disk_with_mu_0_6_z() {
     }
 }
 
-/// Table 5.2: level, faces, steps, L2 (squared).
-const TABLE_5_2: [(usize, usize, usize, f64); 7] = [
-    (0, 8, 9, 0.1246),
-    (1, 32, 13, 0.3892),
-    (2, 128, 14, 0.2692),
-    (3, 512, 14, 0.1145),
-    (4, 2048, 12, 0.0412),
-    (5, 8192, 11, 0.0138),
-    (6, 32768, 10, 0.0044),
-];
-
 #[test]
 fn table_5_2_sphere_with_constant_mu() {
     let k = Complex64::new(0.3, 0.3);
@@ -116,7 +97,13 @@ fn table_5_2_sphere_with_constant_mu() {
     };
     let mut l2 = Vec::new();
     let mut position = Vec::new();
-    for &(level, faces, paper_steps, paper_l2) in &TABLE_5_2 {
+    for &SphereRow {
+        level,
+        faces,
+        steps: paper_steps,
+        l2: paper_l2,
+    } in &TABLE_5_2
+    {
         let mesh = Mesh::from_soup(&primitives::octahedral_sphere(level)).unwrap();
         assert_eq!(mesh.face_count(), faces);
         let field = stereographic::field(&mesh, |_| k).unwrap();
@@ -229,15 +216,17 @@ fn figure_5_9_annulus_with_mu_0_6_z_cubed() {
     }
 }
 
-/// Table 5.3, Beltrami flow: vertices, iterations, seconds, L2 error.
-const TABLE_5_3: [(usize, usize); 4] = [(33, 9), (65, 7), (129, 7), (257, 7)];
-
 #[test]
 fn table_5_3_square_diffeomorphism_reconstructed_at_second_order() {
     let mut errors = Vec::new();
-    for &(n, paper_iterations) in &TABLE_5_3 {
+    for &SquareRow {
+        side: n,
+        iterations: paper_iterations,
+        ..
+    } in &TABLE_5_3
+    {
         let mesh = square(n - 1);
-        let sigma = sample(&mesh, |z| beltrami_of(square_diffeomorphism, z));
+        let sigma = sample(&mesh, |z| beltrami_coefficient_of(square_diffeomorphism, z));
         let mut problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Keep));
         problem.goal =
             beltrami_core::Goal::Prescribed(BeltramiField::new(Frame::Global, sigma.clone()));

@@ -64,35 +64,6 @@ pub fn sample(mesh: &Mesh, mu: impl Fn(Complex64) -> Complex64) -> Vec<Complex64
         .collect()
 }
 
-/// A strongly distorted diffeomorphism of the square `[-1, 1]^2` onto itself, fixing the
-/// corners and moving points along the top and left sides (Wong-Zhao 2014, Table 5.3
-/// uses one such map; the paper does not give its formula, this one is ours): a shear
-/// `S` sliding the boundary, then a swirl rotating the circle of radius `r <= 1` by
-/// `2 (1 - r^2)^3` radians.
-pub fn square_diffeomorphism(p: Complex64) -> Complex64 {
-    use std::f64::consts::PI;
-    let (x, y) = (p.re, p.im);
-    let s = Complex64::new(
-        x + 0.1 * (PI * x).sin() * (1.0 + y),
-        y + 0.1 * (PI * y).sin() * (1.0 - x),
-    );
-    let r2 = s.norm_sqr();
-    if r2 >= 1.0 {
-        return s;
-    }
-    s * Complex64::from_polar(1.0, 2.0 * (1.0 - r2).powi(3))
-}
-
-/// The Beltrami coefficient of `f` at `p` from central differences (step `1e-5`, error
-/// about `1e-10`).
-pub fn beltrami_of(f: impl Fn(Complex64) -> Complex64, p: Complex64) -> Complex64 {
-    let h = 1e-5;
-    let i = Complex64::i();
-    let fx = (f(p + h) - f(p - h)) / (2.0 * h);
-    let fy = (f(p + i * h) - f(p - i * h)) / (2.0 * h);
-    (fx + i * fy) / (fx - i * fy)
-}
-
 /// The square `[-1, 1]^2` with `n` by `n` cells split into triangles.
 pub fn square(n: usize) -> Mesh {
     let mut soup =
