@@ -51,6 +51,9 @@ pub struct QcArgs {
     /// image) or .glb/.gltf.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Also draw the result (source and image side by side, |mu| colors) as PNG.
+    #[arg(long, value_parser = mapping::png_path)]
+    pub png: Option<PathBuf>,
     /// Write the JSON report here.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -104,6 +107,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         bail!("this command writes planar maps only");
     }
     mapping::write_map(&args.output, mesh, &solution)?;
+    mapping::write_png(args.png.as_deref(), mesh, &solution)?;
 
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     report.insert("mu_error_l2".into(), json!(error.as_ref().map(|e| e.rms)));

@@ -157,7 +157,10 @@ impl<'a> Scene<'a> {
     /// texture coordinates ([`Layout::Plane`], a map into the plane) or positions
     /// ([`Layout::Space`], a map into R^3). The map is measured here (per-face `|mu|`
     /// and flips, in the global frame for a mesh in the plane z = 0, in the face frames
-    /// otherwise), which costs about as much as loading the mesh.
+    /// otherwise), which costs about as much as loading the mesh. A map into R^3 is
+    /// judged flipped against the radial direction when its image lies on a sphere
+    /// about the origin (the `sphere` solver's output), else against the source normals
+    /// (right for images near the source).
     ///
     /// Fails for a mesh without faces and when the measure fails (a degenerate face).
     pub fn new(mesh: &'a Mesh, image: Option<Layout>) -> Result<Self, RenderError> {
@@ -167,10 +170,13 @@ impl<'a> Scene<'a> {
         let planar_source = element::is_planar(mesh);
         let distortion = match &image {
             None => None,
-            Some(Layout::Space(points)) => Some(FaceDistortion::from_measured(
-                mesh,
-                distortion::measure_surface(mesh, points, None)?,
-            )),
+            Some(Layout::Space(points)) => {
+                let normals = sphere_normals(mesh, points);
+                Some(FaceDistortion::from_measured(
+                    mesh,
+                    distortion::measure_surface(mesh, points, normals.as_deref())?,
+                ))
+            }
             Some(Layout::Plane(corners)) => {
                 let frame = if planar_source {
                     Frame::Global
@@ -207,6 +213,29 @@ impl<'a> Scene<'a> {
     pub fn distortion(&self) -> Option<&FaceDistortion> {
         self.distortion.as_ref()
     }
+}
+
+/// The outward radial directions at the face images when every image point lies on one
+/// sphere about the origin (relative tolerance 1e-6), else `None`.
+fn sphere_normals(mesh: &Mesh, points: &[Point3<f64>]) -> Option<Vec<beltrami_mesh::Vector3<f64>>> {
+    let radius = points.iter().map(|p| p.coords.norm()).sum::<f64>() / points.len().max(1) as f64;
+    let on_sphere = radius > 0.0
+        && points
+            .iter()
+            .all(|p| (p.coords.norm() - radius).abs() <= 1e-6 * radius);
+    if !on_sphere {
+        return None;
+    }
+    Some(
+        mesh.faces()
+            .map(|f| {
+                let sum: beltrami_mesh::Vector3<f64> =
+                    mesh.face_vertices(f).map(|v| points[v.idx()].coords).sum();
+                let n = sum.norm();
+                if n > 0.0 { sum / n } else { sum }
+            })
+            .collect(),
+    )
 }
 
 /// Measures a map into the plane given per corner: through the vertices when there are
