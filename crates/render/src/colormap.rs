@@ -128,4 +128,4 @@ pub const WARNING: Rgb = [228, 26, 28];
 /// Faces without a coloring.
 pub const PLAIN: Rgb = [205, 205, 210];
 /// The two colors of a checkerboard.
-pub const CHECKER: [Rgb; 2] = [[250, 250, 250], [235, 120, 45]];
+pub const CHECKER: [Rgb; 2] = [[240, 240, 240], [235, 120, 45]];
