@@ -138,7 +138,7 @@ pub fn render(scene: &Scene<'_>, style: &Style) -> Result<Picture, RenderError> 
 
     let size = style.size;
     let mut picture = Picture::new(size);
-    let short = size.width.min(size.height);
+    let short = size.width().min(size.height());
     let scale = (short / 500).max(1);
     let unit = (short as f32 / 800.0).max(1.0);
     let samples = style.samples.clamp(1, 4);
@@ -150,8 +150,8 @@ pub fn render(scene: &Scene<'_>, style: &Style) -> Result<Picture, RenderError> 
     } else {
         0
     };
-    let area_width = size.width.saturating_sub(bar);
-    let area_height = size.height.saturating_sub(2 * strip);
+    let area_width = size.width().saturating_sub(bar);
+    let area_height = size.height().saturating_sub(2 * strip);
     let n = panels.len() as u32;
     let panel_width = area_width / n;
     let flipped = distortion.map(|d| d.flipped.as_slice());
@@ -210,7 +210,7 @@ pub fn render(scene: &Scene<'_>, style: &Style) -> Result<Picture, RenderError> 
     legend::draw(
         &mut picture,
         i64::from(pad) * 2,
-        i64::from(size.height - strip + pad),
+        i64::from(size.height() - strip + pad),
         &items,
         scale,
     );

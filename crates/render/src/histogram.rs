@@ -154,7 +154,7 @@ pub fn render_histogram(
     let bars = Bars::new(&distortion.modulus, weights, style.bins, style.range)?;
     let size = style.size;
     let mut picture = Picture::new(size);
-    let short = size.width.min(size.height);
+    let short = size.width().min(size.height());
     let scale = (short / 400).max(1);
     let k = i64::from(scale);
     let line = text::height(scale);
@@ -164,9 +164,9 @@ pub fn render_histogram(
     // the title above and the beyond bar on the right.
     let left = text::width("100.0%", scale) + 6 * k;
     let top = 3 * line;
-    let bottom = i64::from(size.height) - 5 * line;
-    let beyond_width = (i64::from(size.width) / 14).max(4 * line);
-    let right = i64::from(size.width) - beyond_width - 4 * line;
+    let bottom = i64::from(size.height()) - 5 * line;
+    let beyond_width = (i64::from(size.width()) / 14).max(4 * line);
+    let right = i64::from(size.width()) - beyond_width - 4 * line;
     if right <= left || bottom <= top {
         return Ok(picture);
     }
@@ -294,7 +294,7 @@ pub fn render_histogram(
         ));
     }
     let mut x = left;
-    let y = i64::from(size.height) - line - line / 2;
+    let y = i64::from(size.height()) - line - line / 2;
     for (i, item) in items.iter().enumerate() {
         let color = if i == 1 && s.flipped > 0 {
             WARNING

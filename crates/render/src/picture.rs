@@ -20,9 +20,9 @@ pub struct Picture {
 impl Picture {
     /// A picture of `size` filled with the white background.
     pub fn new(size: Size) -> Self {
-        let mut pixmap = match Pixmap::new(size.width, size.height) {
+        let mut pixmap = match Pixmap::new(size.width(), size.height()) {
             Some(p) => p,
-            // Size::new keeps both sides in 64..=16384, which Pixmap accepts.
+            // A Size has both sides in 64..=16384, which Pixmap accepts.
             None => unreachable!("a checked Size makes a pixmap"),
         };
         let [r, g, b] = BACKGROUND;

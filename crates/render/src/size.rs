@@ -5,13 +5,11 @@ use std::str::FromStr;
 
 use crate::RenderError;
 
-/// The size of a picture in pixels.
+/// The size of a picture in pixels, both sides in [`Size::MIN`]`..=`[`Size::MAX`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Size {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
+    width: u32,
+    height: u32,
 }
 
 impl Size {
@@ -36,6 +34,16 @@ impl Size {
             }
         }
         Ok(Self { width, height })
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
     }
 }
 
