@@ -15,6 +15,13 @@
 //! - `|mu|` colors span a [`MuRange`], `[0, 1]` by default; values outside take the
 //!   end colors.
 //!
+//! Dependencies (all permissive): `tiny-skia` (BSD-3-Clause) for antialiased lines and
+//! shapes, `png` (MIT OR Apache-2.0) to encode (the `image` crate would only wrap it),
+//! `font8x8` (MIT, public-domain glyphs) for text. The fills of both views go through the
+//! small rasterizer of this crate ([`Raster`]): exact integer edge functions with a tie
+//! rule (no cracks between neighbouring triangles, which per-triangle antialiased fills
+//! would show), a z-buffer, and 2x2 supersampling for antialiasing.
+//!
 //! ```
 //! use beltrami_mesh::{Mesh, Vector2, primitives::{self, Cells}};
 //! use beltrami_render::{ColorBy, Layout, Scene, Size, Style, View, render};
