@@ -12,6 +12,8 @@
 //!
 //! - [`core`]: the `Solver` trait, problems, solutions, reports and the registry.
 //! - [`init`]: the initialization solvers (tutte, harmonic, lscm).
+//! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
+//!   |mu| histograms as PNG.
 //! - [`lsqc`]: the least-squares quasiconformal map for a prescribed Beltrami
 //!   coefficient (lsqc).
 //!
@@ -26,6 +28,7 @@ pub use beltrami_flow as flow;
 pub use beltrami_init as init;
 pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
+pub use beltrami_render as render;
 
 /// Every solver shipped with beltrami, by name.
 pub fn registry() -> beltrami_core::Registry {

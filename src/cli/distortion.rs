@@ -144,7 +144,7 @@ impl MapKind {
 /// the map is a measurement (`|mu| = 1`, flipped), not a defect. So no face counts as
 /// degenerate by its area and no vertices are merged; with `--repair`, faces with a
 /// repeated vertex and duplicate faces are dropped, as in SOURCE.
-fn load_mapped(path: &Path, repair: bool) -> anyhow::Result<LoadedMesh> {
+pub(super) fn load_mapped(path: &Path, repair: bool) -> anyhow::Result<LoadedMesh> {
     let options = BuildOptions {
         // The threshold `tolerance * diagonal^2` is then -inf (or NaN): no area is below.
         degenerate_area_tolerance: f64::NEG_INFINITY,
@@ -159,7 +159,7 @@ fn load_mapped(path: &Path, repair: bool) -> anyhow::Result<LoadedMesh> {
 
 /// For every SOURCE vertex, the MAPPED vertex with the same input index, after checking
 /// that both meshes have the same faces with the same input vertex indices (in order).
-fn correspondence(
+pub(super) fn correspondence(
     source: &Mesh,
     mapped: &Mesh,
     source_path: &Path,

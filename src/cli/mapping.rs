@@ -1,17 +1,17 @@
 //! What every mapping command shares: the output-format check, pins, the solve with a
 //! late progress bar, writing the map, the JSON report and the summary.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
 use beltrami_core::{Context, Map, Pin, Problem, Progress, Solution, Solver};
 use beltrami_mesh::io::{self, Format, VertexAttributes};
 use beltrami_mesh::{Mesh, Vector2};
+use beltrami_render::{Layout, Scene, Style, check_png_path, viridis};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::{Map as JsonMap, Value, json};
 
-use super::colormap::viridis;
 use super::pins::PinSpec;
 
 /// Fails, before any work, when `output` is not a mesh format beltrami writes.
@@ -104,6 +104,35 @@ pub fn solve(
     };
     bar.finish();
     Ok((solution?, start.elapsed().as_secs_f64()))
+}
+
+/// Parses `--png`: a path ending in `.png`, so that a wrong name fails before the solve.
+pub fn png_path(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    check_png_path(&path).map_err(|e| e.to_string())?;
+    Ok(path)
+}
+
+/// With `--png`, writes the picture of the result: source and image side by side,
+/// faces colored by |mu|, with the color bar and the legend (the picture is made only
+/// when asked, after the solve).
+pub fn write_png(png: Option<&Path>, mesh: &Mesh, solution: &Solution) -> anyhow::Result<()> {
+    let Some(path) = png else {
+        return Ok(());
+    };
+    let image = match &solution.map {
+        Map::Planar(z) => {
+            let uv: Vec<Vector2<f64>> = z.iter().map(|z| Vector2::new(z.re, z.im)).collect();
+            Layout::plane_from_vertices(mesh, &uv)?
+        }
+        Map::Spatial(p) => Layout::space(mesh, p.clone())?,
+        Map::OnMesh(_) => bail!("--png draws planar and spatial maps only"),
+    };
+    let scene = Scene::new(mesh, Some(image))?;
+    beltrami_render::render(&scene, &Style::default())?
+        .write_png(path)
+        .with_context(|| format!("cannot write the picture {}", path.display()))?;
+    Ok(())
 }
 
 /// Writes the map of `solution` on `mesh`'s connectivity: a planar map as one texture

@@ -1,16 +1,18 @@
 //! Command-line interface: argument parsing and one module per command.
 
 mod bench;
-mod colormap;
 mod cut;
 mod distortion;
+mod histogram;
 mod info;
 mod interrupt;
 mod load;
 mod mapping;
 mod param;
+mod picture;
 mod pins;
 mod qc;
+mod render;
 mod solvers;
 
 use clap::{Parser, Subcommand};
@@ -44,6 +46,11 @@ pub enum Command {
     Solvers(solvers::SolversArgs),
     /// Time the library on generated and given meshes and print a table.
     Bench(bench::BenchArgs),
+    /// Draw a mesh or a map as PNG: the parameter domain, the surface in 3D or both side
+    /// by side, colored by |mu| or with a checkerboard of the map.
+    Render(render::RenderArgs),
+    /// Draw the histogram of |mu| of a map as PNG (share of faces or of area).
+    Histogram(histogram::HistogramArgs),
     /// Cut a surface of genus >= 1 (or with several boundary loops) into a disk along a
     /// greedy shortest system of loops and write it as OBJ.
     Cut(cut::CutArgs),
@@ -59,5 +66,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Solvers(args) => solvers::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Cut(args) => cut::run(&args, cli.quiet),
+        Command::Render(args) => render::run(&args, cli.quiet),
+        Command::Histogram(args) => histogram::run(&args, cli.quiet),
     }
 }

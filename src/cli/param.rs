@@ -53,6 +53,9 @@ pub struct ParamArgs {
     /// sphere, the sphere positions) or .glb/.gltf (UVs and |mu| colors).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Also draw the result (source and image side by side, |mu| colors) as PNG.
+    #[arg(long, value_parser = mapping::png_path)]
+    pub png: Option<PathBuf>,
     /// Write the JSON report here.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -97,6 +100,7 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
 
     let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.json)?;
     mapping::write_map(&args.output, mesh, &solution)?;
+    mapping::write_png(args.png.as_deref(), mesh, &solution)?;
     let report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     mapping::finish(
         report,

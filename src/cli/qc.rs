@@ -103,6 +103,9 @@ pub struct QcArgs {
     /// planar image, or the image positions for the sphere) or .glb/.gltf.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Also draw the result (source and image side by side, |mu| colors) as PNG.
+    #[arg(long, value_parser = mapping::png_path)]
+    pub png: Option<PathBuf>,
     /// Write the JSON report here.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -238,6 +241,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         bail!("{} gave points in space for a planar target", solver.name());
     }
     mapping::write_map(&args.output, mesh, &solution)?;
+    mapping::write_png(args.png.as_deref(), mesh, &solution)?;
 
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     report.insert(

@@ -220,11 +220,13 @@ pub fn beltrami_coefficient_of(f: impl Fn(Complex64) -> Complex64, z: Complex64)
 mod tests {
     use super::*;
 
+    type DistanceToSide = fn(Complex64) -> f64;
+
     #[test]
     fn the_diffeomorphism_keeps_the_square() {
         for k in 0..=20 {
             let t = -1.0 + 0.1 * k as f64;
-            let sides: [(Complex64, fn(Complex64) -> f64); 4] = [
+            let sides: [(Complex64, DistanceToSide); 4] = [
                 (Complex64::new(t, -1.0), |w: Complex64| (w.im + 1.0).abs()),
                 (Complex64::new(t, 1.0), |w: Complex64| (w.im - 1.0).abs()),
                 (Complex64::new(-1.0, t), |w: Complex64| (w.re + 1.0).abs()),

@@ -2,6 +2,7 @@
 
 mod fem;
 mod load;
+mod render;
 
 use clap::{Args, Subcommand};
 
@@ -19,11 +20,15 @@ pub enum BenchKind {
     /// the LSCM system (complex N form and real 2N form), against faer on the same
     /// matrices.
     Fem(fem::FemArgs),
+    /// Pictures (scene measure, uv and 3D rasterization, PNG encoding) of generated
+    /// grids of up to ~1M triangles.
+    Render(render::RenderArgs),
 }
 
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {
         BenchKind::Load(a) => load::run(a),
         BenchKind::Fem(a) => fem::run(a),
+        BenchKind::Render(a) => render::run(a),
     }
 }
