@@ -1,6 +1,7 @@
 //! `beltrami bench`: timings printed as tables (the figures go to docs/benchmarks.md).
 
 mod fem;
+mod flow;
 mod load;
 mod render;
 
@@ -20,6 +21,9 @@ pub enum BenchKind {
     /// the LSCM system (complex N form and real 2N form), against faer on the same
     /// matrices.
     Fem(fem::FemArgs),
+    /// The discrete Beltrami flow against the tables of Wong-Zhao 2014, and the cost of
+    /// one flow step on meshes of about 100K faces.
+    Flow(flow::FlowArgs),
     /// Pictures (scene measure, uv and 3D rasterization, PNG encoding) of generated
     /// grids of up to ~1M triangles.
     Render(render::RenderArgs),
@@ -29,6 +33,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {
         BenchKind::Load(a) => load::run(a),
         BenchKind::Fem(a) => fem::run(a),
+        BenchKind::Flow(a) => flow::run(a),
         BenchKind::Render(a) => render::run(a),
     }
 }
