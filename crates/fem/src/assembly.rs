@@ -36,6 +36,26 @@ impl Pattern {
         })
     }
 
+    /// For each of `positions` (the list given to [`Pattern::new`]), the index of its
+    /// entry in the values of the assembled matrix: callers that refill one matrix many
+    /// times add into `values[slot[k]]` instead of assembling a new matrix.
+    pub fn value_slots(&self, positions: &[(usize, usize)]) -> Result<Vec<usize>, FemError> {
+        let col_ptr = self.symbolic.col_ptr();
+        let rows = self.symbolic.row_idx();
+        positions
+            .iter()
+            .map(|&(row, col)| {
+                let range = col_ptr.get(col).copied().zip(col_ptr.get(col + 1).copied());
+                let found = range.and_then(|(start, end)| {
+                    rows[start..end].binary_search(&row).ok().map(|k| start + k)
+                });
+                found.ok_or_else(|| {
+                    FemError::Assembly(format!("({row}, {col}) is not in the pattern"))
+                })
+            })
+            .collect()
+    }
+
     /// Number of entry positions (before summing duplicates).
     pub fn entry_count(&self) -> usize {
         self.entries

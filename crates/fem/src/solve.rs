@@ -592,6 +592,82 @@ impl<T: Scalar> SpdSolver<T> {
         Ok(())
     }
 
+    /// Solves `matrix x = rhs` (lower triangle of `matrix` read, the pattern given to
+    /// [`SpdSolver::new`]) by conjugate gradients preconditioned with the last successful
+    /// factorization, of a nearby matrix: iterative solvers whose matrix changes a little
+    /// per step keep one factorization for several steps. Stops once
+    /// `|matrix x - rhs| <= tolerance |rhs|`; returns the number of iterations, or `None`
+    /// (with `rhs` unspecified) when `max_iterations` will not be enough — then factor
+    /// `matrix` and solve directly. It gives up early, as soon as the mean reduction of
+    /// the residual per iteration so far predicts more than `max_iterations`. `x` starts
+    /// at zero and replaces `rhs`.
+    pub fn solve_preconditioned(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, T>,
+        rhs: &mut [T],
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<Option<usize>, SolveError> {
+        let n = self.len();
+        check_len("the length of the right-hand side", n, rhs.len())?;
+        check_len("the row count of the matrix", n, matrix.nrows())?;
+        check_finite("the right-hand side", rhs)?;
+        if !self.factored {
+            return Err(SolveError::NotFactored);
+        }
+        let zero = T::from_f64(0.0);
+        let dot = |a: &[T], b: &[T]| -> T {
+            a.iter().zip(b).fold(zero, |acc, (&x, &y)| {
+                acc + faer::traits::ComplexField::conj_impl(&x) * y
+            })
+        };
+        let norm = |a: &[T]| faer::traits::ComplexField::real_part_impl(&dot(a, a)).sqrt();
+        let target = tolerance * norm(rhs);
+        let mut residual = rhs.to_vec();
+        let mut x = vec![zero; n];
+        let start = norm(&residual);
+        if start <= target {
+            rhs.copy_from_slice(&x);
+            return Ok(Some(0));
+        }
+        let mut z = residual.clone();
+        self.cholesky.solve_in_place(column_mut(&mut z))?;
+        let mut direction = z.clone();
+        let mut rz = dot(&residual, &z);
+        let mut product = vec![zero; n];
+        for iteration in 1..=max_iterations {
+            symmetric_lower_product(matrix, &direction, &mut product);
+            let alpha = rz / dot(&direction, &product);
+            for i in 0..n {
+                x[i] += alpha * direction[i];
+                residual[i] -= alpha * product[i];
+            }
+            let r = norm(&residual);
+            if r <= target {
+                check_finite_solution(&x)?;
+                rhs.copy_from_slice(&x);
+                return Ok(Some(iteration));
+            }
+            // Mean reduction per iteration so far, and the iterations it predicts.
+            let rate = (r / start).powf(1.0 / iteration as f64);
+            if rate.is_nan()
+                || rate >= 1.0
+                || (target / start).ln() / rate.ln() > max_iterations as f64
+            {
+                return Ok(None);
+            }
+            z.copy_from_slice(&residual);
+            self.cholesky.solve_in_place(column_mut(&mut z))?;
+            let rz_next = dot(&residual, &z);
+            let beta = rz_next / rz;
+            rz = rz_next;
+            for i in 0..n {
+                direction[i] = z[i] + beta * direction[i];
+            }
+        }
+        Ok(None)
+    }
+
     /// Overwrites the columns of `rhs` with the solutions of `matrix x = rhs` for the
     /// matrix of the last successful [`SpdSolver::factorize`] (error
     /// [`SolveError::NotFactored`] if there is none).
@@ -650,4 +726,20 @@ pub fn amd_order(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Vec<usiz
         MemStack::new(&mut buffer),
     )?;
     Ok(forward)
+}
+
+/// `y = M x` for a Hermitian `M` given by its lower triangle (entries above the diagonal
+/// are ignored).
+fn symmetric_lower_product<T: Scalar>(m: SparseColMatRef<'_, usize, T>, x: &[T], y: &mut [T]) {
+    y.iter_mut().for_each(|v| *v = T::from_f64(0.0));
+    for j in 0..m.ncols() {
+        for (i, &v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+            if i > j {
+                y[i] += v * x[j];
+                y[j] += faer::traits::ComplexField::conj_impl(&v) * x[i];
+            } else if i == j {
+                y[i] += v * x[j];
+            }
+        }
+    }
 }

@@ -97,6 +97,10 @@ pub struct FlowRun<G> {
     pub solve_seconds: f64,
     /// Seconds spent stepping, projecting and measuring (the step-size search).
     pub step_seconds: f64,
+    /// Numeric factorizations of the flow's normal equations.
+    pub factorizations: usize,
+    /// Conjugate-gradient iterations of steps solved with a kept factorization.
+    pub cg_iterations: usize,
 }
 
 impl<G> FlowRun<G> {
@@ -281,5 +285,7 @@ pub fn run<G: TargetGeometry>(
         stop,
         solve_seconds,
         step_seconds,
+        factorizations: system.work().0,
+        cg_iterations: system.work().1,
     })
 }

@@ -673,6 +673,10 @@ fn run<G: TargetGeometry>(
         .timings
         .push(("flow: steps".into(), run.step_seconds));
     report.iterations = run.iterations();
+    report.notes.push(format!(
+        "{} numeric factorizations; {} conjugate-gradient iterations on steps that reused one",
+        run.factorizations, run.cg_iterations
+    ));
     report.energy_history = run.energy_history.clone();
     report.step_sizes = run.step_sizes.clone();
     report.notes.push(match run.stop {

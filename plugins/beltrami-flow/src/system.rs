@@ -30,6 +30,7 @@ use beltrami_fem::solve::amd_order;
 use beltrami_fem::{Elements, SolveOptions, SpdSolver};
 use beltrami_mesh::{FaceId, Point3, Vector3};
 use faer::MatMut;
+use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
 use crate::measure::{ImageFace, triangle};
@@ -59,17 +60,34 @@ pub struct FlowSystem {
     /// Per face, its distinct unknowns and where each comes from.
     local: Vec<([(usize, Source); MAX_LOCAL], u8)>,
     n: usize,
-    pattern: Pattern,
+    /// The normal matrix (lower triangle), refilled in place every step.
+    matrix: SparseColMat<usize, f64>,
+    /// Per local entry (in assembly order), its index in the matrix's values.
+    slots: Vec<usize>,
     solver: SpdSolver<f64>,
-    values: Vec<f64>,
     rhs: Vec<f64>,
+    /// Whether the last attempt to reuse the factorization failed.
+    reuse_failed: bool,
+    /// Numeric factorizations so far.
+    factorizations: usize,
+    /// Conjugate-gradient iterations so far (steps solved with a kept factorization).
+    cg_iterations: usize,
 }
+
+/// Relative residual at which a step solved by conjugate gradients with a kept
+/// factorization is accepted.
+const CG_TOLERANCE: f64 = 1e-7;
+
+/// Conjugate-gradient iterations tried with a kept factorization before refactoring
+/// (each costs about a fifth of a factorization).
+const CG_ITERATIONS: usize = 4;
 
 impl std::fmt::Debug for FlowSystem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("FlowSystem")
             .field("unknowns", &self.n)
-            .field("entries", &self.values.len())
+            .field("entries", &self.slots.len())
+            .field("factorizations", &self.factorizations)
             .finish_non_exhaustive()
     }
 }
@@ -160,6 +178,8 @@ impl FlowSystem {
             });
         }
         let pattern = Pattern::new(n, n, &positions)?;
+        let slots = pattern.value_slots(&positions)?;
+        let matrix = pattern.assemble(&vec![0.0; positions.len()])?;
         let order = block_order(&faces, &roles, &first, n)?;
         let solver = SpdSolver::with_order(pattern.symbolic().as_ref(), &order, options)?;
         Ok(Self {
@@ -169,10 +189,13 @@ impl FlowSystem {
             faces,
             local,
             n,
-            values: vec![0.0; positions.len()],
             rhs: vec![0.0; n],
-            pattern,
+            matrix,
+            slots,
             solver,
+            reuse_failed: false,
+            factorizations: 0,
+            cg_iterations: 0,
         })
     }
 
@@ -197,6 +220,8 @@ impl FlowSystem {
         rho: &[Complex64],
     ) -> Result<Flow, SolverError> {
         self.rhs.iter_mut().for_each(|r| *r = 0.0);
+        let values = self.matrix.val_mut();
+        values.iter_mut().for_each(|v| *v = 0.0);
         let mut at = 0;
         for (f, face) in faces.iter().enumerate() {
             let (list, m) = &self.local[f];
@@ -228,16 +253,12 @@ impl FlowSystem {
             for a in 0..m {
                 self.rhs[list[a].0] += w * (beta[a].conj() * rho[f]).re;
                 for b in 0..=a {
-                    self.values[at] = w * (beta[a].conj() * beta[b]).re;
+                    values[self.slots[at]] += w * (beta[a].conj() * beta[b]).re;
                     at += 1;
                 }
             }
         }
-        let matrix = self.pattern.assemble(&self.values)?;
-        self.solver.factorize(matrix.as_ref())?;
-        let n = self.rhs.len();
-        self.solver
-            .solve_in_place(MatMut::from_column_major_slice_mut(&mut self.rhs, n, 1))?;
+        self.solve_normal_equations()?;
         let mut flow = Flow {
             vertex: vec![Vector3::zeros(); self.roles.len()],
             offset: vec![0.0; self.offset.len()],
@@ -260,6 +281,48 @@ impl FlowSystem {
             flow.vertex[v] = vec;
         }
         Ok(flow)
+    }
+}
+
+impl FlowSystem {
+    /// Numeric factorizations and conjugate-gradient iterations so far.
+    pub fn work(&self) -> (usize, usize) {
+        (self.factorizations, self.cg_iterations)
+    }
+
+    /// Solves the assembled normal equations in place of `rhs`: by conjugate gradients
+    /// preconditioned with the kept factorization when there is one (the matrix changes
+    /// little between late steps), else — or when that does not converge within
+    /// [`CG_ITERATIONS`] — by factoring the new matrix. After a failed reuse the next
+    /// step factors directly.
+    fn solve_normal_equations(&mut self) -> Result<(), SolverError> {
+        if self.factorizations > 0 && !self.reuse_failed {
+            let mut x = self.rhs.clone();
+            match self.solver.solve_preconditioned(
+                self.matrix.as_ref(),
+                &mut x,
+                CG_TOLERANCE,
+                CG_ITERATIONS,
+            )? {
+                Some(iterations) => {
+                    self.cg_iterations += iterations;
+                    self.rhs = x;
+                    return Ok(());
+                }
+                None => {
+                    self.cg_iterations += CG_ITERATIONS;
+                    self.reuse_failed = true;
+                }
+            }
+        } else {
+            self.reuse_failed = false;
+        }
+        self.solver.factorize(self.matrix.as_ref())?;
+        self.factorizations += 1;
+        let n = self.rhs.len();
+        self.solver
+            .solve_in_place(MatMut::from_column_major_slice_mut(&mut self.rhs, n, 1))?;
+        Ok(())
     }
 }
 
