@@ -119,3 +119,47 @@ fn bad_coefficients_fail_with_the_column_the_line_or_the_face() {
     assert!(!run(&[]).status.success());
     assert!(!out_path.exists());
 }
+
+#[test]
+fn given_boundary_comes_from_a_map_file() {
+    // With mu = 0 and the boundary of z -> 2 z, that map itself is the least-squares
+    // map of a planar mesh: every vt is twice its vertex (keeping the boundary would give
+    // the vertex itself).
+    let dir = tempfile::tempdir().unwrap();
+    let (mesh_path, mesh) = planar_grid(dir.path(), Cells::Triangles);
+    let doubled: Vec<_> = mesh.positions().iter().map(|p| p * 2.0).collect();
+    let map_path = dir.path().join("doubled.obj");
+    let attributes = VertexAttributes {
+        positions: Some(&doubled),
+        ..VertexAttributes::default()
+    };
+    io::write(&map_path, &mesh, &attributes).unwrap();
+    let out_path = dir.path().join("out.obj");
+    let out = beltrami(&[
+        "qc",
+        s(&mesh_path),
+        "--mu-expr",
+        "0",
+        "--boundary",
+        "given",
+        "--boundary-map",
+        s(&map_path),
+        "-o",
+        s(&out_path),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let written = std::fs::read_to_string(&out_path).unwrap();
+    let vt: Vec<(f64, f64)> = written
+        .lines()
+        .filter_map(|l| l.strip_prefix("vt "))
+        .map(|l| {
+            let mut it = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
+            (it.next().unwrap(), it.next().unwrap())
+        })
+        .collect();
+    assert_eq!(vt.len(), mesh.vertex_count());
+    for (v, (x, y)) in mesh.vertices().zip(vt) {
+        let p = mesh.position(v);
+        assert!((2.0 * p.x - x).abs() < 1e-12 && (2.0 * p.y - y).abs() < 1e-12);
+    }
+}
