@@ -3,6 +3,7 @@
 mod bench;
 mod cut;
 mod distortion;
+mod generate;
 mod histogram;
 mod info;
 mod interrupt;
@@ -42,6 +43,9 @@ pub enum Command {
     /// A quasiconformal map with a prescribed Beltrami coefficient or the most conformal
     /// one (lsqc, beltrami-flow) onto the plane, a disk, an annulus or the sphere.
     Qc(qc::QcArgs),
+    /// Write a generated mesh: the disk, sphere, annulus and square of the paper
+    /// reproductions.
+    Generate(generate::GenerateArgs),
     /// List the registered solvers and what each accepts.
     Solvers(solvers::SolversArgs),
     /// Time the library on generated and given meshes and print a table.
@@ -63,6 +67,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Distortion(args) => distortion::run(&args, cli.quiet),
         Command::Param(args) => param::run(&args, cli.quiet),
         Command::Qc(args) => qc::run(&args, cli.quiet),
+        Command::Generate(args) => generate::run(&args, cli.quiet),
         Command::Solvers(args) => solvers::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Cut(args) => cut::run(&args, cli.quiet),

@@ -1,0 +1,79 @@
+//! `beltrami generate`: the meshes of the paper reproductions, as OBJ files.
+
+use std::path::PathBuf;
+
+use anyhow::bail;
+use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_mesh::primitives::{self, Cells};
+use beltrami_mesh::{Mesh, PolygonSoup};
+use clap::{Args, ValueEnum};
+
+/// The generated shapes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Shape {
+    /// The unit disk of Wong-Zhao's Table 5.1: 4^(level+1) triangles, boundary on the
+    /// circle.
+    Disk,
+    /// The unit sphere of Table 5.2: an octahedron refined `level` times, 8 * 4^level
+    /// triangles.
+    Sphere,
+    /// The annulus `inner <= |z| <= 1` of Fig. 5.9: `8 * 2^level` sectors, `2^(level+1)`
+    /// rings.
+    Annulus,
+    /// The square `[-1, 1]^2` of Table 5.3: `2^(level+5)` cells per side (33^2 vertices
+    /// at level 0), each split into two triangles.
+    Square,
+}
+
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    /// What to generate.
+    #[arg(value_enum)]
+    pub shape: Shape,
+    /// Refinement level.
+    #[arg(long, default_value_t = 3)]
+    pub level: usize,
+    /// The annulus's inner radius.
+    #[arg(long, default_value_t = 0.4)]
+    pub inner: f64,
+    /// Output mesh (.obj, .gltf, .glb).
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+pub fn run(args: &GenerateArgs, quiet: bool) -> anyhow::Result<()> {
+    super::mapping::check_output_format(&args.output)?;
+    if args.level > 10 {
+        bail!("--level {} is too fine (at most 10)", args.level);
+    }
+    let soup: PolygonSoup = match args.shape {
+        Shape::Disk => primitives::disk(args.level),
+        Shape::Sphere => primitives::octahedral_sphere(args.level),
+        Shape::Annulus => {
+            if !(args.inner > 0.0 && args.inner < 1.0) {
+                bail!("--inner must be in (0, 1), got {}", args.inner);
+            }
+            primitives::annulus(args.inner, 2 << args.level, 8 << args.level)
+        }
+        Shape::Square => {
+            let n = 32 << args.level;
+            let mut soup = primitives::grid(n, n, Cells::Triangles);
+            for p in &mut soup.positions {
+                p.x = 2.0 * p.x - 1.0;
+                p.y = 2.0 * p.y - 1.0;
+            }
+            soup
+        }
+    };
+    let mesh = Mesh::from_soup(&soup)?;
+    io::write(&args.output, &mesh, &VertexAttributes::default())?;
+    if !quiet {
+        println!(
+            "{}: {} vertices, {} faces",
+            args.output.display(),
+            mesh.vertex_count(),
+            mesh.face_count()
+        );
+    }
+    Ok(())
+}
