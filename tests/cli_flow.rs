@@ -229,3 +229,35 @@ fn bad_requests_fail_with_a_reason() {
     assert!(!run.status.success());
     assert!(text(&run.stderr).contains("--conformal"));
 }
+
+#[test]
+fn generate_writes_the_paper_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    for (shape, faces) in [
+        ("disk", 64),
+        ("sphere", 128),
+        ("annulus", 2 * 2 * 8),
+        ("square", 2 * 32 * 32),
+    ] {
+        let out = dir.path().join(format!("{shape}.obj"));
+        let level = if shape == "annulus" || shape == "square" {
+            "0"
+        } else {
+            "2"
+        };
+        let run = beltrami(&["generate", shape, "--level", level, "-o", s(&out)]);
+        assert!(run.status.success(), "{}", text(&run.stderr));
+        let mesh = io::read(&out, &BuildOptions::default()).unwrap().mesh;
+        assert_eq!(mesh.face_count(), faces, "{shape}");
+    }
+    let run = beltrami(&[
+        "generate",
+        "annulus",
+        "--inner",
+        "1.5",
+        "-o",
+        s(&dir.path().join("a.obj")),
+    ]);
+    assert!(!run.status.success());
+    assert!(text(&run.stderr).contains("--inner"));
+}
