@@ -1,0 +1,359 @@
+//! Point location on a target surface: the exact closest point of a mesh, found through
+//! a kd-tree.
+//!
+//! # The index
+//!
+//! Every face is covered by *samples*: balls `B(c, r)` that contain a piece of the face.
+//! A face whose radius (largest distance from its vertex average to a vertex) is at most
+//! the target radius `R0` is one sample: its vertex average and that radius (a triangle
+//! is the convex hull of its corners, and the bilinear patch of a quad lies in the
+//! convex hull of its four corners, so the ball around any point with the largest corner
+//! distance as radius contains the face). A larger face is split 1-to-4 (at edge
+//! midpoints for a triangle, at parameter midpoints for a quad) until the pieces fit,
+//! at most [`MAX_SPLIT_LEVEL`] times; each piece is again the hull of its corners. `R0` is
+//! the 90th percentile of the face radii, so about nine faces in ten are one sample and
+//! a few very large faces cannot blow up the search radius. The sample centers go into
+//! a kiddo kd-tree; `R` is the largest sample radius.
+//!
+//! # Why `locate` is exact
+//!
+//! Let `d*` be the distance from `p` to the mesh, attained at a point `x*` of face `f*`,
+//! and `d >= d*` the distance to any face evaluated so far. Some sample `B(c, r)` of `f*`
+//! contains `x*`, so `|p - c| <= |p - x*| + |x* - c| <= d* + r <= d + R`: the samples
+//! within `d + R` of `p` include one of `f*`. Every face with a sample within that radius
+//! is a candidate, and a candidate sample `(c, r)` can only hold a point closer than the
+//! best so far when `|p - c| - r` is below it. `locate` therefore takes one face (the
+//! hint, or the face of the nearest sample center), asks the tree for all samples within
+//! its distance plus `R`, and evaluates the exact closest point (see
+//! [`crate::closest_point`]) of every candidate face that passes the lower bound. The
+//! result is the closest point of the whole mesh; among faces at the same distance (a
+//! point on an edge or at a vertex) the lowest face id wins, so the answer does not
+//! depend on the hint.
+//!
+//! The cost is one tree query plus the faces near `p`: for points near the surface (the
+//! flow's case) a handful of faces. For a point far from the surface the ball of radius
+//! `d + R` holds every sample within `R` of the sphere of radius `d`, which grows with
+//! `d / R`; the answer stays exact.
+
+use beltrami_mesh::{FaceId, Mesh, SurfacePoint};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use nalgebra::{Point3, Vector3};
+
+use crate::closest_point::{ClosestPoint, closest_on_face};
+use crate::error::{SpatialError, check_point};
+
+/// Faces larger than the target sample radius are split 1-to-4 at most this many times
+/// (at most `4^6 = 4096` samples per face).
+pub const MAX_SPLIT_LEVEL: usize = 6;
+
+/// Quantile of the face radii used as the target sample radius.
+const TARGET_QUANTILE: f64 = 0.9;
+
+/// Steps of the hinted descent to a better neighbouring face before the tree query.
+const HINT_DESCENT_STEPS: usize = 4;
+
+/// The closest point of the mesh to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Located {
+    /// The closest point as a surface point (face and coordinates).
+    pub point: SurfacePoint,
+    /// Its position: `point.position(mesh)`, bit for bit.
+    pub position: Point3<f64>,
+    /// Euclidean distance from the query point to `position`.
+    pub distance: f64,
+}
+
+/// One kd-tree entry: a ball containing a piece of a face.
+#[derive(Debug, Clone, Copy)]
+struct Sample {
+    face: FaceId,
+    radius: f64,
+}
+
+/// A kd-tree index of a mesh for exact closest-point queries, with the mesh's vertex
+/// normals for tangent frames and motion. See the module docs for the method and the
+/// proof of exactness.
+pub struct SurfaceIndex<'m> {
+    mesh: &'m Mesh,
+    tree: ImmutableKdTree<f64, 3>,
+    samples: Vec<Sample>,
+    max_radius: f64,
+    vertex_normals: Vec<Vector3<f64>>,
+}
+
+impl std::fmt::Debug for SurfaceIndex<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SurfaceIndex")
+            .field("faces", &self.mesh.face_count())
+            .field("samples", &self.samples.len())
+            .field("max_radius", &self.max_radius)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Vertex average and largest corner distance of a set of corners, the latter padded
+/// by a few ulps of the coordinates so that rounding of the corners cannot shrink the
+/// ball below the piece it bounds.
+fn ball(corners: &[Point3<f64>]) -> (Point3<f64>, f64) {
+    let sum: Vector3<f64> = corners.iter().map(|c| c.coords).sum();
+    let center = Point3::from(sum / corners.len() as f64);
+    let radius = corners
+        .iter()
+        .map(|c| (c - center).norm())
+        .fold(0.0, f64::max);
+    let pad = 8.0 * f64::EPSILON * (center.coords.amax() + radius);
+    (center, radius * (1.0 + 1e-12) + pad)
+}
+
+/// The samples of one face, appended to `centers` and `samples`.
+fn push_face_samples(
+    mesh: &Mesh,
+    f: FaceId,
+    target: f64,
+    centers: &mut Vec<[f64; 3]>,
+    samples: &mut Vec<Sample>,
+) {
+    let (v, n) = mesh.face_vertex_array(f);
+    let p = |k: usize| mesh.position(v[k]);
+    let mut push = |corners: &[Point3<f64>]| {
+        let (c, radius) = ball(corners);
+        centers.push([c.x, c.y, c.z]);
+        samples.push(Sample { face: f, radius });
+    };
+    if n == 3 {
+        split_triangle([p(0), p(1), p(2)], target, 0, &mut push);
+    } else {
+        let q = [p(0), p(1), p(2), p(3)];
+        split_quad(&q, (0.0, 1.0, 0.0, 1.0), target, 0, &mut push);
+    }
+}
+
+fn split_triangle(
+    t: [Point3<f64>; 3],
+    target: f64,
+    level: usize,
+    push: &mut impl FnMut(&[Point3<f64>]),
+) {
+    if level == MAX_SPLIT_LEVEL || ball(&t).1 <= target {
+        push(&t);
+        return;
+    }
+    let mid = |a: &Point3<f64>, b: &Point3<f64>| Point3::from((a.coords + b.coords) * 0.5);
+    let (ab, bc, ca) = (mid(&t[0], &t[1]), mid(&t[1], &t[2]), mid(&t[2], &t[0]));
+    for piece in [[t[0], ab, ca], [ab, t[1], bc], [ca, bc, t[2]], [ab, bc, ca]] {
+        split_triangle(piece, target, level + 1, push);
+    }
+}
+
+fn split_quad(
+    q: &[Point3<f64>; 4],
+    (u0, u1, v0, v1): (f64, f64, f64, f64),
+    target: f64,
+    level: usize,
+    push: &mut impl FnMut(&[Point3<f64>]),
+) {
+    let x = |u: f64, v: f64| {
+        crate::closest_point::weighted_sum(q, &beltrami_mesh::surface_point::bilinear_weights(u, v))
+    };
+    let corners = [x(u0, v0), x(u1, v0), x(u1, v1), x(u0, v1)];
+    if level == MAX_SPLIT_LEVEL || ball(&corners).1 <= target {
+        push(&corners);
+        return;
+    }
+    let (um, vm) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    for rect in [
+        (u0, um, v0, vm),
+        (um, u1, v0, vm),
+        (um, u1, vm, v1),
+        (u0, um, vm, v1),
+    ] {
+        split_quad(q, rect, target, level + 1, push);
+    }
+}
+
+impl<'m> SurfaceIndex<'m> {
+    /// Builds the index of `mesh`: face samples, their kd-tree, and the angle-weighted
+    /// vertex normals. Fails only if the mesh needs more than `u32::MAX` samples.
+    pub fn new(mesh: &'m Mesh) -> Result<Self, SpatialError> {
+        let mut radii: Vec<f64> = mesh
+            .faces()
+            .map(|f| {
+                let (v, n) = mesh.face_vertex_array(f);
+                let corners: Vec<Point3<f64>> = v[..n].iter().map(|&v| mesh.position(v)).collect();
+                ball(&corners).1
+            })
+            .collect();
+        let k = ((radii.len() - 1) as f64 * TARGET_QUANTILE).round() as usize;
+        let (_, &mut target, _) = radii.select_nth_unstable_by(k, f64::total_cmp);
+
+        let mut centers = Vec::with_capacity(mesh.face_count() + mesh.face_count() / 4);
+        let mut samples = Vec::with_capacity(centers.capacity());
+        for f in mesh.faces() {
+            push_face_samples(mesh, f, target, &mut centers, &mut samples);
+        }
+        if u32::try_from(samples.len()).is_err() {
+            return Err(SpatialError::TooLarge {
+                samples: samples.len(),
+            });
+        }
+        let max_radius = samples.iter().map(|s| s.radius).fold(0.0, f64::max);
+        let tree =
+            ImmutableKdTree::new_from_slice(&centers).map_err(|_| SpatialError::TooLarge {
+                samples: samples.len(),
+            })?;
+        Ok(Self {
+            mesh,
+            tree,
+            samples,
+            max_radius,
+            vertex_normals: mesh.vertex_normals(),
+        })
+    }
+
+    /// The indexed mesh.
+    pub fn mesh(&self) -> &'m Mesh {
+        self.mesh
+    }
+
+    /// Angle-weighted unit vertex normals of the mesh, by vertex id.
+    pub fn vertex_normals(&self) -> &[Vector3<f64>] {
+        &self.vertex_normals
+    }
+
+    /// Number of kd-tree samples (at least one per face).
+    pub fn sample_count(&self) -> usize {
+        self.samples.len()
+    }
+
+    /// The largest sample radius `R`: a face with a point within distance `d` of a query
+    /// has a sample center within `d + R`.
+    pub fn max_sample_radius(&self) -> f64 {
+        self.max_radius
+    }
+
+    /// The exact closest point of the mesh to `p`. Fails on a non-finite `p`.
+    pub fn locate(&self, p: &Point3<f64>) -> Result<Located, SpatialError> {
+        check_point(p)?;
+        let q = [p.x, p.y, p.z];
+        let nearest = self
+            .tree
+            .query(&q)
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        let start = self.samples[nearest.item as usize].face;
+        Ok(self.search(p, start, closest_on_face(self.mesh, start, p)))
+    }
+
+    /// The exact closest point of the mesh to `p`, starting from face `hint` (typically
+    /// the face the point was on before it moved): a few steps of descent to better
+    /// neighbouring faces, then the same exact search as [`SurfaceIndex::locate`], with
+    /// a smaller radius when the hint is good. The answer does not depend on the hint.
+    pub fn locate_near(&self, p: &Point3<f64>, hint: FaceId) -> Result<Located, SpatialError> {
+        check_point(p)?;
+        if hint.idx() >= self.mesh.face_count() {
+            return Err(SpatialError::HintOutOfRange {
+                face: hint,
+                face_count: self.mesh.face_count(),
+            });
+        }
+        let (face, best) = self.descend(p, hint);
+        Ok(self.search(p, face, best))
+    }
+
+    /// [`SurfaceIndex::locate`] for every point, in order. An error names the first bad
+    /// point's index ([`SpatialError::InBatch`]).
+    pub fn locate_all(&self, points: &[Point3<f64>]) -> Result<Vec<Located>, SpatialError> {
+        points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| self.locate(p).map_err(|e| e.in_batch(i)))
+            .collect()
+    }
+
+    /// [`SurfaceIndex::locate_near`] for every point with its own hint (`hints[i]` for
+    /// `points[i]`), in order: the per-step re-location of a flow.
+    pub fn locate_all_near(
+        &self,
+        points: &[Point3<f64>],
+        hints: &[FaceId],
+    ) -> Result<Vec<Located>, SpatialError> {
+        if hints.len() != points.len() {
+            return Err(SpatialError::LengthMismatch {
+                what: "hints",
+                expected: points.len(),
+                found: hints.len(),
+            });
+        }
+        points
+            .iter()
+            .zip(hints)
+            .enumerate()
+            .map(|(i, (p, &h))| self.locate_near(p, h).map_err(|e| e.in_batch(i)))
+            .collect()
+    }
+
+    /// Greedy descent from `face` across edges to the neighbour with the closest point
+    /// nearest to `p`, for a few steps.
+    fn descend(&self, p: &Point3<f64>, face: FaceId) -> (FaceId, ClosestPoint) {
+        let mesh = self.mesh;
+        let mut face = face;
+        let mut best = closest_on_face(mesh, face, p);
+        for _ in 0..HINT_DESCENT_STEPS {
+            if best.distance_squared == 0.0 {
+                break;
+            }
+            let mut next = None;
+            for h in mesh.face_halfedges(face) {
+                if let Some(g) = mesh.face(mesh.twin(h)) {
+                    let c = closest_on_face(mesh, g, p);
+                    if c.distance_squared < best.distance_squared {
+                        best = c;
+                        next = Some(g);
+                    }
+                }
+            }
+            match next {
+                Some(g) => face = g,
+                None => break,
+            }
+        }
+        (face, best)
+    }
+
+    /// The exact search: all samples within `|p - best| + R`, pruned by their lower
+    /// bounds, ties to the lowest face id.
+    fn search(&self, p: &Point3<f64>, face: FaceId, best: ClosestPoint) -> Located {
+        let mesh = self.mesh;
+        let (mut face, mut best) = (face, best);
+        let mut best_distance = best.distance();
+        // Padded so that rounding of the squared distances cannot drop a sample on the
+        // sphere.
+        let radius = (best_distance + self.max_radius) * (1.0 + 1e-12);
+        self.tree
+            .query(&[p.x, p.y, p.z])
+            .within::<SquaredEuclidean<f64>>(radius * radius)
+            .unsorted()
+            .visit(|item| {
+                let sample = self.samples[item.item as usize];
+                if sample.face == face || item.distance.sqrt() - sample.radius > best_distance {
+                    return;
+                }
+                let c = closest_on_face(mesh, sample.face, p);
+                let closer = c.distance_squared < best.distance_squared;
+                let tie = c.distance_squared == best.distance_squared && sample.face < face;
+                if closer || tie {
+                    best = c;
+                    face = sample.face;
+                    best_distance = c.distance();
+                }
+            });
+        Located {
+            point: SurfacePoint {
+                face,
+                coords: best.coords,
+            },
+            position: best.position,
+            distance: best.distance(),
+        }
+    }
+}
