@@ -128,8 +128,8 @@ impl SurfacePoint {
     pub fn position(&self, mesh: &Mesh) -> Point3<f64> {
         let (vertices, n) = mesh.face_vertex_array(self.face);
         let mut sum = nalgebra::Vector3::zeros();
-        for k in 0..n {
-            sum += self.coords[k] * mesh.position(vertices[k]).coords;
+        for (c, &v) in self.coords.iter().zip(&vertices[..n]) {
+            sum += *c * mesh.position(v).coords;
         }
         Point3::from(sum)
     }

@@ -286,9 +286,9 @@ mod tests {
 
     fn check(p: Point3<f64>, t: &[Point3<f64>; 3], coords: [f64; 3]) {
         let r = closest_on_triangle(&p, t);
-        for k in 0..3 {
+        for (c, e) in r.coords.iter().zip(&coords) {
             assert!(
-                (r.coords[k] - coords[k]).abs() < 1e-14,
+                (c - e).abs() < 1e-14,
                 "p {p:?}: coords {:?}, expected {coords:?}",
                 r.coords
             );
@@ -410,8 +410,8 @@ mod tests {
                 assert!((r.position - x).norm() < 1e-14, "{u} {v} {h}");
                 assert!((r.distance() - h.abs()).abs() < 1e-14);
                 let expected = bilinear_weights(u, v);
-                for k in 0..4 {
-                    assert!((r.coords[k] - expected[k]).abs() < 1e-13);
+                for (c, e) in r.coords.iter().zip(&expected) {
+                    assert!((c - e).abs() < 1e-13);
                 }
             }
         }

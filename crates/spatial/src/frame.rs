@@ -17,6 +17,9 @@
 use beltrami_mesh::{Mesh, SurfacePoint};
 use nalgebra::{Point3, Vector2, Vector3};
 
+use crate::error::SpatialError;
+use crate::index::SurfaceIndex;
+
 /// An orthonormal tangent frame at a point of a surface: see the module docs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TangentFrame {
@@ -113,4 +116,24 @@ pub(crate) fn any_orthogonal(n: &Vector3<f64>) -> Vector3<f64> {
         Vector3::z()
     };
     n.cross(&axis).normalize()
+}
+
+impl SurfaceIndex<'_> {
+    /// The tangent frame at `point` (see the module docs). Fails if `point` does not
+    /// belong to the indexed mesh.
+    pub fn frame(&self, point: &SurfacePoint) -> Result<TangentFrame, SpatialError> {
+        point.validate(self.mesh())?;
+        Ok(TangentFrame::at(self.mesh(), self.vertex_normals(), point))
+    }
+
+    /// The interpolated unit normal at `point` (see the module docs). Fails if `point`
+    /// does not belong to the indexed mesh.
+    pub fn normal(&self, point: &SurfacePoint) -> Result<Vector3<f64>, SpatialError> {
+        point.validate(self.mesh())?;
+        Ok(interpolated_normal(
+            self.mesh(),
+            self.vertex_normals(),
+            point,
+        ))
+    }
 }
