@@ -150,16 +150,19 @@ pub fn closest_on_triangle(p: &Point3<f64>, t: &[Point3<f64>; 3]) -> ClosestPoin
             }
             interior = Some(candidate);
         } else if well_shaped {
-            let negative: Vec<usize> = (0..3).filter(|&k| l[k] < 0.0).collect();
-            return match negative.as_slice() {
-                [k] => on_edge(*k),
-                // Two negatives: the edges through the remaining (positive) corner,
-                // which are the edges opposite the two negative corners.
-                [k, m] => nearer(on_edge(*k), on_edge(*m)),
-                // Three negative coordinates cannot sum to 1; rounding aside, fall
-                // through to all edges.
-                _ => nearer(nearer(on_edge(0), on_edge(1)), on_edge(2)),
-            };
+            // One negative coordinate: the opposite edge. Two: the edges through the
+            // remaining positive corner, which are those opposite the negative ones.
+            let mut result: Option<ClosestPoint> = None;
+            for k in (0..3).filter(|&k| l[k] < 0.0) {
+                let candidate = on_edge(k);
+                result = Some(match result {
+                    Some(best) => nearer(best, candidate),
+                    None => candidate,
+                });
+            }
+            if let Some(result) = result {
+                return result;
+            }
         }
     }
     let edges = nearer(nearer(on_edge(0), on_edge(1)), on_edge(2));

@@ -36,10 +36,13 @@
 //! `d / R`; the answer stays exact.
 
 use beltrami_mesh::{FaceId, Mesh, SurfacePoint};
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use kiddo::kd_tree::KdTree;
+use kiddo::leaf_strategies::VecOfArenas;
+use kiddo::stem_strategies::eytzinger::Eytzinger;
+use kiddo::{QueryScratch, SquaredEuclidean};
 use nalgebra::{Point3, Vector3};
 
-use crate::closest_point::{ClosestPoint, closest_on_face};
+use crate::closest_point::{ClosestPoint, closest_on_quad, closest_on_triangle};
 use crate::error::{SpatialError, check_point};
 
 /// Faces larger than the target sample radius are split 1-to-4 at most this many times
@@ -49,8 +52,16 @@ pub const MAX_SPLIT_LEVEL: usize = 6;
 /// Quantile of the face radii used as the target sample radius.
 const TARGET_QUANTILE: f64 = 0.9;
 
-/// Steps of the hinted descent to a better neighbouring face before the tree query.
-const HINT_DESCENT_STEPS: usize = 4;
+/// Items per kd-tree leaf.
+const BUCKET: usize = 16;
+
+/// The kd-tree of sample centers: kiddo's immutable layout (Eytzinger stems, arena
+/// leaves) with leaves of [`BUCKET`] items, items being sample indices.
+type Tree = KdTree<f64, u32, Eytzinger, VecOfArenas<f64, u32, 3, BUCKET>, 3, BUCKET>;
+
+/// Reusable traversal storage of the kd-tree queries (one per batch, so that a query
+/// does not set up its stack anew).
+type Scratch = QueryScratch<Eytzinger, f64, 3>;
 
 /// The closest point of the mesh to a query point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,11 +74,33 @@ pub struct Located {
     pub distance: f64,
 }
 
-/// One kd-tree entry: a ball containing a piece of a face.
+/// One kd-tree entry: a piece of a face, bounded by the ball of radius `radius` around
+/// the entry's center `c` and by the slab `|normal . x - offset| <= thickness` (with
+/// `offset = normal . c`; `normal` is the face's unit normal, or zero for a degenerate
+/// face).
 #[derive(Debug, Clone, Copy)]
 struct Sample {
     face: FaceId,
     radius: f64,
+    normal: [f64; 3],
+    offset: f64,
+    thickness: f64,
+}
+
+impl Sample {
+    /// A lower bound on the distance from `p` to this piece, given `|p - c|^2`: a point
+    /// `x` of the piece has `|n . (p - x)| >= |n . (p - c)| - thickness` across the slab
+    /// and, in the plane, `|P(p - x)| >= |P(p - c)| - radius` (`P` the projection along
+    /// `n`), and the two parts are orthogonal.
+    #[inline]
+    fn lower_bound(&self, p: &Point3<f64>, center_distance_squared: f64) -> f64 {
+        let [a, b, c] = self.normal;
+        let height = (a * p.x + b * p.y + c * p.z - self.offset).abs();
+        let across = (height - self.thickness).max(0.0);
+        let along =
+            ((center_distance_squared - height * height).max(0.0).sqrt() - self.radius).max(0.0);
+        (across * across + along * along).sqrt()
+    }
 }
 
 /// A kd-tree index of a mesh for exact closest-point queries, with the mesh's vertex
@@ -75,9 +108,12 @@ struct Sample {
 /// proof of exactness.
 pub struct SurfaceIndex<'m> {
     mesh: &'m Mesh,
-    tree: ImmutableKdTree<f64, 3>,
+    tree: Tree,
     samples: Vec<Sample>,
     max_radius: f64,
+    /// Position of the origin of every face halfedge, by halfedge id: the corners of
+    /// each face, contiguous.
+    corners: Vec<Point3<f64>>,
     vertex_normals: Vec<Vector3<f64>>,
 }
 
@@ -105,20 +141,48 @@ fn ball(corners: &[Point3<f64>]) -> (Point3<f64>, f64) {
     (center, radius * (1.0 + 1e-12) + pad)
 }
 
+/// The sample of a piece of face `face` (the convex hull of `corners` contains it) with
+/// the face's unit normal `normal`, and its center.
+fn sample(face: FaceId, corners: &[Point3<f64>], normal: &Vector3<f64>) -> (Point3<f64>, Sample) {
+    let (c, radius) = ball(corners);
+    let offset = normal.dot(&c.coords);
+    let thickness = corners
+        .iter()
+        .map(|x| normal.dot(&(x - c)).abs())
+        .fold(0.0, f64::max);
+    let pad = 8.0 * f64::EPSILON * (c.coords.amax() + radius);
+    (
+        c,
+        Sample {
+            face,
+            radius,
+            normal: [normal.x, normal.y, normal.z],
+            offset,
+            thickness: thickness * (1.0 + 1e-12) + pad,
+        },
+    )
+}
+
 /// The samples of one face, appended to `centers` and `samples`.
 fn push_face_samples(
     mesh: &Mesh,
     f: FaceId,
     target: f64,
-    centers: &mut Vec<[f64; 3]>,
+    centers: &mut Vec<Point3<f64>>,
     samples: &mut Vec<Sample>,
 ) {
     let (v, n) = mesh.face_vertex_array(f);
     let p = |k: usize| mesh.position(v[k]);
+    let area = mesh.face_vector_area(f);
+    let normal = if area.norm() > 0.0 {
+        area.normalize()
+    } else {
+        Vector3::zeros()
+    };
     let mut push = |corners: &[Point3<f64>]| {
-        let (c, radius) = ball(corners);
-        centers.push([c.x, c.y, c.z]);
-        samples.push(Sample { face: f, radius });
+        let (c, s) = sample(f, corners, &normal);
+        centers.push(c);
+        samples.push(s);
     };
     if n == 3 {
         split_triangle([p(0), p(1), p(2)], target, 0, &mut push);
@@ -197,15 +261,25 @@ impl<'m> SurfaceIndex<'m> {
             });
         }
         let max_radius = samples.iter().map(|s| s.radius).fold(0.0, f64::max);
-        let tree =
-            ImmutableKdTree::new_from_slice(&centers).map_err(|_| SpatialError::TooLarge {
-                samples: samples.len(),
-            })?;
+        // Morton order, so that the samples of one kd-tree leaf are close in memory.
+        let order = crate::morton::order(&centers);
+        let samples: Vec<Sample> = order.iter().map(|&i| samples[i as usize]).collect();
+        let centers: Vec<[f64; 3]> = order
+            .iter()
+            .map(|&i| centers[i as usize].coords.into())
+            .collect();
+        let tree = Tree::new_from_slice(&centers).map_err(|_| SpatialError::TooLarge {
+            samples: samples.len(),
+        })?;
         Ok(Self {
             mesh,
             tree,
             samples,
             max_radius,
+            corners: mesh
+                .faces()
+                .flat_map(|f| mesh.face_vertices(f).map(|v| mesh.position(v)))
+                .collect(),
             vertex_normals: mesh.vertex_normals(),
         })
     }
@@ -234,44 +308,34 @@ impl<'m> SurfaceIndex<'m> {
     /// The exact closest point of the mesh to `p`. Fails on a non-finite `p`.
     pub fn locate(&self, p: &Point3<f64>) -> Result<Located, SpatialError> {
         check_point(p)?;
-        let q = [p.x, p.y, p.z];
-        let nearest = self
-            .tree
-            .query(&q)
-            .nearest_one::<SquaredEuclidean<f64>>()
-            .execute();
-        let start = self.samples[nearest.item as usize].face;
-        Ok(self.search(p, start, closest_on_face(self.mesh, start, p)))
+        Ok(self.search(p, None, &mut Scratch::new()))
     }
 
-    /// The exact closest point of the mesh to `p`, starting from face `hint` (typically
-    /// the face the point was on before it moved): a few steps of descent to better
-    /// neighbouring faces, then the same exact search as [`SurfaceIndex::locate`], with
-    /// a smaller radius when the hint is good. The answer does not depend on the hint.
+    /// The exact closest point of the mesh to `p`, with the search started from face
+    /// `hint` (typically the face the point was on before it moved) instead of the face
+    /// of the nearest sample: one kd-tree query instead of two, with a small radius when
+    /// the hint is good. The answer does not depend on the hint.
     pub fn locate_near(&self, p: &Point3<f64>, hint: FaceId) -> Result<Located, SpatialError> {
         check_point(p)?;
-        if hint.idx() >= self.mesh.face_count() {
-            return Err(SpatialError::HintOutOfRange {
-                face: hint,
-                face_count: self.mesh.face_count(),
-            });
-        }
-        let (face, best) = self.descend(p, hint);
-        Ok(self.search(p, face, best))
+        self.check_hint(hint)?;
+        Ok(self.search(p, Some(hint), &mut Scratch::new()))
     }
 
-    /// [`SurfaceIndex::locate`] for every point, in order. An error names the first bad
-    /// point's index ([`SpatialError::InBatch`]).
+    /// [`SurfaceIndex::locate`] for every point; results in the order of `points`. The
+    /// points are processed in Morton order, each search starting from the previous
+    /// point's face when that point is within the largest sample radius (see
+    /// [`crate::morton`]). An error names the first bad point's index
+    /// ([`SpatialError::InBatch`]).
     pub fn locate_all(&self, points: &[Point3<f64>]) -> Result<Vec<Located>, SpatialError> {
-        points
-            .iter()
-            .enumerate()
-            .map(|(i, p)| self.locate(p).map_err(|e| e.in_batch(i)))
-            .collect()
+        for (i, p) in points.iter().enumerate() {
+            check_point(p).map_err(|e| e.in_batch(i))?;
+        }
+        Ok(self.batch(points, |_, previous| previous))
     }
 
     /// [`SurfaceIndex::locate_near`] for every point with its own hint (`hints[i]` for
-    /// `points[i]`), in order: the per-step re-location of a flow.
+    /// `points[i]`): the per-step re-location of a flow. Results in the order of
+    /// `points`; the points are processed in Morton order.
     pub fn locate_all_near(
         &self,
         points: &[Point3<f64>],
@@ -284,61 +348,102 @@ impl<'m> SurfaceIndex<'m> {
                 found: hints.len(),
             });
         }
-        points
-            .iter()
-            .zip(hints)
-            .enumerate()
-            .map(|(i, (p, &h))| self.locate_near(p, h).map_err(|e| e.in_batch(i)))
-            .collect()
-    }
-
-    /// Greedy descent from `face` across edges to the neighbour with the closest point
-    /// nearest to `p`, for a few steps.
-    fn descend(&self, p: &Point3<f64>, face: FaceId) -> (FaceId, ClosestPoint) {
-        let mesh = self.mesh;
-        let mut face = face;
-        let mut best = closest_on_face(mesh, face, p);
-        for _ in 0..HINT_DESCENT_STEPS {
-            if best.distance_squared == 0.0 {
-                break;
-            }
-            let mut next = None;
-            for h in mesh.face_halfedges(face) {
-                if let Some(g) = mesh.face(mesh.twin(h)) {
-                    let c = closest_on_face(mesh, g, p);
-                    if c.distance_squared < best.distance_squared {
-                        best = c;
-                        next = Some(g);
-                    }
-                }
-            }
-            match next {
-                Some(g) => face = g,
-                None => break,
-            }
+        for (i, (p, &h)) in points.iter().zip(hints).enumerate() {
+            check_point(p).map_err(|e| e.in_batch(i))?;
+            self.check_hint(h).map_err(|e| e.in_batch(i))?;
         }
-        (face, best)
+        Ok(self.batch(points, |i, _| Some(hints[i])))
     }
 
-    /// The exact search: all samples within `|p - best| + R`, pruned by their lower
-    /// bounds, ties to the lowest face id.
-    fn search(&self, p: &Point3<f64>, face: FaceId, best: ClosestPoint) -> Located {
-        let mesh = self.mesh;
+    fn check_hint(&self, hint: FaceId) -> Result<(), SpatialError> {
+        if hint.idx() < self.mesh.face_count() {
+            Ok(())
+        } else {
+            Err(SpatialError::HintOutOfRange {
+                face: hint,
+                face_count: self.mesh.face_count(),
+            })
+        }
+    }
+
+    /// Searches for every (checked) point in Morton order, starting from
+    /// `start(i, previous)` where `previous` is the face found for the previous point
+    /// if that point is within the largest sample radius of point `i`.
+    fn batch(
+        &self,
+        points: &[Point3<f64>],
+        start: impl Fn(usize, Option<FaceId>) -> Option<FaceId>,
+    ) -> Vec<Located> {
+        let unset = Located {
+            point: SurfacePoint {
+                face: FaceId(0),
+                coords: [0.0; 4],
+            },
+            position: Point3::origin(),
+            distance: f64::INFINITY,
+        };
+        let mut out = vec![unset; points.len()];
+        let mut scratch = Scratch::new();
+        let mut previous: Option<(usize, FaceId)> = None;
+        for i in crate::morton::order(points) {
+            let i = i as usize;
+            let p = &points[i];
+            let near = previous
+                .filter(|&(j, _)| (points[j] - p).norm() <= self.max_radius)
+                .map(|(_, face)| face);
+            let located = self.search(p, start(i, near), &mut scratch);
+            previous = Some((i, located.point.face));
+            out[i] = located;
+        }
+        out
+    }
+
+    /// [`crate::closest_point::closest_on_face`] from the index's contiguous corners.
+    #[inline]
+    fn closest_on(&self, f: FaceId, p: &Point3<f64>) -> ClosestPoint {
+        let h = self.mesh.face_halfedge(f).idx();
+        let c = &self.corners;
+        if self.mesh.face_degree(f) == 3 {
+            closest_on_triangle(p, &[c[h], c[h + 1], c[h + 2]])
+        } else {
+            closest_on_quad(p, &[c[h], c[h + 1], c[h + 2], c[h + 3]])
+        }
+    }
+
+    /// The exact search, from face `start` or else from the face of the nearest sample
+    /// center: all samples within `|p - best| + R`, pruned by their lower bounds, ties to
+    /// the lowest face id.
+    fn search(&self, p: &Point3<f64>, start: Option<FaceId>, scratch: &mut Scratch) -> Located {
+        let face = start.unwrap_or_else(|| {
+            let nearest = self
+                .tree
+                .query(&[p.x, p.y, p.z])
+                .nearest_one::<SquaredEuclidean<f64>>()
+                .with_scratch(scratch)
+                .execute();
+            self.samples[nearest.item as usize].face
+        });
+        let best = self.closest_on(face, p);
         let (mut face, mut best) = (face, best);
         let mut best_distance = best.distance();
         // Padded so that rounding of the squared distances cannot drop a sample on the
         // sphere.
         let radius = (best_distance + self.max_radius) * (1.0 + 1e-12);
+        // Rounding of the bound is of the order of the coordinates' ulps.
+        let pad = 16.0 * f64::EPSILON * p.coords.amax();
         self.tree
             .query(&[p.x, p.y, p.z])
             .within::<SquaredEuclidean<f64>>(radius * radius)
             .unsorted()
+            .with_scratch(scratch)
             .visit(|item| {
-                let sample = self.samples[item.item as usize];
-                if sample.face == face || item.distance.sqrt() - sample.radius > best_distance {
+                let sample = &self.samples[item.item as usize];
+                if sample.face == face
+                    || sample.lower_bound(p, item.distance) > best_distance * (1.0 + 1e-12) + pad
+                {
                     return;
                 }
-                let c = closest_on_face(mesh, sample.face, p);
+                let c = self.closest_on(sample.face, p);
                 let closer = c.distance_squared < best.distance_squared;
                 let tie = c.distance_squared == best.distance_squared && sample.face < face;
                 if closer || tie {

@@ -5,6 +5,7 @@ pub mod closest_point;
 pub mod error;
 pub mod frame;
 pub mod index;
+pub mod morton;
 pub mod motion;
 
 pub use error::SpatialError;

@@ -2,6 +2,7 @@
 
 mod fem;
 mod load;
+mod spatial;
 
 use clap::{Args, Subcommand};
 
@@ -19,11 +20,15 @@ pub enum BenchKind {
     /// the LSCM system (complex N form and real 2N form), against faer on the same
     /// matrices.
     Fem(fem::FemArgs),
+    /// Building the surface index, locating random points near a target surface, and
+    /// one flow step (every vertex re-located, with and without hints, or walked).
+    Spatial(spatial::SpatialArgs),
 }
 
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     match &args.what {
         BenchKind::Load(a) => load::run(a),
         BenchKind::Fem(a) => fem::run(a),
+        BenchKind::Spatial(a) => spatial::run(a),
     }
 }
