@@ -44,15 +44,6 @@ pub enum SpatialError {
     #[error(transparent)]
     InvalidSurfacePoint(#[from] SurfacePointError),
 
-    /// A surface point that should lie on a boundary edge but does not.
-    #[error("surface point on face {face} is not on a boundary edge (coordinates {coords:?})")]
-    NotOnBoundary {
-        /// Its face.
-        face: FaceId,
-        /// Its coordinates.
-        coords: [f64; 4],
-    },
-
     /// Two slices of a batch call with different lengths.
     #[error("{what}: expected {expected} entries, got {found}")]
     LengthMismatch {

@@ -3,37 +3,43 @@
 //!
 //! # The index
 //!
-//! Every face is covered by *samples*: balls `B(c, r)` that contain a piece of the face.
-//! A face whose radius (largest distance from its vertex average to a vertex) is at most
-//! the target radius `R0` is one sample: its vertex average and that radius (a triangle
-//! is the convex hull of its corners, and the bilinear patch of a quad lies in the
-//! convex hull of its four corners, so the ball around any point with the largest corner
-//! distance as radius contains the face). A larger face is split 1-to-4 (at edge
-//! midpoints for a triangle, at parameter midpoints for a quad) until the pieces fit,
-//! at most [`MAX_SPLIT_LEVEL`] times; each piece is again the hull of its corners. `R0` is
-//! the 90th percentile of the face radii, so about nine faces in ten are one sample and
-//! a few very large faces cannot blow up the search radius. The sample centers go into
-//! a kiddo kd-tree; `R` is the largest sample radius.
+//! Every face is covered by *samples*, each a piece of the face bounded by a ball
+//! `B(c, r)` and a slab `|n . (x - c)| <= t` (`n` the face's unit normal). A face whose
+//! radius (largest distance from its vertex average to a vertex) is at most the target
+//! radius `R0` is one sample: its vertex average, that radius, and the largest distance
+//! of a corner from the plane through `c` as `t` (0 for a triangle). These bound the face
+//! because a triangle is the convex hull of its corners and the bilinear patch of a quad
+//! lies in the convex hull of its four corners. A larger face is split 1-to-4 (at edge
+//! midpoints for a triangle, at parameter midpoints for a quad) until the pieces fit, at
+//! most [`MAX_SPLIT_LEVEL`] times; each piece is again inside the hull of its corners.
+//! `R0` is the 90th percentile of the face radii, so about nine faces in ten are one
+//! sample and a few very large faces cannot blow up the search radius. Radii and
+//! thicknesses are padded by a few ulps so that rounding cannot shrink them. The sample
+//! centers go, in Morton order (see [`crate::morton`]), into a kiddo kd-tree; `R` is the
+//! largest sample radius.
 //!
 //! # Why `locate` is exact
 //!
 //! Let `d*` be the distance from `p` to the mesh, attained at a point `x*` of face `f*`,
-//! and `d >= d*` the distance to any face evaluated so far. Some sample `B(c, r)` of `f*`
-//! contains `x*`, so `|p - c| <= |p - x*| + |x* - c| <= d* + r <= d + R`: the samples
-//! within `d + R` of `p` include one of `f*`. Every face with a sample within that radius
-//! is a candidate, and a candidate sample `(c, r)` can only hold a point closer than the
-//! best so far when `|p - c| - r` is below it. `locate` therefore takes one face (the
-//! hint, or the face of the nearest sample center), asks the tree for all samples within
-//! its distance plus `R`, and evaluates the exact closest point (see
-//! [`crate::closest_point`]) of every candidate face that passes the lower bound. The
-//! result is the closest point of the whole mesh; among faces at the same distance (a
-//! point on an edge or at a vertex) the lowest face id wins, so the answer does not
-//! depend on the hint.
+//! and `d >= d*` the distance to any face evaluated so far. Some sample of `f*` contains
+//! `x*`, so its center has `|p - c| <= |p - x*| + |x* - c| <= d* + r <= d + R`: the
+//! samples within `d + R` of `p` include one of `f*`. A sample can only hold a point
+//! closer than `d` if its lower bound is below `d`: for `x` in the piece,
+//! `|n . (p - x)| >= |n . (p - c)| - t` across the slab and, in the plane,
+//! `|P (p - x)| >= |P (p - c)| - r` (`P` the projection along `n`); the two parts are
+//! orthogonal, so `|p - x|^2` is at least the sum of their squares (clamped at 0).
+//! `locate` therefore takes one face (a hint, the previous point's face in a batch, or the
+//! face of the nearest sample center), asks the tree for all samples within its distance
+//! plus `R`, and evaluates the exact closest point (see [`crate::closest_point`]) of every
+//! face whose sample passes the lower bound. The result is the closest point of the
+//! whole mesh; among faces at the same distance (a point on an edge or at a vertex) the
+//! lowest face id wins, so the answer does not depend on the hint.
 //!
-//! The cost is one tree query plus the faces near `p`: for points near the surface (the
-//! flow's case) a handful of faces. For a point far from the surface the ball of radius
-//! `d + R` holds every sample within `R` of the sphere of radius `d`, which grows with
-//! `d / R`; the answer stays exact.
+//! The cost is one or two tree queries plus the faces near `p`: for points near the
+//! surface (the flow's case) a handful of faces, more near a vertex, whose whole fan
+//! passes the bound. For a point far from the surface the ball of radius `d + R` holds
+//! every sample within `R` of the sphere of radius `d`, which grows with `d / R`; the
+//! answer stays exact.
 
 use beltrami_mesh::{FaceId, Mesh, SurfacePoint};
 use kiddo::kd_tree::KdTree;

@@ -20,9 +20,9 @@ fn spread(x: u64) -> u64 {
     x
 }
 
-/// The indices of `points` sorted by Morton code within their bounding box. The points
-/// must be finite.
-pub(crate) fn order(points: &[Point3<f64>]) -> Vec<u32> {
+/// The indices of `points` sorted by Morton code within their bounding box (ties keep
+/// index order). Non-finite coordinates give arbitrary but valid positions in the order.
+pub fn order(points: &[Point3<f64>]) -> Vec<u32> {
     let Some(first) = points.first() else {
         return Vec::new();
     };

@@ -42,8 +42,10 @@
 //! rest of the displacement moving along the boundary: its component along the boundary
 //! edge that was hit (at a vertex, along the nearer boundary edge by angle) is walked as
 //! arc length along the boundary polyline, across boundary vertices, so the point stays on
-//! the boundary. A point on the boundary with a displacement pointing into the surface
-//! leaves the boundary.
+//! the boundary. With these two modes a point on the boundary with a displacement
+//! pointing into the surface leaves the boundary; [`BoundaryMode::Keep`] slides like
+//! `Slide` and also keeps points that start on the boundary on it, moving them by the
+//! displacement's component along the boundary.
 //!
 //! # Projection
 //!
@@ -80,13 +82,20 @@ pub enum MoveMethod {
     Project,
 }
 
-/// What a walk does when it reaches the boundary.
+/// What a move does at the boundary.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BoundaryMode {
-    /// End the move where the path meets the boundary.
+    /// A walk ends where its path meets the boundary.
     Stop,
-    /// Spend the rest of the displacement's component along the boundary moving along it.
+    /// A walk that meets the boundary spends the rest of the displacement's component
+    /// along the boundary moving along it.
     Slide,
+    /// As [`BoundaryMode::Slide`], and a point that starts on the boundary (on a boundary
+    /// edge or at a boundary vertex) moves only along it, by the displacement's component
+    /// along its boundary edge (at a vertex, the boundary edge the displacement points
+    /// most along), with either method: boundary points stay on the boundary, as a
+    /// boundary-to-boundary registration needs.
+    Keep,
 }
 
 /// Options of [`SurfaceIndex::move_point`] and [`SurfaceIndex::move_all`].
@@ -487,7 +496,7 @@ impl Walker<'_> {
         let mesh = self.mesh;
         match self.options.boundary {
             BoundaryMode::Stop => End::OnHalfedge(h, t, MoveOutcome::StoppedAtBoundary),
-            BoundaryMode::Slide => {
+            BoundaryMode::Slide | BoundaryMode::Keep => {
                 let edge = mesh.halfedge_vector(h);
                 let length = edge.norm();
                 let along = if length > 0.0 {
@@ -631,6 +640,8 @@ fn slide(mesh: &Mesh, b: HalfedgeId, s: f64, distance: f64) -> (HalfedgeId, f64)
             }
             if perimeter > 0.0 {
                 left %= perimeter;
+            } else {
+                return (b, s);
             }
         }
         edges_passed += 1;
@@ -653,6 +664,36 @@ fn slide(mesh: &Mesh, b: HalfedgeId, s: f64, distance: f64) -> (HalfedgeId, f64)
             return (b, s);
         }
     }
+}
+
+/// Where a surface point lies on the boundary.
+enum OnBoundary {
+    /// At a boundary vertex.
+    Vertex(VertexId),
+    /// On the boundary edge of face halfedge `h`, at fraction `t` from its origin.
+    Edge(HalfedgeId, f64),
+}
+
+/// Whether `p` is on the boundary (coordinates within [`VERTEX_TOLERANCE`] of a boundary
+/// vertex or edge).
+fn on_boundary(mesh: &Mesh, p: &SurfacePoint) -> Option<OnBoundary> {
+    let (v, n) = mesh.face_vertex_array(p.face);
+    if let Some(k) = (0..n).find(|&k| p.coords[k] >= 1.0 - VERTEX_TOLERANCE) {
+        return mesh
+            .is_boundary_vertex(v[k])
+            .then_some(OnBoundary::Vertex(v[k]));
+    }
+    (0..n).find_map(|j| {
+        let next = (j + 1) % n;
+        let on_edge = (0..n)
+            .filter(|&k| k != j && k != next)
+            .all(|k| p.coords[k] <= VERTEX_TOLERANCE);
+        let h = HalfedgeId(mesh.face_halfedge(p.face).0 + j as u32);
+        (on_edge && mesh.is_boundary_halfedge(mesh.twin(h))).then(|| {
+            let (a, b) = (p.coords[j], p.coords[next]);
+            OnBoundary::Edge(h, b / (a + b))
+        })
+    })
 }
 
 impl SurfaceIndex<'_> {
@@ -679,6 +720,11 @@ impl SurfaceIndex<'_> {
                 outcome: MoveOutcome::Arrived,
                 faces_crossed: 0,
             });
+        }
+        if options.boundary == BoundaryMode::Keep {
+            if let Some(on) = on_boundary(mesh, point) {
+                return Ok(self.along_boundary(on, &tangent));
+            }
         }
         if options.method == MoveMethod::Project {
             return self.project(point, &tangent);
@@ -774,6 +820,39 @@ impl SurfaceIndex<'_> {
             heading * total / std::f64::consts::TAU
         };
         walker.direction_in_fan(&entries, angle, length)
+    }
+
+    /// Moves a boundary point along the boundary by the component of `tangent` along its
+    /// edge ([`BoundaryMode::Keep`]).
+    fn along_boundary(&self, on: OnBoundary, tangent: &Vector3<f64>) -> Moved {
+        let mesh = self.mesh();
+        let unit = |h: HalfedgeId| {
+            let e = mesh.halfedge_vector(h);
+            let length = e.norm();
+            if length > 0.0 { e / length } else { e }
+        };
+        // The boundary halfedge, fraction along it, and signed distance to slide.
+        let (b, s, distance) = match on {
+            OnBoundary::Edge(h, t) => (mesh.twin(h), 1.0 - t, -tangent.dot(&unit(h))),
+            OnBoundary::Vertex(v) => {
+                let out = mesh.vertex_halfedge(v);
+                let into = mesh.prev(out);
+                let (forward, backward) = (tangent.dot(&unit(out)), -tangent.dot(&unit(into)));
+                if forward >= backward {
+                    (out, 0.0, forward.max(0.0))
+                } else {
+                    (into, 1.0, -backward.max(0.0))
+                }
+            }
+        };
+        let (b, s) = slide(mesh, b, s, distance);
+        let point = point_on_halfedge(mesh, mesh.twin(b), 1.0 - s);
+        Moved {
+            point,
+            position: point.position(mesh),
+            outcome: MoveOutcome::SlidAlongBoundary,
+            faces_crossed: 0,
+        }
     }
 
     /// Moves `point` in space by `tangent` and takes the closest point of the mesh.

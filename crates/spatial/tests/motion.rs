@@ -263,6 +263,34 @@ fn boundary_stop_and_slide() {
         // From a boundary vertex, outwards at an angle.
         let m = mv(p(1.0, 0.3), d(0.5, -0.1), &slide);
         assert_close(&m.position, &p(1.0, 0.2), 1e-14, "from a boundary vertex");
+        // Keep: boundary points move along the boundary only.
+        let keep = walk(BoundaryMode::Keep);
+        let m = mv(p(1.0, 0.45), d(-0.2, 0.1), &keep);
+        assert_eq!(m.outcome, MoveOutcome::SlidAlongBoundary);
+        assert_close(&m.position, &p(1.0, 0.55), 1e-14, "keep on an edge");
+        let m = mv(p(1.0, 0.3), d(-0.3, 0.1), &keep);
+        assert_close(&m.position, &p(1.0, 0.4), 1e-14, "keep from a vertex");
+        let m = mv(p(1.0, 1.0), d(-0.2, -0.1), &keep);
+        assert_close(&m.position, &p(0.8, 1.0), 1e-14, "keep from a corner");
+        // Down 0.35 to the corner, then on along the bottom by the remaining 0.25.
+        let m = mv(p(0.0, 0.35), d(0.5, -0.6), &keep);
+        assert_close(&m.position, &p(0.25, 0.0), 1e-14, "keep round a corner");
+        let project_keep = MoveOptions {
+            method: MoveMethod::Project,
+            boundary: BoundaryMode::Keep,
+            ..MoveOptions::default()
+        };
+        let m = mv(p(0.45, 0.0), d(0.1, 0.3), &project_keep);
+        assert_close(&m.position, &p(0.55, 0.0), 1e-14, "keep with projection");
+        let m = mv(p(0.55, 0.55), d(1.0, 0.3), &keep);
+        assert_close(
+            &m.position,
+            &p(1.0, 0.85),
+            1e-14,
+            "keep slides inner points",
+        );
+        let m = mv(p(0.5, 0.5), d(0.1, 0.2), &keep);
+        assert_eq!(m.outcome, MoveOutcome::Arrived);
         // A long slide wraps around the loop.
         let m = mv(p(1.0, 0.45), d(1.0, 4.0 * 3.0 + 0.1), &slide);
         assert_close(&m.position, &p(1.0, 0.55), 1e-12, "wrapping");
