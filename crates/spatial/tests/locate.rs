@@ -3,10 +3,10 @@
 mod common;
 
 use beltrami_mesh::primitives::{Cells, icosphere, jittered_grid, torus};
-use beltrami_mesh::{FaceId, Mesh, SurfacePoint};
+use beltrami_mesh::{BuildOptions, FaceId, Mesh, SurfacePoint};
 use beltrami_spatial::closest_point::closest_on_face;
 use beltrami_spatial::{SpatialError, SurfaceIndex};
-use common::{Rng, build, shared_mesh};
+use common::{Rng, build, mixed_grid, shared_mesh};
 use nalgebra::{Point3, Vector3};
 
 /// The smallest distance from `p` to any face, and the lowest face attaining it.
@@ -174,4 +174,40 @@ fn bad_queries_are_typed_errors() {
     assert!(err.to_string().starts_with("item 1:"), "{err}");
     let err = index.locate_all_near(&[Point3::origin()], &[]).unwrap_err();
     assert!(matches!(err, SpatialError::LengthMismatch { .. }));
+}
+
+#[test]
+fn mixed_triangles_and_quads() {
+    check_against_brute_force("mixed grid", &mixed_grid(12), 1500, 0.2);
+}
+
+#[test]
+fn a_zero_area_face_is_handled() {
+    // A 4 x 4 grid whose corner (1, 0) is moved onto the segment between its neighbours
+    // (0.75, 0) and (1, 0.25): the triangle of the three is collinear, which a negative
+    // degenerate-area tolerance lets through.
+    let mut soup = beltrami_mesh::primitives::grid(4, 4, Cells::Triangles);
+    soup.positions[4] = Point3::new(0.875, 0.125, 0.0);
+    let options = BuildOptions {
+        degenerate_area_tolerance: -1.0,
+        ..BuildOptions::default()
+    };
+    let (mesh, _) = Mesh::build(&soup, &options).unwrap();
+    let degenerate = mesh.faces().filter(|&f| mesh.face_area(f) < 1e-17).count();
+    assert_eq!(degenerate, 1, "the test mesh has one zero-area face");
+    check_against_brute_force("degenerate", &mesh, 1500, 0.3);
+    // Walking onto it: the walk falls back to the projection, which lands on the cut
+    // corner's diagonal.
+    let index = SurfaceIndex::new(&mesh).unwrap();
+    let start = index.locate(&Point3::new(0.8, 0.1, 0.0)).unwrap().point;
+    let moved = index
+        .move_point(
+            &start,
+            &Vector3::new(0.1, -0.05, 0.0),
+            &beltrami_spatial::MoveOptions::default(),
+        )
+        .unwrap();
+    let expected = index.locate(&Point3::new(0.9, 0.05, 0.0)).unwrap();
+    assert!((moved.position - expected.position).norm() < 1e-12);
+    moved.point.validate(&mesh).unwrap();
 }

@@ -8,7 +8,7 @@ use beltrami_mesh::{FaceId, Mesh, SurfacePoint};
 use beltrami_spatial::{
     BoundaryMode, MoveMethod, MoveOptions, MoveOutcome, SpatialError, SurfaceIndex,
 };
-use common::{Rng, build, cube, prism};
+use common::{Rng, build, cube, mixed_grid, prism};
 use nalgebra::{Point3, Vector3};
 
 fn walk(boundary: BoundaryMode) -> MoveOptions {
@@ -96,6 +96,18 @@ fn a_walk_on_a_flat_grid_is_vector_addition() {
             crossed += moved.faces_crossed;
         }
         assert!(crossed > 2000 * 4, "the walks cross faces ({crossed})");
+    }
+    // Across a checkerboard of quads and triangle pairs.
+    let mesh = mixed_grid(10);
+    let index = SurfaceIndex::new(&mesh).unwrap();
+    let mut rng = Rng::new(12);
+    for _ in 0..1000 {
+        let x = Point3::new(rng.range(0.2, 0.8), rng.range(0.2, 0.8), 0.0);
+        let d = Vector3::new(rng.range(-0.2, 0.2), rng.range(-0.2, 0.2), 0.0);
+        let moved = index
+            .move_point(&at(&index, x), &d, &MoveOptions::default())
+            .unwrap();
+        assert_close(&moved.position, &(x + d), 1e-13, "mixed walk");
     }
     // Through vertices and along edges of a regular grid.
     let mesh = build(&grid(10, 10, Cells::Triangles));

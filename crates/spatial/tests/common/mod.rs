@@ -167,3 +167,28 @@ pub fn cube(k: usize, quads: bool) -> Mesh {
     }
     build(&soup)
 }
+
+/// The unit square as a `k` x `k` grid whose cells are alternately quads and triangle
+/// pairs (a checkerboard of both kinds).
+pub fn mixed_grid(k: usize) -> Mesh {
+    let mut positions = Vec::new();
+    for j in 0..=k {
+        for i in 0..=k {
+            positions.push(Point3::new(i as f64 / k as f64, j as f64 / k as f64, 0.0));
+        }
+    }
+    let id = |i: usize, j: usize| (i + (k + 1) * j) as u32;
+    let mut soup = PolygonSoup::new(positions);
+    for j in 0..k {
+        for i in 0..k {
+            let c = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+            if (i + j) % 2 == 0 {
+                soup.push_face(&c);
+            } else {
+                soup.push_face(&[c[0], c[1], c[2]]);
+                soup.push_face(&[c[0], c[2], c[3]]);
+            }
+        }
+    }
+    build(&soup)
+}
