@@ -9,7 +9,8 @@
 //!   the surface (a tangent step of up to half a mean edge plus a normal offset of up to
 //!   a tenth) and re-located, without hints (`locate_all`) and with each vertex's
 //!   previous face as hint (`locate_all_near`);
-//! - the same tangent steps as walks on the surface (`move_all`).
+//! - the next step as walks on the surface (`move_all`): the same tangent steps, from
+//!   the points where the re-location landed.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -174,12 +175,14 @@ pub fn run(args: &SpatialArgs) -> anyhow::Result<()> {
         }
         let hints: Vec<FaceId> = start.iter().map(|p| p.face).collect();
         let (cold, _) = fastest(args.repeat, || Ok(index.locate_all(&moved_points)?))?;
-        let (warm, _) = fastest(args.repeat, || {
+        let (warm, located) = fastest(args.repeat, || {
             Ok(index.locate_all_near(&moved_points, &hints)?)
         })?;
+        // The next step walks from where this one landed (points inside faces).
+        let landed: Vec<SurfacePoint> = located.iter().map(|l| l.point).collect();
         let options = MoveOptions::default();
         let (walk, summary) = fastest(args.repeat, || {
-            let mut points = start.clone();
+            let mut points = landed.clone();
             Ok(index.move_all(&mut points, &tangent_steps, &options)?)
         })?;
         steps.push((
@@ -198,13 +201,14 @@ pub fn run(args: &SpatialArgs) -> anyhow::Result<()> {
     );
     println!();
     println!(
-        "| target | faces | moved vertices | locate_all s | locate_all_near (hints) s | move_all (walk) s | faces crossed per walk |"
+        "| target | faces | moved vertices | locate_all s | locate_all_near (hints) s | move_all (walk) s | faces crossed per walk | walks projected |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for (name, faces, n, cold, warm, walk, summary) in steps {
         println!(
-            "| {name} | {faces} | {n} | {cold:.4} | {warm:.4} | {walk:.4} | {:.2} |",
-            summary.faces_crossed as f64 / n as f64
+            "| {name} | {faces} | {n} | {cold:.4} | {warm:.4} | {walk:.4} | {:.2} | {} |",
+            summary.faces_crossed as f64 / n as f64,
+            summary.projected
         );
     }
     Ok(())
