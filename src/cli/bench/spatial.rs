@@ -197,7 +197,7 @@ pub fn run(args: &SpatialArgs) -> anyhow::Result<()> {
     }
     println!();
     println!(
-        "One flow step: every vertex of the target moved off the surface and re-located, or walked:"
+        "One flow step: every vertex of the target moved off the surface and re-located; the next step walked:"
     );
     println!();
     println!(
