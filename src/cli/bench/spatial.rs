@@ -5,6 +5,8 @@
 //! - building the `SurfaceIndex` (face samples, kd-tree, vertex normals);
 //! - locating `--points` random points near the surface: a uniformly chosen face, a
 //!   uniform point on it, moved in a uniform direction by up to two mean edge lengths;
+//!   as a floor, the same points' nearest face centroid in a bare kiddo tree (not the
+//!   closest point, only the tree query);
 //! - one step of a flow on a source with the target's vertices: every vertex moved off
 //!   the surface (a tangent step of up to half a mean edge plus a normal offset of up to
 //!   a tenth) and re-located, without hints (`locate_all`) and with each vertex's
@@ -20,6 +22,7 @@ use beltrami_mesh::primitives::{Cells, torus};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, SurfacePoint, Vector3, io};
 use beltrami_spatial::{MoveOptions, SurfaceIndex};
 use clap::Args;
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 #[derive(Debug, Args)]
 pub struct SpatialArgs {
@@ -127,9 +130,9 @@ pub fn run(args: &SpatialArgs) -> anyhow::Result<()> {
     );
     println!();
     println!(
-        "| target | faces | vertices | samples | index build s | points | locate s | per point us |"
+        "| target | faces | vertices | samples | index build s | points | locate_all s | per point us | kiddo nearest centroid s |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     let mut steps = Vec::new();
     for (name, mesh) in &cases {
         let (build, index) = fastest(args.repeat, || Ok(SurfaceIndex::new(mesh)?))?;
@@ -144,8 +147,24 @@ pub fn run(args: &SpatialArgs) -> anyhow::Result<()> {
             .collect();
         let (locate, located) = fastest(args.repeat, || Ok(index.locate_all(&points)?))?;
         std::hint::black_box(&located);
+        let centroids: Vec<[f64; 3]> = mesh
+            .faces()
+            .map(|f| mesh.face_centroid(f).coords.into())
+            .collect();
+        let tree: ImmutableKdTree<f64, 3> = ImmutableKdTree::new_from_slice(&centroids)?;
+        let (bare, _) = fastest(args.repeat, || {
+            Ok(points
+                .iter()
+                .map(|p| {
+                    tree.query(&[p.x, p.y, p.z])
+                        .nearest_one::<SquaredEuclidean<f64>>()
+                        .execute()
+                        .item
+                })
+                .fold(0u64, |a, i| a.wrapping_add(u64::from(i))))
+        })?;
         println!(
-            "| {name} | {} | {} | {} | {build:.3} | {} | {locate:.3} | {:.2} |",
+            "| {name} | {} | {} | {} | {build:.3} | {} | {locate:.3} | {:.2} | {bare:.3} |",
             mesh.face_count(),
             mesh.vertex_count(),
             index.sample_count(),
