@@ -7,12 +7,12 @@
 //!   uniform point on it, moved in a uniform direction by up to two mean edge lengths;
 //!   as a floor, the same points' nearest face centroid in a bare kiddo tree (not the
 //!   closest point, only the tree query);
-//! - one step of a flow on a source with the target's vertices: every vertex moved off
-//!   the surface (a tangent step of up to half a mean edge plus a normal offset of up to
-//!   a tenth) and re-located, without hints (`locate_all`) and with each vertex's
-//!   previous face as hint (`locate_all_near`);
-//! - the next step as walks on the surface (`move_all`): the same tangent steps, from
-//!   the points where the re-location landed.
+//! - two steps of a flow on a source with the target's vertices. Step 1: every vertex
+//!   moved off the surface (a tangent step of up to half a mean edge plus a normal
+//!   offset of up to a tenth) and re-located, without hints (`locate_all`) and with a
+//!   face of the vertex as hint (`locate_all_near`). Step 2: the same from where step 1
+//!   landed (points inside faces, their faces as hints), re-located with hints, or
+//!   walked on the surface (`move_all`) by the same tangent steps.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -20,7 +20,7 @@ use std::time::Instant;
 use anyhow::Context;
 use beltrami_mesh::primitives::{Cells, torus};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, SurfacePoint, Vector3, io};
-use beltrami_spatial::{MoveOptions, SurfaceIndex};
+use beltrami_spatial::{MoveOptions, MoveSummary, SurfaceIndex};
 use clap::Args;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
@@ -100,6 +100,50 @@ fn fastest<T>(repeat: usize, mut f: impl FnMut() -> anyhow::Result<T>) -> anyhow
     Ok((best, last.context("at least one run")?))
 }
 
+/// Timings of the flow steps on one target.
+struct StepTimes {
+    name: String,
+    faces: usize,
+    points: usize,
+    cold: f64,
+    warm: f64,
+    next: f64,
+    walk: f64,
+    summary: MoveSummary,
+}
+
+/// The moved positions and the tangent steps of a flow step.
+struct Step {
+    moved: Vec<Point3<f64>>,
+    tangents: Vec<Vector3<f64>>,
+}
+
+/// A flow step from `points`: each moved in its tangent plane by up to half of `edge` in
+/// a uniform direction and off the surface by up to a tenth of `edge` along the normal.
+fn perturb(
+    index: &SurfaceIndex,
+    points: &[SurfacePoint],
+    edge: f64,
+    rng: &mut Uniform,
+) -> anyhow::Result<Step> {
+    let mut moved = Vec::with_capacity(points.len());
+    let mut tangents = Vec::with_capacity(points.len());
+    for p in points {
+        let frame = index.frame(p)?;
+        let t = frame.tangential(&rng.direction());
+        let t = if t.norm() > 0.0 {
+            t.normalize()
+        } else {
+            frame.e1
+        };
+        let step = 0.5 * edge * rng.next() * t;
+        let offset = 0.1 * edge * (2.0 * rng.next() - 1.0) * frame.normal;
+        moved.push(frame.origin + step + offset);
+        tangents.push(step);
+    }
+    Ok(Step { moved, tangents })
+}
+
 fn targets(args: &SpatialArgs) -> anyhow::Result<Vec<(String, Mesh)>> {
     let mut out = Vec::new();
     if args.faces > 0 {
@@ -172,62 +216,57 @@ pub fn run(args: &SpatialArgs) -> anyhow::Result<()> {
             1e6 * locate / points.len() as f64,
         );
 
-        // One flow step on a source with the target's vertices.
+        // Flow steps on a source with the target's vertices.
         let start: Vec<SurfacePoint> = mesh
             .vertices()
             .map(|v| SurfacePoint::at_vertex(mesh, v))
             .collect();
-        let mut moved_points = Vec::with_capacity(start.len());
-        let mut tangent_steps = Vec::with_capacity(start.len());
-        for p in &start {
-            let frame = index.frame(p)?;
-            let t = frame.tangential(&rng.direction());
-            let t = if t.norm() > 0.0 {
-                t.normalize()
-            } else {
-                frame.e1
-            };
-            let step = 0.5 * edge * rng.next() * t;
-            let offset = 0.1 * edge * (2.0 * rng.next() - 1.0) * frame.normal;
-            moved_points.push(frame.origin + step + offset);
-            tangent_steps.push(step);
-        }
+        let moved = perturb(&index, &start, edge, &mut rng)?.moved;
         let hints: Vec<FaceId> = start.iter().map(|p| p.face).collect();
-        let (cold, _) = fastest(args.repeat, || Ok(index.locate_all(&moved_points)?))?;
-        let (warm, located) = fastest(args.repeat, || {
-            Ok(index.locate_all_near(&moved_points, &hints)?)
-        })?;
-        // The next step walks from where this one landed (points inside faces).
+        let (cold, _) = fastest(args.repeat, || Ok(index.locate_all(&moved)?))?;
+        let (warm, located) = fastest(args.repeat, || Ok(index.locate_all_near(&moved, &hints)?))?;
+        // The next step starts where this one landed (points inside faces).
         let landed: Vec<SurfacePoint> = located.iter().map(|l| l.point).collect();
+        let Step { moved, tangents } = perturb(&index, &landed, edge, &mut rng)?;
+        let hints: Vec<FaceId> = landed.iter().map(|p| p.face).collect();
+        let (next, _) = fastest(args.repeat, || Ok(index.locate_all_near(&moved, &hints)?))?;
         let options = MoveOptions::default();
         let (walk, summary) = fastest(args.repeat, || {
             let mut points = landed.clone();
-            Ok(index.move_all(&mut points, &tangent_steps, &options)?)
+            Ok(index.move_all(&mut points, &tangents, &options)?)
         })?;
-        steps.push((
-            name.clone(),
-            mesh.face_count(),
-            start.len(),
+        steps.push(StepTimes {
+            name: name.clone(),
+            faces: mesh.face_count(),
+            points: start.len(),
             cold,
             warm,
+            next,
             walk,
             summary,
-        ));
+        });
     }
     println!();
     println!(
-        "One flow step: every vertex of the target moved off the surface and re-located; the next step walked:"
+        "Flow steps on a source with the target's vertices (1: from the vertices, 2: from where step 1 landed):"
     );
     println!();
     println!(
-        "| target | faces | moved vertices | locate_all s | locate_all_near (hints) s | move_all (walk) s | faces crossed per walk | walks projected |"
+        "| target | faces | points | step 1 locate_all s | step 1 locate_all_near s | step 2 locate_all_near s | step 2 move_all (walk) s | faces crossed per walk | walks projected |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
-    for (name, faces, n, cold, warm, walk, summary) in steps {
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for t in steps {
         println!(
-            "| {name} | {faces} | {n} | {cold:.4} | {warm:.4} | {walk:.4} | {:.2} | {} |",
-            summary.faces_crossed as f64 / n as f64,
-            summary.projected
+            "| {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} | {} |",
+            t.name,
+            t.faces,
+            t.points,
+            t.cold,
+            t.warm,
+            t.next,
+            t.walk,
+            t.summary.faces_crossed as f64 / t.points as f64,
+            t.summary.projected
         );
     }
     Ok(())
