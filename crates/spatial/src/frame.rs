@@ -10,8 +10,9 @@
 //! `n` in place of the face normal: `e1` is the face's first edge projected onto the
 //! tangent plane and normalized, and `e2 = n x e1`, so `(e1, e2, n)` is a positively
 //! oriented orthonormal basis and a tangent vector `a e1 + b e2` has local coordinates
-//! `a + i b`. If the first edge is nearly parallel to `n` (a sharp feature), the face
-//! edge with the largest tangential part is projected instead. On a flat face with
+//! `a + i b`. If the first edge is within about 6 degrees of `n` (at a sharp feature,
+//! where the vertex normals turn far from the face normal), the face edge most
+//! orthogonal to `n` is projected instead. On a flat face with
 //! vertex normals equal to the face normal the frame is the face frame.
 
 use beltrami_mesh::{Mesh, SurfacePoint};
@@ -46,10 +47,10 @@ impl TangentFrame {
             let length = e.norm();
             (t, if length > 0.0 { t.norm() / length } else { 0.0 })
         };
-        // The first edge unless it is within about 8 degrees of the normal; then the
-        // edge most orthogonal to it.
+        // The first edge unless it is within about 6 degrees of the normal (a sine below
+        // 0.1); then the edge most orthogonal to the normal.
         let mut best = tangential(0);
-        if best.1 < 0.99 {
+        if best.1 < 0.1 {
             for k in 1..n {
                 let candidate = tangential(k);
                 if candidate.1 > best.1 {

@@ -438,6 +438,36 @@ fn frames_are_orthonormal_and_tangent() {
 }
 
 #[test]
+fn frames_follow_the_first_edge_on_curved_meshes() {
+    // On an icosahedron and a cube the vertex normals turn 37 and 55 degrees from the
+    // face normals; e1 stays the first edge's tangential direction all over each face.
+    for mesh in [build(&icosphere(0)), cube(2, false)] {
+        let index = SurfaceIndex::new(&mesh).unwrap();
+        for f in mesh.faces() {
+            let (v, _) = mesh.face_vertex_array(f);
+            let edge = mesh.position(v[1]) - mesh.position(v[0]);
+            for l in [
+                [1.0, 0.0, 0.0],
+                [0.05, 0.9, 0.05],
+                [0.0, 0.0, 1.0],
+                [0.4, 0.3, 0.3],
+            ] {
+                let fr = index.frame(&SurfacePoint::in_triangle(f, l)).unwrap();
+                let t = fr.tangential(&edge).normalize();
+                assert!((fr.e1 - t).norm() < 1e-14);
+            }
+        }
+    }
+}
+
+#[test]
+fn the_index_can_be_shared_across_threads() {
+    fn shared<T: Send + Sync>(_: &T) {}
+    let mesh = build(&icosphere(1));
+    shared(&SurfaceIndex::new(&mesh).unwrap());
+}
+
+#[test]
 fn zero_and_normal_displacements_stay_put() {
     let mesh = build(&torus(12, 8, 1.0, 0.3, Cells::Quads));
     let index = SurfaceIndex::new(&mesh).unwrap();
