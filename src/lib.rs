@@ -16,6 +16,8 @@
 //!   |mu| histograms as PNG.
 //! - [`lsqc`]: the least-squares quasiconformal map for a prescribed Beltrami
 //!   coefficient (lsqc).
+//! - [`spatial`]: exact closest points on a target mesh through a kd-tree, tangent
+//!   frames, and moving surface points along the surface.
 //!
 //! [`registry`] returns every solver shipped with this package.
 //!
@@ -29,6 +31,7 @@ pub use beltrami_init as init;
 pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
 pub use beltrami_render as render;
+pub use beltrami_spatial as spatial;
 
 /// Every solver shipped with beltrami, by name.
 pub fn registry() -> beltrami_core::Registry {

@@ -1,17 +1,9 @@
 //! Maps: the images of a mesh's vertices.
 
-use beltrami_mesh::{FaceId, Point3};
+use beltrami_mesh::Point3;
 use num_complex::Complex64;
 
-/// A point on a target mesh: a face and barycentric coordinates (one per face vertex,
-/// summing to 1; for a quad, the bilinear coordinates `(1-u)(1-v), u(1-v), uv, (1-u)v`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SurfacePoint {
-    /// The face containing the point.
-    pub face: FaceId,
-    /// Coordinates with respect to the face's vertices, in face order.
-    pub coords: [f64; 4],
-}
+pub use beltrami_mesh::SurfacePoint;
 
 /// The images of the vertices of a source mesh, indexed by [`beltrami_mesh::VertexId`].
 #[derive(Debug, Clone, PartialEq)]

@@ -25,7 +25,8 @@
 //! ```
 //!
 //! Conventions (orientation, boundary halfedges, circulation order, face frames) are
-//! stated in the docs of [`mesh`](crate::Mesh), [`circulators`] and [`frame`].
+//! stated in the docs of [`mesh`](crate::Mesh), [`circulators`], [`frame`] and
+//! [`surface_point`].
 
 mod build;
 pub mod circulators;
@@ -39,6 +40,7 @@ mod mesh;
 pub mod primitives;
 mod soup;
 pub mod subdivision;
+pub mod surface_point;
 mod topology;
 mod vertex_map;
 
@@ -52,6 +54,7 @@ pub use geometry::BoundingBox;
 pub use ids::{BoundaryLoopId, ComponentId, EdgeId, FaceId, HalfedgeId, VertexId};
 pub use mesh::Mesh;
 pub use soup::PolygonSoup;
+pub use surface_point::{SurfacePoint, SurfacePointError};
 pub use topology::{BoundaryLoop, Component};
 pub use vertex_map::VertexMap;
 

@@ -4,6 +4,7 @@ mod fem;
 mod flow;
 mod load;
 mod render;
+mod spatial;
 
 use clap::{Args, Subcommand};
 
@@ -27,6 +28,9 @@ pub enum BenchKind {
     /// Pictures (scene measure, uv and 3D rasterization, PNG encoding) of generated
     /// grids of up to ~1M triangles.
     Render(render::RenderArgs),
+    /// Building the surface index, locating random points near a target surface, and
+    /// one flow step (every vertex re-located, with and without hints, or walked).
+    Spatial(spatial::SpatialArgs),
 }
 
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
@@ -35,5 +39,6 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchKind::Fem(a) => fem::run(a),
         BenchKind::Flow(a) => flow::run(a),
         BenchKind::Render(a) => render::run(a),
+        BenchKind::Spatial(a) => spatial::run(a),
     }
 }
