@@ -153,6 +153,7 @@ fn step<G: TargetGeometry>(
     extension: Option<&mut HarmonicExtension>,
     delta: &mut Vec<Vector3<f64>>,
     out: &mut Vec<Point3<f64>>,
+    normals: &mut Vec<Vector3<f64>>,
 ) -> Result<G, SolverError> {
     let mut moved = target.clone();
     for (c, &d) in flow.offset.iter().enumerate() {
@@ -174,16 +175,13 @@ fn step<G: TargetGeometry>(
     if let Some(extension) = extension {
         extension.apply(delta, out)?;
     }
-    for (p, &role) in out.iter_mut().zip(roles) {
-        if role == Role::Free {
-            *p = moved.project(role, p);
-        }
-    }
+    moved.project_all(roles, out, normals)?;
     Ok(moved)
 }
 
-/// Runs the flow from `image` (one point per source vertex, on `target`) with the
-/// unknowns of `system`, for `objective` measured on the source `elements`.
+/// Runs the flow from `image` (one point per source vertex, projected onto `target`
+/// first) with the unknowns of `system`, for `objective` measured on the source
+/// `elements`.
 pub fn run<G: TargetGeometry>(
     elements: &Elements,
     mut target: G,
@@ -202,13 +200,15 @@ pub fn run<G: TargetGeometry>(
         None
     };
     let mut delta = Vec::new();
+    let mut normals = Vec::new();
+    target.project_all(system.roles(), &mut image, &mut normals)?;
     let mut faces = Vec::with_capacity(elements.face_count());
-    image_faces(elements, &target, &image, &mut faces);
+    image_faces(elements, &normals, &image, &mut faces);
     let (mut energy, mut flipped) = objective.evaluate(&faces);
     let mut energy_history = vec![energy];
     let (mut step_sizes, mut updates) = (Vec::new(), Vec::new());
     let (mut weights, mut rho) = (Vec::new(), Vec::new());
-    let (mut trial, mut trial_faces) = (Vec::new(), Vec::new());
+    let (mut trial, mut trial_faces, mut trial_normals) = (Vec::new(), Vec::new(), Vec::new());
     let report = |context: &mut Context<'_>, done: usize, energy: f64| {
         context.report(&Progress {
             stage: "flow",
@@ -227,7 +227,7 @@ pub fn run<G: TargetGeometry>(
         }
         let clock = Instant::now();
         weights_and_targets(objective, &faces, &mut weights, &mut rho);
-        let flow = system.solve(&target, &image, &faces, &weights, &rho)?;
+        let flow = system.solve(&target, &image, &normals, &faces, &weights, &rho)?;
         solve_seconds += clock.elapsed().as_secs_f64();
         let clock = Instant::now();
         let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
@@ -245,8 +245,9 @@ pub fn run<G: TargetGeometry>(
                 extension.as_mut(),
                 &mut delta,
                 &mut trial,
+                &mut trial_normals,
             )?;
-            image_faces(elements, &moved, &trial, &mut trial_faces);
+            image_faces(elements, &trial_normals, &trial, &mut trial_faces);
             let (e, flips) = objective.evaluate(&trial_faces);
             if flips <= flipped && e < energy {
                 break Some((moved, e, flips));
@@ -265,6 +266,7 @@ pub fn run<G: TargetGeometry>(
         target = moved;
         std::mem::swap(&mut image, &mut trial);
         std::mem::swap(&mut faces, &mut trial_faces);
+        std::mem::swap(&mut normals, &mut trial_normals);
         (energy, flipped) = (e, flips);
         energy_history.push(energy);
         step_sizes.push(t);

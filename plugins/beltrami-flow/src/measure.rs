@@ -4,7 +4,7 @@
 //! For a P1 face `T` of the source (one quadrature point, tangent frame `(e1, e2)` of
 //! the source elements) and its image triangle `Y_0 Y_1 Y_2` on the target, the image
 //! frame is `(r, s, n)`: `r` along `Y_1 - Y_0`, `n` the triangle's normal turned to the
-//! side of the target's normal at its centroid, `s = n x r` (Wong-Zhao 2014, Appendix:
+//! side of the target's normals at its vertices (summed), `s = n x r` (Wong-Zhao 2014, Appendix:
 //! "local isometric coordinates (r, s) on each image face"). With
 //! `f_x = sum_k Y_k d_x N_k` and `f_y = sum_k Y_k d_y N_k` in R^3,
 //!
@@ -22,8 +22,6 @@ use beltrami_fem::Elements;
 use beltrami_fem::beltrami::PointDerivatives;
 use beltrami_mesh::{FaceId, Point3, Vector2, Vector3, VertexId};
 use num_complex::Complex64;
-
-use crate::target::TargetGeometry;
 
 /// One image face of the current map.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,18 +54,24 @@ pub(crate) fn triangle(elements: &Elements, f: FaceId) -> [VertexId; 3] {
     [n[0], n[1], n[2]]
 }
 
-/// The image face of `f` under the map `image`.
-pub fn image_face<G: TargetGeometry>(
+/// The image face of `f` under the map `image`, oriented by the sum of the target's
+/// normals `normals` at its vertices' images.
+pub fn image_face(
     elements: &Elements,
-    target: &G,
+    normals: &[Vector3<f64>],
     image: &[Point3<f64>],
     f: FaceId,
 ) -> ImageFace {
     let q = &elements.face_points(f)[0];
-    let [a, b, c] = triangle(elements, f).map(|v| image[v.idx()]);
+    let nodes = triangle(elements, f);
+    let [a, b, c] = nodes.map(|v| image[v.idx()]);
     let (e1, e2) = (b - a, c - a);
-    let centroid = Point3::from((a.coords + b.coords + c.coords) / 3.0);
-    let reference = target.normal(&centroid);
+    let summed: Vector3<f64> = nodes.iter().map(|v| normals[v.idx()]).sum();
+    let reference = if summed.norm_squared() > 0.0 {
+        summed.normalize()
+    } else {
+        normals[nodes[0].idx()]
+    };
     let m = e1.cross(&e2);
     let n = if m.norm_squared() > 0.0 {
         let m = m.normalize();
@@ -84,7 +88,6 @@ pub fn image_face<G: TargetGeometry>(
         }
     };
     let s = n.cross(&r);
-    let nodes = triangle(elements, f);
     let (mut fx, mut fy) = (Vector3::zeros(), Vector3::zeros());
     for (k, v) in nodes.iter().enumerate() {
         fx += image[v.idx()].coords * q.grad[k].x;
@@ -103,16 +106,16 @@ pub fn image_face<G: TargetGeometry>(
     }
 }
 
-/// Every image face of the map `image`, into `out` (cleared first).
-pub fn image_faces<G: TargetGeometry>(
+/// Every image face of the map `image` ([`image_face`]), into `out` (cleared first).
+pub fn image_faces(
     elements: &Elements,
-    target: &G,
+    normals: &[Vector3<f64>],
     image: &[Point3<f64>],
     out: &mut Vec<ImageFace>,
 ) {
     out.clear();
     out.extend(
-        (0..elements.face_count()).map(|f| image_face(elements, target, image, FaceId(f as u32))),
+        (0..elements.face_count()).map(|f| image_face(elements, normals, image, FaceId(f as u32))),
     );
 }
 

@@ -88,12 +88,11 @@ impl Solver for BeltramiFlow {
             ));
         }
         let domain = domain(problem, &initial)?;
-        let mut image = initial;
+        let image = initial;
         let outcome = match domain {
             Domain::Region(g) => {
                 let scale = diagonal(&image);
                 let roles = region_roles(mesh, &g, &image, &pins);
-                project_all(&g, &roles, &mut image);
                 run(
                     &elements,
                     g,
@@ -110,7 +109,6 @@ impl Solver for BeltramiFlow {
             }
             Domain::Disk(g) => {
                 let roles = curve_roles(mesh, &pins, |_| 0);
-                project_all(&g, &roles, &mut image);
                 run(
                     &elements,
                     g,
@@ -127,7 +125,6 @@ impl Solver for BeltramiFlow {
             }
             Domain::Annulus(g, outer) => {
                 let roles = curve_roles(mesh, &pins, |l| if l == outer { OUTER } else { INNER });
-                project_all(&g, &roles, &mut image);
                 let run = run(
                     &elements,
                     g,
@@ -150,7 +147,6 @@ impl Solver for BeltramiFlow {
             }
             Domain::Sphere(g) => {
                 let roles = curve_roles(mesh, &pins, |_| 0);
-                project_all(&g, &roles, &mut image);
                 run(
                     &elements,
                     g,
@@ -565,12 +561,6 @@ fn curve_roles(mesh: &Mesh, pins: &[VertexId], curve_of: impl Fn(usize) -> usize
         roles[v.idx()] = Role::Fixed;
     }
     roles
-}
-
-fn project_all<G: TargetGeometry>(target: &G, roles: &[Role], image: &mut [Point3<f64>]) {
-    for (p, &role) in image.iter_mut().zip(roles) {
-        *p = target.project(role, p);
-    }
 }
 
 /// The pinned vertices: the problem's, or the default ones of the target (the vertex

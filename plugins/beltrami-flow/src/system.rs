@@ -3,7 +3,8 @@
 //! The flow `V` is piecewise linear on the image mesh, `V_i = sum_k c_ik b_ik` at vertex
 //! `i` with real unknowns `c_ik` along directions `b_ik` in R^3 (two tangent directions
 //! of the target for a [`Role::Free`] vertex, the curve tangent for a [`Role::Curve`]
-//! vertex, none for a [`Role::Fixed`] one; plus, for a curve with a free offset, one
+//! vertex, none for a [`Role::Fixed`] one — the tangent directions are
+//! [`orthonormal_basis`] of the target's normal at the image; plus, for a curve with a free offset, one
 //! unknown shared by all its vertices along the offset direction). On image face `T`,
 //! with frame `(r, s)` and the image triangle's shape-function gradients `grad N_k` in
 //! that frame,
@@ -34,7 +35,7 @@ use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
 use crate::measure::{ImageFace, triangle};
-use crate::target::{Role, TargetGeometry};
+use crate::target::{Role, TargetGeometry, orthonormal_basis};
 
 /// Most distinct unknowns of one face: two per vertex and one shared offset per vertex.
 const MAX_LOCAL: usize = 9;
@@ -215,6 +216,7 @@ impl FlowSystem {
         &mut self,
         target: &G,
         image: &[Point3<f64>],
+        normals: &[Vector3<f64>],
         faces: &[ImageFace],
         weights: &[f64],
         rho: &[Complex64],
@@ -234,7 +236,13 @@ impl FlowSystem {
                 beta[a] = match source {
                     Source::Vertex { k, index } => {
                         let v = self.faces[f][k as usize];
-                        let b = direction(target, self.roles[v], &image[v], index as usize);
+                        let b = direction(
+                            target,
+                            self.roles[v],
+                            &image[v],
+                            &normals[v],
+                            index as usize,
+                        );
                         g[k as usize] * along(face, &b)
                     }
                     Source::Offset { curve } => {
@@ -271,7 +279,8 @@ impl FlowSystem {
         for (v, &role) in self.roles.iter().enumerate() {
             let mut vec = Vector3::zeros();
             for index in 0..unknowns_of(role) {
-                vec += self.rhs[self.first[v] + index] * direction(target, role, &image[v], index);
+                vec += self.rhs[self.first[v] + index]
+                    * direction(target, role, &image[v], &normals[v], index);
             }
             if let Role::Curve(c) = role
                 && let Some(b) = target.curve_offset_direction(c, &image[v])
@@ -356,15 +365,17 @@ fn block_order(
     Ok(order)
 }
 
-/// The unknown direction `index` of a vertex with `role` at `p`.
+/// The unknown direction `index` of a vertex with `role` at `p`, where the target's
+/// normal is `normal`.
 fn direction<G: TargetGeometry>(
     target: &G,
     role: Role,
     p: &Point3<f64>,
+    normal: &Vector3<f64>,
     index: usize,
 ) -> Vector3<f64> {
     match role {
-        Role::Free => target.tangent_basis(p)[index],
+        Role::Free => orthonormal_basis(normal)[index],
         Role::Curve(c) => target.curve_tangent(c, p),
         Role::Fixed => Vector3::zeros(),
     }

@@ -10,8 +10,11 @@
 //! vertices on it, moving them along [`TargetGeometry::curve_offset_direction`].
 //!
 //! Orientation: [`TargetGeometry::normal`] is the side a counter-clockwise source face
-//! must face once mapped; an image face turning the other way is flipped.
+//! must face once mapped; an image face turning the other way is flipped. A free vertex
+//! moves in the plane orthogonal to the normal at its image, along the positively
+//! oriented basis [`orthonormal_basis`] of that plane.
 
+use beltrami_core::SolverError;
 use beltrami_mesh::{Point3, Vector3};
 
 /// How a vertex may move on the target.
@@ -29,12 +32,6 @@ pub enum Role {
 pub trait TargetGeometry: Clone {
     /// The unit normal at `p` (the orientation reference).
     fn normal(&self, p: &Point3<f64>) -> Vector3<f64>;
-
-    /// A positively oriented orthonormal tangent basis `(u, v)` at `p`
-    /// (`u x v = normal(p)`).
-    fn tangent_basis(&self, p: &Point3<f64>) -> [Vector3<f64>; 2] {
-        orthonormal_basis(&self.normal(p))
-    }
 
     /// The unit tangent of boundary curve `curve` at `p`.
     fn curve_tangent(&self, curve: usize, p: &Point3<f64>) -> Vector3<f64>;
@@ -62,6 +59,24 @@ pub trait TargetGeometry: Clone {
     /// The point of the target (for [`Role::Free`]) or of its curve (for
     /// [`Role::Curve`]) nearest to `p`; [`Role::Fixed`] points are returned unchanged.
     fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64>;
+
+    /// [`TargetGeometry::project`] of every point by its role, and into `normals` the
+    /// target's unit normal at each projected point (free vertices move in the plane
+    /// orthogonal to it; image faces are oriented by it). Targets that locate points in
+    /// a mesh override it to batch the work.
+    fn project_all(
+        &self,
+        roles: &[Role],
+        points: &mut [Point3<f64>],
+        normals: &mut Vec<Vector3<f64>>,
+    ) -> Result<(), SolverError> {
+        normals.clear();
+        for (p, &role) in points.iter_mut().zip(roles) {
+            *p = self.project(role, p);
+            normals.push(self.normal(p));
+        }
+        Ok(())
+    }
 }
 
 /// A positively oriented orthonormal basis `(u, v)` of the plane orthogonal to the unit
@@ -106,10 +121,6 @@ pub struct PlaneRegion {
 impl TargetGeometry for PlaneRegion {
     fn normal(&self, _p: &Point3<f64>) -> Vector3<f64> {
         Vector3::z()
-    }
-
-    fn tangent_basis(&self, _p: &Point3<f64>) -> [Vector3<f64>; 2] {
-        [Vector3::x(), Vector3::y()]
     }
 
     fn curve_tangent(&self, curve: usize, _p: &Point3<f64>) -> Vector3<f64> {
@@ -157,10 +168,6 @@ impl TargetGeometry for UnitDisk {
         Vector3::z()
     }
 
-    fn tangent_basis(&self, _p: &Point3<f64>) -> [Vector3<f64>; 2] {
-        [Vector3::x(), Vector3::y()]
-    }
-
     fn curve_tangent(&self, _curve: usize, p: &Point3<f64>) -> Vector3<f64> {
         circle_tangent(p)
     }
@@ -197,10 +204,6 @@ pub const INNER: usize = 1;
 impl TargetGeometry for Annulus {
     fn normal(&self, _p: &Point3<f64>) -> Vector3<f64> {
         Vector3::z()
-    }
-
-    fn tangent_basis(&self, _p: &Point3<f64>) -> [Vector3<f64>; 2] {
-        [Vector3::x(), Vector3::y()]
     }
 
     fn curve_tangent(&self, _curve: usize, p: &Point3<f64>) -> Vector3<f64> {
