@@ -22,6 +22,7 @@
 pub mod extension;
 pub mod flow;
 pub mod measure;
+pub mod mesh_target;
 pub mod paper;
 mod solver;
 pub mod stereographic;

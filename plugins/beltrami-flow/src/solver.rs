@@ -8,11 +8,13 @@ use beltrami_fem::element::is_planar;
 use beltrami_fem::{BeltramiField, DistortionStats, Elements, Frame, SolveOptions};
 use beltrami_init::{Sphere, Tutte};
 use beltrami_mesh::{Mesh, Point3, VertexId};
+use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
 use crate::NAME;
 use crate::flow::{self, FlowOptions, FlowRun, Stop};
 use crate::measure::Objective;
+use crate::mesh_target::{MeshTarget, TargetCurve};
 use crate::system::FlowSystem;
 use crate::target::{
     Annulus, INNER, OUTER, PlaneRegion, Role, Side, TargetGeometry, UnitDisk, UnitSphere,
@@ -21,7 +23,8 @@ use crate::target::{
 /// Discrete Beltrami flow onto a fixed target (crate docs).
 ///
 /// Reads: `goal` (`Conformal { p >= 2 }` or `Prescribed(field)`), `target`
-/// (`Plane(Keep | Square | Polygon | Circle)`, `Disk`, `Annulus`, `Sphere`),
+/// (`Plane(Keep | Square | Polygon | Circle)`, `Disk`, `Annulus`, `Sphere`, `Mesh` with
+/// an initial map onto it — the register solver builds one — and `constraints.curves`),
 /// `constraints.pins` (held where the initial map puts them), `initial` (a planar or
 /// spatial map to start from; its images are projected onto the target first),
 /// `params.tolerance` (largest vertex update, relative to the target's size),
@@ -86,6 +89,36 @@ impl Solver for BeltramiFlow {
                 "pinned vertices {} (input indices) where the initial map puts them, to fix the target's conformal automorphisms",
                 names.join(", ")
             ));
+        }
+        if let Target::Mesh(target) = &problem.target {
+            let index = context.stage("target index", &mut report, || {
+                SurfaceIndex::new(target).map_err(|e| invalid(format!("the target mesh: {e}")))
+            })?;
+            let (curves, roles) = mesh_roles(problem, target, &initial, &pins)?;
+            let geometry = MeshTarget::new(&index, curves);
+            let scale = diagonal(target.positions());
+            let run = run(
+                &elements,
+                geometry.clone(),
+                roles,
+                initial,
+                &objective,
+                problem,
+                scale,
+                options,
+                context,
+                &mut report,
+            )?;
+            let points = geometry.locate_all(&run.image)?;
+            let (_, faces_mu, flipped) = run.finish(false);
+            return finish_solution(
+                report,
+                goal.frame,
+                &objective,
+                faces_mu,
+                &flipped,
+                Map::OnMesh(points),
+            );
         }
         let domain = domain(problem, &initial)?;
         let image = initial;
@@ -163,17 +196,74 @@ impl Solver for BeltramiFlow {
             }
         };
         let (map, faces_mu, flipped) = outcome;
-        let stats = DistortionStats::new(&faces_mu, &objective.areas, &flipped)?;
-        if stats.flipped > 0 {
-            report.notes.push(format!(
-                "{} faces are flipped: the initial map had flips the flow could not remove",
-                stats.flipped
-            ));
-        }
-        report.mu = Some(BeltramiField::new(goal.frame, faces_mu));
-        report.distortion = Some(stats);
-        Ok(Solution { map, report })
+        finish_solution(report, goal.frame, &objective, faces_mu, &flipped, map)
     }
+}
+
+/// The solution with its measured `mu`, statistics and a note on remaining flips.
+fn finish_solution(
+    mut report: Report,
+    frame: Frame,
+    objective: &Objective,
+    faces_mu: Vec<Complex64>,
+    flipped: &[bool],
+    map: Map,
+) -> Result<Solution, SolverError> {
+    let stats = DistortionStats::new(&faces_mu, &objective.areas, flipped)?;
+    if stats.flipped > 0 {
+        report.notes.push(format!(
+            "{} faces are flipped: the initial map had flips the flow could not remove",
+            stats.flipped
+        ));
+    }
+    report.mu = Some(BeltramiField::new(frame, faces_mu));
+    report.distortion = Some(stats);
+    Ok(Solution { map, report })
+}
+
+/// The curves of a target mesh (its boundary loops, then the problem's feature curves)
+/// and the roles of the source vertices: each source boundary loop slides on the target
+/// loop nearest to its initial image, each feature curve's inner vertices on its target
+/// chain (ends fixed), pins fixed, the rest free.
+fn mesh_roles(
+    problem: &Problem<'_>,
+    target: &Mesh,
+    image: &[Point3<f64>],
+    pins: &[VertexId],
+) -> Result<(Vec<TargetCurve>, Vec<Role>), SolverError> {
+    let mesh = problem.source;
+    let mut curves = TargetCurve::boundary_loops(target);
+    let mut roles = vec![Role::Free; mesh.vertex_count()];
+    for l in mesh.boundary_loop_list() {
+        let nearest = (0..curves.len()).min_by(|&a, &b| {
+            let d = |c: usize| curves[c].mean_distance(l.vertices.iter().map(|v| &image[v.idx()]));
+            d(a).total_cmp(&d(b))
+        });
+        let Some(c) = nearest else {
+            return Err(unsupported(
+                "the source has a boundary and the target mesh none",
+            ));
+        };
+        for &v in &l.vertices {
+            roles[v.idx()] = Role::Curve(c);
+        }
+    }
+    for curve in &problem.constraints.curves {
+        let c = curves.len();
+        curves.push(TargetCurve::through(target, &curve.target, false));
+        let n = curve.source.len();
+        for (k, &v) in curve.source.iter().enumerate() {
+            roles[v.idx()] = if k == 0 || k + 1 == n {
+                Role::Fixed
+            } else {
+                Role::Curve(c)
+            };
+        }
+    }
+    for &v in pins {
+        roles[v.idx()] = Role::Fixed;
+    }
+    Ok((curves, roles))
 }
 
 /// The goal, checked: the frame `mu` is measured in, the target per face and `p`.
@@ -264,9 +354,53 @@ fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError> {
                 "use the disk or annulus targets for meshes with boundary",
             )?;
         }
-        Target::CircleDomain | Target::Mesh(_) | Target::Surface => {
+        Target::Mesh(target) => {
+            if target.boundary_loop_count() != mesh.boundary_loop_count()
+                || target.genus() != mesh.genus()
+                || target.component_count() != mesh.component_count()
+            {
+                return Err(unsupported(format!(
+                    "the source and the target mesh differ in topology: source has {}, target has {}",
+                    topology::describe(mesh),
+                    topology::describe(target)
+                )));
+            }
+            if problem.initial.is_none() {
+                return Err(unsupported(
+                    "a target mesh needs an initial map onto it: use the register solver, which builds one",
+                ));
+            }
+            if let Some(f) = target.faces().find(|&f| target.face_degree(f) != 3) {
+                return Err(unsupported(format!(
+                    "the target mesh must be made of triangles; its face {} (input index) is not",
+                    target.face_to_input(f)
+                )));
+            }
+            for (k, curve) in problem.constraints.curves.iter().enumerate() {
+                if curve.source.len() < 2 || curve.target.len() < 2 {
+                    return Err(invalid(format!(
+                        "curve {k} needs at least two source and two target vertices"
+                    )));
+                }
+                if let Some(v) = curve.source.iter().find(|v| v.idx() >= mesh.vertex_count()) {
+                    return Err(invalid(format!(
+                        "curve {k}: source vertex {v} does not exist"
+                    )));
+                }
+                if let Some(v) = curve
+                    .target
+                    .iter()
+                    .find(|v| v.idx() >= target.vertex_count())
+                {
+                    return Err(invalid(format!(
+                        "curve {k}: target vertex {v} does not exist"
+                    )));
+                }
+            }
+        }
+        Target::CircleDomain | Target::Surface => {
             return Err(unsupported(
-                "targets here: plane, disk, annulus, sphere (target meshes and circle domains come with other solvers)",
+                "targets here: plane, disk, annulus, sphere, a target mesh (circle domains come with another solver)",
             ));
         }
     }
@@ -284,7 +418,7 @@ fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError> {
             ));
         }
     }
-    if !problem.constraints.curves.is_empty() {
+    if !problem.constraints.curves.is_empty() && !matches!(problem.target, Target::Mesh(_)) {
         return Err(unsupported(
             "curve constraints come with target meshes (register)",
         ));
@@ -293,7 +427,7 @@ fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError> {
         let n = match initial {
             Map::Planar(z) => z.len(),
             Map::Spatial(p) => p.len(),
-            Map::OnMesh(_) => return Err(unsupported("the initial map must be planar or spatial")),
+            Map::OnMesh(p) => p.len(),
         };
         if n != mesh.vertex_count() {
             return Err(invalid(format!(
@@ -367,10 +501,23 @@ fn annulus_of(mesh: &Mesh) -> Result<(f64, usize), SolverError> {
 fn initial_map(problem: &Problem<'_>) -> Result<Vec<Point3<f64>>, SolverError> {
     let mesh = problem.source;
     if let Some(map) = &problem.initial {
-        return Ok(match map {
-            Map::Planar(z) => z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect(),
-            Map::Spatial(p) => p.clone(),
-            Map::OnMesh(_) => return Err(unsupported("the initial map must be planar or spatial")),
+        return Ok(match (map, &problem.target) {
+            (Map::Planar(z), _) => z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect(),
+            (Map::Spatial(p), _) => p.clone(),
+            (Map::OnMesh(points), Target::Mesh(target)) => points
+                .iter()
+                .enumerate()
+                .map(|(v, p)| {
+                    p.validate(target)
+                        .map(|()| p.position(target))
+                        .map_err(|e| invalid(format!("the initial map at vertex {v}: {e}")))
+                })
+                .collect::<Result<_, _>>()?,
+            (Map::OnMesh(_), _) => {
+                return Err(unsupported(
+                    "an initial map on a mesh needs that mesh as the target",
+                ));
+            }
         });
     }
     let planar_points = |map: Map| match map {

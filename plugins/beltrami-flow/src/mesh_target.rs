@@ -1,0 +1,190 @@
+//! A target mesh as the flow's target (Wong-Zhao 2014, sections 4.5 and 5.4): images
+//! live on its surface, free vertices move in the tangent plane of the interpolated
+//! normal and are projected back by exact closest-point location
+//! ([`beltrami_spatial::SurfaceIndex`]); vertices on a boundary or feature curve slide
+//! along it, as a polyline of target vertices.
+
+use std::cell::RefCell;
+
+use beltrami_core::SolverError;
+use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3, VertexId};
+use beltrami_spatial::SurfaceIndex;
+use beltrami_spatial::frame::interpolated_normal;
+
+use crate::target::{Role, TargetGeometry};
+
+/// A polyline of target vertices a chain of source vertices slides along.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetCurve {
+    /// Its points, in order.
+    pub points: Vec<Point3<f64>>,
+    /// Whether the last point connects back to the first (a boundary loop).
+    pub closed: bool,
+}
+
+impl TargetCurve {
+    /// The curve through target vertices `vertices`.
+    pub fn through(mesh: &Mesh, vertices: &[VertexId], closed: bool) -> Self {
+        Self {
+            points: vertices.iter().map(|&v| mesh.position(v)).collect(),
+            closed,
+        }
+    }
+
+    /// Every boundary loop of `mesh`, in `boundary_loop_list` order.
+    pub fn boundary_loops(mesh: &Mesh) -> Vec<Self> {
+        mesh.boundary_loop_list()
+            .iter()
+            .map(|l| Self::through(mesh, &l.vertices, true))
+            .collect()
+    }
+
+    fn segments(&self) -> impl Iterator<Item = (Point3<f64>, Point3<f64>)> + '_ {
+        let n = self.points.len();
+        let count = if self.closed { n } else { n.saturating_sub(1) };
+        (0..count).map(move |k| (self.points[k], self.points[(k + 1) % n]))
+    }
+
+    /// The closest point of the curve to `p` and the unit direction of its segment.
+    pub fn closest(&self, p: &Point3<f64>) -> (Point3<f64>, Vector3<f64>) {
+        let mut best = (f64::INFINITY, *p, Vector3::x());
+        for (a, b) in self.segments() {
+            let d = b - a;
+            let len2 = d.norm_squared();
+            if len2 == 0.0 {
+                continue;
+            }
+            let t = ((p - a).dot(&d) / len2).clamp(0.0, 1.0);
+            let q = a + t * d;
+            let dist = (p - q).norm_squared();
+            if dist < best.0 {
+                best = (dist, q, d / len2.sqrt());
+            }
+        }
+        if best.0.is_infinite()
+            && let Some(&q) = self.points.first()
+        {
+            return (q, Vector3::x());
+        }
+        (best.1, best.2)
+    }
+
+    /// The mean distance of `points` to the curve.
+    pub fn mean_distance<'p>(&self, points: impl Iterator<Item = &'p Point3<f64>>) -> f64 {
+        let (sum, n) = points.fold((0.0, 0usize), |(s, n), p| {
+            (s + (self.closest(p).0 - p).norm(), n + 1)
+        });
+        if n > 0 { sum / n as f64 } else { f64::INFINITY }
+    }
+}
+
+/// A target mesh with its curves (curve `c` is `curves[c]`).
+#[derive(Clone)]
+pub struct MeshTarget<'a> {
+    index: &'a SurfaceIndex<'a>,
+    curves: Vec<TargetCurve>,
+    /// The face each source vertex was last located in: the start of the next search.
+    hints: RefCell<Vec<FaceId>>,
+}
+
+impl std::fmt::Debug for MeshTarget<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MeshTarget")
+            .field("faces", &self.index.mesh().face_count())
+            .field("curves", &self.curves.len())
+            .finish_non_exhaustive()
+    }
+}
+
+fn spatial_error(error: beltrami_spatial::SpatialError) -> SolverError {
+    SolverError::InvalidInput {
+        solver: crate::NAME,
+        message: format!("locating a point on the target mesh: {error}"),
+    }
+}
+
+impl<'a> MeshTarget<'a> {
+    /// The target of `index`'s mesh with `curves`.
+    pub fn new(index: &'a SurfaceIndex<'a>, curves: Vec<TargetCurve>) -> Self {
+        Self {
+            index,
+            curves,
+            hints: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// The target mesh.
+    pub fn mesh(&self) -> &'a Mesh {
+        self.index.mesh()
+    }
+
+    /// The surface points of `points` (their closest points on the target).
+    pub fn locate_all(&self, points: &[Point3<f64>]) -> Result<Vec<SurfacePoint>, SolverError> {
+        let located = self.locate(points)?;
+        Ok(located.into_iter().map(|l| l.point).collect())
+    }
+
+    fn locate(
+        &self,
+        points: &[Point3<f64>],
+    ) -> Result<Vec<beltrami_spatial::Located>, SolverError> {
+        let mut hints = self.hints.borrow_mut();
+        let located = if hints.len() == points.len() {
+            self.index.locate_all_near(points, &hints)
+        } else {
+            self.index.locate_all(points)
+        }
+        .map_err(spatial_error)?;
+        hints.clear();
+        hints.extend(located.iter().map(|l| l.point.face));
+        Ok(located)
+    }
+}
+
+impl TargetGeometry for MeshTarget<'_> {
+    fn normal(&self, p: &Point3<f64>) -> Vector3<f64> {
+        match self.index.locate(p) {
+            Ok(l) => interpolated_normal(self.mesh(), self.index.vertex_normals(), &l.point),
+            Err(_) => Vector3::z(),
+        }
+    }
+
+    fn curve_tangent(&self, curve: usize, p: &Point3<f64>) -> Vector3<f64> {
+        self.curves[curve].closest(p).1
+    }
+
+    fn curve_count(&self) -> usize {
+        self.curves.len()
+    }
+
+    fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64> {
+        match role {
+            Role::Free => self.index.locate(p).map_or(*p, |l| l.position),
+            Role::Curve(c) => self.curves[c].closest(p).0,
+            Role::Fixed => *p,
+        }
+    }
+
+    fn project_all(
+        &self,
+        roles: &[Role],
+        points: &mut [Point3<f64>],
+        normals: &mut Vec<Vector3<f64>>,
+    ) -> Result<(), SolverError> {
+        let located = self.locate(points)?;
+        normals.clear();
+        for ((p, l), &role) in points.iter_mut().zip(&located).zip(roles) {
+            normals.push(interpolated_normal(
+                self.mesh(),
+                self.index.vertex_normals(),
+                &l.point,
+            ));
+            match role {
+                Role::Free => *p = l.position,
+                Role::Curve(c) => *p = self.curves[c].closest(p).0,
+                Role::Fixed => {}
+            }
+        }
+        Ok(())
+    }
+}
