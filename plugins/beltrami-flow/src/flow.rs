@@ -182,15 +182,29 @@ fn step<G: TargetGeometry>(
 /// Runs the flow from `image` (one point per source vertex, projected onto `target`
 /// first) with the unknowns of `system`, for `objective` measured on the source
 /// `elements`.
+#[allow(clippy::too_many_arguments)]
 pub fn run<G: TargetGeometry>(
     elements: &Elements,
     mut target: G,
     system: &mut FlowSystem,
     mut image: Vec<Point3<f64>>,
+    goals: &[Option<Point3<f64>>],
     objective: &Objective,
     options: FlowOptions,
     context: &mut Context<'_>,
 ) -> Result<FlowRun<G>, SolverError> {
+    // Fixed vertices pulled towards a goal move by a known flow and are projected onto
+    // the target like free ones.
+    let pulled: Vec<bool> = (0..image.len())
+        .map(|v| goals.get(v).is_some_and(|g| g.is_some()))
+        .collect();
+    let step_roles: Vec<Role> = system
+        .roles()
+        .iter()
+        .zip(&pulled)
+        .map(|(&role, &pulled)| if pulled { Role::Free } else { role })
+        .collect();
+    let mut prescribed = vec![Vector3::zeros(); image.len()];
     let triangles: Vec<[usize; 3]> = (0..elements.face_count())
         .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
         .collect();
@@ -227,6 +241,16 @@ pub fn run<G: TargetGeometry>(
         }
         let clock = Instant::now();
         weights_and_targets(objective, &faces, &mut weights, &mut rho);
+        if pulled.iter().any(|&p| p) {
+            for (v, goal) in goals.iter().enumerate() {
+                if let Some(goal) = goal {
+                    let d = goal - image[v];
+                    // The tangential part: the projection brings the point back.
+                    prescribed[v] = d - normals[v] * normals[v].dot(&d);
+                }
+            }
+            system.set_prescribed(&prescribed);
+        }
         let flow = system.solve(&target, &image, &normals, &faces, &weights, &rho)?;
         solve_seconds += clock.elapsed().as_secs_f64();
         let clock = Instant::now();
@@ -238,7 +262,7 @@ pub fn run<G: TargetGeometry>(
             }
             let moved = step(
                 &target,
-                system.roles(),
+                &step_roles,
                 &image,
                 &flow,
                 t,

@@ -1,8 +1,8 @@
 //! [`BeltramiFlow`]: the solver behind `--solver beltrami-flow` (crate docs).
 
 use beltrami_core::{
-    Context, Goal, Map, PlanarBoundary, Problem, Report, Solution, Solver, SolverError, Target,
-    topology,
+    Context, Goal, Map, PlanarBoundary, Position, Problem, Report, Solution, Solver, SolverError,
+    Target, topology,
 };
 use beltrami_fem::element::is_planar;
 use beltrami_fem::{BeltramiField, DistortionStats, Elements, Frame, SolveOptions};
@@ -412,10 +412,13 @@ fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError> {
                 mesh.vertex_count()
             )));
         }
-        if pin.position.is_some() {
-            return Err(unsupported(
-                "pins hold their vertex where the initial map puts it; pins at given positions are not supported",
-            ));
+        match (&pin.position, &problem.target) {
+            (None, _) | (Some(Position::Spatial(_)), Target::Mesh(_)) => {}
+            _ => {
+                return Err(unsupported(
+                    "pins hold their vertex where the initial map puts it; pins at given positions (landmarks) are for target meshes",
+                ));
+            }
         }
     }
     if !problem.constraints.curves.is_empty() && !matches!(problem.target, Target::Mesh(_)) {
@@ -772,6 +775,18 @@ fn diagonal(image: &[Point3<f64>]) -> f64 {
         .max(f64::MIN_POSITIVE)
 }
 
+/// Per source vertex, the point a landmark pulls it to (pins with a position on a target
+/// mesh: the vertex is moved there by the flow, then held).
+fn goals(problem: &Problem<'_>) -> Vec<Option<Point3<f64>>> {
+    let mut goals = vec![None; problem.source.vertex_count()];
+    for pin in &problem.constraints.pins {
+        if let Some(Position::Spatial(p)) = pin.position {
+            goals[pin.vertex.idx()] = Some(p);
+        }
+    }
+    goals
+}
+
 /// Runs the flow and records its history in `report`.
 #[allow(clippy::too_many_arguments)]
 fn run<G: TargetGeometry>(
@@ -795,7 +810,16 @@ fn run<G: TargetGeometry>(
         solve: options,
     };
     let run = report.time("flow", || {
-        flow::run(elements, target, &mut system, image, objective, flow_options, context)
+        flow::run(
+            elements,
+            target,
+            &mut system,
+            image,
+            &goals(problem),
+            objective,
+            flow_options,
+            context,
+        )
     })
     .map_err(|e| match e {
         SolverError::Solve(beltrami_fem::SolveError::Singular { .. } | beltrami_fem::SolveError::NotPositiveDefinite { .. }) => invalid(

@@ -73,6 +73,9 @@ pub struct FlowSystem {
     factorizations: usize,
     /// Conjugate-gradient iterations so far (steps solved with a kept factorization).
     cg_iterations: usize,
+    /// The known flow of the fixed vertices that are pulled towards a goal (zero for
+    /// the others): it moves them, and the rest of the flow follows.
+    prescribed: Vec<Vector3<f64>>,
 }
 
 /// Relative residual at which a step solved by conjugate gradients with a kept
@@ -197,7 +200,16 @@ impl FlowSystem {
             reuse_failed: false,
             factorizations: 0,
             cg_iterations: 0,
+            prescribed: Vec::new(),
         })
+    }
+
+    /// Sets the known flow of fixed vertices (one vector per vertex, read at
+    /// [`Role::Fixed`] vertices only; empty: none). Their known part of `V_zbar` moves to
+    /// the right-hand side, `rho_T - sum_fixed g_k (V_k . r + i V_k . s)`.
+    pub fn set_prescribed(&mut self, prescribed: &[Vector3<f64>]) {
+        self.prescribed.clear();
+        self.prescribed.extend_from_slice(prescribed);
     }
 
     /// The role of every vertex.
@@ -258,8 +270,16 @@ impl FlowSystem {
                     }
                 };
             }
+            let mut known = rho[f];
+            if !self.prescribed.is_empty() {
+                for (&v, gk) in self.faces[f].iter().zip(&g) {
+                    if self.roles[v] == Role::Fixed && self.prescribed[v] != Vector3::zeros() {
+                        known -= gk * along(face, &self.prescribed[v]);
+                    }
+                }
+            }
             for a in 0..m {
-                self.rhs[list[a].0] += w * (beta[a].conj() * rho[f]).re;
+                self.rhs[list[a].0] += w * (beta[a].conj() * known).re;
                 for b in 0..=a {
                     values[self.slots[at]] += w * (beta[a].conj() * beta[b]).re;
                     at += 1;
@@ -286,6 +306,9 @@ impl FlowSystem {
                 && let Some(b) = target.curve_offset_direction(c, &image[v])
             {
                 vec += flow.offset[c] * b;
+            }
+            if role == Role::Fixed && !self.prescribed.is_empty() {
+                vec = self.prescribed[v];
             }
             flow.vertex[v] = vec;
         }

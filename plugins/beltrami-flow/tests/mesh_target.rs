@@ -176,3 +176,53 @@ fn sphere_onto_an_ellipsoid_mesh() {
     let error = BeltramiFlow.check(&problem).unwrap_err().to_string();
     assert!(error.contains("differ in topology"), "{error}");
 }
+
+#[test]
+fn landmarks_pull_their_vertex_onto_the_goal() {
+    let source = Mesh::from_soup(&primitives::icosphere(3)).unwrap();
+    let mut soup = primitives::icosphere(4);
+    for p in &mut soup.positions {
+        p.y *= 0.8;
+        p.z *= 0.6;
+    }
+    let target = Mesh::from_soup(&soup).unwrap();
+    let index = SurfaceIndex::new(&target).unwrap();
+    let start: Vec<SurfacePoint> = source
+        .positions()
+        .iter()
+        .map(|p| {
+            index
+                .locate(&Point3::new(p.x, 0.8 * p.y, 0.6 * p.z))
+                .unwrap()
+                .point
+        })
+        .collect();
+    // Source vertex 0 goes to a target vertex about 0.15 away from where it starts.
+    let from = start[0].position(&target);
+    let goal_vertex = target
+        .vertices()
+        .min_by(|&a, &b| {
+            let d = |v: VertexId| ((target.position(v) - from).norm() - 0.15).abs();
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    let goal = target.position(goal_vertex);
+    let mut problem = Problem::new(&source, Target::Mesh(&target));
+    problem.initial = Some(Map::OnMesh(start));
+    problem.constraints.pins = vec![beltrami_core::Pin {
+        vertex: VertexId(0),
+        position: Some(beltrami_core::Position::Spatial(goal)),
+    }];
+    problem.params.tolerance = 1e-9;
+    let solution = BeltramiFlow.solve(&problem, &mut Context::new()).unwrap();
+    let Map::OnMesh(points) = &solution.map else {
+        panic!()
+    };
+    assert_eq!(solution.report.flipped(), Some(0));
+    let reached = points[0].position(&target);
+    assert!(
+        (reached - goal).norm() < 1e-9,
+        "{}",
+        (reached - goal).norm()
+    );
+}
