@@ -25,7 +25,8 @@
 //!    reweighted `p = 2` sum at the current map). The paper weights by the image area;
 //!    both have the same continuous limit, and these make the flow a descent direction
 //!    for the error it is judged by.
-//! 3. Step (section 4.4). The largest `t` in `{1, 1/2, 1/4, ...}` for which
+//! 3. Step (section 4.4). The largest `t` in `{1, 1/2, 1/4, ...}` (on target meshes
+//!    starting below the cap of [`FlowOptions::max_move`]) for which
 //!    `Y' = P(Y + t V)` (each vertex projected back onto the target by its role) has no
 //!    more flipped faces than `Y` and a smaller `E`.
 //! 4. Stop when the largest vertex update `t max_i |V_i|` is below the tolerance, or no
@@ -74,6 +75,11 @@ pub struct FlowOptions {
     pub max_iterations: usize,
     /// Options of the sparse factorizations.
     pub solve: SolveOptions,
+    /// The largest vertex move tried (target units): the step-size search starts at
+    /// `t = min(1, max_move / max_i |V_i|)`. Infinite for the fixed targets, where any
+    /// trial is cheap; on a target mesh a trial that moves points across much of the
+    /// surface costs a long walk and is not accepted anyway.
+    pub max_move: f64,
 }
 
 /// The result of [`run`].
@@ -175,7 +181,7 @@ fn step<G: TargetGeometry>(
     if let Some(extension) = extension {
         extension.apply(delta, out)?;
     }
-    moved.project_all(roles, out, normals)?;
+    moved.project_all(roles, Some(image), out, normals)?;
     Ok(moved)
 }
 
@@ -215,7 +221,7 @@ pub fn run<G: TargetGeometry>(
     };
     let mut delta = Vec::new();
     let mut normals = Vec::new();
-    target.project_all(system.roles(), &mut image, &mut normals)?;
+    target.project_all(system.roles(), None, &mut image, &mut normals)?;
     let mut faces = Vec::with_capacity(elements.face_count());
     image_faces(elements, &normals, &image, &mut faces);
     let (mut energy, mut flipped) = objective.evaluate(&faces);
@@ -255,7 +261,12 @@ pub fn run<G: TargetGeometry>(
         solve_seconds += clock.elapsed().as_secs_f64();
         let clock = Instant::now();
         let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
-        let mut t = 1.0;
+        target.prepare_step(&image)?;
+        let mut t = if largest > options.max_move {
+            options.max_move / largest
+        } else {
+            1.0
+        };
         let accepted = loop {
             if t * largest < options.tolerance || t < MIN_STEP {
                 break None;

@@ -8,8 +8,8 @@ use std::cell::RefCell;
 
 use beltrami_core::SolverError;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3, VertexId};
-use beltrami_spatial::SurfaceIndex;
 use beltrami_spatial::frame::interpolated_normal;
+use beltrami_spatial::{BoundaryMode, MoveOptions, SurfaceIndex};
 
 use crate::target::{Role, TargetGeometry};
 
@@ -85,6 +85,8 @@ pub struct MeshTarget<'a> {
     curves: Vec<TargetCurve>,
     /// The face each source vertex was last located in: the start of the next search.
     hints: RefCell<Vec<FaceId>>,
+    /// The surface points of the images a step starts from ([`TargetGeometry::prepare_step`]).
+    start: RefCell<Vec<SurfacePoint>>,
 }
 
 impl std::fmt::Debug for MeshTarget<'_> {
@@ -110,6 +112,7 @@ impl<'a> MeshTarget<'a> {
             index,
             curves,
             hints: RefCell::new(Vec::new()),
+            start: RefCell::new(Vec::new()),
         }
     }
 
@@ -153,6 +156,12 @@ impl TargetGeometry for MeshTarget<'_> {
         self.curves[curve].closest(p).1
     }
 
+    fn prepare_step(&self, from: &[Point3<f64>]) -> Result<(), SolverError> {
+        let located = self.locate_all(from)?;
+        *self.start.borrow_mut() = located;
+        Ok(())
+    }
+
     fn curve_count(&self) -> usize {
         self.curves.len()
     }
@@ -168,19 +177,44 @@ impl TargetGeometry for MeshTarget<'_> {
     fn project_all(
         &self,
         roles: &[Role],
+        from: Option<&[Point3<f64>]>,
         points: &mut [Point3<f64>],
         normals: &mut Vec<Vector3<f64>>,
     ) -> Result<(), SolverError> {
-        let located = self.locate(points)?;
+        let surface: Vec<SurfacePoint> = match from {
+            // A step: walk every point from where it was by its tangential displacement
+            // (its cost grows with the faces crossed, where locating a point far off the
+            // surface searches a ball as large as that distance).
+            Some(from) => {
+                let mut start = self.start.borrow().clone();
+                if start.len() != from.len() {
+                    start = self.locate_all(from)?;
+                }
+                let displacements: Vec<Vector3<f64>> =
+                    points.iter().zip(from).map(|(p, q)| p - q).collect();
+                let options = MoveOptions {
+                    boundary: BoundaryMode::Stop,
+                    ..MoveOptions::default()
+                };
+                self.index
+                    .move_all(&mut start, &displacements, &options)
+                    .map_err(spatial_error)?;
+                let mut hints = self.hints.borrow_mut();
+                hints.clear();
+                hints.extend(start.iter().map(|p| p.face));
+                start
+            }
+            None => self.locate_all(points)?,
+        };
         normals.clear();
-        for ((p, l), &role) in points.iter_mut().zip(&located).zip(roles) {
+        for ((p, s), &role) in points.iter_mut().zip(&surface).zip(roles) {
             normals.push(interpolated_normal(
                 self.mesh(),
                 self.index.vertex_normals(),
-                &l.point,
+                s,
             ));
             match role {
-                Role::Free => *p = l.position,
+                Role::Free => *p = s.position(self.mesh()),
                 Role::Curve(c) => *p = self.curves[c].closest(p).0,
                 Role::Fixed => {}
             }

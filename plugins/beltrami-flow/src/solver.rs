@@ -36,6 +36,10 @@ pub struct BeltramiFlow;
 /// straight side of a planar region; the others are corners and stay.
 const CORNER_ANGLE: f64 = 1e-6;
 
+/// On a target mesh, the largest vertex move tried in one step, relative to the target's
+/// bounding-box diagonal ([`FlowOptions::max_move`]).
+const MESH_MAX_MOVE: f64 = 0.05;
+
 /// How far (relative) a vertex may be off the unit circle or sphere for the source to be
 /// taken as already on the target.
 const ON_TARGET: f64 = 1e-9;
@@ -808,6 +812,11 @@ fn run<G: TargetGeometry>(
         tolerance: problem.params.tolerance * scale,
         max_iterations: problem.params.max_iterations,
         solve: options,
+        max_move: if matches!(problem.target, Target::Mesh(_)) {
+            MESH_MAX_MOVE * scale
+        } else {
+            f64::INFINITY
+        },
     };
     let run = report.time("flow", || {
         flow::run(

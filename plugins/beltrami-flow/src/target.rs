@@ -60,13 +60,22 @@ pub trait TargetGeometry: Clone {
     /// [`Role::Curve`]) nearest to `p`; [`Role::Fixed`] points are returned unchanged.
     fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64>;
 
+    /// Called once per flow step, before the step sizes are tried, with the images the
+    /// step starts from (targets that locate points in a mesh locate them once here).
+    fn prepare_step(&self, _from: &[Point3<f64>]) -> Result<(), SolverError> {
+        Ok(())
+    }
+
     /// [`TargetGeometry::project`] of every point by its role, and into `normals` the
     /// target's unit normal at each projected point (free vertices move in the plane
-    /// orthogonal to it; image faces are oriented by it). Targets that locate points in
-    /// a mesh override it to batch the work.
+    /// orthogonal to it; image faces are oriented by it). `from`, when given, holds
+    /// where each point was on the target before it moved to `points` (a flow step):
+    /// targets that locate points in a mesh override this to batch the work and to walk
+    /// free points along the surface from there instead of projecting from far away.
     fn project_all(
         &self,
         roles: &[Role],
+        _from: Option<&[Point3<f64>]>,
         points: &mut [Point3<f64>],
         normals: &mut Vec<Vector3<f64>>,
     ) -> Result<(), SolverError> {
