@@ -90,10 +90,7 @@ fn radial(domain: &Mesh, direction: &Vector3<f64>, start: FaceId) -> Option<Surf
             return None;
         }
         let w = l.map(|x| x / sum);
-        let (k, &lowest) = w
-            .iter()
-            .enumerate()
-            .min_by(|x, y| x.1.total_cmp(y.1))?;
+        let (k, &lowest) = w.iter().enumerate().min_by(|x, y| x.1.total_cmp(y.1))?;
         if lowest >= -INSIDE_TOLERANCE {
             let w = w.map(|x| x.max(0.0));
             let total = w[0] + w[1] + w[2];

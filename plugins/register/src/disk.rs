@@ -57,7 +57,11 @@ impl Outline {
             .fractions
             .partition_point(|&t| t <= tau)
             .saturating_sub(1);
-        let end = if j + 1 < n { self.fractions[j + 1] } else { 1.0 };
+        let end = if j + 1 < n {
+            self.fractions[j + 1]
+        } else {
+            1.0
+        };
         let span = end - self.fractions[j];
         let lambda = if span > 0.0 {
             ((tau - self.fractions[j]) / span).clamp(0.0, 1.0)
@@ -253,7 +257,10 @@ fn best_rotation(
     (0..ROTATIONS)
         .map(|k| k as f64 / ROTATIONS as f64)
         .map(|d| (d, cost(d)))
-        .fold((0.0, f64::INFINITY), |best, c| if c.1 < best.1 { c } else { best })
+        .fold(
+            (0.0, f64::INFINITY),
+            |best, c| if c.1 < best.1 { c } else { best },
+        )
         .0
 }
 
@@ -262,7 +269,12 @@ fn best_rotation(
 /// and `w`: their three vertices land on one side of the target polygon, which no choice
 /// of `m`'s image avoids. `tau` are the unwrapped boundary fractions, increasing along
 /// the loop.
-fn collapsed_ears(source: &Mesh, source_loop: &[VertexId], tau: &[f64], outline: &Outline) -> usize {
+fn collapsed_ears(
+    source: &Mesh,
+    source_loop: &[VertexId],
+    tau: &[f64],
+    outline: &Outline,
+) -> usize {
     let n = source_loop.len();
     source_loop
         .iter()

@@ -267,7 +267,10 @@ fn cross_ratio_map(points: [Vector3<f64>; 3]) -> Option<[[Complex64; 2]; 2]> {
     let c1 = bracket(p2, p3);
     let c3 = bracket(p2, p1);
     let scale = (p1[0].norm() + p1[1].norm()) * (p2[0].norm() + p2[1].norm());
-    if c1.norm() <= 1e-12 * scale || c3.norm() <= 1e-12 * scale || bracket(p1, p3).norm() <= 1e-12 * scale {
+    if c1.norm() <= 1e-12 * scale
+        || c3.norm() <= 1e-12 * scale
+        || bracket(p1, p3).norm() <= 1e-12 * scale
+    {
         return None;
     }
     Some([[c1 * p1[1], -c1 * p1[0]], [c3 * p3[1], -c3 * p3[0]]])

@@ -81,7 +81,10 @@ pub(crate) fn domain_mesh(
 
 /// Planar values as points in the plane z = 0.
 pub(crate) fn planar_points(values: &[Complex64]) -> Vec<Point3<f64>> {
-    values.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect()
+    values
+        .iter()
+        .map(|z| Point3::new(z.re, z.im, 0.0))
+        .collect()
 }
 
 /// The input indices of the vertices of a path of `mesh`, for notes.

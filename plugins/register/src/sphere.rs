@@ -43,9 +43,8 @@ pub(crate) fn map(
 ) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
     let source_sphere = sphere(source, Side::Source, notes)?;
     let target_sphere = sphere(target, Side::Target, notes)?;
-    let target_at = |p: &SurfacePoint| -> Vector3<f64> {
-        interpolate(target, &target_sphere, p).normalize()
-    };
+    let target_at =
+        |p: &SurfacePoint| -> Vector3<f64> { interpolate(target, &target_sphere, p).normalize() };
 
     let fit = || -> Result<nalgebra::Matrix3<f64>, RegisterError> {
         let spatial = SpatialMatch::new(source, target);
@@ -69,7 +68,10 @@ pub(crate) fn map(
         }
         [mark] => {
             let r0 = fit()?;
-            let r = rotation_between(&(r0 * source_sphere[mark.source.idx()]), &target_at(&mark.target)) * r0;
+            let r = rotation_between(
+                &(r0 * source_sphere[mark.source.idx()]),
+                &target_at(&mark.target),
+            ) * r0;
             notes.push(format!(
                 "sphere: rotated so that landmark {} lands on its target, the rest by a rough spatial correspondence",
                 mark.index
@@ -77,14 +79,21 @@ pub(crate) fn map(
             (source_sphere.iter().map(|s| r * s).collect(), vec![0])
         }
         _ => {
-            let s: Vec<Vector3<f64>> = marks.iter().map(|m| source_sphere[m.source.idx()]).collect();
+            let s: Vec<Vector3<f64>> = marks
+                .iter()
+                .map(|m| source_sphere[m.source.idx()])
+                .collect();
             let t: Vec<Vector3<f64>> = marks.iter().map(|m| target_at(&m.target)).collect();
             let (from, to, used) = if marks.len() == 2 {
                 let pole = |a: &Vector3<f64>, b: &Vector3<f64>| {
                     let c = a.cross(b);
                     if c.norm() > 0.0 { c.normalize() } else { c }
                 };
-                ([s[0], s[1], pole(&s[0], &s[1])], [t[0], t[1], pole(&t[0], &t[1])], 2)
+                (
+                    [s[0], s[1], pole(&s[0], &s[1])],
+                    [t[0], t[1], pole(&t[0], &t[1])],
+                    2,
+                )
             } else {
                 ([s[0], s[1], s[2]], [t[0], t[1], t[2]], 3)
             };
@@ -102,7 +111,10 @@ pub(crate) fn map(
                     .join(", ")
             ));
             (
-                source_sphere.iter().map(|p| moebius.apply(p).normalize()).collect(),
+                source_sphere
+                    .iter()
+                    .map(|p| moebius.apply(p).normalize())
+                    .collect(),
                 (0..used).collect(),
             )
         }

@@ -99,10 +99,8 @@ pub fn check_topology(source: &Mesh, target: &Mesh) -> Result<Topology, Register
             target_shape,
         });
     }
-    source_shape
-        .topology()
-        .ok_or(RegisterError::Unsupported {
-            side: Side::Source,
-            shape: source_shape,
-        })
+    source_shape.topology().ok_or(RegisterError::Unsupported {
+        side: Side::Source,
+        shape: source_shape,
+    })
 }

@@ -91,7 +91,11 @@ pub(crate) fn map(
             .map(|m| interpolate(&target_square.cut.mesh, &target_square.param, &m.target))
             .collect();
         let s: Vec<Complex64> = marks.iter().map(|m| s_param[m.source.idx()]).collect();
-        let turns: &[u8] = if marks.len() == 1 { &[0] } else { &[0, 1, 2, 3] };
+        let turns: &[u8] = if marks.len() == 1 {
+            &[0]
+        } else {
+            &[0, 1, 2, 3]
+        };
         let mut best: Option<(f64, SquareMap)> = None;
         for &quarter_turns in turns {
             let mut map = SquareMap {
@@ -212,7 +216,11 @@ fn path_fractions(mesh: &Mesh, path: &[VertexId]) -> Vec<f64> {
     }
     let n = path.len().saturating_sub(1).max(1) as f64;
     for (k, x) in out.iter_mut().enumerate() {
-        *x = if total > 0.0 { *x / total } else { k as f64 / n };
+        *x = if total > 0.0 {
+            *x / total
+        } else {
+            k as f64 / n
+        };
     }
     if let Some(last) = out.last_mut() {
         *last = 1.0;

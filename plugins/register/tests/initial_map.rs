@@ -212,7 +212,11 @@ fn sphere_landmarks_land_exactly() {
         }],
     )
     .unwrap();
-    let expected = SurfaceIndex::new(&target).unwrap().locate(&p).unwrap().position;
+    let expected = SurfaceIndex::new(&target)
+        .unwrap()
+        .locate(&p)
+        .unwrap()
+        .position;
     assert!((map.positions[7] - expected).norm() < 1e-12);
 }
 
@@ -221,7 +225,10 @@ fn sphere_onto_itself_is_the_identity() {
     let m = ellipsoid(3);
     let map = initial_map(&m, &m, &[]).unwrap();
     for v in m.vertices() {
-        assert!((map.positions[v.idx()] - m.position(v)).norm() < 1e-6, "{v}");
+        assert!(
+            (map.positions[v.idx()] - m.position(v)).norm() < 1e-6,
+            "{v}"
+        );
     }
 }
 
@@ -236,14 +243,20 @@ fn spot_onto_bunny() {
     writeln!(
         std::io::stderr(),
         "spot onto bunny: {} flips; {:?}",
-        map.flipped, map.notes
+        map.flipped,
+        map.notes
     )
     .unwrap();
     assert!(map.flipped * 500 <= source.face_count(), "{:?}", map.notes);
     let sphere = mesh(&primitives::icosphere(4));
     let map = initial_map(&source, &sphere, &[]).unwrap();
     check_on_target(&source, &sphere, &map);
-    writeln!(std::io::stderr(), "spot onto icosphere: {} flips", map.flipped).unwrap();
+    writeln!(
+        std::io::stderr(),
+        "spot onto icosphere: {} flips",
+        map.flipped
+    )
+    .unwrap();
     assert!(map.flipped * 1000 <= source.face_count(), "{:?}", map.notes);
 }
 
@@ -263,7 +276,11 @@ fn torus_onto_modified_tori_has_no_flips_and_names_its_loops() {
         // The loops: a around the tube on both (shortest paired with shortest).
         let loops: Vec<&String> = map.notes.iter().filter(|n| n.contains(" loop ")).collect();
         assert_eq!(loops.len(), 4, "{:?}", map.notes);
-        assert!(loops[0].contains("source loop a: length 6.2"), "{}", loops[0]);
+        assert!(
+            loops[0].contains("source loop a: length 6.2"),
+            "{}",
+            loops[0]
+        );
         assert!(loops[2].contains("target loop a"), "{}", loops[2]);
     }
 }
@@ -278,7 +295,10 @@ fn torus_landmarks_and_identity() {
     let map = initial_map(&m, &m, &landmarks).unwrap();
     assert_eq!(map.flipped, 0);
     for v in m.vertices() {
-        assert!((map.positions[v.idx()] - m.position(v)).norm() < 1e-9, "{v}");
+        assert!(
+            (map.positions[v.idx()] - m.position(v)).norm() < 1e-9,
+            "{v}"
+        );
     }
     let target = mesh(&primitives::modified_torus(ModifiedTorus::Phi1, 60, 24));
     let landmarks = [
@@ -318,9 +338,15 @@ fn topology_mismatches_are_errors() {
     let torus = torus(12, 6);
     let err = check_topology(&disk, &sphere).unwrap_err();
     assert!(matches!(err, RegisterError::TopologyMismatch { .. }));
-    assert!(err.to_string().contains("genus 0 with 1 boundary loop"), "{err}");
+    assert!(
+        err.to_string().contains("genus 0 with 1 boundary loop"),
+        "{err}"
+    );
     let err = initial_map(&torus, &sphere, &[]).unwrap_err();
-    assert!(err.to_string().contains("genus 1 with 0 boundary loops"), "{err}");
+    assert!(
+        err.to_string().contains("genus 1 with 0 boundary loops"),
+        "{err}"
+    );
     assert_eq!(check_topology(&torus, &torus).unwrap(), Topology::Torus);
     assert_eq!(check_topology(&sphere, &sphere).unwrap(), Topology::Sphere);
     assert_eq!(check_topology(&disk, &disk).unwrap(), Topology::Disk);
@@ -350,7 +376,10 @@ fn bad_landmarks_name_their_index() {
         },
     ];
     let err = initial_map(&sphere, &sphere, &out_of_range).unwrap_err();
-    assert!(matches!(err, RegisterError::Landmark { index: 1, .. }), "{err}");
+    assert!(
+        matches!(err, RegisterError::Landmark { index: 1, .. }),
+        "{err}"
+    );
     let nan = [Landmark {
         source: VertexId(0),
         target: LandmarkTarget::Point(Point3::new(f64::NAN, 0.0, 0.0)),
