@@ -31,7 +31,7 @@ struct Bin {
 
 impl Bin {
     fn view(&mut self, data: Vec<u8>) -> usize {
-        while self.bytes.len() % 4 != 0 {
+        while !self.bytes.len().is_multiple_of(4) {
             self.bytes.push(0);
         }
         self.views.push(json!({

@@ -116,10 +116,10 @@ impl TriangleShader {
             if let Some((w, _)) = flipped {
                 return Some((w, WARNING, 1.0));
             }
-            if let Some(w) = lines.boundary {
-                if mesh.is_boundary_halfedge(mesh.twin(e)) {
-                    return Some((w, INK, 1.0));
-                }
+            if let Some(w) = lines.boundary
+                && mesh.is_boundary_halfedge(mesh.twin(e))
+            {
+                return Some((w, INK, 1.0));
             }
             lines.wire.map(|w| (w, INK, 0.6))
         };

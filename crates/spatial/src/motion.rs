@@ -721,10 +721,10 @@ impl SurfaceIndex<'_> {
                 faces_crossed: 0,
             });
         }
-        if options.boundary == BoundaryMode::Keep {
-            if let Some(on) = on_boundary(mesh, point) {
-                return Ok(self.along_boundary(on, &tangent));
-            }
+        if options.boundary == BoundaryMode::Keep
+            && let Some(on) = on_boundary(mesh, point)
+        {
+            return Ok(self.along_boundary(on, &tangent));
         }
         if options.method == MoveMethod::Project {
             return self.project(point, &tangent);

@@ -409,7 +409,7 @@ fn triangles(mode: Mode, indices: &[u32]) -> Result<Vec<[u32; 3]>, String> {
             None => Vec::new(),
         },
         _ => {
-            if indices.len() % 3 != 0 {
+            if !indices.len().is_multiple_of(3) {
                 return Err(format!(
                     "{} indices is not a whole number of triangles",
                     indices.len()
