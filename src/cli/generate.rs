@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use beltrami_mesh::io::{self, VertexAttributes};
-use beltrami_mesh::primitives::{self, Cells};
+use beltrami_mesh::primitives::{self, Cells, ModifiedTorus};
 use beltrami_mesh::{Mesh, PolygonSoup};
 use clap::{Args, ValueEnum};
 
@@ -23,6 +23,11 @@ pub enum Shape {
     /// The square `[-1, 1]^2` of Table 5.3: `2^(level+5)` cells per side (33^2 vertices
     /// at level 0), each split into two triangles.
     Square,
+    /// The modified torus phi_1 of Wong-Zhao's section 5.4 (r1 = 4, r2 = 1.7, r3 = 0.3):
+    /// a 40 * 2^level by 16 * 2^level grid of (u, v), 1280 * 4^level triangles.
+    Torus1,
+    /// The modified torus phi_2 of section 5.4 (r1 = 4, r2 = 1.5, r3 = 0.4), same grid.
+    Torus2,
 }
 
 #[derive(Debug, Args)]
@@ -63,6 +68,17 @@ pub fn run(args: &GenerateArgs, quiet: bool) -> anyhow::Result<()> {
                 p.y = 2.0 * p.y - 1.0;
             }
             soup
+        }
+        Shape::Torus1 | Shape::Torus2 => {
+            if args.level > 6 {
+                bail!("--level {} is too fine for a torus (at most 6)", args.level);
+            }
+            let kind = if args.shape == Shape::Torus1 {
+                ModifiedTorus::Phi1
+            } else {
+                ModifiedTorus::Phi2
+            };
+            primitives::modified_torus(kind, 40 << args.level, 16 << args.level)
         }
     };
     let mesh = Mesh::from_soup(&soup)?;

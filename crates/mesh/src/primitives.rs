@@ -290,3 +290,67 @@ pub fn annulus(inner: f64, rings: usize, sectors: usize) -> PolygonSoup {
     }
     soup
 }
+
+/// The modified tori of Wong-Zhao 2014 (T. W. Wong and H. Zhao, "Computation of
+/// quasiconformal surface maps using discrete Beltrami flow", SIAM J. Imaging Sci. 7,
+/// section 5.4), targets of their genus-1 registrations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModifiedTorus {
+    /// `phi_1(u, v)`, with `r(u, v) = r1 + r2 cos 2 pi v + r3 cos 6 pi (u + v)`:
+    /// `(r cos 2 pi u, r sin 2 pi u, r2 sin 2 pi v)`, `r1 = 4`, `r2 = 1.7`, `r3 = 0.3`
+    /// (a tube whose distance from the axis ripples three times along a helix).
+    Phi1,
+    /// `phi_2(u, v)`, with tube radius `t(u) = r2 + r3 cos 10 pi u`:
+    /// `((r1 + t cos 2 pi v) cos 2 pi u, (r1 + t cos 2 pi v) sin 2 pi u, t sin 2 pi v)`,
+    /// `r1 = 4`, `r2 = 1.5`, `r3 = 0.4` (a tube that swells and narrows five times).
+    Phi2,
+}
+
+impl ModifiedTorus {
+    /// The point `phi(u, v)` for `(u, v)` in `[0, 1]^2` (periodic in both).
+    pub fn point(self, u: f64, v: f64) -> Point3<f64> {
+        let (su, cu) = (TAU * u).sin_cos();
+        let (sv, cv) = (TAU * v).sin_cos();
+        match self {
+            ModifiedTorus::Phi1 => {
+                let (r1, r2, r3) = (4.0, 1.7, 0.3);
+                let r = r1 + r2 * cv + r3 * (3.0 * TAU * (u + v)).cos();
+                Point3::new(r * cu, r * su, r2 * sv)
+            }
+            ModifiedTorus::Phi2 => {
+                let (r1, r2, r3) = (4.0, 1.5, 0.4);
+                let t = r2 + r3 * (5.0 * TAU * u).cos();
+                let r = r1 + t * cv;
+                Point3::new(r * cu, r * su, t * sv)
+            }
+        }
+    }
+}
+
+/// A modified torus ([`ModifiedTorus`]) sampled on the `nu` by `nv` grid of `(u, v) =
+/// (i / nu, j / nv)`, each cell split into two triangles; vertex `i nv + j` is at
+/// `(i, j)`, and the faces are counter-clockwise seen from outside, as in [`torus`].
+pub fn modified_torus(kind: ModifiedTorus, nu: usize, nv: usize) -> PolygonSoup {
+    let mut positions = Vec::with_capacity(nu * nv);
+    for i in 0..nu {
+        for j in 0..nv {
+            positions.push(kind.point(i as f64 / nu as f64, j as f64 / nv as f64));
+        }
+    }
+    let mut soup = PolygonSoup::new(positions);
+    soup.reserve(2 * nu * nv, 6 * nu * nv);
+    let id = |i: usize, j: usize| ((i % nu) * nv + (j % nv)) as u32;
+    for i in 0..nu {
+        for j in 0..nv {
+            push_cell(
+                &mut soup,
+                Cells::Triangles,
+                id(i, j),
+                id(i + 1, j),
+                id(i + 1, j + 1),
+                id(i, j + 1),
+            );
+        }
+    }
+    soup
+}

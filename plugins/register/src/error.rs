@@ -1,0 +1,127 @@
+//! Errors of the initial bijection.
+
+use beltrami_core::SolverError;
+use beltrami_fem::SolveError;
+use beltrami_init::boundary::BoundaryError;
+use beltrami_init::weights::WeightError;
+use beltrami_mesh::{CutError, MeshError, VertexId};
+use beltrami_spatial::SpatialError;
+use thiserror::Error;
+
+use crate::topology::Shape;
+
+/// Which of the two meshes an error is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// The source mesh (the one whose vertices are mapped).
+    Source,
+    /// The target mesh (the one they are mapped onto).
+    Target,
+}
+
+impl std::fmt::Display for Side {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Side::Source => "source",
+            Side::Target => "target",
+        })
+    }
+}
+
+/// Why no initial map could be built. Topology errors come before any work
+/// ([`crate::check_topology`]); landmark errors name the landmark's index in the given
+/// slice and its vertex (an index of the mesh, which is the input index when the file had
+/// no unreferenced or merged vertices).
+#[derive(Debug, Error)]
+pub enum RegisterError {
+    /// The two meshes have different topologies.
+    #[error(
+        "the meshes have different topologies: the source is {source_shape}, the target is {target_shape}; a bijection needs the same genus and number of boundary loops"
+    )]
+    TopologyMismatch {
+        /// What the source is.
+        source_shape: Shape,
+        /// What the target is.
+        target_shape: Shape,
+    },
+    /// A topology the initial map does not handle.
+    #[error(
+        "the {side} is {shape}; the initial map supports one connected component that is a disk (genus 0, one boundary loop), a closed genus-0 surface or a closed genus-1 surface"
+    )]
+    Unsupported {
+        /// Which mesh.
+        side: Side,
+        /// What it is.
+        shape: Shape,
+    },
+    /// A landmark that cannot be honoured or names a vertex that does not exist.
+    #[error("landmark {index} (source vertex {vertex}): {reason}")]
+    Landmark {
+        /// Its index in the landmark slice.
+        index: usize,
+        /// Its source vertex.
+        vertex: VertexId,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A closed torus whose cut did not give the four sides of a square (only very coarse
+    /// meshes, whose edge graph has no loop crossing the shortest loop once).
+    #[error(
+        "the {side} torus could not be cut into a square along two loops crossing once (the mesh is too coarse: refine it)"
+    )]
+    NoSquare {
+        /// Which mesh.
+        side: Side,
+    },
+    /// Cutting a mesh into a disk failed.
+    #[error("cutting the {side}: {error}")]
+    Cut {
+        /// Which mesh.
+        side: Side,
+        /// The cut error.
+        error: CutError,
+    },
+    /// Edge weights of a Tutte embedding could not be computed.
+    #[error("weights of the {side}: {error}")]
+    Weights {
+        /// Which mesh.
+        side: Side,
+        /// The weight error.
+        error: WeightError,
+    },
+    /// A boundary map could not be built.
+    #[error("boundary of the {side}: {error}")]
+    Boundary {
+        /// Which mesh.
+        side: Side,
+        /// The boundary error.
+        error: BoundaryError,
+    },
+    /// A Tutte system could not be solved.
+    #[error("Tutte embedding of the {side}: {error}")]
+    Solve {
+        /// Which mesh.
+        side: Side,
+        /// The solve error.
+        error: SolveError,
+    },
+    /// The spherical initialization failed.
+    #[error("sphere map of the {side}: {error}")]
+    Sphere {
+        /// Which mesh.
+        side: Side,
+        /// The solver error.
+        error: SolverError,
+    },
+    /// Building a parameter-domain mesh failed.
+    #[error("parameter mesh of the {side}: {error}")]
+    Mesh {
+        /// Which mesh.
+        side: Side,
+        /// The mesh error.
+        error: MeshError,
+    },
+    /// Point location failed.
+    #[error("point location: {0}")]
+    Spatial(#[from] SpatialError),
+}

@@ -1,0 +1,313 @@
+//! Landmarks and the alignments they choose: the rotation of the disk's boundary, a
+//! rotation or Moebius transformation of the sphere, and the symmetry of the square of
+//! a torus. Without landmarks the same freedoms are fixed by a rough spatial match of
+//! the two meshes ([`SpatialMatch`]).
+
+use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3, VertexId};
+use beltrami_spatial::SurfaceIndex;
+use nalgebra::{Matrix3, Rotation3, Unit};
+use num_complex::Complex64;
+
+use crate::error::RegisterError;
+
+/// Where a landmark's source vertex must go on the target.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LandmarkTarget {
+    /// Onto this target vertex.
+    Vertex(VertexId),
+    /// Onto the closest point of the target to this point.
+    Point(Point3<f64>),
+}
+
+/// A correspondence given by the user: source vertex `source` goes to `target`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Landmark {
+    /// The source vertex.
+    pub source: VertexId,
+    /// Where it goes.
+    pub target: LandmarkTarget,
+}
+
+/// A checked landmark with its target as a surface point of the target mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Resolved {
+    /// Index in the user's slice.
+    pub index: usize,
+    /// The source vertex.
+    pub source: VertexId,
+    /// The target point.
+    pub target: SurfacePoint,
+    /// The target vertex, for [`LandmarkTarget::Vertex`].
+    pub vertex: Option<VertexId>,
+}
+
+/// Checks every landmark and locates point targets on the target mesh.
+///
+/// # Errors
+/// [`RegisterError::Landmark`] for a source or target vertex out of range, a source
+/// vertex given twice, or a target point with a NaN or infinite coordinate.
+pub(crate) fn resolve(
+    source: &Mesh,
+    target: &Mesh,
+    target_index: &SurfaceIndex<'_>,
+    landmarks: &[Landmark],
+) -> Result<Vec<Resolved>, RegisterError> {
+    let mut seen = vec![usize::MAX; source.vertex_count()];
+    let mut out = Vec::with_capacity(landmarks.len());
+    for (index, landmark) in landmarks.iter().enumerate() {
+        let fail = |reason: String| RegisterError::Landmark {
+            index,
+            vertex: landmark.source,
+            reason,
+        };
+        let s = landmark.source;
+        if s.idx() >= source.vertex_count() {
+            return Err(fail(format!(
+                "the source has only {} vertices",
+                source.vertex_count()
+            )));
+        }
+        if seen[s.idx()] != usize::MAX {
+            return Err(fail(format!(
+                "the vertex already has landmark {}",
+                seen[s.idx()]
+            )));
+        }
+        seen[s.idx()] = index;
+        let (point, vertex) = match landmark.target {
+            LandmarkTarget::Vertex(v) => {
+                if v.idx() >= target.vertex_count() {
+                    return Err(fail(format!(
+                        "target vertex {v} does not exist: the target has {} vertices",
+                        target.vertex_count()
+                    )));
+                }
+                (SurfacePoint::at_vertex(target, v), Some(v))
+            }
+            LandmarkTarget::Point(p) => {
+                if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
+                    return Err(fail(format!("the target point {p:?} is not finite")));
+                }
+                (target_index.locate(&p)?.point, None)
+            }
+        };
+        out.push(Resolved {
+            index,
+            source: s,
+            target: point,
+            vertex,
+        });
+    }
+    Ok(out)
+}
+
+/// The value of a per-vertex parameterization at a surface point: the coordinates
+/// applied to the values of the face's vertices in `mesh` (the target, or its cut).
+pub(crate) fn interpolate<T>(mesh: &Mesh, values: &[T], point: &SurfacePoint) -> T
+where
+    T: Copy + std::ops::Mul<f64, Output = T> + std::ops::Add<Output = T>,
+{
+    let (vertices, degree) = mesh.face_vertex_array(point.face);
+    let mut sum = values[vertices[0].idx()] * point.coords[0];
+    for k in 1..degree {
+        sum = sum + values[vertices[k].idx()] * point.coords[k];
+    }
+    sum
+}
+
+/// A rough correspondence in space used when no landmark fixes an alignment: both meshes
+/// are centred at their area centroids and scaled to the same root-mean-square vertex
+/// distance from it (no rotation), and a source vertex's *spatial partner* is the closest
+/// point of the target to its moved position.
+pub(crate) struct SpatialMatch {
+    source_center: Point3<f64>,
+    target_center: Point3<f64>,
+    scale: f64,
+}
+
+impl SpatialMatch {
+    /// The centring and scaling of `source` onto `target`.
+    pub(crate) fn new(source: &Mesh, target: &Mesh) -> Self {
+        let (source_center, source_radius) = center_and_radius(source);
+        let (target_center, target_radius) = center_and_radius(target);
+        let scale = if source_radius > 0.0 {
+            target_radius / source_radius
+        } else {
+            1.0
+        };
+        Self {
+            source_center,
+            target_center,
+            scale,
+        }
+    }
+
+    /// A source position moved into the target's frame.
+    pub(crate) fn to_target(&self, p: &Point3<f64>) -> Point3<f64> {
+        self.target_center + (p - self.source_center) * self.scale
+    }
+}
+
+fn center_and_radius(mesh: &Mesh) -> (Point3<f64>, f64) {
+    let mut weighted = Vector3::zeros();
+    let mut area = 0.0;
+    for f in mesh.faces() {
+        let a = mesh.face_area(f);
+        weighted += mesh.face_centroid(f).coords * a;
+        area += a;
+    }
+    let center = if area > 0.0 {
+        Point3::from(weighted / area)
+    } else {
+        Point3::origin()
+    };
+    let n = mesh.vertex_count().max(1) as f64;
+    let squares: f64 = mesh
+        .positions()
+        .iter()
+        .map(|p| (p - center).norm_squared())
+        .sum();
+    (center, (squares / n).sqrt())
+}
+
+/// The rotation `R` minimizing `sum_i |R a_i - b_i|^2` (Kabsch: `R = V diag(1, 1, d) U^T`
+/// from the SVD `U S V^T` of `sum_i a_i b_i^T`, `d = det(V U^T)`), or the identity when
+/// the SVD fails.
+pub(crate) fn best_rotation(pairs: &[(Vector3<f64>, Vector3<f64>)]) -> Matrix3<f64> {
+    let mut h = Matrix3::zeros();
+    for (a, b) in pairs {
+        h += a * b.transpose();
+    }
+    let svd = h.svd(true, true);
+    match (svd.u, svd.v_t) {
+        (Some(u), Some(v_t)) => {
+            let v = v_t.transpose();
+            let d = (v * u.transpose()).determinant().signum();
+            v * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d)) * u.transpose()
+        }
+        _ => Matrix3::identity(),
+    }
+}
+
+/// The smallest rotation taking the unit vector `a` to the unit vector `b` (a half turn
+/// about an axis orthogonal to `a` when they are opposite).
+pub(crate) fn rotation_between(a: &Vector3<f64>, b: &Vector3<f64>) -> Matrix3<f64> {
+    Rotation3::rotation_between(a, b)
+        .unwrap_or_else(|| {
+            let helper = if a.x.abs() < 0.9 {
+                Vector3::x()
+            } else {
+                Vector3::y()
+            };
+            Rotation3::from_axis_angle(&Unit::new_normalize(a.cross(&helper)), std::f64::consts::PI)
+        })
+        .into_inner()
+}
+
+/// A Moebius transformation of the unit sphere, `z -> (m00 z + m01) / (m10 z + m11)` in
+/// the stereographic coordinate `z = (x + i y) / (1 - z_3)` from the north pole, kept in
+/// homogeneous form so that the pole (`z = infinity`) needs no special case.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Moebius {
+    m: [[Complex64; 2]; 2],
+}
+
+impl Moebius {
+    /// The transformation taking `from[k]` to `to[k]` (three distinct unit vectors each),
+    /// or `None` when points coincide. Built as `B^-1 A` with `A` taking `from` to
+    /// `0, 1, infinity` (the cross-ratio map) and `B` the same for `to`.
+    pub(crate) fn through(from: [Vector3<f64>; 3], to: [Vector3<f64>; 3]) -> Option<Self> {
+        let a = cross_ratio_map(from)?;
+        let b = cross_ratio_map(to)?;
+        // The adjugate inverts up to a scalar, which a homogeneous map ignores.
+        let b_inv = [[b[1][1], -b[0][1]], [-b[1][0], b[0][0]]];
+        let mut m = [[Complex64::new(0.0, 0.0); 2]; 2];
+        for (i, row) in m.iter_mut().enumerate() {
+            for (j, entry) in row.iter_mut().enumerate() {
+                *entry = b_inv[i][0] * a[0][j] + b_inv[i][1] * a[1][j];
+            }
+        }
+        Some(Self { m })
+    }
+
+    /// The image of a unit vector.
+    pub(crate) fn apply(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        let [w0, w1] = homogeneous(p);
+        let a = self.m[0][0] * w0 + self.m[0][1] * w1;
+        let b = self.m[1][0] * w0 + self.m[1][1] * w1;
+        from_homogeneous(a, b)
+    }
+}
+
+/// Homogeneous stereographic coordinates `[w0 : w1]` with `w0 / w1 = (x + i y) / (1 -
+/// z)`, taken as `(1 + z) / (x - i y)` on the upper half to stay away from `0 / 0`.
+fn homogeneous(p: &Vector3<f64>) -> [Complex64; 2] {
+    if p.z <= 0.0 {
+        [Complex64::new(p.x, p.y), Complex64::new(1.0 - p.z, 0.0)]
+    } else {
+        [Complex64::new(1.0 + p.z, 0.0), Complex64::new(p.x, -p.y)]
+    }
+}
+
+/// The inverse stereographic projection of `a / b`:
+/// `(2 Re(a conj b), 2 Im(a conj b), |a|^2 - |b|^2) / (|a|^2 + |b|^2)`.
+fn from_homogeneous(a: Complex64, b: Complex64) -> Vector3<f64> {
+    let ab = a * b.conj();
+    let (na, nb) = (a.norm_sqr(), b.norm_sqr());
+    let s = na + nb;
+    Vector3::new(2.0 * ab.re / s, 2.0 * ab.im / s, (na - nb) / s)
+}
+
+/// The homogeneous matrix of `z -> ((z - z1)(z2 - z3)) / ((z - z3)(z2 - z1))`, which takes
+/// `z1, z2, z3` to `0, 1, infinity`; with `[p, q] = p_0 q_1 - p_1 q_0` the rows are
+/// `[z2, z3] (b1, -a1)` and `[z2, z1] (b3, -a3)` for `z_k = a_k / b_k`.
+fn cross_ratio_map(points: [Vector3<f64>; 3]) -> Option<[[Complex64; 2]; 2]> {
+    let [p1, p2, p3] = points.map(|p| homogeneous(&p));
+    let bracket = |p: [Complex64; 2], q: [Complex64; 2]| p[0] * q[1] - p[1] * q[0];
+    let c1 = bracket(p2, p3);
+    let c3 = bracket(p2, p1);
+    let scale = (p1[0].norm() + p1[1].norm()) * (p2[0].norm() + p2[1].norm());
+    if c1.norm() <= 1e-12 * scale
+        || c3.norm() <= 1e-12 * scale
+        || bracket(p1, p3).norm() <= 1e-12 * scale
+    {
+        return None;
+    }
+    Some([[c1 * p1[1], -c1 * p1[0]], [c3 * p3[1], -c3 * p3[0]]])
+}
+
+/// An orientation-preserving symmetry of the torus `R^2 / Z^2` as seen on the square:
+/// `quarter_turns` rotations by 90 degrees about the centre `(1/2, 1/2)` (each maps the
+/// lattice to itself) followed by a translation by `shift`, the result wrapped into
+/// `[0, 1)^2`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SquareMap {
+    /// Number of counter-clockwise quarter turns (0..4).
+    pub quarter_turns: u8,
+    /// The translation.
+    pub shift: Complex64,
+}
+
+impl SquareMap {
+    /// The rotation part alone, no wrap.
+    pub(crate) fn turn(&self, x: Complex64) -> Complex64 {
+        let center = Complex64::new(0.5, 0.5);
+        let mut d = x - center;
+        for _ in 0..self.quarter_turns {
+            d *= Complex64::i();
+        }
+        center + d
+    }
+
+    /// The image of a point of the square, wrapped into `[0, 1)^2`.
+    pub(crate) fn apply(&self, x: Complex64) -> Complex64 {
+        let y = self.turn(x) + self.shift;
+        Complex64::new(y.re.rem_euclid(1.0), y.im.rem_euclid(1.0))
+    }
+}
+
+/// The distance on the torus `R^2 / Z^2` between two points of the square.
+pub(crate) fn periodic_distance(a: Complex64, b: Complex64) -> f64 {
+    let d = a - b;
+    Complex64::new(d.re - d.re.round(), d.im - d.im.round()).norm()
+}

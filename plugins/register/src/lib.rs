@@ -1,0 +1,128 @@
+//! # beltrami-register
+//!
+//! The initial bijection of surface registration (Wong-Zhao 2014, section 5.4): a map
+//! from every vertex of a source mesh onto a target mesh of the same topology, built by
+//! mapping both onto a common parameter domain and locating the source's images in the
+//! target's parameterization.
+//!
+//! | topology | common domain | alignment |
+//! |---|---|---|
+//! | disk (one boundary loop) | the target's Tutte disk ([`disk`](crate::disk)) | boundary rotation |
+//! | closed genus 0 | the unit sphere ([`sphere`](crate::sphere)) | rotation or Moebius transformation |
+//! | closed genus 1 | the square `[0, 1]^2` glued periodically ([`torus`](crate::torus)) | symmetry of the square |
+//!
+//! Other topologies (genus 2 and more, several boundary loops, several components) are
+//! refused by [`check_topology`] before any work, as are meshes of different topologies.
+//!
+//! ```
+//! use beltrami_mesh::{Mesh, primitives};
+//! use beltrami_register::{Topology, initial_map};
+//!
+//! let source = Mesh::from_soup(&primitives::icosphere(2)).unwrap();
+//! let target = Mesh::from_soup(&primitives::octahedral_sphere(3)).unwrap();
+//! let map = initial_map(&source, &target, &[]).unwrap();
+//! assert_eq!(map.topology, Topology::Sphere);
+//! assert_eq!(map.points.len(), source.vertex_count());
+//! assert_eq!(map.flipped, 0);
+//! ```
+//!
+//! See `docs/register.md` for the conventions, the choice of loops and the timings.
+
+mod compose;
+mod disk;
+mod error;
+mod landmarks;
+mod param;
+mod sphere;
+mod topology;
+mod torus;
+
+use beltrami_mesh::{Mesh, Point3, SurfacePoint};
+use beltrami_spatial::SurfaceIndex;
+
+pub use error::{RegisterError, Side};
+pub use landmarks::{Landmark, LandmarkTarget};
+pub use topology::{Shape, Topology, check_topology};
+
+/// An initial map from a source mesh onto a target mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InitialMap {
+    /// The image of every source vertex (by source vertex id) as a point of the target
+    /// mesh: a target face and its coordinates ([`SurfacePoint`] conventions).
+    pub points: Vec<SurfacePoint>,
+    /// The same images as positions: `points[i].position(target)`.
+    pub positions: Vec<Point3<f64>>,
+    /// The shared topology.
+    pub topology: Topology,
+    /// What was done, in words: the loops cut along (per mesh, lengths and input vertex
+    /// indices), the alignment and the landmarks it honours, the flips.
+    pub notes: Vec<String>,
+    /// Source faces whose image is flipped: the triangle through the images of its
+    /// corners (for a quad, any of its four corner triangles) has a normal pointing
+    /// against (or orthogonal to) the target's interpolated vertex normals at those
+    /// images. Zero for a bijective map between well-shaped meshes.
+    pub flipped: usize,
+}
+
+/// The initial bijection from `source` onto `target` (crate docs): both meshes onto a
+/// common parameter domain chosen by their topology, aligned by the `landmarks` (or by a
+/// rough spatial match when none apply), and each source vertex's image located in the
+/// target's parameterization.
+///
+/// Landmarks that the alignment makes exact land exactly on their targets (a vertex
+/// target gives the surface point of that vertex); the others are listed in the notes,
+/// for the flow to honour.
+///
+/// # Errors
+/// Topology errors of [`check_topology`] (before any work), [`RegisterError::Landmark`]
+/// for a bad landmark (naming its index and vertex), and the wrapped errors of the
+/// cuts, Tutte embeddings, the sphere initialization and point location.
+pub fn initial_map(
+    source: &Mesh,
+    target: &Mesh,
+    landmarks: &[Landmark],
+) -> Result<InitialMap, RegisterError> {
+    let topology = check_topology(source, target)?;
+    let target_index = SurfaceIndex::new(target)?;
+    let marks = landmarks::resolve(source, target, &target_index, landmarks)?;
+    let mut notes = Vec::new();
+    let (mut points, honoured) = match topology {
+        Topology::Disk => disk::map(source, target, &marks, &mut notes)?,
+        Topology::Sphere => sphere::map(source, target, &target_index, &marks, &mut notes)?,
+        Topology::Torus => torus::map(source, target, &marks, &mut notes)?,
+    };
+    let mut exact = vec![false; marks.len()];
+    for &m in &honoured {
+        points[marks[m].source.idx()] = marks[m].target;
+        exact[m] = true;
+    }
+    let positions: Vec<Point3<f64>> = points.iter().map(|p| p.position(target)).collect();
+    for (mark, &exact) in marks.iter().zip(&exact) {
+        if !exact {
+            let distance = (positions[mark.source.idx()] - mark.target.position(target)).norm();
+            notes.push(format!(
+                "landmark {} (source vertex {}) is not enforced by the initial map: its image is {distance:.4e} from its target (left to the flow)",
+                mark.index,
+                source.vertex_map().to_input(mark.source)
+            ));
+        }
+    }
+    let flipped = compose::count_flips(source, &target_index, &points, &positions)?;
+    notes.push(format!(
+        "{flipped} of {} source faces flipped on the target",
+        source.face_count()
+    ));
+    if flipped * 2 > source.face_count() {
+        notes.push(
+            "most faces are flipped: the two meshes are probably oriented oppositely (one has its normals inward)"
+                .to_string(),
+        );
+    }
+    Ok(InitialMap {
+        points,
+        positions,
+        topology,
+        notes,
+        flipped,
+    })
+}

@@ -1,0 +1,281 @@
+//! Closed genus 1: both meshes cut into squares with matched sides, composed on the
+//! torus `R^2 / Z^2`.
+//!
+//! [`beltrami_mesh::cut_to_disk`] cuts a torus along a figure-eight through one vertex:
+//! `a`, the shortest loop of the greedy shortest homotopy basis (Erickson-Whittlesey
+//! weights of the tree-cotree decomposition), and `b`, the shortest loop that crosses
+//! `a` once. The cut mesh is a disk whose boundary (surface on its right) reads
+//! `a, b, a^-1, b^-1`. It goes onto the unit square clockwise:
+//!
+//! ```text
+//! a:     (0, s)      s from 0 to 1      (u = 0, upwards)
+//! b:     (s, 1)      s from 0 to 1      (v = 1, rightwards)
+//! a^-1:  (1, 1 - s)                     (u = 1, downwards)
+//! b^-1:  (1 - s, 0)                     (v = 0, leftwards)
+//! ```
+//!
+//! with `s` the arc-length fraction along the side, computed once for `a` and `b` and
+//! reused for the copies on `a^-1` and `b^-1`, so that the two copies of every seam
+//! vertex differ by exactly `(1, 0)` or `(0, 1)`: the map is continuous on the torus.
+//! The interior follows by Tutte's embedding (a bijection onto the square), so each
+//! mesh's square, glued periodically, is a homeomorphism of the torus onto
+//! `R^2 / Z^2` taking `a` to the first and `b` to the second lattice direction.
+//!
+//! The homotopy class of the composed map is then fixed by pairing the source's `a`
+//! with the target's `a` (shortest with shortest) and `b` with `b`; both squares run in
+//! the same rotational sense, so the map preserves orientation. The remaining freedom is
+//! an orientation-preserving symmetry of the square ([`SquareMap`]): a quarter turn
+//! count and a translation. Without landmarks it is the half turn (0 or 2, which keep
+//! the pairing) and one of 8 x 8 translations that best match the two meshes in space
+//! (sum of squared distances, over up to 512 source vertices, between a vertex moved by
+//! the rough spatial match and its image); with one landmark no turn and the translation
+//! that takes the landmark onto its target; with more, the quarter turn (any of four,
+//! so a landmark set may pair `a` with the target's `b`) with the smallest periodic
+//! distances of the other landmarks to their targets.
+
+use beltrami_init::boundary::BoundaryMap;
+use beltrami_mesh::{CutMesh, Mesh, Point3, SurfacePoint, VertexId, cut_to_disk};
+use beltrami_spatial::SurfaceIndex;
+use num_complex::Complex64;
+
+use crate::compose;
+use crate::error::{RegisterError, Side};
+use crate::landmarks::{Resolved, SpatialMatch, SquareMap, interpolate, periodic_distance};
+use crate::param::{domain_mesh, input_indices, planar_points, tutte};
+
+/// Translations per direction tried without landmarks.
+const SHIFTS: usize = 8;
+
+/// Source vertices used to score the translations at most.
+const SCORE_SAMPLES: usize = 512;
+
+/// A landmark whose image is this close to its target (in the square) counts as honoured.
+const HONOURED: f64 = 1e-9;
+
+/// A torus cut into its square.
+struct Square {
+    cut: CutMesh,
+    /// Parameter of every cut-mesh vertex in `[0, 1]^2`.
+    param: Vec<Complex64>,
+}
+
+/// The source's images on the target and the landmarks honoured exactly (indices into
+/// `marks`).
+pub(crate) fn map(
+    source: &Mesh,
+    target: &Mesh,
+    marks: &[Resolved],
+    notes: &mut Vec<String>,
+) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
+    let source_square = square(source, Side::Source, notes)?;
+    let target_square = square(target, Side::Target, notes)?;
+    let domain = domain_mesh(
+        &target_square.cut.mesh,
+        planar_points(&target_square.param),
+        Side::Target,
+    )?;
+    let s_param = &source_square.param[..source.vertex_count()];
+
+    let (map, honoured) = if marks.is_empty() {
+        let map = best_by_space(source, target, &domain, s_param)?;
+        notes.push(format!(
+            "torus: no landmark; a paired with a, b with b, {} and translation ({:.3}, {:.3}) of the square chosen by a rough spatial match",
+            if map.quarter_turns == 0 { "no turn" } else { "half turn" },
+            map.shift.re,
+            map.shift.im
+        ));
+        (map, Vec::new())
+    } else {
+        let t: Vec<Complex64> = marks
+            .iter()
+            .map(|m| interpolate(&target_square.cut.mesh, &target_square.param, &m.target))
+            .collect();
+        let s: Vec<Complex64> = marks.iter().map(|m| s_param[m.source.idx()]).collect();
+        let turns: &[u8] = if marks.len() == 1 {
+            &[0]
+        } else {
+            &[0, 1, 2, 3]
+        };
+        let mut best: Option<(f64, SquareMap)> = None;
+        for &quarter_turns in turns {
+            let mut map = SquareMap {
+                quarter_turns,
+                shift: Complex64::new(0.0, 0.0),
+            };
+            map.shift = t[0] - map.turn(s[0]);
+            let residual: f64 = s
+                .iter()
+                .zip(&t)
+                .skip(1)
+                .map(|(&a, &b)| periodic_distance(map.apply(a), b))
+                .sum();
+            if best.is_none_or(|(r, _)| residual < r - 1e-12) {
+                best = Some((residual, map));
+            }
+        }
+        let Some((_, map)) = best else {
+            return Err(RegisterError::NoSquare { side: Side::Source });
+        };
+        let honoured: Vec<usize> = (0..marks.len())
+            .filter(|&k| periodic_distance(map.apply(s[k]), t[k]) <= HONOURED)
+            .collect();
+        notes.push(format!(
+            "torus: {} quarter turns and translation ({:.4}, {:.4}) of the square from the landmarks ({} of {} honoured exactly{})",
+            map.quarter_turns,
+            map.shift.re,
+            map.shift.im,
+            honoured.len(),
+            marks.len(),
+            if map.quarter_turns % 2 == 1 {
+                "; the source's a goes to the target's b"
+            } else {
+                ""
+            }
+        ));
+        (map, honoured)
+    };
+    let images: Vec<Complex64> = s_param.iter().map(|&x| map.apply(x)).collect();
+    let (points, gap) = compose::locate(&domain, &planar_points(&images))?;
+    if gap > 1e-12 {
+        notes.push(format!(
+            "torus: the farthest source image was {gap:.3e} outside the target's square and was moved onto it"
+        ));
+    }
+    Ok((points, honoured))
+}
+
+/// Cuts `mesh` and maps it onto the unit square (module docs), noting the loops.
+fn square(mesh: &Mesh, side: Side, notes: &mut Vec<String>) -> Result<Square, RegisterError> {
+    let cut = cut_to_disk(mesh).map_err(|error| RegisterError::Cut { side, error })?;
+    let sides = cut
+        .torus_sides
+        .clone()
+        .ok_or(RegisterError::NoSquare { side })?;
+    for (name, generator) in ["a", "b"].iter().zip(&cut.cut.generators) {
+        notes.push(format!(
+            "torus: {side} loop {name}: length {:.6}, {} vertices (input indices) {:?}",
+            generator.length,
+            generator.halfedges.len(),
+            input_indices(mesh, &generator.vertices(mesh))
+        ));
+    }
+    let a = cut.path_vertices(sides.a.clone());
+    let b = cut.path_vertices(sides.b.clone());
+    let a_inv = cut.path_vertices(sides.a_inv.clone());
+    let b_inv = cut.path_vertices(sides.b_inv.clone());
+    let fa = path_fractions(&cut.mesh, &a);
+    let fb = path_fractions(&cut.mesh, &b);
+    let same = |x: &[VertexId], y: &[VertexId]| {
+        x.len() == y.len()
+            && x.iter()
+                .zip(y.iter().rev())
+                .all(|(&p, &q)| cut.original_vertex(p) == cut.original_vertex(q))
+    };
+    if !same(&a, &a_inv) || !same(&b, &b_inv) {
+        return Err(RegisterError::NoSquare { side });
+    }
+    let mut vertices = Vec::with_capacity(cut.boundary.len());
+    let mut positions = Vec::with_capacity(cut.boundary.len());
+    let na = a.len() - 1;
+    let nb = b.len() - 1;
+    for k in 0..na {
+        vertices.push(a[k]);
+        positions.push(Complex64::new(0.0, fa[k]));
+    }
+    for k in 0..nb {
+        vertices.push(b[k]);
+        positions.push(Complex64::new(fb[k], 1.0));
+    }
+    for k in 0..na {
+        vertices.push(a_inv[k]);
+        positions.push(Complex64::new(1.0, fa[na - k]));
+    }
+    for k in 0..nb {
+        vertices.push(b_inv[k]);
+        positions.push(Complex64::new(fb[nb - k], 0.0));
+    }
+    let param = tutte(
+        &cut.mesh,
+        &BoundaryMap {
+            vertices,
+            positions,
+        },
+        side,
+    )?;
+    Ok(Square { cut, param })
+}
+
+/// Arc-length fractions along an open path, 0 at its first and 1 at its last vertex.
+fn path_fractions(mesh: &Mesh, path: &[VertexId]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(path.len());
+    let mut total = 0.0;
+    out.push(0.0);
+    for w in path.windows(2) {
+        total += (mesh.position(w[1]) - mesh.position(w[0])).norm();
+        out.push(total);
+    }
+    let n = path.len().saturating_sub(1).max(1) as f64;
+    for (k, x) in out.iter_mut().enumerate() {
+        *x = if total > 0.0 {
+            *x / total
+        } else {
+            k as f64 / n
+        };
+    }
+    if let Some(last) = out.last_mut() {
+        *last = 1.0;
+    }
+    out
+}
+
+/// The half turn and translation (of `SHIFTS^2`) whose images best match the source in
+/// space (module docs).
+fn best_by_space(
+    source: &Mesh,
+    target: &Mesh,
+    domain: &Mesh,
+    s_param: &[Complex64],
+) -> Result<SquareMap, RegisterError> {
+    let spatial = SpatialMatch::new(source, target);
+    let step = source.vertex_count().div_ceil(SCORE_SAMPLES).max(1);
+    let samples: Vec<VertexId> = source.vertices().step_by(step).collect();
+    let moved: Vec<Point3<f64>> = samples
+        .iter()
+        .map(|&v| spatial.to_target(&source.position(v)))
+        .collect();
+    let index = SurfaceIndex::new(domain)?;
+    let mut best = (
+        f64::INFINITY,
+        SquareMap {
+            quarter_turns: 0,
+            shift: Complex64::new(0.0, 0.0),
+        },
+    );
+    for quarter_turns in [0, 2] {
+        for i in 0..SHIFTS {
+            for j in 0..SHIFTS {
+                let map = SquareMap {
+                    quarter_turns,
+                    shift: Complex64::new(i as f64, j as f64) / SHIFTS as f64,
+                };
+                let images: Vec<Point3<f64>> = samples
+                    .iter()
+                    .map(|v| {
+                        let z = map.apply(s_param[v.idx()]);
+                        Point3::new(z.re, z.im, 0.0)
+                    })
+                    .collect();
+                let located = index.locate_all(&images)?;
+                let cost: f64 = located
+                    .iter()
+                    .zip(&moved)
+                    .map(|(l, p)| (l.point.position(target) - p).norm_squared())
+                    .sum();
+                if cost < best.0 {
+                    best = (cost, map);
+                }
+            }
+        }
+    }
+    Ok(best.1)
+}

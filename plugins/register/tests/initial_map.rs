@@ -1,0 +1,393 @@
+//! The initial bijection on every supported topology: zero flips, images on the target,
+//! valid surface points, landmarks, the identity, topology errors and the torus loops.
+//! The shared meshes (`../shared/meshes`) are skipped with a message when absent.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use beltrami_mesh::primitives::{self, Cells, ModifiedTorus};
+use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup, VertexId, io};
+use beltrami_register::{
+    InitialMap, Landmark, LandmarkTarget, RegisterError, Topology, check_topology, initial_map,
+};
+use beltrami_spatial::SurfaceIndex;
+
+fn mesh(soup: &PolygonSoup) -> Mesh {
+    Mesh::from_soup(soup).unwrap()
+}
+
+fn shared(file: &str) -> Option<Mesh> {
+    let dir: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes");
+    let path = dir.join(file);
+    if !path.exists() {
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED: {} not found; this test needs ../shared beside the repo",
+            path.display()
+        );
+        return None;
+    }
+    Some(io::read(&path, &BuildOptions::default()).unwrap().mesh)
+}
+
+/// Every image is a valid surface point of the target, its position matches, and it is
+/// on the target surface.
+fn check_on_target(source: &Mesh, target: &Mesh, map: &InitialMap) {
+    assert_eq!(map.points.len(), source.vertex_count());
+    assert_eq!(map.positions.len(), source.vertex_count());
+    let index = SurfaceIndex::new(target).unwrap();
+    let scale = target.bounding_box().diagonal();
+    for (p, x) in map.points.iter().zip(&map.positions) {
+        p.validate(target).unwrap();
+        assert!((p.position(target) - x).norm() <= 1e-12 * scale);
+        let located = index.locate(x).unwrap();
+        assert!(located.distance <= 1e-9 * scale, "{}", located.distance);
+    }
+}
+
+fn jittered_disk(level: usize, amount: f64, seed: u64) -> Mesh {
+    let mut soup = primitives::disk(level);
+    let mut state = seed;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+    };
+    for p in &mut soup.positions {
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        if r < 1.0 - 1e-9 {
+            p.x += amount * next();
+            p.y += amount * next();
+        }
+        p.z = 0.3 * (p.x * 2.0).sin() * (p.y * 3.0).cos();
+    }
+    mesh(&soup)
+}
+
+#[test]
+fn disk_onto_disk_has_no_flips() {
+    let source = jittered_disk(4, 0.01, 1);
+    let target = jittered_disk(5, 0.005, 2);
+    let map = initial_map(&source, &target, &[]).unwrap();
+    assert_eq!(map.topology, Topology::Disk);
+    check_on_target(&source, &target, &map);
+    assert_eq!(map.flipped, 0, "{:?}", map.notes);
+    // Boundary onto boundary.
+    let index = SurfaceIndex::new(&target).unwrap();
+    for v in source.vertices().filter(|&v| source.is_boundary_vertex(v)) {
+        let p = map.positions[v.idx()];
+        assert!((p.x * p.x + p.y * p.y).sqrt() > 0.99, "{p:?}");
+        let _ = index.locate(&p).unwrap();
+    }
+}
+
+#[test]
+fn bundled_hemisphere_onto_planar_disk() {
+    let source = io::read(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../meshes/disk_hemisphere.obj"),
+        &BuildOptions::default(),
+    )
+    .unwrap()
+    .mesh;
+    let target = mesh(&primitives::disk(6));
+    let map = initial_map(&source, &target, &[]).unwrap();
+    check_on_target(&source, &target, &map);
+    assert_eq!(map.flipped, 0, "{:?}", map.notes);
+}
+
+#[test]
+fn disk_boundary_landmark_lands_exactly() {
+    let source = jittered_disk(4, 0.01, 3);
+    let target = jittered_disk(4, 0.01, 4);
+    let s = source
+        .vertices()
+        .filter(|&v| source.is_boundary_vertex(v))
+        .nth(5)
+        .unwrap();
+    let t = target
+        .vertices()
+        .filter(|&v| target.is_boundary_vertex(v))
+        .nth(20)
+        .unwrap();
+    let landmarks = [Landmark {
+        source: s,
+        target: LandmarkTarget::Vertex(t),
+    }];
+    let map = initial_map(&source, &target, &landmarks).unwrap();
+    check_on_target(&source, &target, &map);
+    assert_eq!(map.flipped, 0);
+    assert_eq!(map.positions[s.idx()], target.position(t));
+    // An interior source vertex cannot go onto the boundary.
+    let inner = source
+        .vertices()
+        .find(|&v| !source.is_boundary_vertex(v))
+        .unwrap();
+    let bad = [Landmark {
+        source: inner,
+        target: LandmarkTarget::Vertex(t),
+    }];
+    assert!(matches!(
+        initial_map(&source, &target, &bad),
+        Err(RegisterError::Landmark { index: 0, .. })
+    ));
+}
+
+#[test]
+fn disk_onto_itself_is_the_identity() {
+    let m = jittered_disk(4, 0.01, 5);
+    let b = m.vertices().find(|&v| m.is_boundary_vertex(v)).unwrap();
+    let landmarks = [Landmark {
+        source: b,
+        target: LandmarkTarget::Vertex(b),
+    }];
+    let map = initial_map(&m, &m, &landmarks).unwrap();
+    for v in m.vertices() {
+        assert!((map.positions[v.idx()] - m.position(v)).norm() < 1e-9);
+    }
+}
+
+#[test]
+fn human_face_onto_hand() {
+    let (Some(source), Some(target)) = (shared("disk_human_face.obj"), shared("disk_hand.obj"))
+    else {
+        return;
+    };
+    let map = initial_map(&source, &target, &[]).unwrap();
+    check_on_target(&source, &target, &map);
+    let _ = writeln!(std::io::stderr(), "face onto hand: {:?}", map.notes);
+    // Real meshes: a handful of flips (reported in the notes) are tolerated.
+    assert!(map.flipped * 1000 <= source.face_count(), "{:?}", map.notes);
+}
+
+fn ellipsoid(level: usize) -> Mesh {
+    let mut soup = primitives::icosphere(level);
+    for p in &mut soup.positions {
+        *p = Point3::new(2.0 * p.x, p.y + 0.2 * p.x * p.x, 0.7 * p.z);
+    }
+    mesh(&soup)
+}
+
+#[test]
+fn sphere_onto_ellipsoid_has_no_flips() {
+    let source = mesh(&primitives::icosphere(3));
+    let target = ellipsoid(4);
+    let map = initial_map(&source, &target, &[]).unwrap();
+    assert_eq!(map.topology, Topology::Sphere);
+    check_on_target(&source, &target, &map);
+    assert_eq!(map.flipped, 0, "{:?}", map.notes);
+}
+
+#[test]
+fn sphere_landmarks_land_exactly() {
+    let source = mesh(&primitives::icosphere(3));
+    let target = ellipsoid(3);
+    for count in 1..=3 {
+        let landmarks: Vec<Landmark> = [(0u32, 5u32), (17, 40), (100, 90)][..count]
+            .iter()
+            .map(|&(s, t)| Landmark {
+                source: VertexId(s),
+                target: LandmarkTarget::Vertex(VertexId(t)),
+            })
+            .collect();
+        let map = initial_map(&source, &target, &landmarks).unwrap();
+        check_on_target(&source, &target, &map);
+        for l in &landmarks {
+            let LandmarkTarget::Vertex(t) = l.target else {
+                unreachable!()
+            };
+            assert_eq!(map.positions[l.source.idx()], target.position(t));
+        }
+        assert_eq!(map.flipped, 0, "{count} landmarks: {:?}", map.notes);
+    }
+    // A point target.
+    let p = Point3::new(0.3, 0.9, 0.1);
+    let map = initial_map(
+        &source,
+        &target,
+        &[Landmark {
+            source: VertexId(7),
+            target: LandmarkTarget::Point(p),
+        }],
+    )
+    .unwrap();
+    let expected = SurfaceIndex::new(&target)
+        .unwrap()
+        .locate(&p)
+        .unwrap()
+        .position;
+    assert!((map.positions[7] - expected).norm() < 1e-12);
+}
+
+#[test]
+fn sphere_onto_itself_is_the_identity() {
+    let m = ellipsoid(3);
+    let map = initial_map(&m, &m, &[]).unwrap();
+    for v in m.vertices() {
+        assert!(
+            (map.positions[v.idx()] - m.position(v)).norm() < 1e-6,
+            "{v}"
+        );
+    }
+}
+
+#[test]
+fn spot_onto_bunny() {
+    let (Some(source), Some(target)) = (shared("g0_spot.obj"), shared("g0_bunny_closed.obj"))
+    else {
+        return;
+    };
+    let map = initial_map(&source, &target, &[]).unwrap();
+    check_on_target(&source, &target, &map);
+    let _ = writeln!(
+        std::io::stderr(),
+        "spot onto bunny: {} flips; {:?}",
+        map.flipped,
+        map.notes
+    );
+    assert!(map.flipped * 500 <= source.face_count(), "{:?}", map.notes);
+    let sphere = mesh(&primitives::icosphere(4));
+    let map = initial_map(&source, &sphere, &[]).unwrap();
+    check_on_target(&source, &sphere, &map);
+    let _ = writeln!(
+        std::io::stderr(),
+        "spot onto icosphere: {} flips",
+        map.flipped
+    );
+    assert!(map.flipped * 1000 <= source.face_count(), "{:?}", map.notes);
+}
+
+fn torus(nu: usize, nv: usize) -> Mesh {
+    mesh(&primitives::torus(nu, nv, 3.0, 1.0, Cells::Triangles))
+}
+
+#[test]
+fn torus_onto_modified_tori_has_no_flips_and_names_its_loops() {
+    let source = torus(48, 16);
+    for kind in [ModifiedTorus::Phi1, ModifiedTorus::Phi2] {
+        let target = mesh(&primitives::modified_torus(kind, 80, 32));
+        let map = initial_map(&source, &target, &[]).unwrap();
+        assert_eq!(map.topology, Topology::Torus);
+        check_on_target(&source, &target, &map);
+        assert_eq!(map.flipped, 0, "{:?}", map.notes);
+        // The loops: a around the tube on both (shortest paired with shortest).
+        let loops: Vec<&String> = map.notes.iter().filter(|n| n.contains(" loop ")).collect();
+        assert_eq!(loops.len(), 4, "{:?}", map.notes);
+        assert!(
+            loops[0].contains("source loop a: length 6.2"),
+            "{}",
+            loops[0]
+        );
+        assert!(loops[2].contains("target loop a"), "{}", loops[2]);
+    }
+}
+
+#[test]
+fn torus_landmarks_and_identity() {
+    let m = torus(40, 16);
+    let landmarks = [Landmark {
+        source: VertexId(0),
+        target: LandmarkTarget::Vertex(VertexId(0)),
+    }];
+    let map = initial_map(&m, &m, &landmarks).unwrap();
+    assert_eq!(map.flipped, 0);
+    for v in m.vertices() {
+        assert!(
+            (map.positions[v.idx()] - m.position(v)).norm() < 1e-9,
+            "{v}"
+        );
+    }
+    let target = mesh(&primitives::modified_torus(ModifiedTorus::Phi1, 60, 24));
+    let landmarks = [
+        Landmark {
+            source: VertexId(3),
+            target: LandmarkTarget::Vertex(VertexId(100)),
+        },
+        Landmark {
+            source: VertexId(300),
+            target: LandmarkTarget::Vertex(VertexId(900)),
+        },
+    ];
+    let map = initial_map(&m, &target, &landmarks).unwrap();
+    check_on_target(&m, &target, &map);
+    assert_eq!(map.positions[3], target.position(VertexId(100)));
+    assert_eq!(map.flipped, 0, "{:?}", map.notes);
+}
+
+#[test]
+fn kitten_onto_modified_tori() {
+    let Some(source) = shared("g1_kitten.obj") else {
+        return;
+    };
+    for kind in [ModifiedTorus::Phi1, ModifiedTorus::Phi2] {
+        let target = mesh(&primitives::modified_torus(kind, 160, 64));
+        let map = initial_map(&source, &target, &[]).unwrap();
+        check_on_target(&source, &target, &map);
+        let _ = writeln!(std::io::stderr(), "kitten onto {kind:?}: {:?}", map.notes);
+        assert!(map.flipped * 1000 <= source.face_count(), "{:?}", map.notes);
+    }
+}
+
+#[test]
+fn topology_mismatches_are_errors() {
+    let disk = jittered_disk(2, 0.0, 1);
+    let sphere = mesh(&primitives::icosphere(1));
+    let torus = torus(12, 6);
+    let err = check_topology(&disk, &sphere).unwrap_err();
+    assert!(matches!(err, RegisterError::TopologyMismatch { .. }));
+    assert!(
+        err.to_string().contains("genus 0 with 1 boundary loop"),
+        "{err}"
+    );
+    let err = initial_map(&torus, &sphere, &[]).unwrap_err();
+    assert!(
+        err.to_string().contains("genus 1 with 0 boundary loops"),
+        "{err}"
+    );
+    assert_eq!(check_topology(&torus, &torus).unwrap(), Topology::Torus);
+    assert_eq!(check_topology(&sphere, &sphere).unwrap(), Topology::Sphere);
+    assert_eq!(check_topology(&disk, &disk).unwrap(), Topology::Disk);
+    if let Some(eight) = shared("g2_eight.obj") {
+        let err = initial_map(&eight, &eight, &[]).unwrap_err();
+        assert!(matches!(err, RegisterError::Unsupported { .. }));
+        assert!(err.to_string().contains("closed genus-1"), "{err}");
+    }
+    let annulus = mesh(&primitives::annulus(0.4, 4, 16));
+    assert!(matches!(
+        check_topology(&annulus, &annulus),
+        Err(RegisterError::Unsupported { .. })
+    ));
+}
+
+#[test]
+fn bad_landmarks_name_their_index() {
+    let sphere = mesh(&primitives::icosphere(2));
+    let out_of_range = [
+        Landmark {
+            source: VertexId(0),
+            target: LandmarkTarget::Vertex(VertexId(1)),
+        },
+        Landmark {
+            source: VertexId(100_000),
+            target: LandmarkTarget::Vertex(VertexId(1)),
+        },
+    ];
+    let err = initial_map(&sphere, &sphere, &out_of_range).unwrap_err();
+    assert!(
+        matches!(err, RegisterError::Landmark { index: 1, .. }),
+        "{err}"
+    );
+    let nan = [Landmark {
+        source: VertexId(0),
+        target: LandmarkTarget::Point(Point3::new(f64::NAN, 0.0, 0.0)),
+    }];
+    assert!(matches!(
+        initial_map(&sphere, &sphere, &nan),
+        Err(RegisterError::Landmark { index: 0, .. })
+    ));
+    let repeated = [out_of_range[0], out_of_range[0]];
+    assert!(matches!(
+        initial_map(&sphere, &sphere, &repeated),
+        Err(RegisterError::Landmark { index: 1, .. })
+    ));
+}
