@@ -30,6 +30,7 @@ pub use beltrami_flow as flow;
 pub use beltrami_init as init;
 pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
+pub use beltrami_register as register;
 pub use beltrami_render as render;
 pub use beltrami_spatial as spatial;
 
@@ -39,5 +40,6 @@ pub fn registry() -> beltrami_core::Registry {
     beltrami_init::register(&mut registry);
     beltrami_lsqc::register(&mut registry);
     beltrami_flow::register(&mut registry);
+    beltrami_register::register(&mut registry);
     registry
 }

@@ -81,7 +81,9 @@ pub fn parse(path: &Path, text: &str, source: &Mesh, target: &Mesh) -> anyhow::R
                 }),
                 ["p", s, x, y, z] => {
                     let coordinate = |c: &str| -> anyhow::Result<f64> {
-                        let value: f64 = c.parse().with_context(|| format!("`{c}` is not a number"))?;
+                        let value: f64 = c
+                            .parse()
+                            .with_context(|| format!("`{c}` is not a number"))?;
                         if !value.is_finite() {
                             bail!("`{c}` is not finite");
                         }

@@ -7,12 +7,14 @@ mod generate;
 mod histogram;
 mod info;
 mod interrupt;
+mod landmarks;
 mod load;
 mod mapping;
 mod param;
 mod picture;
 mod pins;
 mod qc;
+mod register;
 mod render;
 mod solvers;
 
@@ -43,6 +45,10 @@ pub enum Command {
     /// A quasiconformal map with a prescribed Beltrami coefficient or the most conformal
     /// one (lsqc, beltrami-flow) onto the plane, a disk, an annulus or the sphere.
     Qc(qc::QcArgs),
+    /// Map one mesh onto another of the same topology (disk, closed genus 0 or 1),
+    /// bijectively and as conformally as the constraints allow, with landmarks and
+    /// feature curves: an initial bijection, then the Beltrami flow on the target.
+    Register(register::RegisterArgs),
     /// Write a generated mesh: the disk, sphere, annulus and square of the paper
     /// reproductions.
     Generate(generate::GenerateArgs),
@@ -67,6 +73,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Distortion(args) => distortion::run(&args, cli.quiet),
         Command::Param(args) => param::run(&args, cli.quiet),
         Command::Qc(args) => qc::run(&args, cli.quiet),
+        Command::Register(args) => register::run(&args, cli.quiet),
         Command::Generate(args) => generate::run(&args, cli.quiet),
         Command::Solvers(args) => solvers::run(&args),
         Command::Bench(args) => bench::run(&args),

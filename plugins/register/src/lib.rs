@@ -1,5 +1,10 @@
 //! # beltrami-register
 //!
+//! Surface registration: [`Register`] maps a source mesh onto a target mesh of the same
+//! topology, bijectively and as conformally as the constraints allow (or with a
+//! prescribed mu): the initial bijection below, then the discrete Beltrami flow on the
+//! target mesh (`beltrami-flow`, Wong-Zhao 2014, sections 4.5 and 5.4).
+//!
 //! The initial bijection of surface registration (Wong-Zhao 2014, section 5.4): a map
 //! from every vertex of a source mesh onto a target mesh of the same topology, built by
 //! mapping both onto a common parameter domain and locating the source's images in the
@@ -33,6 +38,7 @@ mod disk;
 mod error;
 mod landmarks;
 mod param;
+mod solver;
 mod sphere;
 mod topology;
 mod torus;
@@ -42,6 +48,7 @@ use beltrami_spatial::SurfaceIndex;
 
 pub use error::{RegisterError, Side};
 pub use landmarks::{Landmark, LandmarkTarget};
+pub use solver::Register;
 pub use topology::{Shape, Topology, check_topology};
 
 /// An initial map from a source mesh onto a target mesh.
@@ -125,4 +132,9 @@ pub fn initial_map(
         notes,
         flipped,
     })
+}
+
+/// Adds [`Register`] to `registry`.
+pub fn register(registry: &mut beltrami_core::Registry) {
+    registry.register(Box::new(Register));
 }

@@ -1,0 +1,160 @@
+//! `beltrami register`: a map of one mesh onto another of the same topology, bijective
+//! and as conformal as the constraints allow (or with a prescribed mu), by an initial
+//! bijection through a common parameter domain and the Beltrami flow on the target mesh.
+
+use std::io::Write as _;
+use std::path::PathBuf;
+
+use anyhow::{Context as _, bail};
+use beltrami_core::{Curve, Goal, Map, Pin, Position, Problem, Solution, Target};
+use beltrami_fem::BeltramiField;
+use beltrami_mesh::io;
+use clap::Args;
+use serde_json::json;
+
+use super::landmarks::{self, LandmarkGoal};
+use super::load::load_mesh;
+use super::mapping;
+
+#[derive(Debug, Args)]
+pub struct RegisterArgs {
+    /// The mesh to map (.obj, .gltf, .glb).
+    pub source: PathBuf,
+    /// The mesh to map onto, of the same topology.
+    pub target: PathBuf,
+    /// Minimize the L^p norm of mu (p >= 2).
+    #[arg(long, default_value_t = 2.0)]
+    pub p: f64,
+    /// A prescribed Beltrami coefficient per source face instead (the field format,
+    /// face frame).
+    #[arg(long)]
+    pub mu: Option<PathBuf>,
+    /// Landmarks and feature curves (`v SRC TGT`, `p SRC x y z`, `c SRC,.. TGT,..`).
+    #[arg(long)]
+    pub landmarks: Option<PathBuf>,
+    /// Most flow iterations.
+    #[arg(long = "max-iters", default_value_t = 100)]
+    pub max_iters: usize,
+    /// Stop when the largest vertex update is below this (relative to the target's size).
+    #[arg(long, default_value_t = 1e-5)]
+    pub tolerance: f64,
+    /// Threads for the sparse factorizations.
+    #[arg(long, default_value_t = 1)]
+    pub threads: usize,
+    /// Output mesh: the source's vertices and faces, every vertex at its image on the
+    /// target (so `beltrami distortion SOURCE OUT` measures the map).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Write one line per source vertex, `face b0 b1 b2`: its image as a target face
+    /// (0-based, the target file's order) and barycentric coordinates.
+    #[arg(long)]
+    pub correspondence: Option<PathBuf>,
+    /// Also draw the result (source and image side by side, |mu| colors) as PNG.
+    #[arg(long, value_parser = mapping::png_path)]
+    pub png: Option<PathBuf>,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Print the JSON report on stdout instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Repair what can be repaired safely in the inputs (see `beltrami info --repair`).
+    #[arg(long)]
+    pub repair: bool,
+}
+
+pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
+    mapping::check_output_format(&args.output)?;
+    let registry = beltrami::registry();
+    let solver = registry.get("register")?;
+    let source_loaded = load_mesh(&args.source, args.repair, quiet || args.json)?;
+    let target_loaded = load_mesh(&args.target, args.repair, quiet || args.json)?;
+    let source = &source_loaded.mesh.mesh;
+    let target = &target_loaded.mesh.mesh;
+
+    let mut problem = Problem::new(source, Target::Mesh(target));
+    problem.goal = match &args.mu {
+        Some(path) => Goal::Prescribed(BeltramiField::read(path, source.face_count())?),
+        None => Goal::Conformal { p: args.p },
+    };
+    if let Some(path) = &args.landmarks {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read the landmarks {}", path.display()))?;
+        let parsed = landmarks::parse(path, &text, source, target)?;
+        problem.constraints.pins = parsed
+            .points
+            .iter()
+            .map(|l| Pin {
+                vertex: l.source,
+                position: Some(Position::Spatial(match l.goal {
+                    LandmarkGoal::Vertex(w) => target.position(w),
+                    LandmarkGoal::Point(p) => p,
+                })),
+            })
+            .collect();
+        problem.constraints.curves = parsed
+            .curves
+            .into_iter()
+            .map(|c| Curve {
+                source: c.source,
+                target: c.target,
+            })
+            .collect();
+    }
+    problem.params.max_iterations = args.max_iters;
+    problem.params.tolerance = args.tolerance;
+    problem.params.threads = args.threads;
+
+    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.json)?;
+    let Map::OnMesh(points) = &solution.map else {
+        bail!("the register solver did not give points on the target mesh");
+    };
+    let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
+    let spatial = Solution {
+        map: Map::Spatial(positions),
+        report: solution.report.clone(),
+    };
+    mapping::write_map(&args.output, source, &spatial)?;
+    if let Some(path) = &args.correspondence {
+        io::write_atomically(path, |w| {
+            for p in points {
+                writeln!(
+                    w,
+                    "{} {} {} {}",
+                    target.face_to_input(p.face),
+                    p.coords[0],
+                    p.coords[1],
+                    p.coords[2]
+                )?;
+            }
+            Ok(())
+        })
+        .with_context(|| format!("cannot write the correspondence {}", path.display()))?;
+    }
+    mapping::write_png(args.png.as_deref(), source, &spatial)?;
+
+    let mut report = mapping::report_json(&args.source, &args.output, &spatial, seconds);
+    report.insert("target".into(), json!(args.target.display().to_string()));
+    let steps = solution.report.iterations.max(1) as f64;
+    let per_step: f64 = solution
+        .report
+        .timings
+        .iter()
+        .filter(|(n, _)| n == "flow: solves" || n == "flow: steps")
+        .map(|(_, s)| s)
+        .sum::<f64>()
+        / steps;
+    report.insert("seconds_per_step".into(), json!(per_step));
+    let extra = vec![format!(
+        "iterations      {} ({per_step:.3} s per step)",
+        solution.report.iterations
+    )];
+    mapping::finish(
+        report,
+        args.report.as_deref(),
+        args.json,
+        quiet,
+        (&args.source, &args.output, &spatial, seconds),
+        &extra,
+    )
+}
