@@ -260,9 +260,10 @@ fn midpoint(a: Point3<f64>, b: Point3<f64>) -> Point3<f64> {
 }
 
 #[test]
-fn flips_are_judged_against_the_target_when_given() {
-    // A half turn about z: conformal, but near the equator each image face's normal
-    // points against its source face's normal.
+fn flips_are_judged_against_the_image_or_the_target() {
+    // A half turn about z: conformal, and no fold, though near the equator each image
+    // face's normal points against its source face's normal. Without a target the image
+    // is judged against its own vertex normals, with one against the target's.
     let dir = tempfile::tempdir().unwrap();
     let sphere = Mesh::from_soup(&icosphere(3)).unwrap();
     let target = Mesh::from_soup(&icosphere(2)).unwrap();
@@ -280,13 +281,28 @@ fn flips_are_judged_against_the_target_when_given() {
     write_mesh(&mapped, &sphere, Some(&image), None);
     write_mesh(&target_path, &target, None, None);
 
-    let against_source = report(&[s(&source), s(&mapped)]);
-    let flipped = against_source["flipped"].as_u64().unwrap();
-    assert!(flipped > 100, "{against_source}");
-
+    let alone = report(&[s(&source), s(&mapped)]);
+    assert_eq!(alone["flipped"], 0, "{alone}");
+    assert!(number(&alone, "mu_max") < 1e-9, "{alone}");
     let against_target = report(&[s(&source), s(&mapped), "--target", s(&target_path)]);
     assert_eq!(against_target["flipped"], 0, "{against_target}");
-    assert!(number(&against_target, "mu_max") < 1e-9, "{against_target}");
+
+    // A vertex slid along the surface past its neighbours folds part of its fan:
+    // flipped with or without the target.
+    let mut folded = image.clone();
+    let p = folded[0].coords;
+    let tangent = p
+        .cross(&beltrami_mesh::Vector3::new(0.3, 0.5, 0.8))
+        .normalize();
+    folded[0] = Point3::from((p + 0.3 * tangent).normalize());
+    let folded_path = dir.path().join("folded.obj");
+    write_mesh(&folded_path, &sphere, Some(&folded), None);
+    for extra in [vec![], vec!["--target", s(&target_path)]] {
+        let mut args = vec![s(&source), s(&folded_path)];
+        args.extend(extra);
+        let v = report(&args);
+        assert!(v["flipped"].as_u64().unwrap() >= 1, "{v}");
+    }
 }
 
 #[test]

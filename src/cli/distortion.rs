@@ -94,7 +94,7 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
                 }
                 Some(found.normals)
             }
-            None => None,
+            None => Some(distortion::image_normals(mesh, &image)),
         };
         let measured = distortion::measure_surface(mesh, &image, normals.as_deref())
             .with_context(measuring)?;

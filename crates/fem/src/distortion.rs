@@ -220,6 +220,34 @@ pub fn measure_surface(
     Distortion::from_derivatives(&elements, &derivatives)
 }
 
+/// Per face, the normal a map's image is judged against when no target surface is
+/// known: the sum, over the face's corners, of the image's own vertex normals (each the
+/// sum of the vector areas `(Y_1 - Y_0) x (Y_2 - Y_0) / 2` of the image faces around the
+/// vertex; quads by their diagonals). Where the image is an embedding these agree with
+/// every image face; a face folded over its neighbours points against them. Unlike the
+/// source normals, this suits images of any shape (a registration onto another surface).
+pub fn image_normals(mesh: &Mesh, image: &[Point3<f64>]) -> Vec<Vector3<f64>> {
+    let face_area = |f: FaceId| -> Vector3<f64> {
+        let (v, n) = mesh.face_vertex_array(f);
+        let p = |k: usize| image[v[k].idx()];
+        if n == 3 {
+            (p(1) - p(0)).cross(&(p(2) - p(0))) / 2.0
+        } else {
+            (p(2) - p(0)).cross(&(p(3) - p(1))) / 2.0
+        }
+    };
+    let mut vertex = vec![Vector3::zeros(); mesh.vertex_count()];
+    for f in mesh.faces() {
+        let a = face_area(f);
+        for v in mesh.face_vertices(f) {
+            vertex[v.idx()] += a;
+        }
+    }
+    mesh.faces()
+        .map(|f| mesh.face_vertices(f).map(|v| vertex[v.idx()]).sum())
+        .collect()
+}
+
 /// `|mu - target|` over the faces, weighted by the face areas (the sums of the
 /// quadrature weights of each face): how far a map is from a prescribed Beltrami
 /// coefficient, in the measures of Wong-Zhao's tables 5.1-5.3.

@@ -159,8 +159,9 @@ impl<'a> Scene<'a> {
     /// and flips, in the global frame for a mesh in the plane z = 0, in the face frames
     /// otherwise), which costs about as much as loading the mesh. A map into R^3 is
     /// judged flipped against the radial direction when its image lies on a sphere
-    /// about the origin (the `sphere` solver's output), else against the source normals
-    /// (right for images near the source).
+    /// about the origin (the `sphere` solver's output), else against the image's own
+    /// vertex normals ([`distortion::image_normals`]: right for images of any shape, a
+    /// registration onto another surface included).
     ///
     /// Fails for a mesh without faces and when the measure fails (a degenerate face).
     pub fn new(mesh: &'a Mesh, image: Option<Layout>) -> Result<Self, RenderError> {
@@ -171,10 +172,11 @@ impl<'a> Scene<'a> {
         let distortion = match &image {
             None => None,
             Some(Layout::Space(points)) => {
-                let normals = sphere_normals(mesh, points);
+                let normals = sphere_normals(mesh, points)
+                    .unwrap_or_else(|| distortion::image_normals(mesh, points));
                 Some(FaceDistortion::from_measured(
                     mesh,
-                    distortion::measure_surface(mesh, points, normals.as_deref())?,
+                    distortion::measure_surface(mesh, points, Some(&normals))?,
                 ))
             }
             Some(Layout::Plane(corners)) => {
