@@ -3,7 +3,7 @@
 
 # Run the main job on the bundled mesh.
 demo:
-    cargo run --release -- param meshes/disk_hemisphere.obj --solver lscm -o hemisphere_lscm.obj
+    cargo run --release -- register meshes/spot.obj meshes/blob.obj -o spot_on_blob.obj
 
 # Build everything in release mode.
 build:

@@ -191,6 +191,9 @@ pub fn report_json(
         "mu_max": d.map(|d| d.mu_max),
         "mu_std": d.map(|d| d.mu_std),
         "mu_l2": d.map(|d| d.mu_l2),
+        "initial_flipped": r.initial_distortion.as_ref().map(|d| d.flipped),
+        "initial_mu_mean": r.initial_distortion.as_ref().map(|d| d.mu_mean),
+        "initial_mu_max": r.initial_distortion.as_ref().map(|d| d.mu_max),
         "energy_history": r.energy_history,
         "step_sizes": r.step_sizes,
         "timings": r.timings.iter().map(|(k, v)| json!({"stage": k, "seconds": v})).collect::<Vec<_>>(),
@@ -230,6 +233,12 @@ pub fn finish(
             output.display(),
             r.solver
         );
+        if let Some(d) = &r.initial_distortion {
+            println!(
+                "  initial map     flipped {}  |mu| mean {:.4e}  max {:.4e}",
+                d.flipped, d.mu_mean, d.mu_max
+            );
+        }
         if let Some(d) = &r.distortion {
             println!("  flipped faces   {}", d.flipped);
             println!(

@@ -146,6 +146,8 @@ pub struct Report {
     pub mu: Option<BeltramiField>,
     /// Statistics of `|mu|` and the flipped-face count, when measured.
     pub distortion: Option<DistortionStats>,
+    /// The same for the map an iterative solver started from, when measured.
+    pub initial_distortion: Option<DistortionStats>,
     /// Named timings in seconds, in the order they happened.
     pub timings: Vec<(String, f64)>,
     /// Remarks for the user (e.g. "3 faces flipped: cotangent weights are negative on

@@ -26,7 +26,8 @@
 //!    both have the same continuous limit, and these make the flow a descent direction
 //!    for the error it is judged by.
 //! 3. Step (section 4.4). The largest `t` in `{1, 1/2, 1/4, ...}` (on target meshes
-//!    starting below the cap of [`FlowOptions::max_move`]) for which
+//!    starting below the cap of [`FlowOptions::max_move`]) for which (while a landmark
+//!    is still pulled towards its goal, only the first condition)
 //!    `Y' = P(Y + t V)` (each vertex projected back onto the target by its role) has no
 //!    more flipped faces than `Y` and a smaller `E`.
 //! 4. Stop when the largest vertex update `t max_i |V_i|` is below the tolerance, or no
@@ -247,10 +248,14 @@ pub fn run<G: TargetGeometry>(
         }
         let clock = Instant::now();
         weights_and_targets(objective, &faces, &mut weights, &mut rho);
+        // While a landmark is away from its goal, a step that brings it closer is
+        // accepted even if the distortion grows (the constraint comes first).
+        let mut pulling = false;
         if pulled.iter().any(|&p| p) {
             for (v, goal) in goals.iter().enumerate() {
                 if let Some(goal) = goal {
                     let d = goal - image[v];
+                    pulling |= d.norm() >= options.tolerance;
                     // The tangential part: the projection brings the point back.
                     prescribed[v] = d - normals[v] * normals[v].dot(&d);
                 }
@@ -284,7 +289,7 @@ pub fn run<G: TargetGeometry>(
             )?;
             image_faces(elements, &trial_normals, &trial, &mut trial_faces);
             let (e, flips) = objective.evaluate(&trial_faces);
-            if flips <= flipped && e < energy {
+            if flips <= flipped && (pulling || e < energy) {
                 break Some((moved, e, flips));
             }
             t *= 0.5;

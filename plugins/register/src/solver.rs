@@ -121,6 +121,7 @@ impl Solver for Register {
             "initial map: mean |mu| {:.4}, max |mu| {:.4}, {} flipped faces",
             start.stats.mu_mean, start.stats.mu_max, start.stats.flipped
         ));
+        let initial_distortion = Some(start.stats);
         let mut flow = problem.clone();
         flow.initial = Some(Map::OnMesh(initial.points));
         let solution = BeltramiFlow.solve(&flow, context)?;
@@ -134,6 +135,7 @@ impl Solver for Register {
                 solver: NAME.into(),
                 timings,
                 notes,
+                initial_distortion,
                 ..solution.report
             },
         })

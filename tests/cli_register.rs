@@ -1,0 +1,278 @@
+//! End-to-end runs of `beltrami register`: the README's bundled pair, each topology,
+//! landmarks and a feature curve honoured exactly, the correspondence file, and the
+//! errors. The kitten onto the modified tori of Wong-Zhao section 5.4 runs when
+//! `../shared/meshes` is present.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_mesh::primitives::{self, Cells};
+use beltrami_mesh::{BuildOptions, Mesh, Point3};
+use beltrami_spatial::SurfaceIndex;
+
+mod common;
+use common::{beltrami, s, text};
+
+fn read(path: &Path) -> Mesh {
+    io::read(path, &BuildOptions::default()).unwrap().mesh
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn write(dir: &Path, name: &str, mesh: &Mesh) -> PathBuf {
+    let path = dir.join(name);
+    io::write(&path, mesh, &VertexAttributes::default()).unwrap();
+    path
+}
+
+/// Runs `register` with `extra` arguments; checks success, zero flips, every image on
+/// the target, a mean |mu| below `ratio` times the initial map's; returns the images and
+/// the report.
+fn register(
+    source: &Path,
+    target: &Path,
+    extra: &[&str],
+    ratio: f64,
+) -> (Vec<Point3<f64>>, serde_json::Value) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("report.json");
+    let mut args = vec![
+        "register",
+        s(source),
+        s(target),
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ];
+    args.extend_from_slice(extra);
+    let run = beltrami(&args);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let r = json(&report);
+    assert_eq!(r["flipped"], 0, "{r}");
+    let (start, end) = (
+        r["initial_mu_mean"].as_f64().unwrap(),
+        r["mu_mean"].as_f64().unwrap(),
+    );
+    assert!(end < ratio * start, "mean |mu| {start} -> {end}");
+    let target_mesh = read(target);
+    let index = SurfaceIndex::new(&target_mesh).unwrap();
+    let scale = target_mesh.bounding_box().diagonal();
+    let image = read(&out).positions().to_vec();
+    for p in &image {
+        assert!(index.locate(p).unwrap().distance < 1e-9 * scale);
+    }
+    (image, r)
+}
+
+#[test]
+fn the_readme_pair_spot_onto_blob() {
+    let dir = tempfile::tempdir().unwrap();
+    let correspondence = dir.path().join("corr.txt");
+    let (image, r) = register(
+        Path::new("meshes/spot.obj"),
+        Path::new("meshes/blob.obj"),
+        &["--correspondence", s(&correspondence)],
+        0.5,
+    );
+    assert!(r["iterations"].as_u64().unwrap() > 0);
+    assert!(r["seconds_per_step"].as_f64().unwrap() > 0.0);
+    // One line per source vertex: a target face and barycentric coordinates summing to 1.
+    let blob = read(Path::new("meshes/blob.obj"));
+    let lines: Vec<String> = std::fs::read_to_string(&correspondence)
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect();
+    assert_eq!(lines.len(), image.len());
+    for (line, p) in lines.iter().zip(&image) {
+        let fields: Vec<f64> = line.split(' ').map(|t| t.parse().unwrap()).collect();
+        let face = beltrami_mesh::FaceId(fields[0] as u32);
+        assert!(face.idx() < blob.face_count());
+        assert!((fields[1] + fields[2] + fields[3] - 1.0).abs() < 1e-9);
+        let q: Point3<f64> = blob
+            .face_vertices(face)
+            .zip(&fields[1..])
+            .fold(Point3::origin(), |acc, (v, w)| {
+                acc + blob.position(v).coords * *w
+            });
+        assert!((q - p).norm() < 1e-9);
+    }
+}
+
+/// A graph over the unit disk.
+fn lifted(level: usize, height: impl Fn(f64, f64) -> f64) -> Mesh {
+    let mut soup = primitives::disk(level);
+    for p in &mut soup.positions {
+        p.z = height(p.x, p.y);
+    }
+    Mesh::from_soup(&soup).unwrap()
+}
+
+#[test]
+fn a_disk_with_landmarks_and_a_feature_curve() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = lifted(4, |x, y| 0.3 * (x * x + y * y));
+    let target = lifted(5, |x, y| 0.2 * (2.0 * x).sin() * y);
+    let (source_path, target_path) = (
+        write(dir.path(), "source.obj", &source),
+        write(dir.path(), "target.obj", &target),
+    );
+    // Vertices on the real axis, in order, in both meshes (nested refinements).
+    let axis = |mesh: &Mesh, limit: f64| {
+        let mut v: Vec<usize> = mesh
+            .vertices()
+            .filter(|&v| {
+                let p = mesh.position(v);
+                p.y.abs() < 1e-12 && p.x.abs() <= limit + 1e-12
+            })
+            .map(|v| v.idx())
+            .collect();
+        v.sort_by(|&a, &b| mesh.positions()[a].x.total_cmp(&mesh.positions()[b].x));
+        v
+    };
+    let (chain_s, chain_t) = (axis(&source, 0.5), axis(&target, 0.5));
+    let join = |v: &[usize]| {
+        v.iter()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    // A vertex landmark off the curve, and a point landmark given by coordinates: the
+    // vertices nearest to points a little apart in the two meshes.
+    let nearest = |mesh: &Mesh, x: f64, y: f64| {
+        mesh.vertices()
+            .min_by(|&a, &b| {
+                let d = |v: beltrami_mesh::VertexId| {
+                    let p = mesh.position(v);
+                    (p.x - x).hypot(p.y - y)
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+            .idx()
+    };
+    let (ls, lt) = (nearest(&source, 0.0, 0.5), nearest(&target, 0.07, 0.5));
+    let (ps, pt) = (nearest(&source, 0.0, -0.5), nearest(&target, -0.07, -0.5));
+    let goal = target.positions()[pt];
+    let marks = dir.path().join("marks.txt");
+    let mut f = std::fs::File::create(&marks).unwrap();
+    writeln!(f, "# landmarks").unwrap();
+    writeln!(f, "v {ls} {lt}").unwrap();
+    writeln!(f, "p {ps} {} {} {}", goal.x, goal.y, goal.z).unwrap();
+    writeln!(f, "c {} {}", join(&chain_s), join(&chain_t)).unwrap();
+    drop(f);
+    // The landmarks move vertices off the conformal map, so the distortion may grow a
+    // little; it stays small.
+    let (image, r) = register(
+        &source_path,
+        &target_path,
+        &["--landmarks", s(&marks)],
+        10.0,
+    );
+    assert!(r["mu_max"].as_f64().unwrap() < 0.3, "{r}");
+    assert!(
+        (image[ls] - target.positions()[lt]).norm() < 1e-9,
+        "vertex landmark"
+    );
+    assert!((image[ps] - goal).norm() < 1e-9, "point landmark");
+    let polyline: Vec<Point3<f64>> = chain_t.iter().map(|&v| target.positions()[v]).collect();
+    for &v in &chain_s[1..chain_s.len() - 1] {
+        let q = image[v];
+        let d = polyline
+            .windows(2)
+            .map(|w| {
+                let t =
+                    ((q - w[0]).dot(&(w[1] - w[0])) / (w[1] - w[0]).norm_squared()).clamp(0.0, 1.0);
+                (w[0] + t * (w[1] - w[0]) - q).norm()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(d < 1e-9, "curve vertex {v} off its chain by {d}");
+    }
+}
+
+#[test]
+fn a_torus_onto_a_modified_torus_with_the_l3_norm() {
+    let dir = tempfile::tempdir().unwrap();
+    let torus = Mesh::from_soup(&primitives::torus(48, 16, 3.0, 1.0, Cells::Triangles)).unwrap();
+    let source = write(dir.path(), "torus.obj", &torus);
+    let target = dir.path().join("phi1.obj");
+    let run = beltrami(&["generate", "torus1", "--level", "0", "-o", s(&target)]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    // Two tori of different conformal moduli: no conformal map exists, the flow lowers
+    // the distortion to a floor.
+    let (_, r) = register(&source, &target, &["--p", "3"], 1.0);
+    let notes = r["notes"].to_string();
+    assert!(
+        notes.contains("source loop a") && notes.contains("target loop b"),
+        "{notes}"
+    );
+}
+
+#[test]
+fn mismatched_topologies_fail_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let run = beltrami(&[
+        "register",
+        "meshes/spot.obj",
+        "meshes/disk_hemisphere.obj",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    let stderr = text(&run.stderr);
+    assert!(
+        stderr.contains("genus") || stderr.contains("topolog"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+    let marks = dir.path().join("bad.txt");
+    std::fs::write(&marks, "v 0 1\nq 1 2\n").unwrap();
+    let run = beltrami(&[
+        "register",
+        "meshes/spot.obj",
+        "meshes/blob.obj",
+        "--landmarks",
+        s(&marks),
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("bad.txt:2"),
+        "{}",
+        text(&run.stderr)
+    );
+}
+
+#[test]
+fn kitten_onto_the_modified_tori() {
+    let kitten = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/meshes/g1_kitten.obj"
+    ));
+    if !kitten.exists() {
+        writeln!(
+            std::io::stderr(),
+            "SKIPPED kitten_onto_the_modified_tori: ../shared/meshes is absent"
+        )
+        .unwrap();
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for (shape, p) in [("torus1", "3"), ("torus2", "4")] {
+        let target = dir.path().join(format!("{shape}.obj"));
+        let run = beltrami(&["generate", shape, "--level", "1", "-o", s(&target)]);
+        assert!(run.status.success(), "{}", text(&run.stderr));
+        let (_, r) = register(kitten, &target, &["--p", p], 0.5);
+        println!(
+            "kitten onto {shape} (L{p}): mean |mu| {} -> {}",
+            r["initial_mu_mean"], r["mu_mean"]
+        );
+    }
+}
