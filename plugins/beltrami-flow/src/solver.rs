@@ -85,6 +85,12 @@ impl Solver for BeltramiFlow {
             ..SolveOptions::default()
         };
         let planar = !matches!(problem.target, Target::Sphere);
+        let runner = Runner {
+            elements: &elements,
+            objective: &objective,
+            problem,
+            options,
+        };
         let input = |v: VertexId| mesh.vertex_map().to_input(v);
         let pins = pins(problem, &initial);
         if problem.constraints.pins.is_empty() && !pins.is_empty() {
@@ -101,15 +107,11 @@ impl Solver for BeltramiFlow {
             let (curves, roles) = mesh_roles(problem, target, &initial, &pins)?;
             let geometry = MeshTarget::new(&index, curves);
             let scale = diagonal(target.positions());
-            let run = run(
-                &elements,
+            let run = runner.run(
                 geometry.clone(),
                 roles,
                 initial,
-                &objective,
-                problem,
                 scale,
-                options,
                 context,
                 &mut report,
             )?;
@@ -130,50 +132,19 @@ impl Solver for BeltramiFlow {
             Domain::Region(g) => {
                 let scale = diagonal(&image);
                 let roles = region_roles(mesh, &g, &image, &pins);
-                run(
-                    &elements,
-                    g,
-                    roles,
-                    image,
-                    &objective,
-                    problem,
-                    scale,
-                    options,
-                    context,
-                    &mut report,
-                )?
-                .finish(planar)
+                runner
+                    .run(g, roles, image, scale, context, &mut report)?
+                    .finish(planar)
             }
             Domain::Disk(g) => {
                 let roles = curve_roles(mesh, &pins, |_| 0);
-                run(
-                    &elements,
-                    g,
-                    roles,
-                    image,
-                    &objective,
-                    problem,
-                    1.0,
-                    options,
-                    context,
-                    &mut report,
-                )?
-                .finish(planar)
+                runner
+                    .run(g, roles, image, 1.0, context, &mut report)?
+                    .finish(planar)
             }
             Domain::Annulus(g, outer) => {
                 let roles = curve_roles(mesh, &pins, |l| if l == outer { OUTER } else { INNER });
-                let run = run(
-                    &elements,
-                    g,
-                    roles,
-                    image,
-                    &objective,
-                    problem,
-                    1.0,
-                    options,
-                    context,
-                    &mut report,
-                )?;
+                let run = runner.run(g, roles, image, 1.0, context, &mut report)?;
                 if g.free_inner {
                     report.notes.push(format!(
                         "inner radius {:.6} (free; started at {:.6})",
@@ -184,19 +155,9 @@ impl Solver for BeltramiFlow {
             }
             Domain::Sphere(g) => {
                 let roles = curve_roles(mesh, &pins, |_| 0);
-                run(
-                    &elements,
-                    g,
-                    roles,
-                    image,
-                    &objective,
-                    problem,
-                    1.0,
-                    options,
-                    context,
-                    &mut report,
-                )?
-                .finish(planar)
+                runner
+                    .run(g, roles, image, 1.0, context, &mut report)?
+                    .finish(planar)
             }
         };
         let (map, faces_mu, flipped) = outcome;
@@ -791,34 +752,42 @@ fn goals(problem: &Problem<'_>) -> Vec<Option<Point3<f64>>> {
     goals
 }
 
-/// Runs the flow and records its history in `report`.
-#[allow(clippy::too_many_arguments)]
-fn run<G: TargetGeometry>(
-    elements: &Elements,
-    target: G,
-    roles: Vec<Role>,
-    image: Vec<Point3<f64>>,
-    objective: &Objective,
-    problem: &Problem<'_>,
-    scale: f64,
+/// What every flow run of one solve shares.
+struct Runner<'a, 'p> {
+    elements: &'a Elements,
+    objective: &'a Objective,
+    problem: &'a Problem<'p>,
     options: SolveOptions,
-    context: &mut Context<'_>,
-    report: &mut Report,
-) -> Result<FlowRun<G>, SolverError> {
-    let mut system = context.stage("symbolic", report, || {
-        FlowSystem::new(elements, &target, &image, roles, options)
-    })?;
-    let flow_options = FlowOptions {
-        tolerance: problem.params.tolerance * scale,
-        max_iterations: problem.params.max_iterations,
-        solve: options,
-        max_move: if matches!(problem.target, Target::Mesh(_)) {
-            MESH_MAX_MOVE * scale
-        } else {
-            f64::INFINITY
-        },
-    };
-    let run = report.time("flow", || {
+}
+
+impl Runner<'_, '_> {
+    /// Runs the flow on `target` from `image` with `roles` (tolerances relative to
+    /// `scale`) and records its history in `report`.
+    fn run<G: TargetGeometry>(
+        &self,
+        target: G,
+        roles: Vec<Role>,
+        image: Vec<Point3<f64>>,
+        scale: f64,
+        context: &mut Context<'_>,
+        report: &mut Report,
+    ) -> Result<FlowRun<G>, SolverError> {
+        let (elements, objective, problem, options) =
+            (self.elements, self.objective, self.problem, self.options);
+        let mut system = context.stage("symbolic", report, || {
+            FlowSystem::new(elements, &target, &image, roles, options)
+        })?;
+        let flow_options = FlowOptions {
+            tolerance: problem.params.tolerance * scale,
+            max_iterations: problem.params.max_iterations,
+            solve: options,
+            max_move: if matches!(problem.target, Target::Mesh(_)) {
+                MESH_MAX_MOVE * scale
+            } else {
+                f64::INFINITY
+            },
+        };
+        let run = report.time("flow", || {
         flow::run(
             elements,
             target,
@@ -836,20 +805,20 @@ fn run<G: TargetGeometry>(
         ),
         e => e,
     })?;
-    report
-        .timings
-        .push(("flow: solves".into(), run.solve_seconds));
-    report
-        .timings
-        .push(("flow: steps".into(), run.step_seconds));
-    report.iterations = run.iterations();
-    report.notes.push(format!(
-        "{} numeric factorizations; {} conjugate-gradient iterations on steps that reused one",
-        run.factorizations, run.cg_iterations
-    ));
-    report.energy_history = run.energy_history.clone();
-    report.step_sizes = run.step_sizes.clone();
-    report.notes.push(match run.stop {
+        report
+            .timings
+            .push(("flow: solves".into(), run.solve_seconds));
+        report
+            .timings
+            .push(("flow: steps".into(), run.step_seconds));
+        report.iterations = run.iterations();
+        report.notes.push(format!(
+            "{} numeric factorizations; {} conjugate-gradient iterations on steps that reused one",
+            run.factorizations, run.cg_iterations
+        ));
+        report.energy_history = run.energy_history.clone();
+        report.step_sizes = run.step_sizes.clone();
+        report.notes.push(match run.stop {
         Stop::Converged => format!(
             "converged after {} iterations: largest vertex update below {:.1e}",
             run.iterations(),
@@ -868,7 +837,8 @@ fn run<G: TargetGeometry>(
             run.iterations()
         ),
     });
-    Ok(run)
+        Ok(run)
+    }
 }
 
 impl<G> FlowRun<G> {

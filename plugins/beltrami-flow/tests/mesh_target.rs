@@ -140,8 +140,9 @@ fn feature_curves_slide_on_their_chain_with_ends_fixed() {
     assert!(distance_to(&target, &points[0].position(&target)) < 1e-12);
 }
 
-#[test]
-fn sphere_onto_an_ellipsoid_mesh() {
+/// An icosphere, an ellipsoid mesh (a finer icosphere scaled by `(1, 0.8, 0.6)`), and a
+/// start: the same scaling of the source, then the closest point on the target.
+fn sphere_onto_ellipsoid() -> (Mesh, Mesh, Vec<SurfacePoint>) {
     let source = Mesh::from_soup(&primitives::icosphere(3)).unwrap();
     let mut soup = primitives::icosphere(4);
     for p in &mut soup.positions {
@@ -149,9 +150,8 @@ fn sphere_onto_an_ellipsoid_mesh() {
         p.z *= 0.6;
     }
     let target = Mesh::from_soup(&soup).unwrap();
-    // Start: the same scaling, then the closest point on the target.
     let index = SurfaceIndex::new(&target).unwrap();
-    let start: Vec<SurfacePoint> = source
+    let start = source
         .positions()
         .iter()
         .map(|p| {
@@ -161,6 +161,12 @@ fn sphere_onto_an_ellipsoid_mesh() {
                 .point
         })
         .collect();
+    (source, target, start)
+}
+
+#[test]
+fn sphere_onto_an_ellipsoid_mesh() {
+    let (source, target, start) = sphere_onto_ellipsoid();
     let mut problem = Problem::new(&source, Target::Mesh(&target));
     problem.initial = Some(Map::OnMesh(start));
     problem.params.tolerance = 1e-7;
@@ -179,24 +185,7 @@ fn sphere_onto_an_ellipsoid_mesh() {
 
 #[test]
 fn landmarks_pull_their_vertex_onto_the_goal() {
-    let source = Mesh::from_soup(&primitives::icosphere(3)).unwrap();
-    let mut soup = primitives::icosphere(4);
-    for p in &mut soup.positions {
-        p.y *= 0.8;
-        p.z *= 0.6;
-    }
-    let target = Mesh::from_soup(&soup).unwrap();
-    let index = SurfaceIndex::new(&target).unwrap();
-    let start: Vec<SurfacePoint> = source
-        .positions()
-        .iter()
-        .map(|p| {
-            index
-                .locate(&Point3::new(p.x, 0.8 * p.y, 0.6 * p.z))
-                .unwrap()
-                .point
-        })
-        .collect();
+    let (source, target, start) = sphere_onto_ellipsoid();
     // Source vertex 0 goes to a target vertex about 0.15 away from where it starts.
     let from = start[0].position(&target);
     let goal_vertex = target
