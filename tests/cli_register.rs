@@ -301,3 +301,47 @@ fn real_genus_zero_and_disk_pairs() {
         );
     }
 }
+
+#[test]
+fn a_prescribed_zero_mu_is_the_conformal_goal() {
+    let dir = tempfile::tempdir().unwrap();
+    let spot = read(Path::new("meshes/spot.obj"));
+    let field = dir.path().join("zero.txt");
+    let mut text = format!("# mu frame=face faces={}\n", spot.face_count());
+    for _ in 0..spot.face_count() {
+        text.push_str("0 0\n");
+    }
+    std::fs::write(&field, text).unwrap();
+    let (conformal, _) = register(
+        Path::new("meshes/spot.obj"),
+        Path::new("meshes/blob.obj"),
+        &[],
+        0.5,
+    );
+    let (prescribed, r) = register(
+        Path::new("meshes/spot.obj"),
+        Path::new("meshes/blob.obj"),
+        &["--mu", s(&field)],
+        0.5,
+    );
+    let worst = conformal
+        .iter()
+        .zip(&prescribed)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-9, "{worst} {r}");
+    // A field of the wrong length is refused before any work.
+    std::fs::write(&field, "# mu frame=face faces=3\n0 0\n0 0\n0 0\n").unwrap();
+    let out = dir.path().join("out.obj");
+    let run = beltrami(&[
+        "register",
+        "meshes/spot.obj",
+        "meshes/blob.obj",
+        "--mu",
+        s(&field),
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(!out.exists());
+}
