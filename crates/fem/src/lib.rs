@@ -27,4 +27,4 @@ pub use dof::{DofConstraints, DofError, DofMap, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
 pub use field::{BeltramiField, FieldError};
-pub use solve::{LeastSquaresSolver, SolveError, SolveOptions, SpdSolver};
+pub use solve::{LeastSquaresSolver, Preconditioned, SolveError, SolveOptions, SpdSolver};

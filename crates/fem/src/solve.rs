@@ -477,6 +477,15 @@ pub fn solve_spd<T: Scalar>(
     Ok(x)
 }
 
+/// How [`SpdSolver::solve_preconditioned`] went.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Preconditioned {
+    /// Whether the residual reached the tolerance (the solution is in `rhs`).
+    pub converged: bool,
+    /// Conjugate-gradient iterations done.
+    pub iterations: usize,
+}
+
 /// Repeated solves `M x = r` with Hermitian positive definite matrices `M` of one fixed
 /// sparsity pattern (iterative solvers that assemble their own normal equations every
 /// step): the symbolic Cholesky factorization (AMD ordering, supernodes) is done once by
@@ -596,18 +605,17 @@ impl<T: Scalar> SpdSolver<T> {
     /// [`SpdSolver::new`]) by conjugate gradients preconditioned with the last successful
     /// factorization, of a nearby matrix: iterative solvers whose matrix changes a little
     /// per step keep one factorization for several steps. Stops once
-    /// `|matrix x - rhs| <= tolerance |rhs|`; returns the number of iterations, or `None`
-    /// (with `rhs` unspecified) when `max_iterations` will not be enough — then factor
-    /// `matrix` and solve directly. It gives up early, as soon as the mean reduction of
-    /// the residual per iteration so far predicts more than `max_iterations`. `x` starts
-    /// at zero and replaces `rhs`.
+    /// `|matrix x - rhs| <= tolerance |rhs|` (then `rhs` holds `x`), or gives up (`rhs`
+    /// unspecified: factor `matrix` and solve directly) once `max_iterations` are done or,
+    /// earlier, as soon as the mean reduction of the residual per iteration so far
+    /// predicts more than `max_iterations`. `x` starts at zero.
     pub fn solve_preconditioned(
         &mut self,
         matrix: SparseColMatRef<'_, usize, T>,
         rhs: &mut [T],
         tolerance: f64,
         max_iterations: usize,
-    ) -> Result<Option<usize>, SolveError> {
+    ) -> Result<Preconditioned, SolveError> {
         let n = self.len();
         check_len("the length of the right-hand side", n, rhs.len())?;
         check_len("the row count of the matrix", n, matrix.nrows())?;
@@ -628,7 +636,10 @@ impl<T: Scalar> SpdSolver<T> {
         let start = norm(&residual);
         if start <= target {
             rhs.copy_from_slice(&x);
-            return Ok(Some(0));
+            return Ok(Preconditioned {
+                converged: true,
+                iterations: 0,
+            });
         }
         let mut z = residual.clone();
         self.cholesky.solve_in_place(column_mut(&mut z))?;
@@ -646,7 +657,10 @@ impl<T: Scalar> SpdSolver<T> {
             if r <= target {
                 check_finite_solution(&x)?;
                 rhs.copy_from_slice(&x);
-                return Ok(Some(iteration));
+                return Ok(Preconditioned {
+                    converged: true,
+                    iterations: iteration,
+                });
             }
             // Mean reduction per iteration so far, and the iterations it predicts.
             let rate = (r / start).powf(1.0 / iteration as f64);
@@ -654,7 +668,10 @@ impl<T: Scalar> SpdSolver<T> {
                 || rate >= 1.0
                 || (target / start).ln() / rate.ln() > max_iterations as f64
             {
-                return Ok(None);
+                return Ok(Preconditioned {
+                    converged: false,
+                    iterations: iteration,
+                });
             }
             z.copy_from_slice(&residual);
             self.cholesky.solve_in_place(column_mut(&mut z))?;
@@ -665,7 +682,10 @@ impl<T: Scalar> SpdSolver<T> {
                 direction[i] = z[i] + beta * direction[i];
             }
         }
-        Ok(None)
+        Ok(Preconditioned {
+            converged: false,
+            iterations: max_iterations,
+        })
     }
 
     /// Overwrites the columns of `rhs` with the solutions of `matrix x = rhs` for the

@@ -67,8 +67,12 @@ pub struct FlowSystem {
     slots: Vec<usize>,
     solver: SpdSolver<f64>,
     rhs: Vec<f64>,
-    /// Whether the last attempt to reuse the factorization failed.
-    reuse_failed: bool,
+    /// Steps to solve directly before trying to reuse the factorization again.
+    skip_reuse: usize,
+    /// How many steps the next failed reuse makes the solver skip (doubling after each
+    /// failure, reset by a success): runs where the matrix keeps changing stop wasting
+    /// iterations on it.
+    backoff: usize,
     /// Numeric factorizations so far.
     factorizations: usize,
     /// Conjugate-gradient iterations so far (steps solved with a kept factorization).
@@ -197,7 +201,8 @@ impl FlowSystem {
             matrix,
             slots,
             solver,
-            reuse_failed: false,
+            skip_reuse: 0,
+            backoff: 1,
             factorizations: 0,
             cg_iterations: 0,
             prescribed: Vec::new(),
@@ -326,28 +331,26 @@ impl FlowSystem {
     /// preconditioned with the kept factorization when there is one (the matrix changes
     /// little between late steps), else — or when that does not converge within
     /// [`CG_ITERATIONS`] — by factoring the new matrix. After a failed reuse the next
-    /// step factors directly.
+    /// 1, 2, 4, .. steps factor directly.
     fn solve_normal_equations(&mut self) -> Result<(), SolverError> {
-        if self.factorizations > 0 && !self.reuse_failed {
+        if self.factorizations > 0 && self.skip_reuse == 0 {
             let mut x = self.rhs.clone();
-            match self.solver.solve_preconditioned(
+            let outcome = self.solver.solve_preconditioned(
                 self.matrix.as_ref(),
                 &mut x,
                 CG_TOLERANCE,
                 CG_ITERATIONS,
-            )? {
-                Some(iterations) => {
-                    self.cg_iterations += iterations;
-                    self.rhs = x;
-                    return Ok(());
-                }
-                None => {
-                    self.cg_iterations += CG_ITERATIONS;
-                    self.reuse_failed = true;
-                }
+            )?;
+            self.cg_iterations += outcome.iterations;
+            if outcome.converged {
+                self.backoff = 1;
+                self.rhs = x;
+                return Ok(());
             }
+            self.skip_reuse = self.backoff;
+            self.backoff *= 2;
         } else {
-            self.reuse_failed = false;
+            self.skip_reuse = self.skip_reuse.saturating_sub(1);
         }
         self.solver.factorize(self.matrix.as_ref())?;
         self.factorizations += 1;
