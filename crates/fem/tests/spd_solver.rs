@@ -144,12 +144,10 @@ fn conjugate_gradients_reuse_a_nearby_factorization() {
     assert!(residual(&near, &x, &f) < 1e-10);
     // A far matrix is given up on, early.
     let mut x = f.clone();
-    assert_eq!(
-        solver
-            .solve_preconditioned(far.as_ref(), &mut x, 1e-10, 4)
-            .unwrap(),
-        None
-    );
+    let outcome = solver
+        .solve_preconditioned(far.as_ref(), &mut x, 1e-10, 4)
+        .unwrap();
+    assert!(!outcome.converged && outcome.iterations < 4, "{outcome:?}");
 }
 
 #[test]
