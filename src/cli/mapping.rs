@@ -14,6 +14,24 @@ use serde_json::{Map as JsonMap, Value, json};
 
 use super::pins::PinSpec;
 
+/// The options every mapping command has besides its output mesh.
+#[derive(Debug, clap::Args)]
+pub struct CommonArgs {
+    /// Also draw the result (source and image side by side, |mu| colors) as PNG.
+    #[arg(long, value_parser = png_path)]
+    pub png: Option<PathBuf>,
+    /// Write the JSON report here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Print the JSON report on stdout instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Repair what can be repaired safely in the input meshes (see `beltrami info
+    /// --repair`).
+    #[arg(long)]
+    pub repair: bool,
+}
+
 /// Fails, before any work, when `output` is not a mesh format beltrami writes.
 pub fn check_output_format(output: &Path) -> anyhow::Result<()> {
     if Format::from_path(output).is_none() {

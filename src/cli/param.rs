@@ -53,18 +53,8 @@ pub struct ParamArgs {
     /// sphere, the sphere positions) or .glb/.gltf (UVs and |mu| colors).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Also draw the result (source and image side by side, |mu| colors) as PNG.
-    #[arg(long, value_parser = mapping::png_path)]
-    pub png: Option<PathBuf>,
-    /// Write the JSON report here.
-    #[arg(long)]
-    pub report: Option<PathBuf>,
-    /// Print the JSON report on stdout instead of the summary.
-    #[arg(long)]
-    pub json: bool,
-    /// Repair what can be repaired safely in the input (see `beltrami info --repair`).
-    #[arg(long)]
-    pub repair: bool,
+    #[command(flatten)]
+    pub common: mapping::CommonArgs,
 }
 
 fn target_of(args: &ParamArgs) -> anyhow::Result<Target<'static>> {
@@ -87,7 +77,7 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     mapping::check_output_format(&args.output)?;
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
-    let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
+    let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
 
     let mut problem = Problem::new(mesh, target_of(args)?);
@@ -98,14 +88,14 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     });
     problem.constraints.pins = mapping::resolve_pins(&args.pins, mesh)?;
 
-    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.json)?;
+    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.common.json)?;
     mapping::write_map(&args.output, mesh, &solution)?;
-    mapping::write_png(args.png.as_deref(), mesh, &solution)?;
+    mapping::write_png(args.common.png.as_deref(), mesh, &solution)?;
     let report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     mapping::finish(
         report,
-        args.report.as_deref(),
-        args.json,
+        args.common.report.as_deref(),
+        args.common.json,
         quiet,
         (&args.mesh, &args.output, &solution, seconds),
         &[],

@@ -103,18 +103,8 @@ pub struct QcArgs {
     /// planar image, or the image positions for the sphere) or .glb/.gltf.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Also draw the result (source and image side by side, |mu| colors) as PNG.
-    #[arg(long, value_parser = mapping::png_path)]
-    pub png: Option<PathBuf>,
-    /// Write the JSON report here.
-    #[arg(long)]
-    pub report: Option<PathBuf>,
-    /// Print the JSON report on stdout instead of the summary.
-    #[arg(long)]
-    pub json: bool,
-    /// Repair what can be repaired safely in the input (see `beltrami info --repair`).
-    #[arg(long)]
-    pub repair: bool,
+    #[command(flatten)]
+    pub common: mapping::CommonArgs,
 }
 
 /// The goal of `--mu`, `--mu-expr` or `--conformal`, and the field it prescribes (zero
@@ -213,7 +203,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     mapping::check_output_format(&args.output)?;
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
-    let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
+    let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
     let (goal, field) = goal_of(args, mesh)?;
 
@@ -224,7 +214,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     problem.params.max_iterations = args.max_iters;
     problem.params.threads = args.threads;
 
-    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.json)?;
+    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.common.json)?;
     let error = match (&solution.report.mu, &field) {
         (Some(measured), Some(field)) if measured.frame == field.frame => {
             let elements = Elements::new(mesh, field.frame)?;
@@ -241,7 +231,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         bail!("{} gave points in space for a planar target", solver.name());
     }
     mapping::write_map(&args.output, mesh, &solution)?;
-    mapping::write_png(args.png.as_deref(), mesh, &solution)?;
+    mapping::write_png(args.common.png.as_deref(), mesh, &solution)?;
 
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     report.insert(
@@ -295,8 +285,8 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     }
     mapping::finish(
         report,
-        args.report.as_deref(),
-        args.json,
+        args.common.report.as_deref(),
+        args.common.json,
         quiet,
         (&args.mesh, &args.output, &solution, seconds),
         &extra,

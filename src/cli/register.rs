@@ -49,26 +49,16 @@ pub struct RegisterArgs {
     /// (0-based, the target file's order) and barycentric coordinates.
     #[arg(long)]
     pub correspondence: Option<PathBuf>,
-    /// Also draw the result (source and image side by side, |mu| colors) as PNG.
-    #[arg(long, value_parser = mapping::png_path)]
-    pub png: Option<PathBuf>,
-    /// Write the JSON report here.
-    #[arg(long)]
-    pub report: Option<PathBuf>,
-    /// Print the JSON report on stdout instead of the summary.
-    #[arg(long)]
-    pub json: bool,
-    /// Repair what can be repaired safely in the inputs (see `beltrami info --repair`).
-    #[arg(long)]
-    pub repair: bool,
+    #[command(flatten)]
+    pub common: mapping::CommonArgs,
 }
 
 pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     mapping::check_output_format(&args.output)?;
     let registry = beltrami::registry();
     let solver = registry.get("register")?;
-    let source_loaded = load_mesh(&args.source, args.repair, quiet || args.json)?;
-    let target_loaded = load_mesh(&args.target, args.repair, quiet || args.json)?;
+    let source_loaded = load_mesh(&args.source, args.common.repair, quiet || args.common.json)?;
+    let target_loaded = load_mesh(&args.target, args.common.repair, quiet || args.common.json)?;
     let source = &source_loaded.mesh.mesh;
     let target = &target_loaded.mesh.mesh;
 
@@ -105,7 +95,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     problem.params.tolerance = args.tolerance;
     problem.params.threads = args.threads;
 
-    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.json)?;
+    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.common.json)?;
     let Map::OnMesh(points) = &solution.map else {
         bail!("the register solver did not give points on the target mesh");
     };
@@ -131,7 +121,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         })
         .with_context(|| format!("cannot write the correspondence {}", path.display()))?;
     }
-    mapping::write_png(args.png.as_deref(), source, &spatial)?;
+    mapping::write_png(args.common.png.as_deref(), source, &spatial)?;
 
     let mut report = mapping::report_json(&args.source, &args.output, &spatial, seconds);
     report.insert("target".into(), json!(args.target.display().to_string()));
@@ -151,8 +141,8 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     )];
     mapping::finish(
         report,
-        args.report.as_deref(),
-        args.json,
+        args.common.report.as_deref(),
+        args.common.json,
         quiet,
         (&args.source, &args.output, &spatial, seconds),
         &extra,
