@@ -361,6 +361,16 @@ fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError> {
                         "curve {k}: target vertex {v} does not exist"
                     )));
                 }
+                // The chain slides along its segments, which must lie on the target.
+                for pair in curve.target.windows(2) {
+                    if !target.vertex_neighbors(pair[0]).any(|w| w == pair[1]) {
+                        return Err(invalid(format!(
+                            "curve {k}: target vertices {} and {} (input indices) are not joined by an edge",
+                            target.vertex_map().to_input(pair[0]),
+                            target.vertex_map().to_input(pair[1])
+                        )));
+                    }
+                }
             }
         }
         Target::CircleDomain | Target::Surface => {

@@ -215,3 +215,17 @@ fn landmarks_pull_their_vertex_onto_the_goal() {
         (reached - goal).norm()
     );
 }
+
+#[test]
+fn a_curve_must_follow_target_edges() {
+    let (source, target, start) = sphere_onto_ellipsoid();
+    let mut problem = Problem::new(&source, Target::Mesh(&target));
+    problem.initial = Some(Map::OnMesh(start));
+    // Vertices 0 and 3 of the icosahedron are antipodal: no edge joins them.
+    problem.constraints.curves = vec![Curve {
+        source: vec![VertexId(0), VertexId(11)],
+        target: vec![VertexId(0), VertexId(3)],
+    }];
+    let message = BeltramiFlow.check(&problem).unwrap_err().to_string();
+    assert!(message.contains("not joined by an edge"), "{message}");
+}
