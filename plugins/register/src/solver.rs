@@ -70,6 +70,15 @@ impl Solver for Register {
             return Err(unsupported("register maps onto a target mesh"));
         };
         check_topology(problem.source, target).map_err(|e| unsupported(e.to_string()))?;
+        for (side, mesh) in [("source", problem.source), ("target", *target)] {
+            if let Some(f) = mesh.faces().find(|&f| mesh.face_degree(f) != 3) {
+                return Err(unsupported(format!(
+                    "the flow works on triangle meshes; {side} face {} (input index) has {} vertices: split quads into triangles first",
+                    mesh.face_to_input(f),
+                    mesh.face_degree(f)
+                )));
+            }
+        }
         landmarks(problem)?;
         if let Goal::Extremal = problem.goal {
             return Err(unsupported("extremal maps come with their own solver"));
