@@ -248,6 +248,23 @@ fn mismatched_topologies_fail_before_any_work() {
         "{}",
         text(&run.stderr)
     );
+    // Quads are refused before any work, naming the face.
+    let quads = Mesh::from_soup(&primitives::grid(4, 4, Cells::Quads)).unwrap();
+    let quads = write(dir.path(), "quads.obj", &quads);
+    let run = beltrami(&[
+        "register",
+        s(&quads),
+        "meshes/disk_hemisphere.obj",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("source face 0"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!out.exists());
 }
 
 #[test]
