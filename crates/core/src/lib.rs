@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-core
 //!
 //! What every solver shares: the [`Solver`] trait with its capability check, the

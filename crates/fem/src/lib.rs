@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-fem
 //!
 //! The numerical floor under every beltrami solver: P1 (triangles) and Q1 (quads)

@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-mesh
 //!
 //! The halfedge mesh under every beltrami solver: triangle and quad faces (mixed

@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-render
 //!
 //! Pictures of maps, written as PNG with no viewer needed: the parameter domain (uv

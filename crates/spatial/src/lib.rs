@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-spatial
 //!
 //! Point location and motion on a target surface, for maps onto a mesh (beltrami-core's

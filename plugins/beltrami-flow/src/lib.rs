@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-flow
 //!
 //! Discrete Beltrami flow (T. W. Wong and H. Zhao, "Computation of quasiconformal

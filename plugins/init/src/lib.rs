@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-init
 //!
 //! The first solvers of beltrami: linear parameterizations of disk-topology meshes

@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-lsqc
 //!
 //! The least-squares quasiconformal (LSQC) map of a disk mesh into the plane for a

@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! # beltrami-register
 //!
 //! Surface registration: [`Register`] maps a source mesh onto a target mesh of the same
