@@ -144,11 +144,12 @@ fn annulus_with_a_free_radius_reports_it() {
 
 #[test]
 fn ctrl_c_writes_the_map_so_far() {
+    use std::io::{BufRead, BufReader, Read};
     let dir = tempfile::tempdir().unwrap();
-    let sphere = Mesh::from_soup(&primitives::octahedral_sphere(7)).unwrap();
+    let sphere = Mesh::from_soup(&primitives::octahedral_sphere(6)).unwrap();
     let input = write(dir.path(), "sphere.obj", &sphere);
     let out = dir.path().join("image.obj");
-    let child = std::process::Command::new(env!("CARGO_BIN_EXE_beltrami"))
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_beltrami"))
         .args([
             "qc",
             s(&input),
@@ -160,25 +161,41 @@ fn ctrl_c_writes_the_map_so_far() {
             "0.3+0.3i",
             "--tolerance",
             "1e-12",
+            "--progress-lines",
             "-o",
             s(&out),
         ])
-        .stdout(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_secs(3));
+    // Interrupt once the first flow step is done (the progress lines say so).
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut seen = String::new();
+    loop {
+        let mut line = String::new();
+        if stderr.read_line(&mut line).unwrap() == 0 {
+            panic!("the run ended before its first step: {seen}");
+        }
+        seen.push_str(&line);
+        if line.starts_with("flow 1/") {
+            break;
+        }
+    }
     // SAFETY: signalling our own child process.
     unsafe {
         libc::kill(child.id() as libc::pid_t, libc::SIGINT);
     }
-    let run = child.wait_with_output().unwrap();
-    let stderr = text(&run.stderr);
-    assert!(!run.status.success());
-    assert!(stderr.contains("interrupted after"), "{stderr}");
-    assert!(stderr.contains("the map so far was written"), "{stderr}");
+    stderr.read_to_string(&mut seen).unwrap();
+    let status = child.wait().unwrap();
+    assert!(!status.success());
+    assert!(seen.contains("interrupted after"), "{seen}");
+    assert!(seen.contains("the map so far was written"), "{seen}");
     let image = io::read(&out, &BuildOptions::default()).unwrap().mesh;
     assert_eq!(image.vertex_count(), sphere.vertex_count());
+    for p in image.positions() {
+        assert!((p.coords.norm() - 1.0).abs() < 1e-9);
+    }
 }
 
 #[test]

@@ -30,6 +30,34 @@ pub struct CommonArgs {
     /// --repair`).
     #[arg(long)]
     pub repair: bool,
+    /// Print one progress line per solver step on stderr instead of the progress bar
+    /// (for logs and pipes, where the bar does not show).
+    #[arg(long = "progress-lines")]
+    pub progress_lines: bool,
+}
+
+/// How a solve reports progress.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProgressStyleArg {
+    /// Nothing.
+    Quiet,
+    /// A bar on stderr, once a run has lasted a second.
+    Bar,
+    /// One line per step on stderr.
+    Lines,
+}
+
+impl CommonArgs {
+    /// The progress style for these options (`quiet`: the global `-q`).
+    pub fn progress(&self, quiet: bool) -> ProgressStyleArg {
+        if self.progress_lines {
+            ProgressStyleArg::Lines
+        } else if quiet || self.json {
+            ProgressStyleArg::Quiet
+        } else {
+            ProgressStyleArg::Bar
+        }
+    }
 }
 
 /// Fails, before any work, when `output` is not a mesh format beltrami writes.
@@ -54,6 +82,18 @@ pub fn resolve_pins(specs: &[PinSpec], mesh: &Mesh) -> anyhow::Result<Vec<Pin>> 
             })
         })
         .collect()
+}
+
+/// `stage done/total energy E` of a progress report.
+fn progress_line(p: &Progress) -> String {
+    let mut line = p.stage.to_string();
+    if let Some(total) = p.total {
+        line.push_str(&format!(" {}/{total}", p.done));
+    }
+    if let Some(e) = p.energy {
+        line.push_str(&format!(" energy {e:.3e}"));
+    }
+    line
 }
 
 /// A progress bar that appears only once a run has lasted a second.
@@ -88,14 +128,7 @@ impl LateBar {
             self.bar.enable_steady_tick(Duration::from_millis(120));
             self.shown = true;
         }
-        let mut msg = p.stage.to_string();
-        if let Some(total) = p.total {
-            msg.push_str(&format!(" {}/{total}", p.done));
-        }
-        if let Some(e) = p.energy {
-            msg.push_str(&format!(" energy {e:.3e}"));
-        }
-        self.bar.set_message(msg);
+        self.bar.set_message(progress_line(p));
     }
 
     fn finish(&self) {
@@ -109,14 +142,20 @@ impl LateBar {
 pub fn solve(
     solver: &dyn Solver,
     problem: &Problem<'_>,
-    show_progress: bool,
+    progress: ProgressStyleArg,
 ) -> anyhow::Result<(Solution, f64)> {
     solver.check(problem)?;
-    let mut bar = LateBar::new(show_progress);
+    let mut bar = LateBar::new(progress == ProgressStyleArg::Bar);
     let start = Instant::now();
     let solution = {
         let mut context = Context::new()
-            .with_progress(|p: &Progress| bar.update(p))
+            .with_progress(|p: &Progress| {
+                if progress == ProgressStyleArg::Lines {
+                    eprintln!("{}", progress_line(p));
+                } else {
+                    bar.update(p);
+                }
+            })
             .with_cancel_flag(super::interrupt::cancel_flag());
         solver.solve(problem, &mut context)
     };

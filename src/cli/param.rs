@@ -88,7 +88,7 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     });
     problem.constraints.pins = mapping::resolve_pins(&args.pins, mesh)?;
 
-    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.common.json)?;
+    let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
     mapping::write_map(&args.output, mesh, &solution)?;
     mapping::write_png(args.common.png.as_deref(), mesh, &solution)?;
     let report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);

@@ -214,7 +214,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     problem.params.max_iterations = args.max_iters;
     problem.params.threads = args.threads;
 
-    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.common.json)?;
+    let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
     let error = match (&solution.report.mu, &field) {
         (Some(measured), Some(field)) if measured.frame == field.frame => {
             let elements = Elements::new(mesh, field.frame)?;

@@ -95,7 +95,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     problem.params.tolerance = args.tolerance;
     problem.params.threads = args.threads;
 
-    let (solution, seconds) = mapping::solve(solver, &problem, !quiet && !args.common.json)?;
+    let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
     let Map::OnMesh(points) = &solution.map else {
         bail!("the register solver did not give points on the target mesh");
     };
