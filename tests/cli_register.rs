@@ -362,3 +362,16 @@ fn a_prescribed_zero_mu_is_the_conformal_goal() {
     assert!(!run.status.success());
     assert!(!out.exists());
 }
+
+#[test]
+fn spot_onto_a_sphere_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = dir.path().join("sphere.obj");
+    let run = beltrami(&["generate", "sphere", "--level", "4", "-o", s(&sphere)]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let (image, _) = register(Path::new("meshes/spot.obj"), &sphere, &["--p", "3"], 0.5);
+    // The octahedral sphere's vertices are on the unit sphere, its faces inside it.
+    for p in &image {
+        assert!(p.coords.norm() <= 1.0 + 1e-12 && p.coords.norm() > 0.9);
+    }
+}
