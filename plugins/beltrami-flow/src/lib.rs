@@ -25,10 +25,12 @@ pub mod flow;
 pub mod measure;
 pub mod mesh_target;
 pub mod paper;
+mod setup;
 mod solver;
 pub mod stereographic;
 pub mod system;
 pub mod target;
+mod validate;
 
 pub use solver::BeltramiFlow;
 

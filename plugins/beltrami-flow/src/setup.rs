@@ -1,0 +1,351 @@
+//! Setting up a flow: the initial map, the target geometry, the role of every vertex,
+//! the pins and the landmark goals.
+
+use beltrami_core::{Context, Map, PlanarBoundary, Position, Problem, Solver, SolverError, Target};
+use beltrami_fem::element::is_planar;
+use beltrami_init::{Sphere, Tutte};
+use beltrami_mesh::{Mesh, Point3, VertexId};
+
+use crate::mesh_target::TargetCurve;
+use crate::target::{Annulus, PlaneRegion, Role, Side, UnitDisk, UnitSphere};
+use crate::validate::{ON_TARGET, annulus_of, invalid, unsupported};
+
+/// Boundary vertices whose boundary turns by less than this (radians) slide along a
+/// straight side of a planar region; the others are corners and stay.
+const CORNER_ANGLE: f64 = 1e-6;
+
+/// The map the flow starts from, as points of R^3 (z = 0 for planar targets).
+pub(crate) fn initial_map(problem: &Problem<'_>) -> Result<Vec<Point3<f64>>, SolverError> {
+    let mesh = problem.source;
+    if let Some(map) = &problem.initial {
+        return Ok(match (map, &problem.target) {
+            (Map::Planar(z), _) => z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect(),
+            (Map::Spatial(p), _) => p.clone(),
+            (Map::OnMesh(points), Target::Mesh(target)) => points
+                .iter()
+                .enumerate()
+                .map(|(v, p)| {
+                    p.validate(target)
+                        .map(|()| p.position(target))
+                        .map_err(|e| invalid(format!("the initial map at vertex {v}: {e}")))
+                })
+                .collect::<Result<_, _>>()?,
+            (Map::OnMesh(_), _) => {
+                return Err(unsupported(
+                    "an initial map on a mesh needs that mesh as the target",
+                ));
+            }
+        });
+    }
+    let planar_points = |map: Map| match map {
+        Map::Planar(z) => Ok(z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect()),
+        _ => Err(invalid("the initial map is not planar")),
+    };
+    let identity = || {
+        mesh.positions()
+            .iter()
+            .map(|p| Point3::new(p.x, p.y, 0.0))
+            .collect()
+    };
+    let mut init = Problem::new(mesh, problem.target.clone());
+    init.params = problem.params;
+    init.constraints.pins = problem.constraints.pins.clone();
+    match &problem.target {
+        Target::Plane(PlanarBoundary::Keep) => Ok(identity()),
+        Target::Plane(b @ (PlanarBoundary::Square { .. } | PlanarBoundary::Polygon(_))) => {
+            init.target = Target::Plane(b.clone());
+            init.constraints.pins.clear();
+            planar_points(Tutte.solve(&init, &mut Context::new())?.map)
+        }
+        Target::Plane(_) | Target::Disk => {
+            let on_circle = is_planar(mesh)
+                && mesh.boundary_loop_list()[0]
+                    .vertices
+                    .iter()
+                    .all(|&v| (mesh.position(v).coords.xy().norm() - 1.0).abs() <= ON_TARGET);
+            if on_circle {
+                return Ok(identity());
+            }
+            init.target = Target::Plane(PlanarBoundary::Circle);
+            init.constraints.pins.clear();
+            planar_points(Tutte.solve(&init, &mut Context::new())?.map)
+        }
+        Target::Annulus { inner_radius } => {
+            let (r0, _) = annulus_of(mesh)?;
+            let r = inner_radius.unwrap_or(r0);
+            // Radial stretch of [r0, 1] onto [r, 1]: a homeomorphism onto the target.
+            Ok(mesh
+                .positions()
+                .iter()
+                .map(|p| {
+                    let rho = p.coords.xy().norm();
+                    let new = r + (rho - r0) * (1.0 - r) / (1.0 - r0);
+                    let s = if rho > 0.0 { new / rho } else { 1.0 };
+                    Point3::new(p.x * s, p.y * s, 0.0)
+                })
+                .collect())
+        }
+        Target::Sphere => {
+            let on_sphere = mesh
+                .positions()
+                .iter()
+                .all(|p| (p.coords.norm() - 1.0).abs() <= ON_TARGET);
+            if on_sphere {
+                return Ok(mesh.positions().to_vec());
+            }
+            init.constraints.pins.clear();
+            match Sphere.solve(&init, &mut Context::new())?.map {
+                Map::Spatial(p) => Ok(p),
+                _ => Err(invalid(
+                    "the sphere initialization did not give points of R^3",
+                )),
+            }
+        }
+        _ => Err(unsupported("no initial map for this target")),
+    }
+}
+
+/// The target geometry, ready for the flow.
+pub(crate) enum Domain {
+    Region(PlaneRegion),
+    Disk(UnitDisk),
+    /// The annulus and the index of its outer loop in `boundary_loop_list`.
+    Annulus(Annulus, usize),
+    Sphere(UnitSphere),
+}
+
+pub(crate) fn domain(problem: &Problem<'_>, image: &[Point3<f64>]) -> Result<Domain, SolverError> {
+    let mesh = problem.source;
+    Ok(match &problem.target {
+        Target::Plane(
+            PlanarBoundary::Keep | PlanarBoundary::Square { .. } | PlanarBoundary::Polygon(_),
+        ) => Domain::Region(region(mesh, image)),
+        Target::Plane(_) | Target::Disk => Domain::Disk(UnitDisk),
+        Target::Annulus { inner_radius } => {
+            let loops = mesh.boundary_loop_list();
+            let radius = |k: usize| {
+                loops[k]
+                    .vertices
+                    .iter()
+                    .map(|&v| image[v.idx()].coords.xy().norm())
+                    .sum::<f64>()
+                    / loops[k].vertices.len() as f64
+            };
+            let outer = usize::from(radius(1) > radius(0));
+            let inner = inner_radius.unwrap_or_else(|| radius(1 - outer));
+            Domain::Annulus(
+                Annulus {
+                    inner_radius: inner,
+                    free_inner: inner_radius.is_none(),
+                },
+                outer,
+            )
+        }
+        Target::Sphere => Domain::Sphere(UnitSphere),
+        _ => return Err(unsupported("no flow for this target")),
+    })
+}
+
+/// The straight sides of the image's boundary: runs of boundary vertices between
+/// corners, where the boundary turns by more than [`CORNER_ANGLE`].
+pub(crate) fn region(mesh: &Mesh, image: &[Point3<f64>]) -> PlaneRegion {
+    let mut sides = Vec::new();
+    for l in mesh.boundary_loop_list() {
+        let corners = loop_corners(&l.vertices, image);
+        for (k, &c) in corners.iter().enumerate() {
+            let next = corners[(k + 1) % corners.len()];
+            sides.push(Side {
+                a: image[l.vertices[c].idx()],
+                b: image[l.vertices[next].idx()],
+            });
+        }
+    }
+    PlaneRegion { sides }
+}
+
+/// Positions in `vertices` (a boundary loop) of its corners (at least one).
+pub(crate) fn loop_corners(vertices: &[VertexId], image: &[Point3<f64>]) -> Vec<usize> {
+    let n = vertices.len();
+    let at = |k: usize| image[vertices[k % n].idx()];
+    let mut corners: Vec<usize> = (0..n)
+        .filter(|&k| {
+            let incoming = at(k) - at(k + n - 1);
+            let outgoing = at(k + 1) - at(k);
+            let cross = incoming.x * outgoing.y - incoming.y * outgoing.x;
+            let dot = incoming.x * outgoing.x + incoming.y * outgoing.y;
+            cross.atan2(dot).abs() > CORNER_ANGLE
+        })
+        .collect();
+    if corners.is_empty() {
+        corners.push(0);
+    }
+    corners
+}
+
+/// Roles on a planar region: corners and pins fixed, other boundary vertices on the side
+/// between their corners, interior vertices free.
+pub(crate) fn region_roles(
+    mesh: &Mesh,
+    region: &PlaneRegion,
+    image: &[Point3<f64>],
+    pins: &[VertexId],
+) -> Vec<Role> {
+    let mut roles = vec![Role::Free; mesh.vertex_count()];
+    let mut side = 0;
+    for l in mesh.boundary_loop_list() {
+        let corners = loop_corners(&l.vertices, image);
+        for (k, &c) in corners.iter().enumerate() {
+            roles[l.vertices[c].idx()] = Role::Fixed;
+            let next = corners[(k + 1) % corners.len()];
+            let mut j = (c + 1) % l.vertices.len();
+            while j != next {
+                roles[l.vertices[j].idx()] = Role::Curve(side);
+                j = (j + 1) % l.vertices.len();
+            }
+            side += 1;
+        }
+    }
+    debug_assert_eq!(side, region.sides.len());
+    for &v in pins {
+        roles[v.idx()] = Role::Fixed;
+    }
+    roles
+}
+
+/// Roles on a domain whose boundary loop `k` lies on curve `curve_of(k)`: boundary
+/// vertices on their curve, pins fixed, the rest free.
+pub(crate) fn curve_roles(
+    mesh: &Mesh,
+    pins: &[VertexId],
+    curve_of: impl Fn(usize) -> usize,
+) -> Vec<Role> {
+    let mut roles = vec![Role::Free; mesh.vertex_count()];
+    for (k, l) in mesh.boundary_loop_list().iter().enumerate() {
+        for &v in &l.vertices {
+            roles[v.idx()] = Role::Curve(curve_of(k));
+        }
+    }
+    for &v in pins {
+        roles[v.idx()] = Role::Fixed;
+    }
+    roles
+}
+
+/// The pinned vertices: the problem's, or the default ones of the target (the vertex
+/// nearest to each normalization point of the initial map).
+pub(crate) fn pins(problem: &Problem<'_>, image: &[Point3<f64>]) -> Vec<VertexId> {
+    let mesh = problem.source;
+    if !problem.constraints.pins.is_empty() {
+        return problem.constraints.pins.iter().map(|p| p.vertex).collect();
+    }
+    let nearest = |candidates: &mut dyn Iterator<Item = VertexId>, q: Point3<f64>| {
+        candidates.min_by(|&a, &b| {
+            (image[a.idx()] - q)
+                .norm()
+                .total_cmp(&(image[b.idx()] - q).norm())
+        })
+    };
+    let boundary = |l: usize| mesh.boundary_loop_list()[l].vertices.clone();
+    let mut out = Vec::new();
+    match &problem.target {
+        Target::Plane(PlanarBoundary::Circle) | Target::Disk => {
+            out.extend(nearest(&mut mesh.vertices(), Point3::origin()));
+            out.extend(nearest(
+                &mut boundary(0).into_iter(),
+                Point3::new(1.0, 0.0, 0.0),
+            ));
+        }
+        Target::Annulus { .. } => {
+            let loops = mesh.boundary_loop_list();
+            let mean = |k: usize| {
+                loops[k]
+                    .vertices
+                    .iter()
+                    .map(|&v| image[v.idx()].coords.norm())
+                    .sum::<f64>()
+                    / loops[k].vertices.len() as f64
+            };
+            let outer = usize::from(mean(1) > mean(0));
+            out.extend(nearest(
+                &mut boundary(outer).into_iter(),
+                Point3::new(1.0, 0.0, 0.0),
+            ));
+        }
+        Target::Sphere => {
+            for q in [
+                Point3::new(0.0, 0.0, -1.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(0.0, 0.0, 1.0),
+            ] {
+                if let Some(v) = nearest(&mut mesh.vertices().filter(|v| !out.contains(v)), q) {
+                    out.push(v);
+                }
+            }
+        }
+        _ => {}
+    }
+    out
+}
+
+pub(crate) fn diagonal(image: &[Point3<f64>]) -> f64 {
+    beltrami_mesh::BoundingBox::around(image)
+        .map_or(1.0, |b| b.diagonal())
+        .max(f64::MIN_POSITIVE)
+}
+
+/// Per source vertex, the point a landmark pulls it to (pins with a position on a target
+/// mesh: the vertex is moved there by the flow, then held).
+pub(crate) fn goals(problem: &Problem<'_>) -> Vec<Option<Point3<f64>>> {
+    let mut goals = vec![None; problem.source.vertex_count()];
+    for pin in &problem.constraints.pins {
+        if let Some(Position::Spatial(p)) = pin.position {
+            goals[pin.vertex.idx()] = Some(p);
+        }
+    }
+    goals
+}
+
+/// The curves of a target mesh (its boundary loops, then the problem's feature curves)
+/// and the roles of the source vertices: each source boundary loop slides on the target
+/// loop nearest to its initial image, each feature curve's inner vertices on its target
+/// chain (ends fixed), pins fixed, the rest free.
+pub(crate) fn mesh_roles(
+    problem: &Problem<'_>,
+    target: &Mesh,
+    image: &[Point3<f64>],
+    pins: &[VertexId],
+) -> Result<(Vec<TargetCurve>, Vec<Role>), SolverError> {
+    let mesh = problem.source;
+    let mut curves = TargetCurve::boundary_loops(target);
+    let mut roles = vec![Role::Free; mesh.vertex_count()];
+    for l in mesh.boundary_loop_list() {
+        let nearest = (0..curves.len()).min_by(|&a, &b| {
+            let d = |c: usize| curves[c].mean_distance(l.vertices.iter().map(|v| &image[v.idx()]));
+            d(a).total_cmp(&d(b))
+        });
+        let Some(c) = nearest else {
+            return Err(unsupported(
+                "the source has a boundary and the target mesh none",
+            ));
+        };
+        for &v in &l.vertices {
+            roles[v.idx()] = Role::Curve(c);
+        }
+    }
+    for curve in &problem.constraints.curves {
+        let c = curves.len();
+        curves.push(TargetCurve::through(target, &curve.target, false));
+        let n = curve.source.len();
+        for (k, &v) in curve.source.iter().enumerate() {
+            roles[v.idx()] = if k == 0 || k + 1 == n {
+                Role::Fixed
+            } else {
+                Role::Curve(c)
+            };
+        }
+    }
+    for &v in pins {
+        roles[v.idx()] = Role::Fixed;
+    }
+    Ok((curves, roles))
+}

@@ -1,0 +1,258 @@
+//! What the flow checks before any work: the mesh, the target's topology, the goal, the
+//! pins, curves and initial map.
+
+use beltrami_core::{Goal, Map, PlanarBoundary, Position, Problem, SolverError, Target, topology};
+use beltrami_fem::Frame;
+use beltrami_fem::element::is_planar;
+use beltrami_mesh::Mesh;
+use num_complex::Complex64;
+
+use crate::NAME;
+
+/// How far (relative) a vertex may be off the unit circle or sphere for the source to be
+/// taken as already on the target.
+pub(crate) const ON_TARGET: f64 = 1e-9;
+
+/// The goal, checked: the frame `mu` is measured in, the target per face and `p`.
+pub(crate) struct CheckedGoal {
+    pub(crate) frame: Frame,
+    pub(crate) sigma: Option<Vec<Complex64>>,
+    pub(crate) p: f64,
+}
+
+pub(crate) fn unsupported(message: impl Into<String>) -> SolverError {
+    SolverError::Unsupported {
+        solver: NAME,
+        message: message.into(),
+    }
+}
+
+pub(crate) fn invalid(message: impl Into<String>) -> SolverError {
+    SolverError::InvalidInput {
+        solver: NAME,
+        message: message.into(),
+    }
+}
+
+/// Everything that can be checked before any work.
+pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError> {
+    let mesh = problem.source;
+    if let Some(f) = mesh.faces().find(|&f| mesh.face_degree(f) != 3) {
+        return Err(unsupported(format!(
+            "the flow works on triangle meshes; face {} (input index) has {} vertices: split quads into triangles first",
+            mesh.face_to_input(f),
+            mesh.face_degree(f)
+        )));
+    }
+    let planar = is_planar(mesh);
+    match &problem.target {
+        Target::Plane(PlanarBoundary::Keep) => {
+            if !planar {
+                return Err(unsupported(
+                    "the target `plane` keeps the input's own planar region; this mesh is not in the plane z = 0: use the disk target",
+                ));
+            }
+            topology::require_disk(
+                NAME,
+                mesh,
+                "use the annulus or sphere targets, or `beltrami cut`",
+            )?;
+        }
+        Target::Plane(
+            PlanarBoundary::Circle | PlanarBoundary::Square { .. } | PlanarBoundary::Polygon(_),
+        )
+        | Target::Disk => {
+            topology::require_disk(
+                NAME,
+                mesh,
+                "use the annulus or sphere targets, or `beltrami cut`",
+            )?;
+        }
+        Target::Plane(PlanarBoundary::Free | PlanarBoundary::Given(_)) => {
+            return Err(unsupported(
+                "the flow needs a target region; for a free or given boundary use lsqc",
+            ));
+        }
+        Target::Annulus { inner_radius } => {
+            if mesh.boundary_loop_count() != 2
+                || mesh.component_count() != 1
+                || mesh.genus() != Some(0)
+            {
+                return Err(unsupported(format!(
+                    "the annulus target needs a connected genus-0 mesh with two boundary loops; this mesh has {}",
+                    topology::describe(mesh)
+                )));
+            }
+            if let Some(r) = inner_radius
+                && !(*r > 0.0 && *r < 1.0)
+            {
+                return Err(invalid(format!(
+                    "the inner radius must be in (0, 1), got {r}"
+                )));
+            }
+            if problem.initial.is_none() {
+                annulus_of(mesh)?;
+            }
+        }
+        Target::Sphere => {
+            topology::require_sphere(
+                NAME,
+                mesh,
+                "use the disk or annulus targets for meshes with boundary",
+            )?;
+        }
+        Target::Mesh(target) => {
+            if target.boundary_loop_count() != mesh.boundary_loop_count()
+                || target.genus() != mesh.genus()
+                || target.component_count() != mesh.component_count()
+            {
+                return Err(unsupported(format!(
+                    "the source and the target mesh differ in topology: source has {}, target has {}",
+                    topology::describe(mesh),
+                    topology::describe(target)
+                )));
+            }
+            if problem.initial.is_none() {
+                return Err(unsupported(
+                    "a target mesh needs an initial map onto it: use the register solver, which builds one",
+                ));
+            }
+            if let Some(f) = target.faces().find(|&f| target.face_degree(f) != 3) {
+                return Err(unsupported(format!(
+                    "the target mesh must be made of triangles; its face {} (input index) is not",
+                    target.face_to_input(f)
+                )));
+            }
+            for (k, curve) in problem.constraints.curves.iter().enumerate() {
+                if curve.source.len() < 2 || curve.target.len() < 2 {
+                    return Err(invalid(format!(
+                        "curve {k} needs at least two source and two target vertices"
+                    )));
+                }
+                if let Some(v) = curve.source.iter().find(|v| v.idx() >= mesh.vertex_count()) {
+                    return Err(invalid(format!(
+                        "curve {k}: source vertex {v} does not exist"
+                    )));
+                }
+                if let Some(v) = curve
+                    .target
+                    .iter()
+                    .find(|v| v.idx() >= target.vertex_count())
+                {
+                    return Err(invalid(format!(
+                        "curve {k}: target vertex {v} does not exist"
+                    )));
+                }
+                // The chain slides along its segments, which must lie on the target.
+                for pair in curve.target.windows(2) {
+                    if !target.vertex_neighbors(pair[0]).any(|w| w == pair[1]) {
+                        return Err(invalid(format!(
+                            "curve {k}: target vertices {} and {} (input indices) are not joined by an edge",
+                            target.vertex_map().to_input(pair[0]),
+                            target.vertex_map().to_input(pair[1])
+                        )));
+                    }
+                }
+            }
+        }
+        Target::CircleDomain | Target::Surface => {
+            return Err(unsupported(
+                "targets here: plane, disk, annulus, sphere, a target mesh (circle domains come with another solver)",
+            ));
+        }
+    }
+    for pin in &problem.constraints.pins {
+        if pin.vertex.idx() >= mesh.vertex_count() {
+            return Err(invalid(format!(
+                "pinned vertex {} does not exist (the mesh has {} vertices)",
+                pin.vertex,
+                mesh.vertex_count()
+            )));
+        }
+        match (&pin.position, &problem.target) {
+            (None, _) | (Some(Position::Spatial(_)), Target::Mesh(_)) => {}
+            _ => {
+                return Err(unsupported(
+                    "pins hold their vertex where the initial map puts it; pins at given positions (landmarks) are for target meshes",
+                ));
+            }
+        }
+    }
+    if !problem.constraints.curves.is_empty() && !matches!(problem.target, Target::Mesh(_)) {
+        return Err(unsupported(
+            "curve constraints come with target meshes (register)",
+        ));
+    }
+    if let Some(initial) = &problem.initial {
+        let n = match initial {
+            Map::Planar(z) => z.len(),
+            Map::Spatial(p) => p.len(),
+            Map::OnMesh(p) => p.len(),
+        };
+        if n != mesh.vertex_count() {
+            return Err(invalid(format!(
+                "the initial map has {n} images for {} vertices",
+                mesh.vertex_count()
+            )));
+        }
+    }
+    match &problem.goal {
+        Goal::Conformal { p } => {
+            if !(p.is_finite() && *p >= 2.0) {
+                return Err(invalid(format!("the L^p goal needs p >= 2, got {p}")));
+            }
+            Ok(CheckedGoal {
+                frame: if planar { Frame::Global } else { Frame::Face },
+                sigma: None,
+                p: *p,
+            })
+        }
+        Goal::Prescribed(field) => {
+            field.check(mesh.face_count())?;
+            if field.frame == Frame::Global && !planar {
+                return Err(invalid(
+                    "a field in the global frame needs a mesh in the plane z = 0; give it in the face frame",
+                ));
+            }
+            Ok(CheckedGoal {
+                frame: field.frame,
+                sigma: Some(field.mu.clone()),
+                p: 2.0,
+            })
+        }
+        Goal::Extremal => Err(unsupported(
+            "extremal (Teichmueller) maps come with their own solver",
+        )),
+    }
+}
+
+/// The inner radius of a planar annulus source centred at 0, and which boundary loop is
+/// the outer one (index in `boundary_loop_list`).
+pub(crate) fn annulus_of(mesh: &Mesh) -> Result<(f64, usize), SolverError> {
+    let loops = mesh.boundary_loop_list();
+    let radii: Vec<(f64, f64)> = loops
+        .iter()
+        .map(|l| {
+            let r: Vec<f64> = l
+                .vertices
+                .iter()
+                .map(|&v| mesh.position(v).coords.xy().norm())
+                .collect();
+            let lo = r.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = r.iter().copied().fold(0.0, f64::max);
+            (lo, hi)
+        })
+        .collect();
+    let outer = usize::from(radii[1].1 > radii[0].1);
+    let inner = 1 - outer;
+    let on = |(lo, hi): (f64, f64), r: f64| {
+        (lo - r).abs() <= ON_TARGET * r.max(1.0) && (hi - r).abs() <= ON_TARGET * r.max(1.0)
+    };
+    let r = radii[inner].1;
+    if !(is_planar(mesh) && on(radii[outer], 1.0) && on(radii[inner], r) && r > 0.0 && r < 1.0) {
+        return Err(unsupported(
+            "the annulus target starts from a mesh already in an annulus r <= |z| <= 1 centred at 0 (both boundary loops on their circles), or from a given initial map",
+        ));
+    }
+    Ok((r, outer))
+}
