@@ -43,7 +43,7 @@ impl Solver for BeltramiFlow {
     }
 
     fn accepts(&self) -> &'static str {
-        "triangle meshes; targets: plane (the input's own polygon, square, polygon), disk, annulus (fixed or free inner radius) for disks/annuli, sphere for closed genus 0; goals: prescribed mu (global or face frame), conformal L^p (p >= 2); pins"
+        "triangle meshes; targets: plane (the input's own polygon, square, polygon), disk, annulus (fixed or free inner radius) for disks/annuli, sphere for closed genus 0, a target mesh of the same topology from an initial map (see register); goals: prescribed mu (global or face frame), conformal L^p (p >= 2); pins, landmarks and feature curves on target meshes"
     }
 
     fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
