@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use beltrami_mesh::io::{self, VertexAttributes};
-use beltrami_mesh::primitives::{self, Cells, ModifiedTorus};
+use beltrami_mesh::primitives::{self, ModifiedTorus};
 use beltrami_mesh::{Mesh, PolygonSoup};
 use clap::{Args, ValueEnum};
 
@@ -60,15 +60,7 @@ pub fn run(args: &GenerateArgs, quiet: bool) -> anyhow::Result<()> {
             }
             primitives::annulus(args.inner, 2 << args.level, 8 << args.level)
         }
-        Shape::Square => {
-            let n = 32 << args.level;
-            let mut soup = primitives::grid(n, n, Cells::Triangles);
-            for p in &mut soup.positions {
-                p.x = 2.0 * p.x - 1.0;
-                p.y = 2.0 * p.y - 1.0;
-            }
-            soup
-        }
+        Shape::Square => primitives::centered_square(32 << args.level),
         Shape::Torus1 | Shape::Torus2 => {
             if args.level > 6 {
                 bail!("--level {} is too fine for a torus (at most 6)", args.level);

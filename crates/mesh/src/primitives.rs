@@ -201,6 +201,18 @@ fn split_triangles(
     next
 }
 
+/// The square `[-1, 1]^2` of Wong-Zhao's Table 5.3 in the plane z = 0: [`grid`] with `n`
+/// by `n` cells split into triangles, scaled and centred (vertex `i + (n + 1) j` at
+/// `(2 i / n - 1, 2 j / n - 1)`).
+pub fn centered_square(n: usize) -> PolygonSoup {
+    let mut soup = grid(n, n, Cells::Triangles);
+    for p in &mut soup.positions {
+        p.x = 2.0 * p.x - 1.0;
+        p.y = 2.0 * p.y - 1.0;
+    }
+    soup
+}
+
 /// The unit disk of Wong-Zhao's Table 5.1: level 0 is the square with corners
 /// `1, i, -1, -i` split into four triangles at the centre; each level splits every
 /// triangle 1-to-4 by its edge midpoints, boundary midpoints projected radially onto the

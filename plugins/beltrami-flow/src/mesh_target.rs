@@ -8,6 +8,7 @@ use std::cell::RefCell;
 
 use beltrami_core::SolverError;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3, VertexId};
+use beltrami_spatial::closest_point::closest_on_segment;
 use beltrami_spatial::frame::interpolated_normal;
 use beltrami_spatial::{BoundaryMode, MoveOptions, SurfaceIndex};
 
@@ -47,26 +48,21 @@ impl TargetCurve {
 
     /// The closest point of the curve to `p` and the unit direction of its segment.
     pub fn closest(&self, p: &Point3<f64>) -> (Point3<f64>, Vector3<f64>) {
-        let mut best = (f64::INFINITY, *p, Vector3::x());
+        let mut best: Option<(f64, Point3<f64>, Vector3<f64>)> = None;
         for (a, b) in self.segments() {
             let d = b - a;
-            let len2 = d.norm_squared();
-            if len2 == 0.0 {
+            if d.norm_squared() == 0.0 {
                 continue;
             }
-            let t = ((p - a).dot(&d) / len2).clamp(0.0, 1.0);
-            let q = a + t * d;
-            let dist = (p - q).norm_squared();
-            if dist < best.0 {
-                best = (dist, q, d / len2.sqrt());
+            let c = closest_on_segment(p, &a, &b);
+            if best.is_none_or(|(dist, _, _)| c.distance_squared < dist) {
+                best = Some((c.distance_squared, c.position, d.normalize()));
             }
         }
-        if best.0.is_infinite()
-            && let Some(&q) = self.points.first()
-        {
-            return (q, Vector3::x());
+        match best {
+            Some((_, q, t)) => (q, t),
+            None => (self.points.first().copied().unwrap_or(*p), Vector3::x()),
         }
-        (best.1, best.2)
     }
 
     /// The mean distance of `points` to the curve.

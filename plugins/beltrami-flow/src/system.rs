@@ -80,6 +80,9 @@ pub struct FlowSystem {
     /// The known flow of the fixed vertices that are pulled towards a goal (zero for
     /// the others): it moves them, and the rest of the flow follows.
     prescribed: Vec<Vector3<f64>>,
+    /// The unknowns' directions of every vertex at the current image (refilled by each
+    /// solve, so each is computed once per step).
+    directions: Vec<[Vector3<f64>; 2]>,
 }
 
 /// Relative residual at which a step solved by conjugate gradients with a kept
@@ -206,6 +209,7 @@ impl FlowSystem {
             factorizations: 0,
             cg_iterations: 0,
             prescribed: Vec::new(),
+            directions: Vec::new(),
         })
     }
 
@@ -238,6 +242,13 @@ impl FlowSystem {
         weights: &[f64],
         rho: &[Complex64],
     ) -> Result<Flow, SolverError> {
+        self.directions.clear();
+        self.directions.extend(
+            self.roles
+                .iter()
+                .zip(image.iter().zip(normals))
+                .map(|(&role, (p, n))| directions(target, role, p, n)),
+        );
         self.rhs.iter_mut().for_each(|r| *r = 0.0);
         let values = self.matrix.val_mut();
         values.iter_mut().for_each(|v| *v = 0.0);
@@ -253,13 +264,7 @@ impl FlowSystem {
                 beta[a] = match source {
                     Source::Vertex { k, index } => {
                         let v = self.faces[f][k as usize];
-                        let b = direction(
-                            target,
-                            self.roles[v],
-                            &image[v],
-                            &normals[v],
-                            index as usize,
-                        );
+                        let b = self.directions[v][index as usize];
                         g[k as usize] * along(face, &b)
                     }
                     Source::Offset { curve } => {
@@ -304,8 +309,7 @@ impl FlowSystem {
         for (v, &role) in self.roles.iter().enumerate() {
             let mut vec = Vector3::zeros();
             for index in 0..unknowns_of(role) {
-                vec += self.rhs[self.first[v] + index]
-                    * direction(target, role, &image[v], &normals[v], index);
+                vec += self.rhs[self.first[v] + index] * self.directions[v][index];
             }
             if let Role::Curve(c) = role
                 && let Some(b) = target.curve_offset_direction(c, &image[v])
@@ -391,19 +395,18 @@ fn block_order(
     Ok(order)
 }
 
-/// The unknown direction `index` of a vertex with `role` at `p`, where the target's
-/// normal is `normal`.
-fn direction<G: TargetGeometry>(
+/// The directions of the unknowns of a vertex with `role` at `p`, where the target's
+/// normal is `normal` (unused entries zero).
+fn directions<G: TargetGeometry>(
     target: &G,
     role: Role,
     p: &Point3<f64>,
     normal: &Vector3<f64>,
-    index: usize,
-) -> Vector3<f64> {
+) -> [Vector3<f64>; 2] {
     match role {
-        Role::Free => orthonormal_basis(normal)[index],
-        Role::Curve(c) => target.curve_tangent(c, p),
-        Role::Fixed => Vector3::zeros(),
+        Role::Free => orthonormal_basis(normal),
+        Role::Curve(c) => [target.curve_tangent(c, p), Vector3::zeros()],
+        Role::Fixed => [Vector3::zeros(); 2],
     }
 }
 

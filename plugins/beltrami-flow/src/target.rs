@@ -16,6 +16,7 @@
 
 use beltrami_core::SolverError;
 use beltrami_mesh::{Point3, Vector3};
+use beltrami_spatial::closest_point::closest_on_segment;
 
 /// How a vertex may move on the target.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,9 +113,7 @@ pub struct Side {
 
 impl Side {
     fn closest(&self, p: &Point3<f64>) -> Point3<f64> {
-        let d = self.b - self.a;
-        let t = ((p - self.a).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
-        self.a + t * d
+        closest_on_segment(p, &self.a, &self.b).position
     }
 }
 

@@ -19,7 +19,7 @@ use beltrami_core::{Context, Goal, Pin, PlanarBoundary, Problem, Solution, Solve
 use beltrami_fem::{BeltramiField, Elements, Frame, MuError};
 use beltrami_flow::paper::{self, TABLE_5_1, TABLE_5_2, TABLE_5_3};
 use beltrami_flow::{BeltramiFlow, stereographic};
-use beltrami_mesh::primitives::{self, Cells};
+use beltrami_mesh::primitives;
 use beltrami_mesh::{BuildOptions, Mesh, VertexId, io};
 use clap::Args;
 use num_complex::Complex64;
@@ -189,12 +189,7 @@ fn annulus_table(repeat: usize) -> anyhow::Result<()> {
 }
 
 fn square_mesh(cells: usize) -> anyhow::Result<Mesh> {
-    let mut soup = primitives::grid(cells, cells, Cells::Triangles);
-    for p in &mut soup.positions {
-        p.x = 2.0 * p.x - 1.0;
-        p.y = 2.0 * p.y - 1.0;
-    }
-    Ok(Mesh::from_soup(&soup)?)
+    Ok(Mesh::from_soup(&primitives::centered_square(cells))?)
 }
 
 fn square_problem(mesh: &Mesh) -> Problem<'_> {

@@ -66,13 +66,7 @@ pub fn sample(mesh: &Mesh, mu: impl Fn(Complex64) -> Complex64) -> Vec<Complex64
 
 /// The square `[-1, 1]^2` with `n` by `n` cells split into triangles.
 pub fn square(n: usize) -> Mesh {
-    let mut soup =
-        beltrami_mesh::primitives::grid(n, n, beltrami_mesh::primitives::Cells::Triangles);
-    for p in &mut soup.positions {
-        p.x = 2.0 * p.x - 1.0;
-        p.y = 2.0 * p.y - 1.0;
-    }
-    Mesh::from_soup(&soup).unwrap()
+    Mesh::from_soup(&beltrami_mesh::primitives::centered_square(n)).unwrap()
 }
 
 /// The bundled hemisphere (a cap of the unit sphere, 3600 triangles).
