@@ -4,25 +4,34 @@
 //! registration and remeshing, finite-element style. This facade re-exports the crates
 //! of the workspace:
 //!
-//! - [`mesh`]: the halfedge mesh (triangles and quads), validation, topology, geometry
-//!   and IO.
+//! - [`mesh`]: the halfedge mesh (triangles and quads), validation, topology, geometry,
+//!   cutting and IO.
 //! - [`fem`]: P1/Q1 elements, assembled operators, Beltrami coefficients of maps,
-//!   Beltrami fields (per-face `mu` in a stated frame, with their file format) and
-//!   distortion statistics.
-//!
-//! - [`core`]: the `Solver` trait, problems, solutions, reports and the registry.
-//! - [`init`]: the initialization solvers (tutte, harmonic, lscm).
-//! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
-//!   |mu| histograms as PNG.
-//! - [`lsqc`]: the least-squares quasiconformal map for a prescribed Beltrami
-//!   coefficient (lsqc).
+//!   Beltrami fields (per-face `mu` in a stated frame, with their file format),
+//!   distortion statistics, DOF maps and sparse least-squares solves.
 //! - [`spatial`]: exact closest points on a target mesh through a kd-tree, tangent
 //!   frames, and moving surface points along the surface.
+//! - [`core`]: the `Solver` trait (what a solver accepts as data, its typed options, one
+//!   validation shared by `check` and `solve`), problems with typed constraints,
+//!   solutions (a map or a new mesh, typed metrics and extras), the registry.
+//! - [`init`]: the initialization solvers (tutte, harmonic, lscm, sphere).
+//! - [`lsqc`]: the least-squares quasiconformal map for a prescribed Beltrami
+//!   coefficient (lsqc).
+//! - [`flow`]: the discrete Beltrami flow (beltrami-flow) onto planar regions, the disk,
+//!   annuli, the sphere and target meshes.
+//! - [`register`]: surface registration (register): initial bijections by topology,
+//!   then the flow on the target mesh.
+//! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
+//!   |mu| histograms as PNG.
 //!
-//! [`registry`] returns every solver shipped with this package.
+//! [`registry`] returns every solver shipped with this package; [`catalog`] describes
+//! each as data (accepts and options), for `beltrami solvers --json` and scripts.
+//! `docs/adding-a-solver.md` walks through writing one.
 //!
 //! The `beltrami` binary built from this package is the command-line front end; see the
 //! README for its commands.
+
+pub mod catalog;
 
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;

@@ -462,11 +462,107 @@ fn solvers_lists_the_registered_solvers() {
         assert!(names.contains(&name), "{names:?}");
     }
     for s in list {
-        for key in ["description", "accepts"] {
-            let value = s[key].as_str().unwrap_or_default();
-            assert!(!value.is_empty(), "{} has no {key}", s["name"]);
+        let description = s["description"].as_str().unwrap_or_default();
+        assert!(!description.is_empty(), "{} has no description", s["name"]);
+        // What it accepts, as data: non-empty lists of stable kind names.
+        for key in ["elements", "topologies", "targets", "goals"] {
+            let list = s["accepts"][key].as_array();
+            assert!(
+                list.is_some_and(|l| !l.is_empty() && l.iter().all(|x| x.is_string())),
+                "{} accepts no {key}: {s}",
+                s["name"]
+            );
+        }
+        assert!(s["accepts"]["constraints"].is_array(), "{s}");
+        // Its options: name, type, default, help; numbers with a range.
+        for option in s["options"].as_array().expect("an options array") {
+            for key in ["name", "type", "help"] {
+                assert!(option[key].is_string(), "{option}");
+            }
+            assert!(!option["default"].is_null(), "{option}");
+            if matches!(option["type"].as_str(), Some("float" | "int")) {
+                assert!(
+                    option["min"].is_number() && option["max"].is_number(),
+                    "{option}"
+                );
+            }
         }
     }
+    let by_name = |name: &str| list.iter().find(|s| s["name"] == name).unwrap();
+    let lscm = by_name("lscm");
+    assert_eq!(
+        lscm["accepts"]["targets"],
+        serde_json::json!(["plane-free"])
+    );
+    assert_eq!(
+        lscm["accepts"]["constraints"],
+        serde_json::json!(["hold", "pin"])
+    );
+    let weights = &by_name("tutte")["options"][0];
+    assert_eq!(weights["name"], "weights");
+    assert_eq!(weights["default"], "uniform");
+    assert_eq!(
+        weights["choices"],
+        serde_json::json!(["uniform", "mean-value"])
+    );
+    let flow = by_name("beltrami-flow");
+    let tolerance = flow["options"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|o| o["name"] == "tolerance")
+        .expect("the flow declares its tolerance");
+    assert_eq!(tolerance["type"], "float");
+    assert_eq!(tolerance["default"], 1e-6);
+}
+
+#[test]
+fn solver_options_are_checked_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("out.obj");
+    let out = beltrami(&[
+        "param",
+        HEMISPHERE,
+        "--solver",
+        "tutte",
+        "--option",
+        "weights=cotan",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("option `weights` is one of uniform, mean-value, got `cotan`"),
+        "{err}"
+    );
+    assert!(!out_path.exists(), "no output after a refused option");
+    let out = beltrami(&[
+        "param",
+        HEMISPHERE,
+        "--solver",
+        "lscm",
+        "-O",
+        "treads=2",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    let err = text(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("lscm has no option `treads`; its options: threads"),
+        "{err}"
+    );
+    let out = beltrami(&[
+        "param",
+        HEMISPHERE,
+        "--solver",
+        "tutte",
+        "-O",
+        "weights=mean-value",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
 }
 
 #[test]

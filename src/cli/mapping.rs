@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
-use beltrami_core::{Context, Map, Pin, Problem, Progress, Solution, Solver};
+use beltrami_core::{Context, Map, OptionValue, Options, Pin, Problem, Progress, Solution, Solver};
 use beltrami_mesh::io::{self, Format, VertexAttributes};
 use beltrami_mesh::{Mesh, Vector2};
 use beltrami_render::{Layout, Scene, Style, check_png_path, viridis};
@@ -34,6 +34,48 @@ pub struct CommonArgs {
     /// (for logs and pipes, where the bar does not show).
     #[arg(long = "progress-lines")]
     pub progress_lines: bool,
+    /// Set a solver option, `NAME=VALUE` (repeatable; `beltrami solvers` lists each
+    /// solver's options with types, defaults and ranges).
+    #[arg(short = 'O', long = "option", value_name = "NAME=VALUE", value_parser = option_pair)]
+    pub options: Vec<(String, String)>,
+}
+
+/// Parses `NAME=VALUE` of `--option`.
+fn option_pair(text: &str) -> Result<(String, String), String> {
+    match text.split_once('=') {
+        Some((name, value)) if !name.trim().is_empty() => {
+            Ok((name.trim().to_string(), value.trim().to_string()))
+        }
+        _ => Err(format!("expected NAME=VALUE, got `{text}`")),
+    }
+}
+
+/// The solver options of a command: each of `command` (an option name, the value the
+/// user gave with a dedicated flag, and the command's default) is set when given, or
+/// set to the command's default when the solver declares that option; then every
+/// `--option NAME=VALUE`. Types and ranges are checked by the solver before any work.
+pub fn solver_options(
+    solver: &dyn Solver,
+    command: &[(&str, Option<OptionValue>, Option<OptionValue>)],
+    common: &CommonArgs,
+) -> Options {
+    let mut options = Options::new();
+    let declared = |name: &str| solver.options().iter().any(|s| s.name == name);
+    for (name, given, default) in command {
+        match (given, default) {
+            (Some(value), _) => {
+                options.set(name, value.clone());
+            }
+            (None, Some(value)) if declared(name) => {
+                options.set(name, value.clone());
+            }
+            _ => {}
+        }
+    }
+    for (name, value) in &common.options {
+        options.set_text(name, value);
+    }
+    options
 }
 
 /// How a solve reports progress.
@@ -177,13 +219,13 @@ pub fn write_png(png: Option<&Path>, mesh: &Mesh, solution: &Solution) -> anyhow
     let Some(path) = png else {
         return Ok(());
     };
-    let image = match &solution.map {
-        Map::Planar(z) => {
+    let image = match solution.map() {
+        Some(Map::Planar(z)) => {
             let uv: Vec<Vector2<f64>> = z.iter().map(|z| Vector2::new(z.re, z.im)).collect();
             Layout::plane_from_vertices(mesh, &uv)?
         }
-        Map::Spatial(p) => Layout::space(mesh, p.clone())?,
-        Map::OnMesh(_) => bail!("--png draws planar and spatial maps only"),
+        Some(Map::Spatial(p)) => Layout::space(mesh, p.clone())?,
+        _ => bail!("--png draws planar and spatial maps only"),
     };
     let scene = Scene::new(mesh, Some(image))?;
     beltrami_render::render(&scene, &Style::default())?
@@ -197,7 +239,7 @@ pub fn write_png(png: Option<&Path>, mesh: &Mesh, solution: &Solution) -> anyhow
 /// per-vertex |mu| (mean over the incident faces) as viridis colors.
 pub fn write_map(output: &Path, mesh: &Mesh, solution: &Solution) -> anyhow::Result<()> {
     let glb = matches!(Format::from_path(output), Some(Format::Glb | Format::Gltf));
-    let colors: Option<Vec<[f32; 3]>> = match (&solution.report.mu, glb) {
+    let colors: Option<Vec<[f32; 3]>> = match (&solution.metrics.mu, glb) {
         (Some(field), true) => Some(
             mesh.vertices()
                 .map(|v| {
@@ -215,13 +257,13 @@ pub fn write_map(output: &Path, mesh: &Mesh, solution: &Solution) -> anyhow::Res
         colors: colors.as_deref(),
         ..Default::default()
     };
-    match &solution.map {
-        Map::Planar(z) => {
+    match solution.map() {
+        Some(Map::Planar(z)) => {
             uv = z.iter().map(|z| Vector2::new(z.re, z.im)).collect();
             attributes.uvs = Some(&uv);
         }
-        Map::Spatial(p) => attributes.positions = Some(p),
-        Map::OnMesh(_) => bail!("this command writes planar and spatial maps only"),
+        Some(Map::Spatial(p)) => attributes.positions = Some(p),
+        _ => bail!("this command writes planar and spatial maps only"),
     }
     io::write(output, mesh, &attributes)?;
     Ok(())
@@ -235,24 +277,32 @@ pub fn report_json(
     solution: &Solution,
     seconds: f64,
 ) -> JsonMap<String, Value> {
-    let r = &solution.report;
-    let d = r.distortion.as_ref();
+    let (r, m, x) = (&solution.report, &solution.metrics, &solution.extras);
+    let d = m.distortion.as_ref();
     let value = json!({
         "solver": r.solver,
         "mesh": mesh.display().to_string(),
         "output": output.display().to_string(),
         "seconds": seconds,
-        "iterations": r.iterations,
+        "iterations": m.iterations,
+        "stop": m.stop.as_ref().map(|s| s.name()),
         "flipped": d.map(|d| d.flipped),
         "mu_mean": d.map(|d| d.mu_mean),
         "mu_max": d.map(|d| d.mu_max),
         "mu_std": d.map(|d| d.mu_std),
         "mu_l2": d.map(|d| d.mu_l2),
-        "initial_flipped": r.initial_distortion.as_ref().map(|d| d.flipped),
-        "initial_mu_mean": r.initial_distortion.as_ref().map(|d| d.mu_mean),
-        "initial_mu_max": r.initial_distortion.as_ref().map(|d| d.mu_max),
-        "energy_history": r.energy_history,
-        "step_sizes": r.step_sizes,
+        "initial_flipped": m.initial_distortion.as_ref().map(|d| d.flipped),
+        "initial_mu_mean": m.initial_distortion.as_ref().map(|d| d.mu_mean),
+        "initial_mu_max": m.initial_distortion.as_ref().map(|d| d.mu_max),
+        "mu_error": m.mu_error.as_ref().map(|e| json!({
+            "rms": e.rms, "l2_squared": e.l2_squared, "sup": e.sup, "sup_face": e.sup_face.idx(),
+        })),
+        "k": m.k,
+        "factorizations": m.factorizations,
+        "cg_iterations": m.cg_iterations,
+        "annulus_radius": x.annulus_radius.map(|a| a.radius),
+        "energy_history": m.energy_history,
+        "step_sizes": m.step_sizes,
         "timings": r.timings.iter().map(|(k, v)| json!({"stage": k, "seconds": v})).collect::<Vec<_>>(),
         "notes": r.notes,
     });
@@ -283,24 +333,30 @@ pub fn finish(
         println!("{report}");
     } else if !quiet {
         let (mesh, output, solution, seconds) = summary;
-        let r = &solution.report;
+        let (r, m) = (&solution.report, &solution.metrics);
         println!(
             "{} -> {} ({}, {seconds:.3} s)",
             mesh.display(),
             output.display(),
             r.solver
         );
-        if let Some(d) = &r.initial_distortion {
+        if let Some(d) = &m.initial_distortion {
             println!(
                 "  initial map     flipped {}  |mu| mean {:.4e}  max {:.4e}",
                 d.flipped, d.mu_mean, d.mu_max
             );
         }
-        if let Some(d) = &r.distortion {
+        if let Some(d) = &m.distortion {
             println!("  flipped faces   {}", d.flipped);
             println!(
                 "  |mu|            mean {:.4e}  max {:.4e}  std {:.4e}",
                 d.mu_mean, d.mu_max, d.mu_std
+            );
+        }
+        if let Some(a) = solution.extras.annulus_radius {
+            println!(
+                "  inner radius {:.6} (free; started at {:.6})",
+                a.radius, a.initial
             );
         }
         for line in extra {
@@ -317,7 +373,7 @@ pub fn finish(
         let (_, output, solution, _) = summary;
         bail!(
             "interrupted after {} iterations: the map so far was written to {}",
-            solution.report.iterations,
+            solution.metrics.iterations,
             output.display()
         );
     }

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use beltrami_core::{PlanarBoundary, Problem, Target, Weights};
+use beltrami_core::{Constraint, OptionValue, PlanarBoundary, Problem, Target};
 use clap::{Args, ValueEnum};
 
 use super::load::load_mesh;
@@ -81,12 +81,22 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     let mesh = &loaded.mesh.mesh;
 
     let mut problem = Problem::new(mesh, target_of(args)?);
-    problem.params.weights = args.weights.map(|w| match w {
-        WeightsArg::Uniform => Weights::Uniform,
-        WeightsArg::MeanValue => Weights::MeanValue,
-        WeightsArg::Cotan => Weights::Cotan,
+    let weights = args.weights.map(|w| {
+        OptionValue::Choice(
+            match w {
+                WeightsArg::Uniform => "uniform",
+                WeightsArg::MeanValue => "mean-value",
+                WeightsArg::Cotan => "cotan",
+            }
+            .to_string(),
+        )
     });
-    problem.constraints.pins = mapping::resolve_pins(&args.pins, mesh)?;
+    problem.options = mapping::solver_options(solver, &[("weights", weights, None)], &args.common);
+    problem.constraints.extend(
+        mapping::resolve_pins(&args.pins, mesh)?
+            .into_iter()
+            .map(Constraint::Pin),
+    );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
     mapping::write_map(&args.output, mesh, &solution)?;

@@ -11,8 +11,8 @@
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
-use beltrami_core::{Goal, Map, PlanarBoundary, Problem, Target};
-use beltrami_fem::{BeltramiField, Elements, MuError};
+use beltrami_core::{Constraint, Goal, Map, OptionValue, PlanarBoundary, Problem, Target};
+use beltrami_fem::BeltramiField;
 use beltrami_lsqc::Expr;
 use beltrami_mesh::io::read;
 use beltrami_mesh::{BuildOptions, Mesh};
@@ -89,16 +89,16 @@ pub struct QcArgs {
     /// nearest vertex; repeatable.
     #[arg(long = "pin")]
     pub pins: Vec<PinSpec>,
-    /// beltrami-flow: stop when the largest vertex update is below this (relative to
-    /// the target's size).
-    #[arg(long, default_value_t = 1e-6)]
-    pub tolerance: f64,
-    /// beltrami-flow: most iterations.
-    #[arg(long = "max-iters", default_value_t = 200)]
-    pub max_iters: usize,
-    /// Threads for the sparse factorizations.
-    #[arg(long, default_value_t = 1)]
-    pub threads: usize,
+    /// Iterative solvers: stop when the largest vertex update is below this (relative
+    /// to the target's size) [default: 1e-6].
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// Iterative solvers: most iterations [default: 200].
+    #[arg(long = "max-iters")]
+    pub max_iters: Option<usize>,
+    /// Threads for the sparse factorizations [default: 1].
+    #[arg(long)]
+    pub threads: Option<usize>,
     /// Output mesh: .obj (the input's vertices and faces, one `vt` per vertex with its
     /// planar image, or the image positions for the sphere) or .glb/.gltf.
     #[arg(short, long)]
@@ -209,25 +209,33 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
 
     let mut problem = Problem::new(mesh, target_of(args, mesh)?);
     problem.goal = goal;
-    problem.constraints.pins = mapping::resolve_pins(&args.pins, mesh)?;
-    problem.params.tolerance = args.tolerance;
-    problem.params.max_iterations = args.max_iters;
-    problem.params.threads = args.threads;
+    problem.constraints.extend(
+        mapping::resolve_pins(&args.pins, mesh)?
+            .into_iter()
+            .map(Constraint::Pin),
+    );
+    problem.options = mapping::solver_options(
+        solver,
+        &[
+            (
+                "tolerance",
+                args.tolerance.map(OptionValue::Float),
+                Some(OptionValue::Float(1e-6)),
+            ),
+            (
+                "max-iters",
+                args.max_iters.map(OptionValue::Int),
+                Some(OptionValue::Int(200)),
+            ),
+            ("threads", args.threads.map(OptionValue::Int), None),
+        ],
+        &args.common,
+    );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    let error = match (&solution.report.mu, &field) {
-        (Some(measured), Some(field)) if measured.frame == field.frame => {
-            let elements = Elements::new(mesh, field.frame)?;
-            Some(MuError::new(&elements, &measured.mu, &field.mu)?)
-        }
-        (Some(measured), None) => {
-            let elements = Elements::new(mesh, measured.frame)?;
-            let zero = vec![Complex64::default(); measured.mu.len()];
-            Some(MuError::new(&elements, &measured.mu, &zero)?)
-        }
-        _ => None,
-    };
-    if let (Map::Spatial(_), false) = (&solution.map, args.target == TargetArg::Sphere) {
+    let error = solution.metrics.mu_error;
+    let _ = &field;
+    if let (Some(Map::Spatial(_)), false) = (solution.map(), args.target == TargetArg::Sphere) {
         bail!("{} gave points in space for a planar target", solver.name());
     }
     mapping::write_map(&args.output, mesh, &solution)?;
@@ -265,18 +273,18 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             )
         })
         .collect();
-    if solution.report.iterations > 0 {
+    if solution.metrics.iterations > 0 {
         extra.push(format!(
             "iterations      {} (error {:.4e} -> {:.4e})",
-            solution.report.iterations,
+            solution.metrics.iterations,
             solution
-                .report
+                .metrics
                 .energy_history
                 .first()
                 .copied()
                 .unwrap_or(0.0),
             solution
-                .report
+                .metrics
                 .energy_history
                 .last()
                 .copied()

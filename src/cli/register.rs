@@ -6,7 +6,9 @@ use std::io::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
-use beltrami_core::{Curve, Goal, Map, Pin, Position, Problem, Solution, Target};
+use beltrami_core::{
+    Constraint, Curve, Goal, Landmark, Map, OptionValue, Output, Position, Problem, Target,
+};
 use beltrami_fem::BeltramiField;
 use beltrami_mesh::io;
 use clap::Args;
@@ -32,15 +34,16 @@ pub struct RegisterArgs {
     /// Landmarks and feature curves (`v SRC TGT`, `p SRC x y z`, `c SRC,.. TGT,..`).
     #[arg(long)]
     pub landmarks: Option<PathBuf>,
-    /// Most flow iterations.
-    #[arg(long = "max-iters", default_value_t = 100)]
-    pub max_iters: usize,
-    /// Stop when the largest vertex update is below this (relative to the target's size).
-    #[arg(long, default_value_t = 1e-5)]
-    pub tolerance: f64,
-    /// Threads for the sparse factorizations.
-    #[arg(long, default_value_t = 1)]
-    pub threads: usize,
+    /// Most flow iterations [default: 100].
+    #[arg(long = "max-iters")]
+    pub max_iters: Option<usize>,
+    /// Stop when the largest vertex update is below this (relative to the target's
+    /// size) [default: 1e-5].
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// Threads for the sparse factorizations [default: 1].
+    #[arg(long)]
+    pub threads: Option<usize>,
     /// Output mesh: the source's vertices and faces, every vertex at its image on the
     /// target (so `beltrami distortion SOURCE OUT` measures the map).
     #[arg(short, long)]
@@ -71,39 +74,47 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read the landmarks {}", path.display()))?;
         let parsed = landmarks::parse(path, &text, source, target)?;
-        problem.constraints.pins = parsed
-            .points
-            .iter()
-            .map(|l| Pin {
+        problem.constraints.extend(parsed.points.iter().map(|l| {
+            Constraint::Landmark(Landmark {
                 vertex: l.source,
-                position: Some(Position::Spatial(match l.goal {
+                position: Position::Spatial(match l.goal {
                     LandmarkGoal::Vertex(w) => target.position(w),
                     LandmarkGoal::Point(p) => p,
-                })),
+                }),
             })
-            .collect();
-        problem.constraints.curves = parsed
-            .curves
-            .into_iter()
-            .map(|c| Curve {
-                source: c.source,
-                target: c.target,
-            })
-            .collect();
+        }));
+        problem.constraints.extend(
+            parsed
+                .curves
+                .into_iter()
+                .map(|c| Constraint::Curve(Curve::open(c.source, c.target))),
+        );
     }
-    problem.params.max_iterations = args.max_iters;
-    problem.params.tolerance = args.tolerance;
-    problem.params.threads = args.threads;
+    problem.options = mapping::solver_options(
+        solver,
+        &[
+            (
+                "tolerance",
+                args.tolerance.map(OptionValue::Float),
+                Some(OptionValue::Float(1e-5)),
+            ),
+            (
+                "max-iters",
+                args.max_iters.map(OptionValue::Int),
+                Some(OptionValue::Int(100)),
+            ),
+            ("threads", args.threads.map(OptionValue::Int), None),
+        ],
+        &args.common,
+    );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    let Map::OnMesh(points) = &solution.map else {
+    let Some(Map::OnMesh(points)) = solution.map() else {
         bail!("the register solver did not give points on the target mesh");
     };
     let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
-    let spatial = Solution {
-        map: Map::Spatial(positions),
-        report: solution.report.clone(),
-    };
+    let mut spatial = solution.clone();
+    spatial.output = Output::Map(Map::Spatial(positions));
     mapping::write_map(&args.output, source, &spatial)?;
     if let Some(path) = &args.correspondence {
         io::write_atomically(path, |w| {
@@ -125,7 +136,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
 
     let mut report = mapping::report_json(&args.source, &args.output, &spatial, seconds);
     report.insert("target".into(), json!(args.target.display().to_string()));
-    let steps = solution.report.iterations.max(1) as f64;
+    let steps = solution.metrics.iterations.max(1) as f64;
     let per_step: f64 = solution
         .report
         .timings
@@ -137,7 +148,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     report.insert("seconds_per_step".into(), json!(per_step));
     let extra = vec![format!(
         "iterations      {} ({per_step:.3} s per step)",
-        solution.report.iterations
+        solution.metrics.iterations
     )];
     mapping::finish(
         report,

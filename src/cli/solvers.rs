@@ -1,7 +1,6 @@
-//! `beltrami solvers`: the registered solvers and what each accepts.
+//! `beltrami solvers`: the registered solvers, what each accepts and its options.
 
 use clap::Args;
-use serde_json::json;
 
 #[derive(Debug, Args)]
 pub struct SolversArgs {
@@ -15,14 +14,13 @@ pub fn run(args: &SolversArgs) -> anyhow::Result<()> {
     if args.json {
         let list: Vec<_> = registry
             .iter()
-            .map(|s| json!({"name": s.name(), "description": s.description(), "accepts": s.accepts()}))
+            .map(beltrami::catalog::solver_json)
             .collect();
         println!("{}", serde_json::Value::Array(list));
         return Ok(());
     }
     for s in registry.iter() {
-        println!("{:<14} {}", s.name(), s.description());
-        println!("{:<14} accepts: {}", "", s.accepts());
+        print!("{}", beltrami::catalog::solver_text(s));
     }
     Ok(())
 }

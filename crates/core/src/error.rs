@@ -4,6 +4,8 @@ use beltrami_fem::{DofError, FemError, FieldError, SolveError};
 use beltrami_mesh::MeshError;
 use thiserror::Error;
 
+use crate::{ConstraintError, OptionError};
+
 /// Why a solve could not be done.
 #[derive(Debug, Error)]
 pub enum SolverError {
@@ -33,6 +35,18 @@ pub enum SolverError {
         name: String,
         /// The registered names, comma-separated.
         available: String,
+    },
+    /// An option value was refused (unknown name, wrong type, out of range).
+    #[error(transparent)]
+    Option(#[from] OptionError),
+    /// A constraint is malformed (a missing vertex, a non-finite point, ...).
+    #[error("{solver}: {error}")]
+    Constraint {
+        /// The solver's name.
+        solver: &'static str,
+        /// What is wrong, naming the constraint and the element.
+        #[source]
+        error: ConstraintError,
     },
     /// The solve was cancelled.
     #[error("cancelled")]

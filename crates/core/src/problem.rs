@@ -1,5 +1,5 @@
 //! What a solver is asked to compute: source, target, goal, constraints, initial map and
-//! parameters.
+//! option values.
 //!
 //! The types cover every solver of the design, not only the ones that exist today:
 //! initial parameterizations (Tutte, harmonic, LSCM, sphere), least-squares QC maps for a
@@ -12,7 +12,7 @@ use beltrami_fem::BeltramiField;
 use beltrami_mesh::{Mesh, Point3, VertexId};
 use num_complex::Complex64;
 
-use crate::Map;
+use crate::{Constraints, Map, Options};
 
 /// Where the boundary of a planar map goes.
 #[derive(Debug, Clone, PartialEq)]
@@ -90,36 +90,6 @@ pub enum Position {
     Spatial(Point3<f64>),
 }
 
-/// A vertex held at a position (`position: None` lets the solver choose, e.g. LSCM's
-/// default (0, 0) and (1, 0)).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Pin {
-    /// The pinned vertex.
-    pub vertex: VertexId,
-    /// Where it goes, if prescribed.
-    pub position: Option<Position>,
-}
-
-/// A chain of source vertices that must map onto a target curve, ends fixed, sliding
-/// in between.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Curve {
-    /// Source vertices, in order.
-    pub source: Vec<VertexId>,
-    /// The target curve: vertices of the target mesh (or of the source, for maps of the
-    /// surface into itself), in order.
-    pub target: Vec<VertexId>,
-}
-
-/// Constraints shared by all solvers.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Constraints {
-    /// Pinned vertices (pins and landmarks).
-    pub pins: Vec<Pin>,
-    /// Curve correspondences.
-    pub curves: Vec<Curve>,
-}
-
 /// Edge weights of linear initializations.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Weights {
@@ -131,30 +101,6 @@ pub enum Weights {
     Cotan,
 }
 
-/// Numerical parameters common to the solvers; each documents which it reads.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Params {
-    /// Edge weights of linear maps (`None`: the solver's default).
-    pub weights: Option<Weights>,
-    /// Convergence tolerance of iterative solvers (largest vertex update).
-    pub tolerance: f64,
-    /// Iteration limit of iterative solvers.
-    pub max_iterations: usize,
-    /// Threads for sparse factorizations (1: sequential).
-    pub threads: usize,
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Self {
-            weights: None,
-            tolerance: 1e-6,
-            max_iterations: 500,
-            threads: 1,
-        }
-    }
-}
-
 /// A mapping problem.
 #[derive(Debug, Clone)]
 pub struct Problem<'a> {
@@ -164,12 +110,13 @@ pub struct Problem<'a> {
     pub target: Target<'a>,
     /// What the map should achieve.
     pub goal: Goal,
-    /// Pins and curves.
+    /// Pins, landmarks, slides, curves, loop matches, normal/area constraints,
+    /// reference angles.
     pub constraints: Constraints,
     /// A starting map for iterative solvers.
     pub initial: Option<Map>,
-    /// Numerical parameters.
-    pub params: Params,
+    /// Option values set by the user (the solver's declarations give the rest).
+    pub options: Options,
 }
 
 impl<'a> Problem<'a> {
@@ -181,7 +128,7 @@ impl<'a> Problem<'a> {
             goal: Goal::default(),
             constraints: Constraints::default(),
             initial: None,
-            params: Params::default(),
+            options: Options::default(),
         }
     }
 }

@@ -1,15 +1,17 @@
-//! The [`Solver`] trait, the solve [`Context`] (progress and cancellation), and the
-//! [`Solution`] with its [`Report`].
+//! The [`Solver`] trait and the solve [`Context`] (progress and cancellation).
 
+use crate::{Accepts, OptionSpec, Problem, Report, Settings, Solution, SolverError, Target};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
-
-use beltrami_fem::{BeltramiField, DistortionStats};
-
-use crate::{Map, Problem, SolverError};
 
 /// A mapping algorithm behind a stable name.
+///
+/// An implementation states what it accepts ([`Solver::accepts`], as data) and its
+/// options ([`Solver::options`]), checks what is particular to it
+/// ([`Solver::check_problem`]) and computes ([`Solver::run`]). Callers use the provided
+/// [`Solver::check`] and [`Solver::solve`], which run one validation: the options
+/// ([`Settings::resolve`]), the constraints ([`crate::Constraints::validate`]), the
+/// solver's own check, then the accepted kinds ([`Accepts::check`]), all before any work.
 pub trait Solver: Send + Sync {
     /// The stable name users select it by (`--solver NAME`).
     fn name(&self) -> &'static str;
@@ -17,19 +19,55 @@ pub trait Solver: Send + Sync {
     /// One line on what it computes.
     fn description(&self) -> &'static str;
 
-    /// What it accepts (topology, targets, goals, constraints), for listings.
-    fn accepts(&self) -> &'static str;
+    /// What it accepts: element types, topologies, targets, goals, constraint kinds.
+    fn accepts(&self) -> Accepts;
 
-    /// Answers, before any work, whether the solver can take `problem`; the error says
-    /// in plain words why not and what to do instead.
-    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError>;
+    /// Its options with types, defaults and ranges (none by default).
+    fn options(&self) -> &'static [OptionSpec] {
+        &[]
+    }
 
-    /// Computes the map. Implementations call [`Solver::check`] first.
+    /// The checks particular to this solver, after the options and constraints were
+    /// found well-formed; the error says in plain words why not and what to do instead.
+    fn check_problem(&self, problem: &Problem<'_>, settings: &Settings) -> Result<(), SolverError>;
+
+    /// Computes the solution of a problem that passed [`Solver::check`].
+    fn run(
+        &self,
+        problem: &Problem<'_>,
+        settings: &Settings,
+        context: &mut Context<'_>,
+    ) -> Result<Solution, SolverError>;
+
+    /// Answers, before any work, whether the solver can take `problem`, and returns its
+    /// resolved settings (module docs of [`Solver`] list the steps).
+    fn check(&self, problem: &Problem<'_>) -> Result<Settings, SolverError> {
+        let settings = Settings::resolve(self.name(), self.options(), &problem.options)?;
+        let target = match &problem.target {
+            Target::Mesh(mesh) => Some(*mesh),
+            _ => None,
+        };
+        problem
+            .constraints
+            .validate(problem.source, target)
+            .map_err(|error| SolverError::Constraint {
+                solver: self.name(),
+                error,
+            })?;
+        self.check_problem(problem, &settings)?;
+        self.accepts().check(self.name(), problem)?;
+        Ok(settings)
+    }
+
+    /// Checks `problem` ([`Solver::check`]) and computes its solution.
     fn solve(
         &self,
         problem: &Problem<'_>,
         context: &mut Context<'_>,
-    ) -> Result<Solution, SolverError>;
+    ) -> Result<Solution, SolverError> {
+        let settings = self.check(problem)?;
+        self.run(problem, &settings, context)
+    }
 }
 
 /// Progress of a running solve.
@@ -128,67 +166,4 @@ impl<'a> Context<'a> {
             Ok(())
         }
     }
-}
-
-/// How a solve went.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Report {
-    /// The solver's name.
-    pub solver: String,
-    /// Iterations done (0 for direct solvers).
-    pub iterations: usize,
-    /// Energy or error after each iteration (direct solvers: the final energy, if any).
-    pub energy_history: Vec<f64>,
-    /// The step size taken at each iteration of an iterative solver (empty for direct
-    /// solvers).
-    pub step_sizes: Vec<f64>,
-    /// Beltrami coefficient of the result per face, when measured.
-    pub mu: Option<BeltramiField>,
-    /// Statistics of `|mu|` and the flipped-face count, when measured.
-    pub distortion: Option<DistortionStats>,
-    /// The same for the map an iterative solver started from, when measured.
-    pub initial_distortion: Option<DistortionStats>,
-    /// Named timings in seconds, in the order they happened.
-    pub timings: Vec<(String, f64)>,
-    /// Remarks for the user (e.g. "3 faces flipped: cotangent weights are negative on
-    /// obtuse triangles").
-    pub notes: Vec<String>,
-}
-
-impl Report {
-    /// An empty report for `solver`.
-    pub fn new(solver: &str) -> Self {
-        Self {
-            solver: solver.to_string(),
-            ..Self::default()
-        }
-    }
-
-    /// Runs `f`, recording its duration under `name`.
-    pub fn time<T>(&mut self, name: &str, f: impl FnOnce() -> T) -> T {
-        let start = Instant::now();
-        let out = f();
-        self.timings
-            .push((name.to_string(), start.elapsed().as_secs_f64()));
-        out
-    }
-
-    /// Total of the recorded timings.
-    pub fn seconds(&self) -> f64 {
-        self.timings.iter().map(|(_, s)| s).sum()
-    }
-
-    /// Number of flipped faces, when measured.
-    pub fn flipped(&self) -> Option<usize> {
-        self.distortion.as_ref().map(|d| d.flipped)
-    }
-}
-
-/// The result of a solve: the map and its report.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Solution {
-    /// Images of the source vertices.
-    pub map: Map,
-    /// How it went.
-    pub report: Report,
 }

@@ -272,7 +272,26 @@ impl MuError {
         measured: &[Complex64],
         target: &[Complex64],
     ) -> Result<Self, FemError> {
-        let faces = elements.face_count();
+        let areas: Vec<f64> = (0..elements.face_count())
+            .map(|f| {
+                elements
+                    .face_points(FaceId(f as u32))
+                    .iter()
+                    .map(|q| q.weight)
+                    .sum()
+            })
+            .collect();
+        Self::from_areas(&areas, measured, target)
+    }
+
+    /// The error of `measured` against `target` with face areas `areas` (one value per
+    /// face each). Fails with [`FemError::Length`] for a wrong length.
+    pub fn from_areas(
+        areas: &[f64],
+        measured: &[Complex64],
+        target: &[Complex64],
+    ) -> Result<Self, FemError> {
+        let faces = areas.len();
         for (what, values) in [("measured mu", measured), ("target mu", target)] {
             if values.len() != faces {
                 return Err(FemError::Length {
@@ -285,7 +304,7 @@ impl MuError {
         let (mut area, mut l2_squared, mut sup, mut sup_face) = (0.0, 0.0, 0.0, FaceId(0));
         for (f, (m, t)) in measured.iter().zip(target).enumerate() {
             let face = FaceId(f as u32);
-            let a: f64 = elements.face_points(face).iter().map(|q| q.weight).sum();
+            let a = areas[f];
             let d = (m - t).norm();
             area += a;
             l2_squared += a * d * d;

@@ -51,9 +51,6 @@ use crate::target::{Role, TargetGeometry};
 /// already conformal keep a positive weight.
 const MU_FLOOR: f64 = 1e-3;
 
-/// The smallest step size tried (`2^-50`): below it the step is lost in rounding.
-const MIN_STEP: f64 = 8.881_784_197_001_252e-16;
-
 /// How the iteration ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stop {
@@ -81,6 +78,9 @@ pub struct FlowOptions {
     /// trial is cheap; on a target mesh a trial that moves points across much of the
     /// surface costs a long walk and is not accepted anyway.
     pub max_move: f64,
+    /// The smallest step size tried; below it a step is lost in rounding (`2^-50` by
+    /// default).
+    pub min_step: f64,
 }
 
 /// The result of [`run`].
@@ -273,7 +273,7 @@ pub fn run<G: TargetGeometry>(
             1.0
         };
         let accepted = loop {
-            if t * largest < options.tolerance || t < MIN_STEP {
+            if t * largest < options.tolerance || t < options.min_step {
                 break None;
             }
             let moved = step(

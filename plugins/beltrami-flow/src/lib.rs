@@ -32,7 +32,7 @@ pub mod system;
 pub mod target;
 mod validate;
 
-pub use solver::BeltramiFlow;
+pub use solver::{ACCEPTS, BeltramiFlow, OPTIONS};
 
 /// The solver's name.
 pub const NAME: &str = "beltrami-flow";

@@ -1,7 +1,9 @@
 //! Setting up a flow: the initial map, the target geometry, the role of every vertex,
 //! the pins and the landmark goals.
 
-use beltrami_core::{Context, Map, PlanarBoundary, Position, Problem, Solver, SolverError, Target};
+use beltrami_core::{
+    Constraint, Context, Map, Output, PlanarBoundary, Problem, Solver, SolverError, Target,
+};
 use beltrami_fem::element::is_planar;
 use beltrami_init::{Sphere, Tutte};
 use beltrami_mesh::{Mesh, Point3, VertexId};
@@ -15,7 +17,11 @@ use crate::validate::{ON_TARGET, annulus_of, invalid, unsupported};
 const CORNER_ANGLE: f64 = 1e-6;
 
 /// The map the flow starts from, as points of R^3 (z = 0 for planar targets).
-pub(crate) fn initial_map(problem: &Problem<'_>) -> Result<Vec<Point3<f64>>, SolverError> {
+/// `threads` is passed to the initialization's factorizations.
+pub(crate) fn initial_map(
+    problem: &Problem<'_>,
+    threads: usize,
+) -> Result<Vec<Point3<f64>>, SolverError> {
     let mesh = problem.source;
     if let Some(map) = &problem.initial {
         return Ok(match (map, &problem.target) {
@@ -37,8 +43,8 @@ pub(crate) fn initial_map(problem: &Problem<'_>) -> Result<Vec<Point3<f64>>, Sol
             }
         });
     }
-    let planar_points = |map: Map| match map {
-        Map::Planar(z) => Ok(z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect()),
+    let planar_points = |output: Output| match output {
+        Output::Map(Map::Planar(z)) => Ok(z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect()),
         _ => Err(invalid("the initial map is not planar")),
     };
     let identity = || {
@@ -48,14 +54,13 @@ pub(crate) fn initial_map(problem: &Problem<'_>) -> Result<Vec<Point3<f64>>, Sol
             .collect()
     };
     let mut init = Problem::new(mesh, problem.target.clone());
-    init.params = problem.params;
-    init.constraints.pins = problem.constraints.pins.clone();
+    init.options
+        .set("threads", beltrami_core::OptionValue::Int(threads));
     match &problem.target {
         Target::Plane(PlanarBoundary::Keep) => Ok(identity()),
         Target::Plane(b @ (PlanarBoundary::Square { .. } | PlanarBoundary::Polygon(_))) => {
             init.target = Target::Plane(b.clone());
-            init.constraints.pins.clear();
-            planar_points(Tutte.solve(&init, &mut Context::new())?.map)
+            planar_points(Tutte.solve(&init, &mut Context::new())?.output)
         }
         Target::Plane(_) | Target::Disk => {
             let on_circle = is_planar(mesh)
@@ -67,8 +72,7 @@ pub(crate) fn initial_map(problem: &Problem<'_>) -> Result<Vec<Point3<f64>>, Sol
                 return Ok(identity());
             }
             init.target = Target::Plane(PlanarBoundary::Circle);
-            init.constraints.pins.clear();
-            planar_points(Tutte.solve(&init, &mut Context::new())?.map)
+            planar_points(Tutte.solve(&init, &mut Context::new())?.output)
         }
         Target::Annulus { inner_radius } => {
             let (r0, _) = annulus_of(mesh)?;
@@ -93,9 +97,8 @@ pub(crate) fn initial_map(problem: &Problem<'_>) -> Result<Vec<Point3<f64>>, Sol
             if on_sphere {
                 return Ok(mesh.positions().to_vec());
             }
-            init.constraints.pins.clear();
-            match Sphere.solve(&init, &mut Context::new())?.map {
-                Map::Spatial(p) => Ok(p),
+            match Sphere.solve(&init, &mut Context::new())?.output {
+                Output::Map(Map::Spatial(p)) => Ok(p),
                 _ => Err(invalid(
                     "the sphere initialization did not give points of R^3",
                 )),
@@ -231,12 +234,22 @@ pub(crate) fn curve_roles(
     roles
 }
 
-/// The pinned vertices: the problem's, or the default ones of the target (the vertex
-/// nearest to each normalization point of the initial map).
+/// The held vertices: the problem's pins and landmarks (a landmark is held once it has
+/// arrived), or, with neither, the default ones of the target (the vertex nearest to
+/// each normalization point of the initial map).
 pub(crate) fn pins(problem: &Problem<'_>, image: &[Point3<f64>]) -> Vec<VertexId> {
     let mesh = problem.source;
-    if !problem.constraints.pins.is_empty() {
-        return problem.constraints.pins.iter().map(|p| p.vertex).collect();
+    let given: Vec<VertexId> = problem
+        .constraints
+        .iter()
+        .filter_map(|c| match c {
+            Constraint::Pin(p) => Some(p.vertex),
+            Constraint::Landmark(l) => Some(l.vertex),
+            _ => None,
+        })
+        .collect();
+    if !given.is_empty() {
+        return given;
     }
     let nearest = |candidates: &mut dyn Iterator<Item = VertexId>, q: Point3<f64>| {
         candidates.min_by(|&a, &b| {
@@ -293,14 +306,12 @@ pub(crate) fn diagonal(image: &[Point3<f64>]) -> f64 {
         .max(f64::MIN_POSITIVE)
 }
 
-/// Per source vertex, the point a landmark pulls it to (pins with a position on a target
-/// mesh: the vertex is moved there by the flow, then held).
+/// Per source vertex, the point a landmark pulls it to (the vertex is moved there by
+/// the flow, then held).
 pub(crate) fn goals(problem: &Problem<'_>) -> Vec<Option<Point3<f64>>> {
     let mut goals = vec![None; problem.source.vertex_count()];
-    for pin in &problem.constraints.pins {
-        if let Some(Position::Spatial(p)) = pin.position {
-            goals[pin.vertex.idx()] = Some(p);
-        }
+    for mark in problem.constraints.landmarks() {
+        goals[mark.vertex.idx()] = Some(mark.position.to_point());
     }
     goals
 }
@@ -332,7 +343,7 @@ pub(crate) fn mesh_roles(
             roles[v.idx()] = Role::Curve(c);
         }
     }
-    for curve in &problem.constraints.curves {
+    for curve in problem.constraints.curves() {
         let c = curves.len();
         curves.push(TargetCurve::through(target, &curve.target, false));
         let n = curve.source.len();

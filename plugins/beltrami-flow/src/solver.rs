@@ -1,7 +1,11 @@
 //! [`BeltramiFlow`]: the solver behind `--solver beltrami-flow` (crate docs).
 
-use beltrami_core::{Context, Map, Problem, Report, Solution, Solver, SolverError, Target};
-use beltrami_fem::{BeltramiField, DistortionStats, Elements, Frame, SolveOptions};
+use beltrami_core::{
+    Accepts, AnnulusRadius, ConstraintKind, Context, Element, Extras, GoalKind, Map, Metrics,
+    OptionKind, OptionSpec, Output, Problem, Report, Settings, Solution, Solver, SolverError,
+    THREADS, Target, TargetKind, Topology,
+};
+use beltrami_fem::{BeltramiField, DistortionStats, Elements, Frame, MuError, SolveOptions};
 use beltrami_mesh::{Point3, VertexId};
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
@@ -21,17 +25,84 @@ use crate::validate::{invalid, validate};
 ///
 /// Reads: `goal` (`Conformal { p >= 2 }` or `Prescribed(field)`), `target`
 /// (`Plane(Keep | Square | Polygon | Circle)`, `Disk`, `Annulus`, `Sphere`, `Mesh` with
-/// an initial map onto it — the register solver builds one — and `constraints.curves`),
-/// `constraints.pins` (held where the initial map puts them), `initial` (a planar or
-/// spatial map to start from; its images are projected onto the target first),
-/// `params.tolerance` (largest vertex update, relative to the target's size),
-/// `params.max_iterations` and `params.threads`.
+/// an initial map onto it — the register solver builds one — with open feature curves
+/// and landmarks), pins without positions (held where the initial map puts them),
+/// `initial` (a planar or spatial map to start from; its images are projected onto the
+/// target first) and the options ([`OPTIONS`]).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BeltramiFlow;
 
-/// On a target mesh, the largest vertex move tried in one step, relative to the target's
-/// bounding-box diagonal ([`FlowOptions::max_move`]).
-const MESH_MAX_MOVE: f64 = 0.05;
+/// The flow's options.
+pub const OPTIONS: &[OptionSpec] = &[
+    OptionSpec {
+        name: "tolerance",
+        kind: OptionKind::Float {
+            default: 1e-6,
+            min: 0.0,
+            max: 1.0,
+        },
+        help: "stop when the largest vertex update is below this, relative to the target's size",
+    },
+    OptionSpec {
+        name: "max-iters",
+        kind: OptionKind::Int {
+            default: 500,
+            min: 0,
+            max: 1_000_000,
+        },
+        help: "flow steps at most",
+    },
+    OptionSpec {
+        name: "max-move",
+        kind: OptionKind::Float {
+            default: 0.05,
+            min: 1e-9,
+            max: 1.0,
+        },
+        help: "on a target mesh, the largest vertex move tried in one step, relative to the target's bounding-box diagonal",
+    },
+    OptionSpec {
+        name: "min-step",
+        kind: OptionKind::Float {
+            default: 8.881_784_197_001_252e-16,
+            min: 0.0,
+            max: 1.0,
+        },
+        help: "the smallest step size tried (2^-50: below it a step is lost in rounding)",
+    },
+    THREADS,
+];
+
+/// What the flow accepts.
+pub const ACCEPTS: Accepts = Accepts {
+    elements: &[Element::Triangle],
+    topologies: &[
+        Topology::Disk,
+        Topology::Annulus,
+        Topology::Sphere,
+        Topology::Torus,
+    ],
+    targets: &[
+        TargetKind::PlaneKeep,
+        TargetKind::PlaneCircle,
+        TargetKind::PlaneSquare,
+        TargetKind::PlanePolygon,
+        TargetKind::Disk,
+        TargetKind::Annulus,
+        TargetKind::Sphere,
+        TargetKind::Mesh,
+    ],
+    goals: &[
+        GoalKind::Conformal,
+        GoalKind::ConformalLp,
+        GoalKind::Prescribed,
+    ],
+    constraints: &[
+        ConstraintKind::Hold,
+        ConstraintKind::Landmark,
+        ConstraintKind::OpenCurve,
+    ],
+};
 
 impl Solver for BeltramiFlow {
     fn name(&self) -> &'static str {
@@ -42,26 +113,39 @@ impl Solver for BeltramiFlow {
         "discrete Beltrami flow: a bijective map onto a fixed target with a prescribed mu or the smallest L^p norm of mu"
     }
 
-    fn accepts(&self) -> &'static str {
-        "triangle meshes; targets: plane (the input's own polygon, square, polygon), disk, annulus (fixed or free inner radius) for disks/annuli, sphere for closed genus 0, a target mesh of the same topology from an initial map (see register); goals: prescribed mu (global or face frame), conformal L^p (p >= 2); pins, landmarks and feature curves on target meshes"
+    fn accepts(&self) -> Accepts {
+        ACCEPTS
     }
 
-    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+    fn options(&self) -> &'static [OptionSpec] {
+        OPTIONS
+    }
+
+    fn check_problem(
+        &self,
+        problem: &Problem<'_>,
+        _settings: &Settings,
+    ) -> Result<(), SolverError> {
         validate(problem).map(|_| ())
     }
 
-    fn solve(
+    fn run(
         &self,
         problem: &Problem<'_>,
+        settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
         let goal = validate(problem)?;
         let mesh = problem.source;
         let mut report = Report::new(NAME);
+        let mut metrics = Metrics::default();
+        let mut extras = Extras::default();
         let elements = context.stage("elements", &mut report, || {
             Ok(Elements::new(mesh, goal.frame)?)
         })?;
-        let initial = context.stage("initial map", &mut report, || initial_map(problem))?;
+        let threads = settings.int("threads");
+        let initial =
+            context.stage("initial map", &mut report, || initial_map(problem, threads))?;
         let objective = Objective {
             areas: (0..mesh.face_count())
                 .map(|f| elements.face_points(beltrami_mesh::FaceId(f as u32))[0].weight)
@@ -70,7 +154,7 @@ impl Solver for BeltramiFlow {
             p: goal.p,
         };
         let options = SolveOptions {
-            threads: problem.params.threads,
+            threads,
             ..SolveOptions::default()
         };
         let planar = !matches!(problem.target, Target::Sphere);
@@ -78,11 +162,13 @@ impl Solver for BeltramiFlow {
             elements: &elements,
             objective: &objective,
             problem,
+            settings,
             options,
         };
         let input = |v: VertexId| mesh.vertex_map().to_input(v);
         let pins = pins(problem, &initial);
-        if problem.constraints.pins.is_empty() && !pins.is_empty() {
+        let given = problem.constraints.pins().count() + problem.constraints.landmarks().count();
+        if given == 0 && !pins.is_empty() {
             let names: Vec<String> = pins.iter().map(|&v| input(v).to_string()).collect();
             report.notes.push(format!(
                 "pinned vertices {} (input indices) where the initial map puts them, to fix the target's conformal automorphisms",
@@ -102,12 +188,12 @@ impl Solver for BeltramiFlow {
                 initial,
                 scale,
                 context,
-                &mut report,
+                (&mut report, &mut metrics),
             )?;
             let points = geometry.locate_all(&run.image)?;
             let (_, faces_mu, flipped) = run.finish(false);
             return finish_solution(
-                report,
+                (report, metrics, extras),
                 goal.frame,
                 &objective,
                 faces_mu,
@@ -122,41 +208,49 @@ impl Solver for BeltramiFlow {
                 let scale = diagonal(&image);
                 let roles = region_roles(mesh, &g, &image, &pins);
                 runner
-                    .run(g, roles, image, scale, context, &mut report)?
+                    .run(g, roles, image, scale, context, (&mut report, &mut metrics))?
                     .finish(planar)
             }
             Domain::Disk(g) => {
                 let roles = curve_roles(mesh, &pins, |_| 0);
                 runner
-                    .run(g, roles, image, 1.0, context, &mut report)?
+                    .run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?
                     .finish(planar)
             }
             Domain::Annulus(g, outer) => {
                 let roles = curve_roles(mesh, &pins, |l| if l == outer { OUTER } else { INNER });
-                let run = runner.run(g, roles, image, 1.0, context, &mut report)?;
+                let run = runner.run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?;
                 if g.free_inner {
-                    report.notes.push(format!(
-                        "inner radius {:.6} (free; started at {:.6})",
-                        run.target.inner_radius, g.inner_radius
-                    ));
+                    extras.annulus_radius = Some(AnnulusRadius {
+                        radius: run.target.inner_radius,
+                        initial: g.inner_radius,
+                    });
                 }
                 run.finish(planar)
             }
             Domain::Sphere(g) => {
                 let roles = curve_roles(mesh, &pins, |_| 0);
                 runner
-                    .run(g, roles, image, 1.0, context, &mut report)?
+                    .run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?
                     .finish(planar)
             }
         };
         let (map, faces_mu, flipped) = outcome;
-        finish_solution(report, goal.frame, &objective, faces_mu, &flipped, map)
+        finish_solution(
+            (report, metrics, extras),
+            goal.frame,
+            &objective,
+            faces_mu,
+            &flipped,
+            map,
+        )
     }
 }
 
-/// The solution with its measured `mu`, statistics and a note on remaining flips.
+/// The solution with its measured `mu`, statistics, `|mu - target|` for a prescribed
+/// goal, and a note on remaining flips.
 fn finish_solution(
-    mut report: Report,
+    (mut report, mut metrics, extras): (Report, Metrics, Extras),
     frame: Frame,
     objective: &Objective,
     faces_mu: Vec<Complex64>,
@@ -170,9 +264,23 @@ fn finish_solution(
             stats.flipped
         ));
     }
-    report.mu = Some(BeltramiField::new(frame, faces_mu));
-    report.distortion = Some(stats);
-    Ok(Solution { map, report })
+    let zero;
+    let sigma = match &objective.sigma {
+        Some(sigma) => sigma,
+        None => {
+            zero = vec![Complex64::default(); faces_mu.len()];
+            &zero
+        }
+    };
+    metrics.mu_error = Some(MuError::from_areas(&objective.areas, &faces_mu, sigma)?);
+    metrics.mu = Some(BeltramiField::new(frame, faces_mu));
+    metrics.distortion = Some(stats);
+    Ok(Solution {
+        output: Output::Map(map),
+        metrics,
+        extras,
+        report,
+    })
 }
 
 /// What every flow run of one solve shares.
@@ -180,6 +288,7 @@ struct Runner<'a, 'p> {
     elements: &'a Elements,
     objective: &'a Objective,
     problem: &'a Problem<'p>,
+    settings: &'a Settings,
     options: SolveOptions,
 }
 
@@ -193,22 +302,28 @@ impl Runner<'_, '_> {
         image: Vec<Point3<f64>>,
         scale: f64,
         context: &mut Context<'_>,
-        report: &mut Report,
+        (report, metrics): (&mut Report, &mut Metrics),
     ) -> Result<FlowRun<G>, SolverError> {
-        let (elements, objective, problem, options) =
-            (self.elements, self.objective, self.problem, self.options);
+        let (elements, objective, problem, settings, options) = (
+            self.elements,
+            self.objective,
+            self.problem,
+            self.settings,
+            self.options,
+        );
         let mut system = context.stage("symbolic", report, || {
             FlowSystem::new(elements, &target, &image, roles, options)
         })?;
         let flow_options = FlowOptions {
-            tolerance: problem.params.tolerance * scale,
-            max_iterations: problem.params.max_iterations,
+            tolerance: settings.float("tolerance") * scale,
+            max_iterations: settings.int("max-iters"),
             solve: options,
             max_move: if matches!(problem.target, Target::Mesh(_)) {
-                MESH_MAX_MOVE * scale
+                settings.float("max-move") * scale
             } else {
                 f64::INFINITY
             },
+            min_step: settings.float("min-step"),
         };
         let run = report.time("flow", || {
         flow::run(
@@ -234,13 +349,19 @@ impl Runner<'_, '_> {
         report
             .timings
             .push(("flow: steps".into(), run.step_seconds));
-        report.iterations = run.iterations();
-        report.notes.push(format!(
-            "{} numeric factorizations; {} conjugate-gradient iterations on steps that reused one",
-            run.factorizations, run.cg_iterations
-        ));
-        report.energy_history = run.energy_history.clone();
-        report.step_sizes = run.step_sizes.clone();
+        metrics.iterations = run.iterations();
+        metrics.factorizations = Some(run.factorizations);
+        metrics.cg_iterations = Some(run.cg_iterations);
+        metrics.energy_history = run.energy_history.clone();
+        metrics.step_sizes = run.step_sizes.clone();
+        metrics.stop = Some(match run.stop {
+            Stop::Converged => beltrami_core::Stop::Converged {
+                tolerance: flow_options.tolerance,
+            },
+            Stop::Stalled => beltrami_core::Stop::Stalled,
+            Stop::IterationLimit => beltrami_core::Stop::IterationLimit,
+            Stop::Cancelled => beltrami_core::Stop::Cancelled,
+        });
         report.notes.push(match run.stop {
         Stop::Converged => format!(
             "converged after {} iterations: largest vertex update below {:.1e}",

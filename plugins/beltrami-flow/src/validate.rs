@@ -1,7 +1,9 @@
 //! What the flow checks before any work: the mesh, the target's topology, the goal, the
 //! pins, curves and initial map.
 
-use beltrami_core::{Goal, Map, PlanarBoundary, Position, Problem, SolverError, Target, topology};
+use beltrami_core::{
+    Constraint, Goal, Map, PlanarBoundary, Position, Problem, SolverError, Target, topology,
+};
 use beltrami_fem::Frame;
 use beltrami_fem::element::is_planar;
 use beltrami_mesh::Mesh;
@@ -123,24 +125,12 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
                     target.face_to_input(f)
                 )));
             }
-            for (k, curve) in problem.constraints.curves.iter().enumerate() {
-                if curve.source.len() < 2 || curve.target.len() < 2 {
-                    return Err(invalid(format!(
-                        "curve {k} needs at least two source and two target vertices"
-                    )));
-                }
-                if let Some(v) = curve.source.iter().find(|v| v.idx() >= mesh.vertex_count()) {
-                    return Err(invalid(format!(
-                        "curve {k}: source vertex {v} does not exist"
-                    )));
-                }
-                if let Some(v) = curve
-                    .target
-                    .iter()
-                    .find(|v| v.idx() >= target.vertex_count())
-                {
-                    return Err(invalid(format!(
-                        "curve {k}: target vertex {v} does not exist"
+            // Lengths and vertex ids were checked with every constraint
+            // (`Constraints::validate`).
+            for (k, curve) in problem.constraints.curves().enumerate() {
+                if curve.closed {
+                    return Err(unsupported(format!(
+                        "curve {k} is closed; the flow slides open feature curves with fixed ends"
                     )));
                 }
                 // The chain slides along its segments, which must lie on the target.
@@ -161,24 +151,22 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
             ));
         }
     }
-    for pin in &problem.constraints.pins {
-        if pin.vertex.idx() >= mesh.vertex_count() {
-            return Err(invalid(format!(
-                "pinned vertex {} does not exist (the mesh has {} vertices)",
-                pin.vertex,
-                mesh.vertex_count()
-            )));
-        }
-        match (&pin.position, &problem.target) {
-            (None, _) | (Some(Position::Spatial(_)), Target::Mesh(_)) => {}
-            _ => {
-                return Err(unsupported(
-                    "pins hold their vertex where the initial map puts it; pins at given positions (landmarks) are for target meshes",
-                ));
+    let on_mesh = matches!(problem.target, Target::Mesh(_));
+    for constraint in problem.constraints.iter() {
+        let refused = match constraint {
+            Constraint::Pin(pin) => pin.position.is_some(),
+            Constraint::Landmark(mark) => {
+                !on_mesh || !matches!(mark.position, Position::Spatial(_))
             }
+            _ => false,
+        };
+        if refused {
+            return Err(unsupported(
+                "pins hold their vertex where the initial map puts it; pins at given positions (landmarks) are for target meshes",
+            ));
         }
     }
-    if !problem.constraints.curves.is_empty() && !matches!(problem.target, Target::Mesh(_)) {
+    if problem.constraints.curves().next().is_some() && !on_mesh {
         return Err(unsupported(
             "curve constraints come with target meshes (register)",
         ));

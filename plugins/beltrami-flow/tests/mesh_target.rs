@@ -3,6 +3,7 @@
 
 mod common;
 
+use beltrami_core::OptionValue;
 use beltrami_core::{Context, Curve, Goal, Map, Problem, Solver, Target};
 use beltrami_flow::BeltramiFlow;
 use beltrami_mesh::primitives;
@@ -55,13 +56,13 @@ fn conformal_flow_between_two_disk_surfaces() {
     let mut problem = Problem::new(&source, Target::Mesh(&target));
     problem.initial = Some(Map::OnMesh(vertical(&source, &target)));
     problem.goal = Goal::Conformal { p: 2.0 };
-    problem.params.tolerance = 1e-7;
+    problem.options.set("tolerance", OptionValue::Float(1e-7));
     let solution = BeltramiFlow.solve(&problem, &mut Context::new()).unwrap();
-    let Map::OnMesh(points) = &solution.map else {
+    let Map::OnMesh(points) = solution.map().expect("a map") else {
         panic!("a map onto the target mesh")
     };
-    assert_eq!(solution.report.flipped(), Some(0));
-    let history = &solution.report.energy_history;
+    assert_eq!(solution.metrics.flipped(), Some(0));
+    let history = &solution.metrics.energy_history;
     assert!(*history.last().unwrap() < 0.5 * history[0]);
     let index = SurfaceIndex::new(&target).unwrap();
     let boundary = target.boundary_loop_list()[0].vertices.clone();
@@ -108,15 +109,12 @@ fn feature_curves_slide_on_their_chain_with_ends_fixed() {
     let mut problem = Problem::new(&source, Target::Mesh(&target));
     let start = vertical(&source, &target);
     problem.initial = Some(Map::OnMesh(start.clone()));
-    problem.constraints.curves = vec![Curve {
-        source: source_chain.clone(),
-        target: target_chain.clone(),
-    }];
+    problem.constraints = vec![Curve::open(source_chain.clone(), target_chain.clone())].into();
     let solution = BeltramiFlow.solve(&problem, &mut Context::new()).unwrap();
-    let Map::OnMesh(points) = &solution.map else {
+    let Map::OnMesh(points) = solution.map().expect("a map") else {
         panic!()
     };
-    assert_eq!(solution.report.flipped(), Some(0));
+    assert_eq!(solution.metrics.flipped(), Some(0));
     let polyline: Vec<Point3<f64>> = target_chain.iter().map(|&v| target.position(v)).collect();
     for (k, &v) in source_chain.iter().enumerate() {
         let q = points[v.idx()].position(&target);
@@ -169,10 +167,10 @@ fn sphere_onto_an_ellipsoid_mesh() {
     let (source, target, start) = sphere_onto_ellipsoid();
     let mut problem = Problem::new(&source, Target::Mesh(&target));
     problem.initial = Some(Map::OnMesh(start));
-    problem.params.tolerance = 1e-7;
+    problem.options.set("tolerance", OptionValue::Float(1e-7));
     let solution = BeltramiFlow.solve(&problem, &mut Context::new()).unwrap();
-    assert_eq!(solution.report.flipped(), Some(0));
-    let history = &solution.report.energy_history;
+    assert_eq!(solution.metrics.flipped(), Some(0));
+    let history = &solution.metrics.energy_history;
     assert!(*history.last().unwrap() < 0.5 * history[0]);
 
     // Topology mismatch: a disk onto the ellipsoid.
@@ -198,16 +196,20 @@ fn landmarks_pull_their_vertex_onto_the_goal() {
     let goal = target.position(goal_vertex);
     let mut problem = Problem::new(&source, Target::Mesh(&target));
     problem.initial = Some(Map::OnMesh(start));
-    problem.constraints.pins = vec![beltrami_core::Pin {
-        vertex: VertexId(0),
-        position: Some(beltrami_core::Position::Spatial(goal)),
-    }];
-    problem.params.tolerance = 1e-9;
+    problem
+        .constraints
+        .push(beltrami_core::Constraint::Landmark(
+            beltrami_core::Landmark {
+                vertex: VertexId(0),
+                position: beltrami_core::Position::Spatial(goal),
+            },
+        ));
+    problem.options.set("tolerance", OptionValue::Float(1e-9));
     let solution = BeltramiFlow.solve(&problem, &mut Context::new()).unwrap();
-    let Map::OnMesh(points) = &solution.map else {
+    let Map::OnMesh(points) = solution.map().expect("a map") else {
         panic!()
     };
-    assert_eq!(solution.report.flipped(), Some(0));
+    assert_eq!(solution.metrics.flipped(), Some(0));
     let reached = points[0].position(&target);
     assert!(
         (reached - goal).norm() < 1e-9,
@@ -222,10 +224,11 @@ fn a_curve_must_follow_target_edges() {
     let mut problem = Problem::new(&source, Target::Mesh(&target));
     problem.initial = Some(Map::OnMesh(start));
     // Vertices 0 and 3 of the icosahedron are antipodal: no edge joins them.
-    problem.constraints.curves = vec![Curve {
-        source: vec![VertexId(0), VertexId(11)],
-        target: vec![VertexId(0), VertexId(3)],
-    }];
+    problem.constraints = vec![Curve::open(
+        vec![VertexId(0), VertexId(11)],
+        vec![VertexId(0), VertexId(3)],
+    )]
+    .into();
     let message = BeltramiFlow.check(&problem).unwrap_err().to_string();
     assert!(message.contains("not joined by an edge"), "{message}");
 }

@@ -5,6 +5,7 @@
 
 mod common;
 
+use beltrami_core::OptionValue;
 use beltrami_core::{PlanarBoundary, Problem, Target};
 use beltrami_fem::{BeltramiField, Frame};
 use beltrami_flow::paper::*;
@@ -31,16 +32,16 @@ fn table_5_1_disk_with_mu_0_6_z() {
         problem.goal =
             beltrami_core::Goal::Prescribed(BeltramiField::new(Frame::Global, sigma.clone()));
         // Vertex 0 is the centre, vertex 1 the point 1.
-        problem.constraints.pins = pins(&[0, 1]);
-        problem.params.tolerance = 1e-8;
+        problem.constraints = pins(&[0, 1]).into();
+        problem.options.set("tolerance", OptionValue::Float(1e-8));
         let solution = flow(&problem);
         let error = mu_error(&mesh, &solution, &sigma, Frame::Global);
         let z = planar(&solution);
         println!(
             "level {level}: {faces} faces, {} steps (paper {paper_steps}), sup {:.4} (paper {paper_sup}), L2^2 {:.3e}, RMS {:.3e}",
-            solution.report.iterations, error.sup, error.l2_squared, error.rms
+            solution.metrics.iterations, error.sup, error.l2_squared, error.rms
         );
-        assert_eq!(solution.report.flipped(), Some(0), "level {level}");
+        assert_eq!(solution.metrics.flipped(), Some(0), "level {level}");
         assert!(
             solution
                 .report
@@ -56,7 +57,7 @@ fn table_5_1_disk_with_mu_0_6_z() {
             error.sup
         );
         assert!(
-            solution.report.iterations <= paper_steps + 3,
+            solution.metrics.iterations <= paper_steps + 3,
             "level {level}"
         );
         assert!(
@@ -110,8 +111,8 @@ fn table_5_2_sphere_with_constant_mu() {
         let mut problem = Problem::new(&mesh, Target::Sphere);
         problem.goal = beltrami_core::Goal::Prescribed(field.clone());
         // Vertices 0, 1, 5 are the points 0, 1 and infinity.
-        problem.constraints.pins = pins(&[0, 1, 5]);
-        problem.params.tolerance = 1e-5;
+        problem.constraints = pins(&[0, 1, 5]).into();
+        problem.options.set("tolerance", OptionValue::Float(1e-5));
         let solution = flow(&problem);
         let error = mu_error(&mesh, &solution, &field.mu, Frame::Face);
         let image = spatial(&solution);
@@ -121,16 +122,16 @@ fn table_5_2_sphere_with_constant_mu() {
             .fold(0.0, f64::max);
         println!(
             "level {level}: {faces} faces, {} steps (paper {paper_steps}), L2^2 {:.4} (paper {paper_l2}), largest vertex error {worst:.3e}",
-            solution.report.iterations, error.l2_squared
+            solution.metrics.iterations, error.l2_squared
         );
-        assert_eq!(solution.report.flipped(), Some(0), "level {level}");
+        assert_eq!(solution.metrics.flipped(), Some(0), "level {level}");
         assert!(
             error.l2_squared <= paper_l2,
             "level {level}: {}",
             error.l2_squared
         );
         assert!(
-            solution.report.iterations <= 2 * paper_steps,
+            solution.metrics.iterations <= 2 * paper_steps,
             "level {level}"
         );
         for p in image {
@@ -176,8 +177,8 @@ fn figure_5_9_annulus_with_mu_0_6_z_cubed() {
             problem.goal =
                 beltrami_core::Goal::Prescribed(BeltramiField::new(Frame::Global, sigma.clone()));
             // The vertex at z = 1.
-            problem.constraints.pins = pins(&[(sectors * rings) as u32]);
-            problem.params.tolerance = 1e-8;
+            problem.constraints = pins(&[(sectors * rings) as u32]).into();
+            problem.options.set("tolerance", OptionValue::Float(1e-8));
             let solution = flow(&problem);
             let error = mu_error(&mesh, &solution, &sigma, Frame::Global);
             let z = planar(&solution);
@@ -185,11 +186,11 @@ fn figure_5_9_annulus_with_mu_0_6_z_cubed() {
             println!(
                 "free radius {free}: {} faces, {} steps, sup {:.4}, RMS {:.3e}, inner radius {radius:.5}",
                 mesh.face_count(),
-                solution.report.iterations,
+                solution.metrics.iterations,
                 error.sup,
                 error.rms
             );
-            assert_eq!(solution.report.flipped(), Some(0));
+            assert_eq!(solution.metrics.flipped(), Some(0));
             assert!((z[sectors * rings] - 1.0).norm() < 1e-15, "the pin holds");
             for v in 0..sectors {
                 assert!((z[v].norm() - radius).abs() < 1e-12, "inner circle");
@@ -230,9 +231,9 @@ fn table_5_3_square_diffeomorphism_reconstructed_at_second_order() {
         let mut problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Keep));
         problem.goal =
             beltrami_core::Goal::Prescribed(BeltramiField::new(Frame::Global, sigma.clone()));
-        problem.params.tolerance = 1e-3;
+        problem.options.set("tolerance", OptionValue::Float(1e-3));
         let loose = flow(&problem);
-        problem.params.tolerance = 1e-10;
+        problem.options.set("tolerance", OptionValue::Float(1e-10));
         let tight = flow(&problem);
         let z = planar(&tight);
         let rms = (mesh
@@ -243,11 +244,11 @@ fn table_5_3_square_diffeomorphism_reconstructed_at_second_order() {
             .sqrt();
         println!(
             "{n}^2 vertices: {} iterations at tolerance 1e-3 (paper {paper_iterations}), {} at 1e-10; RMS vertex error {rms:.3e}",
-            loose.report.iterations, tight.report.iterations
+            loose.metrics.iterations, tight.metrics.iterations
         );
         for solution in [&loose, &tight] {
-            assert_eq!(solution.report.flipped(), Some(0));
-            assert!(solution.report.iterations <= paper_iterations);
+            assert_eq!(solution.metrics.flipped(), Some(0));
+            assert!(solution.metrics.iterations <= paper_iterations);
         }
         // Corners stay, sides slide on themselves.
         for v in mesh.vertices() {

@@ -18,24 +18,32 @@
 //! more than `pi`, and then faces may flip even on a convex boundary; the report counts
 //! the flipped faces and the negative weights in its notes.
 
-use beltrami_core::{Context, Problem, Solution, Solver, SolverError, Weights};
+use beltrami_core::{
+    Accepts, Context, OptionSpec, Problem, Settings, Solution, Solver, SolverError, THREADS,
+};
 
-use crate::tutte::FixedBoundary;
+use crate::tutte::{ACCEPTS, FixedBoundary};
+use crate::weights_option;
 
 /// The harmonic map (module docs): a disk mesh onto a fixed boundary, cotangent weights
 /// by default.
 ///
-/// Reads what [`crate::Tutte`] reads; `params.weights` may choose `Cotan` (default),
-/// `Uniform` or `MeanValue`. The report's energy is the Dirichlet energy
+/// Reads what [`crate::Tutte`] reads; the option `weights` may choose `cotan` (default),
+/// `uniform` or `mean-value`. The report's energy is the Dirichlet energy
 /// `(1/2) sum_{pairs ij} w_ij |x_i - x_j|^2` for the symmetric weights.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Harmonic;
 
-const FIXED_HARMONIC: FixedBoundary = FixedBoundary {
-    solver: "harmonic",
-    default_weights: Weights::Cotan,
-    accepted_weights: &[Weights::Cotan, Weights::Uniform, Weights::MeanValue],
-};
+const FIXED_HARMONIC: FixedBoundary = FixedBoundary { solver: "harmonic" };
+
+const OPTIONS: &[OptionSpec] = &[
+    weights_option(
+        "cotan",
+        &["cotan", "uniform", "mean-value"],
+        "edge weights: cotan (Pinkall-Polthier, the Dirichlet energy), uniform or mean-value",
+    ),
+    THREADS,
+];
 
 impl Solver for Harmonic {
     fn name(&self) -> &'static str {
@@ -46,19 +54,28 @@ impl Solver for Harmonic {
         "harmonic map: disk onto a fixed boundary minimizing the Dirichlet energy (cotangent weights); may flip faces on obtuse meshes"
     }
 
-    fn accepts(&self) -> &'static str {
-        "disk meshes (triangles, quads); targets: circle, square, convex polygon, disk, keep, given boundary; weights: cotangent, uniform, mean-value; one boundary pin to choose the start"
+    fn accepts(&self) -> Accepts {
+        ACCEPTS
     }
 
-    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+    fn options(&self) -> &'static [OptionSpec] {
+        OPTIONS
+    }
+
+    fn check_problem(
+        &self,
+        problem: &Problem<'_>,
+        _settings: &Settings,
+    ) -> Result<(), SolverError> {
         FIXED_HARMONIC.check(problem)
     }
 
-    fn solve(
+    fn run(
         &self,
         problem: &Problem<'_>,
+        settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
-        FIXED_HARMONIC.solve(problem, context)
+        FIXED_HARMONIC.run(problem, settings, context)
     }
 }

@@ -47,7 +47,7 @@
 //! let mesh = Mesh::from_soup(&grid(8, 8, Cells::Triangles)).unwrap();
 //! let problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Circle));
 //! let solution = Tutte.solve(&problem, &mut Context::new()).unwrap();
-//! assert_eq!(solution.report.flipped(), Some(0));
+//! assert_eq!(solution.metrics.flipped(), Some(0));
 //! ```
 
 pub mod boundary;
@@ -62,7 +62,9 @@ pub use lscm::Lscm;
 pub use sphere::Sphere;
 pub use tutte::Tutte;
 
-use beltrami_core::{Context, Goal, Problem, Report, SolverError};
+use beltrami_core::{
+    Context, Goal, Metrics, OptionKind, OptionSpec, Problem, Report, Settings, SolverError, Weights,
+};
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::distortion::{Distortion, measure_planar};
 use beltrami_fem::{Elements, Frame, SolveOptions};
@@ -102,7 +104,7 @@ fn check_goal_and_curves(solver: &'static str, problem: &Problem<'_>) -> Result<
             ));
         }
     }
-    if !problem.constraints.curves.is_empty() {
+    if problem.constraints.curves().next().is_some() {
         return unsupported(format!(
             "{solver} cannot make vertices follow curves; use lsqc or beltrami-flow"
         ));
@@ -110,16 +112,39 @@ fn check_goal_and_curves(solver: &'static str, problem: &Problem<'_>) -> Result<
     Ok(())
 }
 
-/// The solve options of the problem's parameters.
-fn solve_options(problem: &Problem<'_>) -> SolveOptions {
+/// The solve options of the settings' `threads`.
+fn solve_options(settings: &Settings) -> SolveOptions {
     SolveOptions {
-        threads: problem.params.threads,
+        threads: settings.int("threads"),
         ..SolveOptions::default()
     }
 }
 
-/// Measures the distortion of a planar map in the face frames into `report.mu` and
-/// `report.distortion` (a "distortion" stage), and returns the number of flipped faces.
+/// The `weights` option of a linear map, with its default and choices.
+const fn weights_option(
+    default: &'static str,
+    choices: &'static [&'static str],
+    help: &'static str,
+) -> OptionSpec {
+    OptionSpec {
+        name: "weights",
+        kind: OptionKind::Choice { default, choices },
+        help,
+    }
+}
+
+/// The edge weights named by the `weights` option.
+fn weights_of(settings: &Settings) -> Weights {
+    match settings.choice("weights") {
+        "mean-value" => Weights::MeanValue,
+        "cotan" => Weights::Cotan,
+        _ => Weights::Uniform,
+    }
+}
+
+/// Measures the distortion of a planar map in the face frames into `metrics.mu` and
+/// `metrics.distortion` (a "distortion" stage timed in `report`), and returns the number
+/// of flipped faces.
 /// `elements` are the solver's own face-frame elements when it has them (reused), else
 /// they are computed.
 fn measure(
@@ -128,6 +153,7 @@ fn measure(
     map: &[Complex64],
     context: &mut Context<'_>,
     report: &mut Report,
+    metrics: &mut Metrics,
 ) -> Result<usize, SolverError> {
     let distortion = context.stage("distortion", report, || match elements {
         Some(elements) => {
@@ -137,7 +163,7 @@ fn measure(
         None => Ok(measure_planar(mesh, map, Frame::Face)?),
     })?;
     let flipped = distortion.stats.flipped;
-    report.mu = Some(distortion.field);
-    report.distortion = Some(distortion.stats);
+    metrics.mu = Some(distortion.field);
+    metrics.distortion = Some(distortion.stats);
     Ok(flipped)
 }

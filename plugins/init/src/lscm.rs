@@ -23,8 +23,9 @@
 //! bijection, so the report counts flipped faces.
 
 use beltrami_core::{
-    Context, Map, PlanarBoundary, Position, Problem, Report, Solution, Solver, SolverError, Target,
-    topology,
+    Accepts, ConstraintKind, Context, Element, Extras, GoalKind, Map, Metrics, OptionSpec, Output,
+    PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver, SolverError, THREADS,
+    Target, TargetKind, Topology, topology,
 };
 use beltrami_fem::operators::{apply, complex_derivatives};
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
@@ -35,7 +36,8 @@ use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
 
 /// The least-squares conformal map (module docs).
 ///
-/// Reads: `target` (`Plane(Free)` only), `constraints.pins` and `params.threads`.
+/// Reads: `target` (`Plane(Free)` only), the pins of `constraints` and the option
+/// `threads`.
 /// Pins: none (two boundary vertices far apart are pinned at `(0, 0)` and `(1, 0)`: the
 /// boundary vertex farthest from the loop's first vertex, then the one farthest from
 /// that), or exactly two (without positions: at `(0, 0)` and `(1, 0)` in order; with
@@ -46,6 +48,16 @@ pub struct Lscm;
 
 const NAME: &str = "lscm";
 
+const OPTIONS: &[OptionSpec] = &[THREADS];
+
+const ACCEPTS: Accepts = Accepts {
+    elements: &[Element::Triangle, Element::Quad],
+    topologies: &[Topology::Disk],
+    targets: &[TargetKind::PlaneFree],
+    goals: &[GoalKind::Conformal],
+    constraints: &[ConstraintKind::Hold, ConstraintKind::Pin],
+};
+
 impl Solver for Lscm {
     fn name(&self) -> &'static str {
         NAME
@@ -55,23 +67,33 @@ impl Solver for Lscm {
         "least-squares conformal map (LSCM): disk into the plane with a free boundary and two pinned vertices"
     }
 
-    fn accepts(&self) -> &'static str {
-        "disk meshes (triangles, quads); target: plane with a free boundary; pins: none, two, or more with positions"
+    fn accepts(&self) -> Accepts {
+        ACCEPTS
     }
 
-    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+    fn options(&self) -> &'static [OptionSpec] {
+        OPTIONS
+    }
+
+    fn check_problem(
+        &self,
+        problem: &Problem<'_>,
+        _settings: &Settings,
+    ) -> Result<(), SolverError> {
         pins(problem).map(|_| ())
     }
 
-    fn solve(
+    fn run(
         &self,
         problem: &Problem<'_>,
+        settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
         let mesh = problem.source;
         let mut report = Report::new(NAME);
+        let mut metrics = Metrics::default();
         let pinned = pins(problem)?;
-        if problem.constraints.pins.is_empty() {
+        if problem.constraints.pins().next().is_none() {
             let input = |v: VertexId| mesh.vertex_map().to_input(v);
             report.notes.push(format!(
                 "pinned the boundary vertices {} (input index) at (0, 0) and {} at (1, 0), far apart",
@@ -90,7 +112,7 @@ impl Solver for Lscm {
             let solver = LeastSquaresSolver::new(
                 derivatives.dzbar.symbolic(),
                 &dofs,
-                solve_options(problem),
+                solve_options(settings),
             )?;
             Ok((elements, derivatives, solver))
         })?;
@@ -108,8 +130,15 @@ impl Solver for Lscm {
             .zip(&derivatives.weights)
             .map(|(r, w)| w * r.norm_sqr())
             .sum();
-        report.energy_history.push(energy);
-        let flipped = measure(mesh, Some(&elements), &map, context, &mut report)?;
+        metrics.energy_history.push(energy);
+        let flipped = measure(
+            mesh,
+            Some(&elements),
+            &map,
+            context,
+            &mut report,
+            &mut metrics,
+        )?;
         if flipped > 0 {
             report.notes.push(format!(
                 "{flipped} of {} faces are flipped: LSCM does not guarantee a bijection; tutte always gives one",
@@ -117,7 +146,9 @@ impl Solver for Lscm {
             ));
         }
         Ok(Solution {
-            map: Map::Planar(map),
+            output: Output::Map(Map::Planar(map)),
+            metrics,
+            extras: Extras::default(),
             report,
         })
     }
@@ -151,8 +182,8 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
             ));
         }
     }
-    let given = &problem.constraints.pins;
-    for pin in given {
+    let given: Vec<_> = problem.constraints.pins().collect();
+    for pin in &given {
         if pin.vertex.idx() >= mesh.vertex_count() {
             return Err(invalid(format!(
                 "a pin is on vertex {}, but the mesh has {} vertices",

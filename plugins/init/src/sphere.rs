@@ -95,8 +95,9 @@
 use std::f64::consts::{PI, TAU};
 
 use beltrami_core::{
-    Context, Goal, Map, Problem, Progress, Report, Solution, Solver, SolverError, Target, Weights,
-    topology,
+    Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
+    Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, THREADS, Target,
+    TargetKind, Topology, Weights, topology,
 };
 use beltrami_fem::distortion::measure_surface;
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
@@ -131,8 +132,31 @@ const NOT_A_SPHERE: &str = "use lscm/tutte for disks, or `beltrami cut` for high
 /// The normalization stops once the centre of mass is this close to the origin.
 const CENTER_TOLERANCE: f64 = 1e-6;
 
-/// The normalization stops after this many Moebius steps.
-const MAX_STEPS: usize = 100;
+const OPTIONS: &[OptionSpec] = &[
+    crate::weights_option(
+        "mean-value",
+        &["mean-value", "uniform"],
+        "edge weights of the Tutte embedding: mean-value (Floater) or uniform; cotangent weights are negative on obtuse triangles and may fold the map",
+    ),
+    OptionSpec {
+        name: "max-steps",
+        kind: OptionKind::Int {
+            default: 100,
+            min: 0,
+            max: 100_000,
+        },
+        help: "Moebius centring steps at most",
+    },
+    THREADS,
+];
+
+const ACCEPTS: Accepts = Accepts {
+    elements: &[Element::Triangle, Element::Quad],
+    topologies: &[Topology::Sphere],
+    targets: &[TargetKind::Sphere],
+    goals: &[GoalKind::Conformal],
+    constraints: &[],
+};
 
 /// A normalization step halves its candidate this many times at most.
 const MAX_HALVINGS: u32 = 20;
@@ -146,22 +170,28 @@ impl Solver for Sphere {
         "closed genus-0 mesh onto the unit sphere: Tutte embedding of the mesh minus one face, inverse stereographic projection, Moebius centering; a bijective initialization, not a conformal map"
     }
 
-    fn accepts(&self) -> &'static str {
-        "closed genus-0 meshes (triangles, quads); target: sphere; goal: conformal (p = 2) initialization; weights: mean-value (default), uniform; no pins or curves"
+    fn accepts(&self) -> Accepts {
+        ACCEPTS
     }
 
-    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
-        weights(problem).map(|_| ())
+    fn options(&self) -> &'static [OptionSpec] {
+        OPTIONS
     }
 
-    fn solve(
+    fn check_problem(&self, problem: &Problem<'_>, settings: &Settings) -> Result<(), SolverError> {
+        weights(problem, settings).map(|_| ())
+    }
+
+    fn run(
         &self,
         problem: &Problem<'_>,
+        settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
         let mesh = problem.source;
-        let kind = weights(problem)?;
+        let kind = weights(problem, settings)?;
         let mut report = Report::new(NAME);
+        let mut metrics = Metrics::default();
 
         let removed = removed_face(mesh);
         let punctured = context.stage("puncture", &mut report, || puncture(mesh, removed))?;
@@ -189,7 +219,7 @@ impl Solver for Sphere {
             let boundary = hole_boundary(&punctured, radius);
             let system = WeightedMeanSystem::new(&weights, &boundary)?;
             let negative = weights.negative_count(system.interior().iter().copied());
-            Ok((system.solve(solve_options(problem))?, negative))
+            Ok((system.solve(solve_options(settings))?, negative))
         })?;
         if negative > 0 {
             report.notes.push(format!(
@@ -201,7 +231,14 @@ impl Solver for Sphere {
             Ok(planar.iter().map(|&z| inverse_stereographic(z)).collect())
         })?;
 
-        normalize(mesh, &mut image, context, &mut report)?;
+        normalize(
+            mesh,
+            &mut image,
+            settings.int("max-steps"),
+            context,
+            &mut report,
+            &mut metrics,
+        )?;
 
         let (inward, distortion) = context.stage("distortion", &mut report, || {
             let inward = inward_faces(mesh, &image);
@@ -218,8 +255,8 @@ impl Solver for Sphere {
             .count();
         let mut stats = distortion.stats;
         stats.flipped = flipped;
-        report.mu = Some(distortion.field);
-        report.distortion = Some(stats);
+        metrics.mu = Some(distortion.field);
+        metrics.distortion = Some(stats);
         if flipped > 0 {
             report.notes.push(format!(
                 "{flipped} of {} faces are flipped: their images face the centre of the sphere (very obtuse faces, whose circumcircles the projection blows up)",
@@ -233,14 +270,16 @@ impl Solver for Sphere {
             );
         }
         Ok(Solution {
-            map: Map::Spatial(image),
+            output: Output::Map(Map::Spatial(image)),
+            metrics,
+            extras: Extras::default(),
             report,
         })
     }
 }
 
 /// The capability check, returning the weights to use.
-fn weights(problem: &Problem<'_>) -> Result<Weights, SolverError> {
+fn weights(problem: &Problem<'_>, settings: &Settings) -> Result<Weights, SolverError> {
     let unsupported = |message: String| {
         Err(SolverError::Unsupported {
             solver: NAME,
@@ -284,26 +323,20 @@ fn weights(problem: &Problem<'_>) -> Result<Weights, SolverError> {
         }
     }
     let constraints = &problem.constraints;
-    if let Some(pin) = constraints.pins.first() {
+    if let Some(pin) = constraints.pins().next() {
         return unsupported(format!(
             "sphere places every vertex itself and takes no pins (given: {}, the first on vertex {}); pin landmarks in beltrami-flow, starting from this map",
-            constraints.pins.len(),
+            constraints.pins().count(),
             pin.vertex
         ));
     }
-    if !constraints.curves.is_empty() {
+    let curves = constraints.curves().count();
+    if curves > 0 {
         return unsupported(format!(
-            "sphere cannot make vertices follow curves (given: {}); use beltrami-flow",
-            constraints.curves.len()
+            "sphere cannot make vertices follow curves (given: {curves}); use beltrami-flow"
         ));
     }
-    match problem.params.weights.unwrap_or(Weights::MeanValue) {
-        Weights::Cotan => unsupported(
-            "sphere takes mean-value or uniform weights, not cotangent: cotangent weights are negative on obtuse triangles and may fold the map"
-                .to_string(),
-        ),
-        w => Ok(w),
-    }
+    Ok(crate::weights_of(settings))
 }
 
 /// The face to remove: the largest area times shape quality `q_f` (module docs). The
@@ -453,7 +486,7 @@ fn moebius(b: Vector3<f64>, source: &[Point3<f64>], target: &mut Vec<Point3<f64>
 
 /// Moebius centering (module docs): applies `phi_b` to every image point until the
 /// centre of mass `c` is within [`CENTER_TOLERANCE`] of the origin or after
-/// [`MAX_STEPS`] steps, recording each step in the report; the "normalization" timing.
+/// [`max_steps`] steps, recording each step in the report; the "normalization" timing.
 ///
 /// Each step tries, in order, the Newton step of the linearization,
 /// `b = (2 (I - M))^{-1} c` (when it is inside the ball), then `b = c` (Baden, Crane and
@@ -463,8 +496,10 @@ fn moebius(b: Vector3<f64>, source: &[Point3<f64>], target: &mut Vec<Point3<f64>
 fn normalize(
     mesh: &Mesh,
     image: &mut Vec<Point3<f64>>,
+    max_steps: usize,
     context: &mut Context<'_>,
     report: &mut Report,
+    metrics: &mut Metrics,
 ) -> Result<(), SolverError> {
     context.check_cancelled()?;
     let start = std::time::Instant::now();
@@ -475,7 +510,7 @@ fn normalize(
     let mut steps = 0;
     // An average of unit vectors lies in the closed ball; on its boundary (all mass at
     // one point) no Moebius transformation can spread it.
-    while c.norm() > CENTER_TOLERANCE && c.norm() < 1.0 && steps < MAX_STEPS {
+    while c.norm() > CENTER_TOLERANCE && c.norm() < 1.0 && steps < max_steps {
         context.check_cancelled()?;
         let newton = (2.0 * (Matrix3::identity() - m))
             .try_inverse()
@@ -497,11 +532,11 @@ fn normalize(
         std::mem::swap(image, &mut trial);
         (c, m) = (c_new, m_new);
         steps += 1;
-        report.energy_history.push(c.norm());
+        metrics.energy_history.push(c.norm());
         context.report(&Progress {
             stage: "normalization",
             done: steps,
-            total: Some(MAX_STEPS),
+            total: Some(max_steps),
             energy: Some(c.norm()),
         });
     }
@@ -509,7 +544,7 @@ fn normalize(
     for p in image.iter_mut() {
         *p = Point3::from(p.coords / p.coords.norm());
     }
-    report.iterations = steps;
+    metrics.iterations = steps;
     report
         .timings
         .push(("normalization".to_string(), start.elapsed().as_secs_f64()));

@@ -24,8 +24,9 @@
 //! [`crate::Harmonic`], which shares this module's machinery.
 
 use beltrami_core::{
-    Context, Map, PlanarBoundary, Problem, Report, Solution, Solver, SolverError, Target, Weights,
-    topology,
+    Accepts, ConstraintKind, Context, Element, Extras, GoalKind, Map, Metrics, OptionSpec, Output,
+    PlanarBoundary, Problem, Report, Settings, Solution, Solver, SolverError, THREADS, Target,
+    TargetKind, Topology, Weights, topology,
 };
 use beltrami_fem::SolveError;
 use beltrami_fem::solve::solve_spd;
@@ -39,7 +40,9 @@ use num_complex::Complex64;
 
 use crate::boundary::{self, BoundaryError, BoundaryMap};
 use crate::weights::{EdgeWeights, WeightError};
-use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
+use crate::{
+    NOT_A_DISK, check_goal_and_curves, measure, solve_options, weights_of, weights_option,
+};
 
 /// The weighted-mean system of a fixed boundary (module docs): `L_II x_I = b`, with one
 /// right-hand side column for the real and one for the imaginary parts.
@@ -191,8 +194,8 @@ impl WeightedMeanSystem {
 /// weights.
 ///
 /// Reads: `target` (`Plane(Circle | Square | Polygon | Keep | Given)` or `Disk`, which
-/// is the circle fixed by arc length), `params.weights` (`Uniform`, `MeanValue`),
-/// `params.threads`, and at most one pin without a position, on the boundary, which
+/// is the circle fixed by arc length), the options `weights` (`uniform`, `mean-value`)
+/// and `threads`, and at most one pin without a position, on the boundary, which
 /// chooses the vertex that goes to `(1, 0)` on the circle or to the first corner of a
 /// polygon. The report's energy is `E = (1/2) sum_{edges ij} w_ij |x_i - x_j|^2` for
 /// uniform weights (none for the non-symmetric mean-value weights).
@@ -208,38 +211,64 @@ impl Solver for Tutte {
         "Tutte embedding: disk onto a convex boundary, interior vertices at weighted means (uniform or mean-value weights); bijective for a convex boundary"
     }
 
-    fn accepts(&self) -> &'static str {
-        "disk meshes (triangles, quads); targets: circle, square, convex polygon, disk, keep, given boundary; weights: uniform, mean-value; one boundary pin to choose the start"
+    fn accepts(&self) -> Accepts {
+        ACCEPTS
     }
 
-    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+    fn options(&self) -> &'static [OptionSpec] {
+        OPTIONS
+    }
+
+    fn check_problem(
+        &self,
+        problem: &Problem<'_>,
+        _settings: &Settings,
+    ) -> Result<(), SolverError> {
         FIXED_TUTTE.check(problem)
     }
 
-    fn solve(
+    fn run(
         &self,
         problem: &Problem<'_>,
+        settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
-        FIXED_TUTTE.solve(problem, context)
+        FIXED_TUTTE.run(problem, settings, context)
     }
 }
 
-const FIXED_TUTTE: FixedBoundary = FixedBoundary {
-    solver: "tutte",
-    default_weights: Weights::Uniform,
-    accepted_weights: &[Weights::Uniform, Weights::MeanValue],
+const FIXED_TUTTE: FixedBoundary = FixedBoundary { solver: "tutte" };
+
+const OPTIONS: &[OptionSpec] = &[
+    weights_option(
+        "uniform",
+        &["uniform", "mean-value"],
+        "edge weights: uniform (Tutte) or mean-value (Floater); cotangent weights are the harmonic solver's",
+    ),
+    THREADS,
+];
+
+/// What [`Tutte`] and [`crate::Harmonic`] accept.
+pub(crate) const ACCEPTS: Accepts = Accepts {
+    elements: &[Element::Triangle, Element::Quad],
+    topologies: &[Topology::Disk],
+    targets: &[
+        TargetKind::PlaneCircle,
+        TargetKind::PlaneSquare,
+        TargetKind::PlanePolygon,
+        TargetKind::PlaneKeep,
+        TargetKind::PlaneGiven,
+        TargetKind::Disk,
+    ],
+    goals: &[GoalKind::Conformal],
+    constraints: &[ConstraintKind::Hold],
 };
 
 /// A linear map with a fixed boundary: the shared machinery of [`Tutte`] and
-/// [`crate::Harmonic`], which differ in their name and weights.
+/// [`crate::Harmonic`], which differ in their name and weights (their `weights` option).
 pub(crate) struct FixedBoundary {
     /// The solver's name.
     pub(crate) solver: &'static str,
-    /// The weights without `params.weights`.
-    pub(crate) default_weights: Weights,
-    /// The weights `params.weights` may choose.
-    pub(crate) accepted_weights: &'static [Weights],
 }
 
 /// Words for a weight kind in messages.
@@ -259,11 +288,6 @@ impl FixedBoundary {
         }
     }
 
-    /// The weights the problem asks for.
-    fn weights(&self, problem: &Problem<'_>) -> Weights {
-        problem.params.weights.unwrap_or(self.default_weights)
-    }
-
     /// The capability check of the solver.
     pub(crate) fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
         self.prepare(problem).map(|_| ())
@@ -276,24 +300,6 @@ impl FixedBoundary {
         let mesh = problem.source;
         topology::require_disk(solver, mesh, NOT_A_DISK)?;
         check_goal_and_curves(solver, problem)?;
-        let weights = self.weights(problem);
-        if !self.accepted_weights.contains(&weights) {
-            let accepted: Vec<&str> = self
-                .accepted_weights
-                .iter()
-                .map(|&w| weight_name(w))
-                .collect();
-            return Err(self.unsupported(format!(
-                "{solver} takes {} weights, not {}{}",
-                accepted.join(" or "),
-                weight_name(weights),
-                if weights == Weights::Cotan {
-                    "; cotangent weights are the harmonic solver's"
-                } else {
-                    ""
-                }
-            )));
-        }
         let start = self.start_vertex(problem)?;
         let invalid = |e: BoundaryError| SolverError::InvalidInput {
             solver,
@@ -344,7 +350,7 @@ impl FixedBoundary {
     /// only for targets that have a free start (circle, disk, automatic square, polygon).
     fn start_vertex(&self, problem: &Problem<'_>) -> Result<Option<VertexId>, SolverError> {
         let solver = self.solver;
-        let pins = &problem.constraints.pins;
+        let pins: Vec<_> = problem.constraints.pins().collect();
         let Some(pin) = pins.first() else {
             return Ok(None);
         };
@@ -379,16 +385,18 @@ impl FixedBoundary {
 
     /// Builds the boundary, the weights and the system, solves it, measures the
     /// distortion and explains flips in the notes.
-    pub(crate) fn solve(
+    pub(crate) fn run(
         &self,
         problem: &Problem<'_>,
+        settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
         let solver = self.solver;
         let mesh = problem.source;
         let mut report = Report::new(solver);
+        let mut metrics = Metrics::default();
         let boundary = context.stage("boundary", &mut report, || self.prepare(problem))?;
-        let kind = self.weights(problem);
+        let kind = weights_of(settings);
         let (weights, system) = context.stage("assembly", &mut report, || {
             let weights = EdgeWeights::new(mesh, kind).map_err(|e| match e {
                 WeightError::Fem(e) => SolverError::Fem(e),
@@ -400,12 +408,12 @@ impl FixedBoundary {
             let system = WeightedMeanSystem::new(&weights, &boundary)?;
             Ok((weights, system))
         })?;
-        let options = solve_options(problem);
+        let options = solve_options(settings);
         let map = context.stage("solve", &mut report, || Ok(system.solve(options)?))?;
         if weights.is_symmetric() {
-            report.energy_history.push(spring_energy(&weights, &map));
+            metrics.energy_history.push(spring_energy(&weights, &map));
         }
-        let flipped = measure(mesh, None, &map, context, &mut report)?;
+        let flipped = measure(mesh, None, &map, context, &mut report, &mut metrics)?;
         let negative = weights.negative_count(system.interior().iter().copied());
         if negative > 0 {
             report.notes.push(format!(
@@ -430,7 +438,9 @@ impl FixedBoundary {
             ));
         }
         Ok(Solution {
-            map: Map::Planar(map),
+            output: Output::Map(Map::Planar(map)),
+            metrics,
+            extras: Extras::default(),
             report,
         })
     }

@@ -3,7 +3,7 @@
 
 mod common;
 
-use beltrami_core::{Context, PlanarBoundary, Problem, Solver, SolverError, Target, Weights};
+use beltrami_core::{Context, PlanarBoundary, Problem, Solver, SolverError, Target};
 use beltrami_init::Harmonic;
 use beltrami_init::weights::EdgeWeights;
 use beltrami_mesh::primitives::{Cells, icosphere};
@@ -20,11 +20,11 @@ fn reproduces_a_planar_mesh_with_its_own_boundary() {
         let mesh = jittered(16, cells, 0.35, seed);
         let problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Keep));
         let solution = Harmonic.solve(&problem, &mut Context::new()).unwrap();
-        let err = identity_error(&mesh, planar(&solution.map));
+        let err = identity_error(&mesh, planar(solution.map().expect("a map")));
         assert!(err < 1e-12, "{cells:?}: {err:e}");
-        assert_eq!(solution.report.flipped(), Some(0));
+        assert_eq!(solution.metrics.flipped(), Some(0));
         // The identity is conformal: |mu| vanishes to rounding.
-        let mu_max = solution.report.distortion.unwrap().mu_max;
+        let mu_max = solution.metrics.distortion.unwrap().mu_max;
         assert!(mu_max < 1e-10, "{cells:?}: {mu_max:e}");
     }
 }
@@ -34,25 +34,25 @@ fn hemisphere_onto_the_circle_reports_its_flips() {
     let mesh = hemisphere();
     let problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Circle));
     let solution = Harmonic.solve(&problem, &mut Context::new()).unwrap();
-    let map = planar(&solution.map);
-    println!("hemisphere harmonic circle: {}", summary(&solution.report));
+    let map = planar(solution.map().expect("a map"));
+    println!("hemisphere harmonic circle: {}", summary(&solution));
     assert!(map.iter().all(|z| z.is_finite()));
     let measured = flipped_faces(&mesh, map).len();
-    assert_eq!(solution.report.flipped(), Some(measured));
+    assert_eq!(solution.metrics.flipped(), Some(measured));
     assert!(measured <= mesh.face_count() / 100, "{measured} flips");
     let noted = solution.report.notes.iter().any(|n| n.contains("flipped"));
     assert_eq!(noted, measured > 0, "{:?}", solution.report.notes);
     // The harmonic map of a cap of the sphere is nearly conformal (stereographic
     // projection is the conformal one, and it maps the boundary circle uniformly).
     // Measured: mu mean 0.0099, max 0.0290; asserted with a margin.
-    let stats = solution.report.distortion.unwrap();
+    let stats = solution.metrics.distortion.unwrap();
     assert!(stats.mu_mean < 0.02, "{}", stats.mu_mean);
     assert!(stats.mu_max < 0.06, "{}", stats.mu_max);
     let weights = EdgeWeights::cotangent(&mesh).unwrap();
     assert!(weighted_mean_error(&mesh, &weights, map) < 1e-10);
     // The Dirichlet energy is reported; it is at least the image area (pi, up to the
     // inscribed polygon), with equality only for conformal maps.
-    let energy = solution.report.energy_history[0];
+    let energy = solution.metrics.energy_history[0];
     assert!(energy > 3.1 && energy < 3.3, "{energy}");
 }
 
@@ -88,9 +88,9 @@ fn negative_weights_and_flips_are_noted() {
             .any(|n| n.contains("2 cotangent weights of interior vertices are negative")),
         "{notes:?}"
     );
-    let measured = flipped_faces(&mesh, planar(&solution.map)).len();
+    let measured = flipped_faces(&mesh, planar(solution.map().expect("a map"))).len();
     assert_eq!(measured, 1);
-    assert_eq!(solution.report.flipped(), Some(measured));
+    assert_eq!(solution.metrics.flipped(), Some(measured));
     assert!(
         notes.iter().any(|n| n.contains("1 of 8 faces are flipped")),
         "{notes:?}"
@@ -99,17 +99,17 @@ fn negative_weights_and_flips_are_noted() {
     let tutte = beltrami_init::Tutte
         .solve(&problem, &mut Context::new())
         .unwrap();
-    assert_eq!(tutte.report.flipped(), Some(0));
+    assert_eq!(tutte.metrics.flipped(), Some(0));
 }
 
 #[test]
 fn other_weights_may_be_chosen() {
     let mesh = hemisphere();
     let mut problem = Problem::new(&mesh, Target::Disk);
-    problem.params.weights = Some(Weights::MeanValue);
+    problem.options.set_text("weights", "mean-value");
     let solution = Harmonic.solve(&problem, &mut Context::new()).unwrap();
-    assert_eq!(solution.report.flipped(), Some(0));
-    assert!(solution.report.energy_history.is_empty());
+    assert_eq!(solution.metrics.flipped(), Some(0));
+    assert!(solution.metrics.energy_history.is_empty());
 }
 
 #[test]
@@ -120,11 +120,11 @@ fn runs_on_the_shared_disks() {
     for (name, mesh) in &meshes {
         let problem = Problem::new(mesh, Target::Plane(PlanarBoundary::Circle));
         let solution = Harmonic.solve(&problem, &mut Context::new()).unwrap();
-        let map = planar(&solution.map);
-        println!("{name} harmonic circle: {}", summary(&solution.report));
+        let map = planar(solution.map().expect("a map"));
+        println!("{name} harmonic circle: {}", summary(&solution));
         assert!(map.iter().all(|z| z.is_finite()), "{name}");
         assert_eq!(
-            solution.report.flipped(),
+            solution.metrics.flipped(),
             Some(flipped_faces(mesh, map).len()),
             "{name}"
         );

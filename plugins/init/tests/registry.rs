@@ -10,7 +10,14 @@ fn registers_tutte_harmonic_lscm_and_sphere() {
     for name in ["tutte", "harmonic", "lscm", "sphere"] {
         let solver = registry.get(name).unwrap();
         assert_eq!(solver.name(), name);
-        assert!(!solver.description().is_empty() && !solver.accepts().is_empty());
+        let accepts = solver.accepts();
+        assert!(
+            !solver.description().is_empty()
+                && !accepts.elements.is_empty()
+                && !accepts.topologies.is_empty()
+                && !accepts.targets.is_empty()
+                && !accepts.goals.is_empty()
+        );
     }
     assert!(registry.get("nope").is_err());
 }

@@ -11,8 +11,7 @@ use std::io::Write as _;
 use std::path::PathBuf;
 
 use beltrami_core::{
-    Constraints, Context, Curve, Goal, Map, Params, Pin, PlanarBoundary, Problem, Solution, Solver,
-    SolverError, Target, Weights,
+    Context, Curve, Goal, Map, Pin, PlanarBoundary, Problem, Solution, Solver, SolverError, Target,
 };
 use beltrami_init::Sphere;
 use beltrami_mesh::io::read;
@@ -116,9 +115,10 @@ fn spatial(map: &Map) -> &[Point3<f64>] {
 /// the origin, covering degree 1, the report's flip count equal to this file's count
 /// and at most `max_flipped`. Returns the flip count.
 fn check(name: &str, mesh: &Mesh, solution: &Solution, max_flipped: usize) -> usize {
-    let image = spatial(&solution.map);
+    let image = spatial(solution.map().expect("a map"));
     let report = &solution.report;
-    println!("{name}: {}", summary(report));
+    let metrics = &solution.metrics;
+    println!("{name}: {}", summary(solution));
     for note in &report.notes {
         println!("  {note}");
     }
@@ -131,11 +131,11 @@ fn check(name: &str, mesh: &Mesh, solution: &Solution, max_flipped: usize) -> us
     println!(
         "  centre of mass {:.2e} after {} steps",
         c.norm(),
-        report.iterations
+        metrics.iterations
     );
     assert!(c.norm() <= 1e-3, "{name}: centre of mass {c:?}");
-    assert!(report.iterations <= 100, "{name}");
-    assert_eq!(report.energy_history.len(), report.iterations, "{name}");
+    assert!(metrics.iterations <= 100, "{name}");
+    assert_eq!(metrics.energy_history.len(), metrics.iterations, "{name}");
     let (signed, absolute) = solid_angles(mesh, image);
     assert!(
         (signed - 4.0 * PI).abs() <= 1e-8,
@@ -144,7 +144,7 @@ fn check(name: &str, mesh: &Mesh, solution: &Solution, max_flipped: usize) -> us
     );
     let flipped = inward_count(mesh, image);
     assert_eq!(
-        report.flipped(),
+        metrics.flipped(),
         Some(flipped),
         "{name}: flip counts differ"
     );
@@ -175,7 +175,7 @@ fn check(name: &str, mesh: &Mesh, solution: &Solution, max_flipped: usize) -> us
         .iter()
         .any(|n| n.starts_with("removed face") && n.contains("input index"));
     assert!(removed, "{name}: no note names the removed face");
-    let mu = report.mu.as_ref().expect("mu measured");
+    let mu = metrics.mu.as_ref().expect("mu measured");
     assert_eq!(mu.len(), mesh.face_count(), "{name}");
     flipped
 }
@@ -190,7 +190,7 @@ fn icosphere_goes_onto_the_sphere_nearly_conformally() {
     // The identity has mu = 0; this map differs from a rotation by the stretch around
     // the removed face's corners and the mean-value weights. Measured: mean 0.072,
     // l2 0.090, max 0.33.
-    let d = solution.report.distortion.unwrap();
+    let d = solution.metrics.distortion.unwrap();
     assert!(d.mu_mean < 0.1, "mu mean {}", d.mu_mean);
     assert!(d.mu_l2 < 0.13, "mu l2 {}", d.mu_l2);
     assert!(d.mu_max < 0.5, "mu max {}", d.mu_max);
@@ -205,7 +205,7 @@ fn the_distortion_of_the_icosphere_shrinks_under_refinement() {
             let mesh = Mesh::from_soup(&icosphere(s)).unwrap();
             let solution = solve(&mesh);
             check(&format!("icosphere({s})"), &mesh, &solution, 0);
-            solution.report.distortion.unwrap().mu_mean
+            solution.metrics.distortion.unwrap().mu_mean
         })
         .collect();
     println!("mu mean by subdivision 2, 3, 4: {means:.4?}");
@@ -217,10 +217,7 @@ fn the_distortion_of_the_icosphere_shrinks_under_refinement() {
 fn uniform_weights_work_too() {
     let mesh = Mesh::from_soup(&icosphere(2)).unwrap();
     let mut problem = Problem::new(&mesh, Target::Sphere);
-    problem.params = Params {
-        weights: Some(Weights::Uniform),
-        ..Params::default()
-    };
+    problem.options.set_text("weights", "uniform");
     let solution = solve_with(&problem);
     assert_eq!(check("icosphere(2), uniform", &mesh, &solution, 0), 0);
 }
@@ -359,7 +356,10 @@ fn rejected(problem: &Problem<'_>) -> String {
         .expect_err("solve accepts");
     assert_eq!(checked.to_string(), solved.to_string());
     assert!(
-        matches!(solved, SolverError::Unsupported { .. }),
+        matches!(
+            solved,
+            SolverError::Unsupported { .. } | SolverError::Option(_)
+        ),
         "{solved}"
     );
     solved.to_string()
@@ -397,26 +397,27 @@ fn other_targets_goals_weights_and_constraints_are_rejected() {
     assert!(message.contains("p = 4"), "{message}");
     let message = problem(&|p| p.goal = Goal::Extremal);
     assert!(message.contains("teichmuller"), "{message}");
-    let message = problem(&|p| p.params.weights = Some(Weights::Cotan));
+    let message = problem(&|p| {
+        p.options.set_text("weights", "cotan");
+    });
     assert!(message.contains("cotangent"), "{message}");
     let message = problem(&|p| {
-        p.constraints = Constraints {
-            pins: vec![Pin {
-                vertex: VertexId(3),
-                position: None,
-            }],
-            curves: Vec::new(),
-        }
+        p.constraints = vec![Pin {
+            vertex: VertexId(3),
+            position: None,
+        }]
+        .into()
     });
     assert!(
         message.contains("no pins") && message.contains("vertex v3"),
         "{message}"
     );
     let message = problem(&|p| {
-        p.constraints.curves = vec![Curve {
-            source: vec![VertexId(0), VertexId(1)],
-            target: vec![VertexId(0), VertexId(1)],
-        }]
+        p.constraints = vec![Curve::open(
+            vec![VertexId(0), VertexId(1)],
+            vec![VertexId(0), VertexId(1)],
+        )]
+        .into()
     });
     assert!(message.contains("curves"), "{message}");
 }

@@ -57,7 +57,7 @@
 //! let mut problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Free));
 //! problem.goal = Goal::Prescribed(BeltramiField::new(Frame::Global, mu));
 //! let solution = Lsqc.solve(&problem, &mut Context::new()).unwrap();
-//! assert_eq!(solution.report.flipped(), Some(0));
+//! assert_eq!(solution.metrics.flipped(), Some(0));
 //! ```
 
 pub mod expr;

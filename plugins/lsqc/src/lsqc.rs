@@ -2,8 +2,9 @@
 //! Beltrami coefficient (module docs of the crate).
 
 use beltrami_core::{
-    Context, Goal, Map, PlanarBoundary, Position, Problem, Report, Solution, Solver, SolverError,
-    Target, topology,
+    Accepts, ConstraintKind, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionSpec,
+    Output, PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver, SolverError,
+    THREADS, Target, TargetKind, Topology, topology,
 };
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
@@ -21,16 +22,31 @@ use num_complex::Complex64;
 /// The least-squares quasiconformal map (crate docs).
 ///
 /// Reads: `goal` (`Prescribed(field)`, or `Conformal { p: 2 }` for `mu = 0`), `target`
-/// (`Plane(Keep | Given | Free)`), `constraints.pins` and `params.threads`. With a fixed
+/// (`Plane(Keep | Given | Free)`), the pins of `constraints` and the option `threads`. With a fixed
 /// boundary (`Keep`, `Given`) pins add further fixed vertices; with a free boundary it
 /// needs two or more pins, or none (two boundary vertices far apart are pinned at
 /// `(0, 0)` and `(1, 0)`, as in lscm). A pin without a position stays where it is on a
 /// planar source; on a curved source two such pins go to `(0, 0)` and `(1, 0)`. The
-/// report's energy is the final `E_mu`; its notes give `|mu - target|` ([`beltrami_fem::MuError`]).
+/// metrics hold the final `E_mu` as the energy and `|mu - target|`
+/// ([`beltrami_fem::MuError`]).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Lsqc;
 
 const NAME: &str = "lsqc";
+
+const OPTIONS: &[OptionSpec] = &[THREADS];
+
+const ACCEPTS: Accepts = Accepts {
+    elements: &[Element::Triangle, Element::Quad],
+    topologies: &[Topology::Disk],
+    targets: &[
+        TargetKind::PlaneKeep,
+        TargetKind::PlaneGiven,
+        TargetKind::PlaneFree,
+    ],
+    goals: &[GoalKind::Conformal, GoalKind::Prescribed],
+    constraints: &[ConstraintKind::Hold, ConstraintKind::Pin],
+};
 
 /// What to do with a mesh that is not a disk.
 const NOT_A_DISK: &str = "run `beltrami cut` first or use beltrami-flow";
@@ -44,21 +60,31 @@ impl Solver for Lsqc {
         "least-squares quasiconformal map for a prescribed Beltrami coefficient (one linear solve)"
     }
 
-    fn accepts(&self) -> &'static str {
-        "disk meshes (triangles, quads); goal: prescribed mu (global or face frame); target: plane with the boundary kept, given, or free with pins"
+    fn accepts(&self) -> Accepts {
+        ACCEPTS
     }
 
-    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+    fn options(&self) -> &'static [OptionSpec] {
+        OPTIONS
+    }
+
+    fn check_problem(
+        &self,
+        problem: &Problem<'_>,
+        _settings: &Settings,
+    ) -> Result<(), SolverError> {
         setup(problem).map(|_| ())
     }
 
-    fn solve(
+    fn run(
         &self,
         problem: &Problem<'_>,
+        settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
         let mesh = problem.source;
         let mut report = Report::new(NAME);
+        let mut metrics = Metrics::default();
         let Setup {
             field,
             fixed,
@@ -81,7 +107,7 @@ impl Solver for Lsqc {
             }
             let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
             let options = SolveOptions {
-                threads: problem.params.threads,
+                threads: settings.int("threads"),
                 ..SolveOptions::default()
             };
             let solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, options)?;
@@ -97,20 +123,13 @@ impl Solver for Lsqc {
             .zip(&weights)
             .map(|(r, w)| w * r.norm_sqr())
             .sum();
-        report.energy_history.push(energy);
+        metrics.energy_history.push(energy);
 
         let distortion = context.stage("distortion", &mut report, || {
             let derivatives = planar_map(&elements, mesh.vertex_count(), &map)?;
             Ok(Distortion::from_derivatives(&elements, &derivatives)?)
         })?;
-        let error = MuError::new(&elements, &distortion.field.mu, &field.mu)?;
-        report.notes.push(format!(
-            "|mu - target| per face ({} frame): L2 (area-weighted RMS) = {:.4e}, sup = {:.4e} at face {}",
-            field.frame.name(),
-            error.rms,
-            error.sup,
-            error.sup_face
-        ));
+        metrics.mu_error = Some(MuError::new(&elements, &distortion.field.mu, &field.mu)?);
         let flipped = distortion.stats.flipped;
         if flipped > 0 {
             report.notes.push(format!(
@@ -118,10 +137,12 @@ impl Solver for Lsqc {
                 mesh.face_count()
             ));
         }
-        report.mu = Some(distortion.field);
-        report.distortion = Some(distortion.stats);
+        metrics.mu = Some(distortion.field);
+        metrics.distortion = Some(distortion.stats);
         Ok(Solution {
-            map: Map::Planar(map),
+            output: Output::Map(Map::Planar(map)),
+            metrics,
+            extras: Extras::default(),
             report,
         })
     }
@@ -210,7 +231,7 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
             ));
         }
     };
-    if !problem.constraints.curves.is_empty() {
+    if problem.constraints.curves().next().is_some() {
         return Err(unsupported(
             "lsqc does not make vertices follow curves yet; use beltrami-flow".to_string(),
         ));
@@ -306,8 +327,7 @@ fn pins(
     let mesh = problem.source;
     problem
         .constraints
-        .pins
-        .iter()
+        .pins()
         .map(|pin| {
             let v = pin.vertex;
             if v.idx() >= mesh.vertex_count() {

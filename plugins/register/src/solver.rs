@@ -1,7 +1,8 @@
 //! [`Register`]: the solver behind `beltrami register` (crate docs).
 
 use beltrami_core::{
-    Context, Goal, Map, Position, Problem, Report, Solution, Solver, SolverError, Target,
+    Accepts, ConstraintKind, Context, Element, GoalKind, Map, OptionSpec, Position, Problem,
+    Report, Settings, Solution, Solver, SolverError, Target, TargetKind, Topology,
 };
 use beltrami_fem::distortion::measure_surface;
 use beltrami_flow::BeltramiFlow;
@@ -16,15 +17,27 @@ use crate::{Landmark, LandmarkTarget, check_topology, initial_map};
 /// Beltrami flow on the target mesh ([`BeltramiFlow`] with `Target::Mesh`).
 ///
 /// Reads: `target` (`Mesh` only), `goal` (`Conformal { p >= 2 }` or `Prescribed`),
-/// `constraints.pins` (landmarks: every pin needs a `Position::Spatial` on the target;
-/// the vertex is pulled there and held), `constraints.curves` (feature curves: a source
-/// chain onto a target chain, ends fixed, sliding between), `params` (as the flow). The
-/// map is `Map::OnMesh`. The report has the initial map's notes (the loops cut along,
-/// the alignment), its `|mu|` statistics, and the flow's history.
+/// landmarks (each with a `Position::Spatial` on the target; the vertex is pulled there
+/// and held), open curves (feature curves: a source chain onto a target chain, ends
+/// fixed, sliding between), and the flow's options. The map is `Map::OnMesh`. The
+/// metrics have the initial map's `|mu|` statistics and the flow's history; the notes
+/// the loops cut along and the alignment.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Register;
 
 const NAME: &str = "register";
+
+const ACCEPTS: Accepts = Accepts {
+    elements: &[Element::Triangle],
+    topologies: &[Topology::Disk, Topology::Sphere, Topology::Torus],
+    targets: &[TargetKind::Mesh],
+    goals: &[
+        GoalKind::Conformal,
+        GoalKind::ConformalLp,
+        GoalKind::Prescribed,
+    ],
+    constraints: &[ConstraintKind::Landmark, ConstraintKind::OpenCurve],
+};
 
 fn unsupported(message: impl Into<String>) -> SolverError {
     SolverError::Unsupported {
@@ -33,20 +46,19 @@ fn unsupported(message: impl Into<String>) -> SolverError {
     }
 }
 
-/// The landmarks of the problem's pins.
+/// The problem's landmarks, as the initial map takes them.
 fn landmarks(problem: &Problem<'_>) -> Result<Vec<Landmark>, SolverError> {
     problem
         .constraints
-        .pins
-        .iter()
-        .map(|pin| match pin.position {
-            Some(Position::Spatial(p)) => Ok(Landmark {
-                source: pin.vertex,
+        .landmarks()
+        .map(|mark| match mark.position {
+            Position::Spatial(p) => Ok(Landmark {
+                source: mark.vertex,
                 target: LandmarkTarget::Point(p),
             }),
-            _ => Err(unsupported(format!(
-                "pin on source vertex {} needs a point on the target (a landmark)",
-                pin.vertex
+            Position::Planar(_) => Err(unsupported(format!(
+                "the landmark on source vertex {} needs a point on the target mesh, not in the plane",
+                mark.vertex
             ))),
         })
         .collect()
@@ -61,11 +73,19 @@ impl Solver for Register {
         "surface registration: a bijective map onto another mesh of the same topology, as conformal as the constraints allow (or with a prescribed mu)"
     }
 
-    fn accepts(&self) -> &'static str {
-        "triangle meshes, source and target of the same topology: one boundary loop, closed genus 0 or closed genus 1; goals: conformal L^p (p >= 2) or prescribed mu; landmarks, feature curves"
+    fn accepts(&self) -> Accepts {
+        ACCEPTS
     }
 
-    fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
+    fn options(&self) -> &'static [OptionSpec] {
+        beltrami_flow::OPTIONS
+    }
+
+    fn check_problem(
+        &self,
+        problem: &Problem<'_>,
+        _settings: &Settings,
+    ) -> Result<(), SolverError> {
         let Target::Mesh(target) = &problem.target else {
             return Err(unsupported("register maps onto a target mesh"));
         };
@@ -80,18 +100,15 @@ impl Solver for Register {
             }
         }
         landmarks(problem)?;
-        if let Goal::Extremal = problem.goal {
-            return Err(unsupported("extremal maps come with their own solver"));
-        }
         Ok(())
     }
 
-    fn solve(
+    fn run(
         &self,
         problem: &Problem<'_>,
+        _settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
-        self.check(problem)?;
         let Target::Mesh(target) = &problem.target else {
             return Err(unsupported("register maps onto a target mesh"));
         };
@@ -126,27 +143,13 @@ impl Solver for Register {
             })
             .collect();
         let start = measure_surface(source, &initial.positions, Some(&normals))?;
-        report.notes.push(format!(
-            "initial map: mean |mu| {:.4}, max |mu| {:.4}, {} flipped faces",
-            start.stats.mu_mean, start.stats.mu_max, start.stats.flipped
-        ));
-        let initial_distortion = Some(start.stats);
         let mut flow = problem.clone();
         flow.initial = Some(Map::OnMesh(initial.points));
-        let solution = BeltramiFlow.solve(&flow, context)?;
-        let mut timings = std::mem::take(&mut report.timings);
-        timings.extend(solution.report.timings);
-        let mut notes = report.notes;
-        notes.extend(solution.report.notes);
-        Ok(Solution {
-            map: solution.map,
-            report: Report {
-                solver: NAME.into(),
-                timings,
-                notes,
-                initial_distortion,
-                ..solution.report
-            },
-        })
+        let mut solution = BeltramiFlow.solve(&flow, context)?;
+        solution.metrics.initial_distortion = Some(start.stats);
+        report.timings.append(&mut solution.report.timings);
+        report.notes.append(&mut solution.report.notes);
+        solution.report = report;
+        Ok(solution)
     }
 }

@@ -152,8 +152,8 @@ fn sphere(
             .iter()
             .map(|n| format!("sphere map of the {side}: {n}")),
     );
-    match solution.map {
-        Map::Spatial(points) => Ok(points.iter().map(|p| p.coords.normalize()).collect()),
+    match solution.map() {
+        Some(Map::Spatial(points)) => Ok(points.iter().map(|p| p.coords.normalize()).collect()),
         _ => Err(RegisterError::Sphere {
             side,
             error: SolverError::InvalidInput {

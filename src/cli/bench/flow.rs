@@ -15,7 +15,10 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use beltrami_core::{Context, Goal, Pin, PlanarBoundary, Problem, Solution, Solver, Target};
+use beltrami_core::{
+    Constraint, Constraints, Context, Goal, OptionValue, Pin, PlanarBoundary, Problem, Solution,
+    Solver, Target,
+};
 use beltrami_fem::{BeltramiField, Elements, Frame, MuError};
 use beltrami_flow::paper::{self, TABLE_5_1, TABLE_5_2, TABLE_5_3};
 use beltrami_flow::{BeltramiFlow, stereographic};
@@ -36,12 +39,14 @@ pub struct FlowArgs {
     pub meshes: Vec<PathBuf>,
 }
 
-fn pins(vertices: &[u32]) -> Vec<Pin> {
+fn pins(vertices: &[u32]) -> Constraints {
     vertices
         .iter()
-        .map(|&v| Pin {
-            vertex: VertexId(v),
-            position: None,
+        .map(|&v| {
+            Constraint::Pin(Pin {
+                vertex: VertexId(v),
+                position: None,
+            })
         })
         .collect()
 }
@@ -62,7 +67,7 @@ fn timed(problem: &Problem<'_>, repeat: usize) -> anyhow::Result<(Solution, f64)
 
 fn error_of(mesh: &Mesh, solution: &Solution, target: &[Complex64]) -> anyhow::Result<MuError> {
     let measured = solution
-        .report
+        .metrics
         .mu
         .as_ref()
         .ok_or_else(|| anyhow::anyhow!("no mu reported"))?;
@@ -80,13 +85,7 @@ fn centroids(mesh: &Mesh, mu: impl Fn(Complex64) -> Complex64) -> Vec<Complex64>
 }
 
 fn timing(solution: &Solution, name: &str) -> f64 {
-    solution
-        .report
-        .timings
-        .iter()
-        .filter(|(n, _)| n == name)
-        .map(|(_, s)| s)
-        .sum()
+    solution.report.timing(name).unwrap_or(0.0)
 }
 
 fn disk_table(repeat: usize) -> anyhow::Result<()> {
@@ -98,15 +97,15 @@ fn disk_table(repeat: usize) -> anyhow::Result<()> {
         let sigma = centroids(&mesh, |z| 0.6 * z);
         let mut problem = Problem::new(&mesh, Target::Disk);
         problem.goal = Goal::Prescribed(BeltramiField::new(Frame::Global, sigma.clone()));
-        problem.constraints.pins = pins(&[0, 1]);
-        problem.params.tolerance = 1e-8;
+        problem.constraints = pins(&[0, 1]);
+        problem.options.set("tolerance", OptionValue::Float(1e-8));
         let (solution, seconds) = timed(&problem, repeat)?;
         let e = error_of(&mesh, &solution, &sigma)?;
         println!(
             "| {} | {} | {} ({}) | {:.4} ({:.4}) | {:.3e} ({:.3e}) | {:.3e} | {seconds:.3} |",
             row.level,
             row.faces,
-            solution.report.iterations,
+            solution.metrics.iterations,
             row.steps,
             e.sup,
             row.sup,
@@ -128,12 +127,12 @@ fn sphere_table(repeat: usize) -> anyhow::Result<()> {
         let field = stereographic::field(&mesh, |_| k)?;
         let mut problem = Problem::new(&mesh, Target::Sphere);
         problem.goal = Goal::Prescribed(field.clone());
-        problem.constraints.pins = pins(&[0, 1, 5]);
-        problem.params.tolerance = 1e-5;
+        problem.constraints = pins(&[0, 1, 5]);
+        problem.options.set("tolerance", OptionValue::Float(1e-5));
         let (solution, seconds) = timed(&problem, repeat)?;
         let e = error_of(&mesh, &solution, &field.mu)?;
-        let worst = match &solution.map {
-            beltrami_core::Map::Spatial(image) => mesh
+        let worst = match solution.map() {
+            Some(beltrami_core::Map::Spatial(image)) => mesh
                 .vertices()
                 .map(|v| {
                     let p = mesh.position(v);
@@ -150,7 +149,7 @@ fn sphere_table(repeat: usize) -> anyhow::Result<()> {
         };
         println!(
             "| {} | {} | {} ({}) | {:.4} ({:.4}) | {worst:.3e} | {seconds:.3} |",
-            row.level, row.faces, solution.report.iterations, row.steps, e.l2_squared, row.l2
+            row.level, row.faces, solution.metrics.iterations, row.steps, e.l2_squared, row.l2
         );
     }
     Ok(())
@@ -167,19 +166,19 @@ fn annulus_table(repeat: usize) -> anyhow::Result<()> {
             let inner_radius = (!free).then_some(0.4);
             let mut problem = Problem::new(&mesh, Target::Annulus { inner_radius });
             problem.goal = Goal::Prescribed(BeltramiField::new(Frame::Global, sigma.clone()));
-            problem.constraints.pins = pins(&[(sectors * rings) as u32]);
-            problem.params.tolerance = 1e-8;
+            problem.constraints = pins(&[(sectors * rings) as u32]);
+            problem.options.set("tolerance", OptionValue::Float(1e-8));
             let (solution, seconds) = timed(&problem, repeat)?;
             let e = error_of(&mesh, &solution, &sigma)?;
-            let radius = match &solution.map {
-                beltrami_core::Map::Planar(z) => z[0].norm(),
+            let radius = match solution.map() {
+                Some(beltrami_core::Map::Planar(z)) => z[0].norm(),
                 _ => f64::NAN,
             };
             println!(
                 "| {} | {} | {} | {:.4} | {:.3e} | {radius:.5} | {seconds:.3} |",
                 if free { "free" } else { "kept" },
                 mesh.face_count(),
-                solution.report.iterations,
+                solution.metrics.iterations,
                 e.sup,
                 e.rms
             );
@@ -210,10 +209,10 @@ fn square_table(repeat: usize) -> anyhow::Result<()> {
     for row in &TABLE_5_3 {
         let mesh = square_mesh(row.side - 1)?;
         let mut problem = square_problem(&mesh);
-        problem.params.tolerance = 1e-3;
+        problem.options.set("tolerance", OptionValue::Float(1e-3));
         let (solution, seconds) = timed(&problem, repeat)?;
-        let rms = match &solution.map {
-            beltrami_core::Map::Planar(z) => {
+        let rms = match solution.map() {
+            Some(beltrami_core::Map::Planar(z)) => {
                 let sum: f64 = mesh
                     .vertices()
                     .map(|v| {
@@ -227,12 +226,12 @@ fn square_table(repeat: usize) -> anyhow::Result<()> {
             _ => f64::NAN,
         };
         let per_step = (timing(&solution, "flow: solves") + timing(&solution, "flow: steps"))
-            / solution.report.iterations.max(1) as f64;
+            / solution.metrics.iterations.max(1) as f64;
         println!(
             "| {}^2 | {} | {} ({}) | {seconds:.3} ({:.2}) | {rms:.3e} | {:.3} | {per_step:.3} |",
             row.side,
             mesh.face_count(),
-            solution.report.iterations,
+            solution.metrics.iterations,
             row.iterations,
             row.seconds,
             timing(&solution, "symbolic")
@@ -275,7 +274,7 @@ fn step_table(args: &FlowArgs) -> anyhow::Result<()> {
                 let mut p = Problem::new(mesh, Target::Sphere);
                 let k = Complex64::new(0.3, 0.3);
                 p.goal = Goal::Prescribed(stereographic::field(mesh, |_| k)?);
-                p.constraints.pins = pins(&[0, 1, 5]);
+                p.constraints = pins(&[0, 1, 5]);
                 p
             }
             (true, true) => Problem::new(mesh, Target::Sphere),
@@ -285,13 +284,13 @@ fn step_table(args: &FlowArgs) -> anyhow::Result<()> {
         if *conformal {
             problem.goal = Goal::Conformal { p: 2.0 };
         }
-        problem.params.tolerance = 1e-6;
+        problem.options.set("tolerance", OptionValue::Float(1e-6));
         let (solution, seconds) = timed(&problem, args.repeat)?;
         let setup = timing(&solution, "elements")
             + timing(&solution, "initial map")
             + timing(&solution, "symbolic");
         let per_step = (timing(&solution, "flow: solves") + timing(&solution, "flow: steps"))
-            / solution.report.iterations.max(1) as f64;
+            / solution.metrics.iterations.max(1) as f64;
         let target = match (&problem.target, conformal) {
             (Target::Sphere, true) => "sphere, L2",
             (Target::Sphere, false) => "sphere, prescribed mu",
@@ -301,7 +300,7 @@ fn step_table(args: &FlowArgs) -> anyhow::Result<()> {
         println!(
             "| {name} | {} | {target} | {setup:.3} | {} | {per_step:.3} | {seconds:.3} |",
             mesh.face_count(),
-            solution.report.iterations
+            solution.metrics.iterations
         );
     }
     Ok(())

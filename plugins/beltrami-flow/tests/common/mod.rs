@@ -31,14 +31,14 @@ pub fn flow(problem: &Problem<'_>) -> Solution {
 /// `|mu - target|` of a solution (measured in `frame`).
 pub fn mu_error(mesh: &Mesh, solution: &Solution, target: &[Complex64], frame: Frame) -> MuError {
     let elements = Elements::new(mesh, frame).unwrap();
-    let measured = solution.report.mu.as_ref().expect("mu is reported");
+    let measured = solution.metrics.mu.as_ref().expect("mu is reported");
     assert_eq!(measured.frame, frame);
     MuError::new(&elements, &measured.mu, target).unwrap()
 }
 
 /// The planar images of a solution.
 pub fn planar(solution: &Solution) -> &[Complex64] {
-    match &solution.map {
+    match solution.map().expect("a map") {
         Map::Planar(z) => z,
         other => panic!("expected a planar map, got {other:?}"),
     }
@@ -46,7 +46,7 @@ pub fn planar(solution: &Solution) -> &[Complex64] {
 
 /// The spatial images of a solution.
 pub fn spatial(solution: &Solution) -> &[Point3<f64>] {
-    match &solution.map {
+    match solution.map().expect("a map") {
         Map::Spatial(p) => p,
         other => panic!("expected a spatial map, got {other:?}"),
     }

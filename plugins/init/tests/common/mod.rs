@@ -7,7 +7,7 @@
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use beltrami_core::{Map, Report};
+use beltrami_core::{Map, Solution};
 use beltrami_mesh::io::read;
 use beltrami_mesh::primitives::{Cells, jittered_grid};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, VertexId};
@@ -134,9 +134,10 @@ pub fn identity_error(mesh: &Mesh, map: &[Complex64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// One line with the report's timings, flips and |mu| statistics.
-pub fn summary(report: &Report) -> String {
-    let d = report.distortion.expect("distortion measured");
+/// One line with the solution's timings, flips and |mu| statistics.
+pub fn summary(solution: &Solution) -> String {
+    let report = &solution.report;
+    let d = solution.metrics.distortion.expect("distortion measured");
     let timings: Vec<String> = report
         .timings
         .iter()

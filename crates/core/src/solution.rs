@@ -1,0 +1,175 @@
+//! The result of a solve: an [`Output`] (a map of the source's vertices, or a new mesh
+//! located on the source), typed [`Metrics`] (distortion, errors, histories), typed
+//! [`Extras`] (what some solvers compute beside the map) and the [`Report`] (timings
+//! and prose notes).
+
+use beltrami_fem::{BeltramiField, DistortionStats, Frame, MuError};
+use beltrami_mesh::{Mesh, SurfacePoint};
+use num_complex::Complex64;
+
+use crate::{Map, Report};
+
+/// What a solver produces.
+#[derive(Debug, Clone)]
+pub enum Output {
+    /// Images of the source's vertices.
+    Map(Map),
+    /// A new mesh (remeshing) with each of its vertices located on the source (boxed:
+    /// a mesh is much larger than a map's vector header).
+    Mesh(Box<Remeshed>),
+}
+
+/// A new mesh and where its vertices lie on the source surface.
+#[derive(Debug, Clone)]
+pub struct Remeshed {
+    /// The new mesh.
+    pub mesh: Mesh,
+    /// Per vertex of the new mesh (by id), its point on the source.
+    pub on_source: Vec<SurfacePoint>,
+}
+
+/// Why an iterative solver stopped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stop {
+    /// The largest update fell below the tolerance (absolute, in the target's units).
+    Converged {
+        /// The tolerance reached.
+        tolerance: f64,
+    },
+    /// No step above the tolerance decreased the error further.
+    Stalled,
+    /// The iteration limit was reached first.
+    IterationLimit,
+    /// Cancelled by the user; the map is the best one so far.
+    Cancelled,
+}
+
+impl Stop {
+    /// The stable name in reports: `converged`, `stalled`, `iteration-limit` or
+    /// `cancelled`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Stop::Converged { .. } => "converged",
+            Stop::Stalled => "stalled",
+            Stop::IterationLimit => "iteration-limit",
+            Stop::Cancelled => "cancelled",
+        }
+    }
+}
+
+/// What a solve measured, typed. Fields a solver does not compute stay `None` or empty.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Metrics {
+    /// The result's Beltrami coefficient per face.
+    pub mu: Option<BeltramiField>,
+    /// Statistics of `|mu|` and the flipped-face count of the result.
+    pub distortion: Option<DistortionStats>,
+    /// The same for the map an iterative solver started from.
+    pub initial_distortion: Option<DistortionStats>,
+    /// `|mu - target|` for a prescribed Beltrami coefficient (area-weighted RMS, squared
+    /// L2, sup and where).
+    pub mu_error: Option<MuError>,
+    /// The dilatation `k = |mu|` of an extremal (Teichmueller) map.
+    pub k: Option<f64>,
+    /// Iterations done (0 for direct solvers).
+    pub iterations: usize,
+    /// Energy or error after each iteration (direct solvers: the final energy, if any).
+    pub energy_history: Vec<f64>,
+    /// The step size of each iteration of an iterative solver.
+    pub step_sizes: Vec<f64>,
+    /// Why an iterative solver stopped.
+    pub stop: Option<Stop>,
+    /// Numeric factorizations done.
+    pub factorizations: Option<usize>,
+    /// Conjugate-gradient iterations done on steps that reused a factorization.
+    pub cg_iterations: Option<usize>,
+}
+
+impl Metrics {
+    /// Number of flipped faces of the result, when measured.
+    pub fn flipped(&self) -> Option<usize> {
+        self.distortion.as_ref().map(|d| d.flipped)
+    }
+}
+
+/// The inner radius of an annulus target when it was an unknown (the conformal modulus
+/// `(1/2 pi) log(1/r)` of the map).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AnnulusRadius {
+    /// The radius found.
+    pub radius: f64,
+    /// The radius the solve started from.
+    pub initial: f64,
+}
+
+/// A circle of a circle domain: the image of boundary loop `boundary_loop` (an index
+/// into the source's [`Mesh::boundary_loop_list`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Circle {
+    /// The boundary loop.
+    pub boundary_loop: usize,
+    /// The centre.
+    pub center: Complex64,
+    /// The radius.
+    pub radius: f64,
+}
+
+/// A holomorphic quadratic differential `phi dz^2` of an extremal map, one value per
+/// face in a stated frame (a frame rotation by `theta` multiplies `phi` by
+/// `e^{-2 i theta}`, like `mu`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct QuadraticDifferential {
+    /// The frame of the values.
+    pub frame: Frame,
+    /// `phi` per face.
+    pub values: Vec<Complex64>,
+}
+
+/// What some solvers compute beside the map, typed.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Extras {
+    /// The free inner radius of an annulus target.
+    pub annulus_radius: Option<AnnulusRadius>,
+    /// The circles of a circle-domain map (the outer one first).
+    pub circles: Option<Vec<Circle>>,
+    /// The quadratic differential of an extremal map.
+    pub quadratic_differential: Option<QuadraticDifferential>,
+}
+
+/// The result of a solve.
+#[derive(Debug, Clone)]
+pub struct Solution {
+    /// The map or the new mesh.
+    pub output: Output,
+    /// What was measured.
+    pub metrics: Metrics,
+    /// What the solver computed beside the map.
+    pub extras: Extras,
+    /// Timings and notes.
+    pub report: Report,
+}
+
+impl Solution {
+    /// A solution with a map, empty metrics and extras.
+    pub fn from_map(map: Map, report: Report) -> Self {
+        Self {
+            output: Output::Map(map),
+            metrics: Metrics::default(),
+            extras: Extras::default(),
+            report,
+        }
+    }
+
+    /// The map, if the output is one.
+    pub fn map(&self) -> Option<&Map> {
+        match &self.output {
+            Output::Map(map) => Some(map),
+            Output::Mesh(_) => None,
+        }
+    }
+
+    /// The planar images, if the output is a planar map.
+    pub fn planar(&self) -> Option<&[Complex64]> {
+        self.map().and_then(Map::as_planar)
+    }
+}
