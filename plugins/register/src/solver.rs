@@ -3,11 +3,10 @@
 use beltrami_core::{
     Context, Goal, Map, Position, Problem, Report, Solution, Solver, SolverError, Target,
 };
+use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
 use beltrami_flow::BeltramiFlow;
-use beltrami_mesh::Vector3;
 use beltrami_spatial::SurfaceIndex;
-use beltrami_spatial::frame::interpolated_normal;
 
 use crate::{Landmark, LandmarkTarget, check_topology, initial_map};
 
@@ -105,27 +104,23 @@ impl Solver for Register {
             })
         })?;
         report.notes.extend(initial.notes.iter().cloned());
-        // The initial map's distortion, judged against the target's normals.
+        // The initial map's distortion, judged against the target's normals at the images
+        // (the rule of `beltrami distortion --target` and of the flow).
         let index = SurfaceIndex::new(target).map_err(|e| SolverError::InvalidInput {
             solver: NAME,
             message: format!("the target mesh: {e}"),
         })?;
-        let normals: Vec<Vector3<f64>> = source
-            .faces()
-            .map(|f| {
-                source
-                    .face_vertices(f)
-                    .map(|v| {
-                        interpolated_normal(
-                            target,
-                            index.vertex_normals(),
-                            &initial.points[v.idx()],
-                        )
-                    })
-                    .sum::<Vector3<f64>>()
-            })
-            .collect();
-        let start = measure_surface(source, &initial.positions, Some(&normals))?;
+        let normals = index
+            .face_reference_normals(source, &initial.points)
+            .map_err(|e| SolverError::InvalidInput {
+                solver: NAME,
+                message: format!("the initial map on the target mesh: {e}"),
+            })?;
+        let start = measure_surface(
+            source,
+            &initial.positions,
+            ReferenceNormal::PerFace(&normals),
+        )?;
         report.notes.push(format!(
             "initial map: mean |mu| {:.4}, max |mu| {:.4}, {} flipped faces",
             start.stats.mu_mean, start.stats.mu_max, start.stats.flipped
