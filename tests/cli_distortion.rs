@@ -1,5 +1,6 @@
 //! End-to-end runs of `beltrami distortion`: affine and conformal maps with known mu,
-//! similarities of surfaces, flips judged against a target, and bad input.
+//! similarities of surfaces, flips judged against the reference normal chosen from the
+//! image (plane, sphere, source) or against a target, and bad input.
 
 use std::path::{Path, PathBuf};
 
@@ -260,10 +261,11 @@ fn midpoint(a: Point3<f64>, b: Point3<f64>) -> Point3<f64> {
 }
 
 #[test]
-fn flips_are_judged_against_the_image_or_the_target() {
+fn flips_are_judged_radially_or_against_the_target() {
     // A half turn about z: conformal, and no fold, though near the equator each image
-    // face's normal points against its source face's normal. Without a target the image
-    // is judged against its own vertex normals, with one against the target's.
+    // face's normal points against its source face's normal. Without a target the image,
+    // on the unit sphere, is judged against the radial direction; with one against the
+    // target's normals at the images.
     let dir = tempfile::tempdir().unwrap();
     let sphere = Mesh::from_soup(&icosphere(3)).unwrap();
     let target = Mesh::from_soup(&icosphere(2)).unwrap();
@@ -282,9 +284,11 @@ fn flips_are_judged_against_the_image_or_the_target() {
     write_mesh(&target_path, &target, None, None);
 
     let alone = report(&[s(&source), s(&mapped)]);
+    assert_eq!(alone["reference"], "radial");
     assert_eq!(alone["flipped"], 0, "{alone}");
     assert!(number(&alone, "mu_max") < 1e-9, "{alone}");
     let against_target = report(&[s(&source), s(&mapped), "--target", s(&target_path)]);
+    assert_eq!(against_target["reference"], "target");
     assert_eq!(against_target["flipped"], 0, "{against_target}");
 
     // A vertex slid along the surface past its neighbours folds part of its fan:
@@ -303,6 +307,116 @@ fn flips_are_judged_against_the_image_or_the_target() {
         let v = report(&args);
         assert!(v["flipped"].as_u64().unwrap() >= 1, "{v}");
     }
+}
+
+/// Twice the signed area of the triangle `a b c` of the plane z = 0.
+fn signed_area2(a: &Point3<f64>, b: &Point3<f64>, c: &Point3<f64>) -> f64 {
+    (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x)
+}
+
+#[test]
+fn a_folded_planar_map_given_as_positions_is_judged_in_the_plane() {
+    // 40 x 40 cells of two triangles on the unit square. Past x = 0.75 the map turns
+    // back at half speed, x -> 0.75 - (x - 0.75) / 2: the 10 columns of cells beyond the
+    // fold line (a grid line) are reversed, 800 of 3200 triangles (|mu| = 3 there), and
+    // the rest is the identity. As positions `v x y 0` the image's own normals would turn
+    // over with the fold; the plane z = 0 is the reference.
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = Mesh::from_soup(&grid(40, 40, Cells::Triangles)).unwrap();
+    assert_eq!(mesh.face_count(), 3200);
+    let fold = |p: &Point3<f64>| {
+        let x = if p.x > 0.75 {
+            0.75 - 0.5 * (p.x - 0.75)
+        } else {
+            p.x
+        };
+        Point3::new(x, p.y, 0.0)
+    };
+    let image: Vec<Point3<f64>> = mesh.positions().iter().map(fold).collect();
+    let uv: Vec<Vector2<f64>> = image.iter().map(|p| Vector2::new(p.x, p.y)).collect();
+    let (source, positions, texture) = (
+        dir.path().join("square.obj"),
+        dir.path().join("folded.obj"),
+        dir.path().join("folded-vt.obj"),
+    );
+    write_mesh(&source, &mesh, None, None);
+    write_mesh(&positions, &mesh, Some(&image), None);
+    write_mesh(&texture, &mesh, None, Some(&uv));
+
+    // The independent count: signed areas of the image triangles as written.
+    let written = io::read(&positions, &BuildOptions::default()).unwrap().mesh;
+    assert!(written.positions().iter().all(|p| p.z == 0.0));
+    let negative = written
+        .faces()
+        .filter(|&f| {
+            let p: Vec<Point3<f64>> = written
+                .face_vertices(f)
+                .map(|v| written.position(v))
+                .collect();
+            signed_area2(&p[0], &p[1], &p[2]) < 0.0
+        })
+        .count();
+    assert_eq!(negative, 800);
+
+    let as_positions = report(&[s(&source), s(&positions)]);
+    assert_eq!(as_positions["map"], "positions");
+    assert_eq!(as_positions["reference"], "plane");
+    assert_eq!(as_positions["flipped"], 800, "{as_positions}");
+    assert_eq!(as_positions["histogram"]["at_least_one"], 800);
+    assert!((number(&as_positions, "mu_max") - 3.0).abs() < 1e-9);
+
+    // The same map as texture coordinates: the same count and the same |mu|.
+    let as_vt = report(&[s(&source), s(&texture)]);
+    assert_eq!(as_vt["map"], "vt");
+    assert_eq!(as_vt["reference"], "plane");
+    assert_eq!(as_vt["flipped"], 800, "{as_vt}");
+    for key in ["mu_mean", "mu_max", "mu_l2"] {
+        let (a, b) = (number(&as_positions, key), number(&as_vt, key));
+        assert!((a - b).abs() <= 1e-12 * b.max(1.0), "{key}: {a} vs {b}");
+    }
+
+    // The text report names the reference.
+    let out = beltrami(&["distortion", s(&source), s(&positions)]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("flipped         800"), "{stdout}");
+    assert!(
+        stdout.contains("flips judged against +z (the image lies in the plane z = 0)"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn an_image_off_the_plane_and_the_sphere_is_judged_by_the_source_with_a_note() {
+    // The square lifted onto the saddle z = x y: neither planar nor spherical.
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = Mesh::from_soup(&grid(6, 6, Cells::Triangles)).unwrap();
+    let image: Vec<Point3<f64>> = mesh
+        .positions()
+        .iter()
+        .map(|p| Point3::new(p.x, p.y, p.x * p.y))
+        .collect();
+    let (source, mapped) = (dir.path().join("square.obj"), dir.path().join("saddle.obj"));
+    write_mesh(&source, &mesh, None, None);
+    write_mesh(&mapped, &mesh, Some(&image), None);
+    let v = report(&[s(&source), s(&mapped)]);
+    assert_eq!(v["reference"], "source");
+    assert_eq!(v["flipped"], 0);
+    let note = v["notes"][0].as_str().unwrap_or_default();
+    assert!(note.contains("--target"), "{v}");
+    let out = beltrami(&["distortion", s(&source), s(&mapped)]);
+    assert!(out.status.success());
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("flips are judged against the normals of") && err.contains("--target"),
+        "{err}"
+    );
+    assert!(text(&out.stdout).contains("flips judged against SOURCE's normals"));
+    // Judged against the saddle itself, given as the target: the same answer, no note.
+    let v = report(&[s(&source), s(&mapped), "--target", s(&mapped)]);
+    assert_eq!(v["reference"], "target");
+    assert_eq!(v["flipped"], 0);
+    assert_eq!(v["notes"], serde_json::json!([]));
 }
 
 #[test]

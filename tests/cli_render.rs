@@ -296,3 +296,86 @@ fn a_sphere_map_of_a_shared_mesh_renders_without_false_flips() {
     let loaded = io::read(&sphere, &BuildOptions::default()).expect("reads");
     assert_eq!(loaded.mesh.face_count(), 5856);
 }
+
+#[test]
+fn render_states_the_reference_normal_of_a_map_into_space() {
+    // A square folded past x = 0.75 and written as positions `v x y 0`: judged in the
+    // plane. The same square on the saddle z = x y: judged against MESH's normals with a
+    // note, or against a TARGET's.
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let mesh = Mesh::from_soup(&grid(8, 8, Cells::Triangles)).expect("a grid");
+    let folded: Vec<_> = mesh
+        .positions()
+        .iter()
+        .map(|p| {
+            let x = if p.x > 0.75 {
+                0.75 - 0.5 * (p.x - 0.75)
+            } else {
+                p.x
+            };
+            beltrami_mesh::Point3::new(x, p.y, 0.0)
+        })
+        .collect();
+    let saddle: Vec<_> = mesh
+        .positions()
+        .iter()
+        .map(|p| beltrami_mesh::Point3::new(p.x, p.y, p.x * p.y))
+        .collect();
+    let write = |name: &str, positions: &[beltrami_mesh::Point3<f64>]| {
+        let path = dir.path().join(name);
+        let attributes = VertexAttributes {
+            positions: Some(positions),
+            ..VertexAttributes::default()
+        };
+        io::obj::write(&path, &mesh, &attributes).expect("writes");
+        path
+    };
+    let source = write("square.obj", mesh.positions());
+    let (folded, saddle) = (write("folded.obj", &folded), write("saddle.obj", &saddle));
+    let picture = dir.path().join("map.png");
+    let render = |map: &Path, extra: &[&str]| {
+        let mut args = vec!["render", s(&source), "--map", s(map), "-o", s(&picture)];
+        args.extend_from_slice(extra);
+        let out = beltrami(&args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        (text(&out.stdout), text(&out.stderr))
+    };
+    let (stdout, stderr) = render(&folded, &[]);
+    assert!(
+        stdout.contains("flips judged against the plane normal"),
+        "{stdout}"
+    );
+    assert!(!stderr.contains("note"), "{stderr}");
+    let (stdout, stderr) = render(&saddle, &[]);
+    assert!(
+        stdout.contains("flips judged against the source normal"),
+        "{stdout}"
+    );
+    assert!(
+        stderr.contains("note") && stderr.contains("--target"),
+        "{stderr}"
+    );
+    let (stdout, stderr) = render(&saddle, &["--target", s(&saddle)]);
+    assert!(
+        stdout.contains("flips judged against TARGET's normals"),
+        "{stdout}"
+    );
+    assert!(!stderr.contains("note"), "{stderr}");
+    // A map into the plane has no use for a target.
+    let uv = dir.path().join("uv.obj");
+    ok(&["param", s(&source), "--solver", "tutte", "-o", s(&uv), "-q"]);
+    let err = fails(&[
+        "render",
+        s(&source),
+        "--map",
+        s(&uv),
+        "--target",
+        s(&saddle),
+        "-o",
+        s(&picture),
+    ]);
+    assert!(
+        err.contains("--target applies only to a map into R^3"),
+        "{err}"
+    );
+}

@@ -5,14 +5,14 @@
 //! into the plane) or, without them, whose positions (a map into R^3) are the images of
 //! SOURCE's vertices. Vertices correspond by their input index (the files' own order).
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow, bail};
 use beltrami_fem::distortion::{self, Distortion, Histogram};
-use beltrami_fem::{Frame, element};
+use beltrami_fem::{Frame, ReferenceNormal, element};
 use beltrami_mesh::io::{self, LoadedMesh};
-use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, Repair, Vector3, VertexId};
+use beltrami_mesh::{BuildOptions, Mesh, Point3, Repair, SurfacePoint, Vector3, VertexId};
+use beltrami_spatial::SurfaceIndex;
 use clap::Args;
 use num_complex::Complex64;
 use serde_json::json;
@@ -27,8 +27,12 @@ pub struct DistortionArgs {
     /// coordinates (`vt`, a map into the plane) or, without them, whose positions (a map
     /// into R^3) are the images of SOURCE's vertices.
     pub mapped: PathBuf,
-    /// For a map into R^3: judge flips against the normals of this surface at the images
-    /// (the nearest face to each image face's centroid) instead of SOURCE's normals.
+    /// For a map into R^3: the surface the map lands on. Flips are judged against its
+    /// normals at the images (each image vertex located on TARGET by its exact closest
+    /// point; per face the sum of TARGET's interpolated normals at its corners' images),
+    /// as `register` judges them. Without it the image's shape decides: +z for an image
+    /// in the plane z = 0, the radial direction for one on a sphere about the origin,
+    /// else SOURCE's normals.
     #[arg(long, value_name = "TARGET")]
     pub target: Option<PathBuf>,
     /// Print one JSON object instead of text.
@@ -59,8 +63,10 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
         Frame::Face
     };
     let measuring = || format!("measuring the map of {}", args.source.display());
+    // Notes on the reference normal: printed, or in the JSON report.
+    let mut notes = Vec::new();
 
-    let (kind, measured) = if mapped.corner_uvs.is_some() {
+    let (kind, reference, measured) = if mapped.corner_uvs.is_some() {
         if args.target.is_some() {
             bail!(
                 "{} has texture coordinates, a map into the plane: --target applies only to \
@@ -76,30 +82,38 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
             .map(|v| Complex64::new(uv[v.idx()].x, uv[v.idx()].y))
             .collect();
         let measured = distortion::measure_planar(mesh, &map, frame).with_context(measuring)?;
-        (MapKind::Planar, measured)
+        (
+            MapKind::Planar,
+            Reference::Chosen(ReferenceNormal::Plane),
+            measured,
+        )
     } else {
         let image: Vec<Point3<f64>> = to_mapped.iter().map(|&v| mapped.mesh.position(v)).collect();
-        let normals = match &args.target {
+        let (reference, measured) = match &args.target {
             Some(path) => {
                 let target = load_mesh(path, args.repair, quiet)?.mesh;
-                let found = target_normals(&target.mesh, mesh, &image);
-                if found.far_faces > 0 && !quiet {
-                    eprintln!(
-                        "note: the images of {} faces lie farther than {:.3e} from every face \
-                         centroid of {}: is it the surface the map lands on?",
-                        found.far_faces,
-                        found.far,
-                        path.display()
-                    );
-                }
-                Some(found.normals)
+                let (normals, note) = target_normals(&target.mesh, mesh, &image, path)?;
+                notes.extend(note);
+                let measured =
+                    distortion::measure_surface(mesh, &image, ReferenceNormal::PerFace(&normals))
+                        .with_context(measuring)?;
+                (Reference::Target, measured)
             }
-            None => Some(distortion::image_normals(mesh, &image)),
+            None => {
+                let reference = ReferenceNormal::for_image(&image);
+                notes.extend(source_reference_note(reference, &args.source));
+                let measured =
+                    distortion::measure_surface(mesh, &image, reference).with_context(measuring)?;
+                (Reference::Chosen(reference), measured)
+            }
         };
-        let measured = distortion::measure_surface(mesh, &image, normals.as_deref())
-            .with_context(measuring)?;
-        (MapKind::Spatial, measured)
+        (MapKind::Spatial, reference, measured)
     };
+    if !quiet {
+        for note in &notes {
+            eprintln!("note: {note}");
+        }
+    }
 
     if let Some(path) = &args.per_face {
         measured
@@ -108,7 +122,7 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
             .and_then(|field| field.write(path))
             .with_context(|| format!("writing the per-face field {}", path.display()))?;
     }
-    print_report(args, kind, frame, &measured);
+    print_report(args, kind, frame, reference, &notes, &measured);
     Ok(())
 }
 
@@ -251,163 +265,95 @@ fn seam_error(mapped: &LoadedMesh, path: &Path) -> anyhow::Error {
     )
 }
 
-/// The normals of a target surface at the images of the source faces.
-struct TargetNormals {
-    /// Per source face: the normal of the target face whose centroid is nearest to the
-    /// centroid of the face's image.
-    normals: Vec<Vector3<f64>>,
-    /// Source faces whose image centroid is farther than [`TargetNormals::far`] from
-    /// every target centroid.
-    far_faces: usize,
-    /// The distance beyond which an image is far from the target: about 8 mean target
-    /// face sizes (the grid's cell size).
-    far: f64,
+/// The reference normal flips were judged against, for the reports.
+#[derive(Debug, Clone, Copy)]
+enum Reference {
+    /// Chosen from the map's image ([`ReferenceNormal::for_image`]), or `Plane` for a
+    /// map given by texture coordinates.
+    Chosen(ReferenceNormal<'static>),
+    /// TARGET's normals at the images.
+    Target,
 }
 
-/// The normals of `target` at the images of the faces of `source` (see
-/// [`TargetNormals`]).
-fn target_normals(target: &Mesh, source: &Mesh, image: &[Point3<f64>]) -> TargetNormals {
-    let centroids: Vec<Point3<f64>> = target.faces().map(|g| target.face_centroid(g)).collect();
-    // Cells 8 mean face sizes wide: about 64 centroids per cell on a surface, few cells
-    // to visit per query even for images a few cells off the target.
+impl Reference {
+    /// The name in JSON reports: `plane`, `radial`, `source` or `target`.
+    fn name(self) -> &'static str {
+        match self {
+            Reference::Chosen(reference) => reference.name(),
+            Reference::Target => "target",
+        }
+    }
+
+    /// The description in text reports.
+    fn describe(self) -> &'static str {
+        match self {
+            Reference::Chosen(ReferenceNormal::Plane) => "+z (the image lies in the plane z = 0)",
+            Reference::Chosen(ReferenceNormal::Radial) => {
+                "the radial direction (the image lies on a sphere about the origin)"
+            }
+            Reference::Chosen(_) => "SOURCE's normals",
+            Reference::Target => "TARGET's normals at the images",
+        }
+    }
+}
+
+/// The note for flips of a map into R^3 judged against SOURCE's normals (`reference`
+/// is [`ReferenceNormal::Source`]), else `None`.
+pub(super) fn source_reference_note(
+    reference: ReferenceNormal<'_>,
+    source: &Path,
+) -> Option<String> {
+    matches!(reference, ReferenceNormal::Source).then(|| {
+        format!(
+            "the image is neither in the plane z = 0 nor on a sphere about the origin: flips \
+             are judged against the normals of {} (right for an image close to it); \
+             --target gives the surface the map lands on",
+            source.display()
+        )
+    })
+}
+
+/// Per face of `source`, the normal of `target` at its image (the reference of
+/// [`ReferenceNormal::PerFace`]): every image point located on `target` by its exact
+/// closest point ([`SurfaceIndex::locate_all`]), then
+/// [`SurfaceIndex::face_reference_normals`], the rule `register` judges its maps by.
+/// Also a note when images lie farther from `target` than its mean face size.
+pub(super) fn target_normals(
+    target: &Mesh,
+    source: &Mesh,
+    image: &[Point3<f64>],
+    target_path: &Path,
+) -> anyhow::Result<(Vec<Vector3<f64>>, Option<String>)> {
+    let context = || format!("locating the map's image on {}", target_path.display());
+    let index = SurfaceIndex::new(target).with_context(context)?;
+    let located = index.locate_all(image).with_context(context)?;
     let face_size = (target.total_area() / target.face_count() as f64).sqrt();
-    let cell = 8.0 * face_size.max(1e-9 * target.bounding_box().diagonal());
-    let grid = CentroidGrid::new(&centroids, if cell > 0.0 { cell } else { 1.0 });
-    let mut far_faces = 0;
-    let normals = source
-        .faces()
-        .map(|f| {
-            let (v, n) = source.face_vertex_array(f);
-            let sum: Vector3<f64> = v[..n].iter().map(|v| image[v.idx()].coords).sum();
-            let (g, distance) = grid.nearest(&Point3::from(sum / n as f64));
-            if distance > grid.cell {
-                far_faces += 1;
-            }
-            target.face_normal(FaceId(g))
-        })
-        .collect();
-    TargetNormals {
-        normals,
-        far_faces,
-        far: grid.cell,
-    }
+    let (far, farthest) = located
+        .iter()
+        .filter(|l| l.distance > face_size)
+        .fold((0, 0.0), |(n, d), l| (n + 1, l.distance.max(d)));
+    let note = (far > 0).then(|| {
+        format!(
+            "{far} image vertices lie farther than a mean face size ({face_size:.3e}) from \
+             {}, up to {farthest:.3e}: is it the surface the map lands on?",
+            target_path.display()
+        )
+    });
+    let points: Vec<SurfacePoint> = located.into_iter().map(|l| l.point).collect();
+    let normals = index
+        .face_reference_normals(source, &points)
+        .with_context(context)?;
+    Ok((normals, note))
 }
 
-/// Nearest-point search over the target's face centroids with a uniform grid of
-/// buckets (a hash map of occupied cells). A stand-in until the `beltrami-spatial` crate
-/// brings its kd-tree (kiddo): fine for ~100K faces whose images lie on or near the
-/// target (0.4 s for 100K faces on the target, 0.7 s at 15 face sizes off it), but a
-/// query visits about `(distance / cell)^3` cells, so images far off the target are slow.
-struct CentroidGrid<'a> {
-    points: &'a [Point3<f64>],
-    origin: Point3<f64>,
-    cell: f64,
-    /// Cell index range occupied by the points, per axis.
-    lo: [i64; 3],
-    hi: [i64; 3],
-    buckets: HashMap<[i64; 3], Vec<u32>>,
-}
-
-impl<'a> CentroidGrid<'a> {
-    /// Buckets `points` (at least one, finite) into cubes of side `cell > 0`.
-    fn new(points: &'a [Point3<f64>], cell: f64) -> Self {
-        let origin = points.iter().fold(points[0], |m, p| m.inf(p));
-        let mut grid = Self {
-            points,
-            origin,
-            cell,
-            lo: [i64::MAX; 3],
-            hi: [i64::MIN; 3],
-            buckets: HashMap::new(),
-        };
-        for (i, p) in points.iter().enumerate() {
-            let key = grid.cell_of(p);
-            for ((lo, hi), &x) in grid.lo.iter_mut().zip(&mut grid.hi).zip(&key) {
-                *lo = (*lo).min(x);
-                *hi = (*hi).max(x);
-            }
-            grid.buckets.entry(key).or_default().push(i as u32);
-        }
-        grid
-    }
-
-    fn cell_of(&self, p: &Point3<f64>) -> [i64; 3] {
-        std::array::from_fn(|k| ((p[k] - self.origin[k]) / self.cell).floor() as i64)
-    }
-
-    /// Index of the point nearest to `q`, and its distance.
-    ///
-    /// Visits shells of cells at Chebyshev index distance `r = 0, 1, ..` around `q`'s
-    /// cell (clamped into the occupied range) and stops once the best point found is no
-    /// farther than [`CentroidGrid::unvisited_bound`], so queries far from the points
-    /// stay cheap too.
-    fn nearest(&self, q: &Point3<f64>) -> (u32, f64) {
-        let c: [i64; 3] = {
-            let u = self.cell_of(q);
-            std::array::from_fn(|k| u[k].clamp(self.lo[k], self.hi[k]))
-        };
-        let mut best = (f64::INFINITY, 0u32);
-        let visit = |cell: [i64; 3], best: &mut (f64, u32)| {
-            for &i in self.buckets.get(&cell).into_iter().flatten() {
-                let d = (self.points[i as usize] - q).norm_squared();
-                if d < best.0 {
-                    *best = (d, i);
-                }
-            }
-        };
-        for r in 0.. {
-            let span = |k: usize| (-r).max(self.lo[k] - c[k])..=r.min(self.hi[k] - c[k]);
-            for dx in span(0) {
-                for dy in span(1) {
-                    if dx.abs() == r || dy.abs() == r {
-                        for dz in span(2) {
-                            visit([c[0] + dx, c[1] + dy, c[2] + dz], &mut best);
-                        }
-                    } else {
-                        // Inside the shell's x-y square only its top and bottom cells.
-                        for dz in [-r, r] {
-                            if span(2).contains(&dz) {
-                                visit([c[0] + dx, c[1] + dy, c[2] + dz], &mut best);
-                            }
-                        }
-                    }
-                }
-            }
-            let bound = self.unvisited_bound(q, c, r);
-            if best.0 <= bound * bound {
-                break;
-            }
-        }
-        (best.1, best.0.sqrt())
-    }
-
-    /// A lower bound of the distance from `q` to every cell of the occupied range whose
-    /// Chebyshev index distance from `c` exceeds `r` (infinite when there is none).
-    ///
-    /// Such a cell lies beyond `c +- r` along some axis `k`; its distance to `q` is at
-    /// least the gap from `q` to the slab of the cells beyond, along `k`, combined with
-    /// the gaps from `q` to the whole occupied range along the other two axes.
-    fn unvisited_bound(&self, q: &Point3<f64>, c: [i64; 3], r: i64) -> f64 {
-        // Distance along axis k from q to the slab of cells first..=last.
-        let gap = |k: usize, first: i64, last: i64| {
-            let a = self.origin[k] + first as f64 * self.cell;
-            let b = self.origin[k] + (last + 1) as f64 * self.cell;
-            (a - q[k]).max(q[k] - b).max(0.0)
-        };
-        let whole: [f64; 3] = std::array::from_fn(|k| gap(k, self.lo[k], self.hi[k]).powi(2));
-        (0..3)
-            .filter_map(|k| {
-                let below = (c[k] - r > self.lo[k]).then(|| gap(k, self.lo[k], c[k] - r - 1));
-                let above = (c[k] + r < self.hi[k]).then(|| gap(k, c[k] + r + 1, self.hi[k]));
-                let g = below.into_iter().chain(above).reduce(f64::min)?;
-                let others: f64 = (0..3).filter(|&m| m != k).map(|m| whole[m]).sum();
-                Some((g * g + others).sqrt())
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
-}
-
-fn print_report(args: &DistortionArgs, kind: MapKind, frame: Frame, d: &Distortion) {
+fn print_report(
+    args: &DistortionArgs,
+    kind: MapKind,
+    frame: Frame,
+    reference: Reference,
+    notes: &[String],
+    d: &Distortion,
+) {
     let s = &d.stats;
     let h = &s.histogram;
     if args.json {
@@ -416,6 +362,8 @@ fn print_report(args: &DistortionArgs, kind: MapKind, frame: Frame, d: &Distorti
             "mapped": args.mapped.display().to_string(),
             "map": kind.name(),
             "frame": frame.name(),
+            "reference": reference.name(),
+            "notes": notes,
             "faces": s.faces,
             "flipped": s.flipped,
             "mu_mean": s.mu_mean,
@@ -438,6 +386,7 @@ fn print_report(args: &DistortionArgs, kind: MapKind, frame: Frame, d: &Distorti
         kind.describe(),
         frame.name()
     );
+    println!("  flips judged against {}", reference.describe());
     println!("  faces           {}", s.faces);
     println!("  flipped         {}", s.flipped);
     println!("  |mu| mean       {:.6e}", s.mu_mean);
@@ -453,46 +402,4 @@ fn print_report(args: &DistortionArgs, kind: MapKind, frame: Frame, d: &Distorti
         println!("    [{a:.1}, {b:.1})    {count}");
     }
     println!("    >= 1          {}", h.at_least_one);
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_bucket_grid_finds_the_nearest_point() {
-        // A deterministic cloud on a wavy sheet, queried near it and far away.
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let points: Vec<Point3<f64>> = (0..2000)
-            .map(|_| {
-                let (x, y) = (next(), next());
-                Point3::new(x, y, 0.1 * (6.0 * x).sin() * y)
-            })
-            .collect();
-        for cell in [0.01, 0.03, 0.4] {
-            let grid = CentroidGrid::new(&points, cell);
-            for k in 0..300 {
-                let spread = [1.2, 10.0, 1000.0][k % 3];
-                let q = Point3::new(
-                    spread * (next() - 0.4),
-                    spread * (next() - 0.4),
-                    spread * (next() - 0.5),
-                );
-                let brute = points
-                    .iter()
-                    .map(|p| (p - q).norm_squared())
-                    .fold(f64::INFINITY, f64::min);
-                let (i, distance) = grid.nearest(&q);
-                let found = (points[i as usize] - q).norm_squared();
-                assert_eq!(found, brute, "cell {cell}, query {q}");
-                assert_eq!(distance, brute.sqrt());
-            }
-        }
-    }
 }

@@ -3,10 +3,13 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::Context as _;
-use beltrami_render::{Camera, ColorBy, MuRange, Scene, Size, Style, View, check_png_path};
+use anyhow::{Context as _, bail};
+use beltrami_fem::ReferenceNormal;
+use beltrami_render::{Camera, ColorBy, Layout, MuRange, Scene, Size, Style, View, check_png_path};
 use clap::{Args, ValueEnum};
 
+use super::distortion::{source_reference_note, target_normals};
+use super::load::load_mesh;
 use super::picture::load_map;
 
 /// Views of `--view`.
@@ -42,6 +45,12 @@ pub struct RenderArgs {
     /// MESH's vertices (e.g. the output of `param` or `qc`).
     #[arg(long = "map", value_name = "MAPPED")]
     pub map: Option<PathBuf>,
+    /// For a map into R^3: the surface the map lands on; flips are judged against its
+    /// normals at the images, as in `beltrami distortion --target`. Without it the
+    /// image's shape decides: +z for an image in the plane z = 0, the radial direction
+    /// for one on a sphere about the origin, else MESH's normals.
+    #[arg(long, value_name = "TARGET")]
+    pub target: Option<PathBuf>,
     /// What to draw [default: both with a map, else 3d].
     #[arg(long, value_enum)]
     pub view: Option<ViewArg>,
@@ -76,8 +85,36 @@ pub fn run(args: &RenderArgs, quiet: bool) -> anyhow::Result<()> {
     let start = Instant::now();
     let (loaded, image) = load_map(&args.mesh, args.map.as_deref(), args.repair, quiet)?;
     let has_map = image.is_some();
-    let scene = Scene::new(&loaded.mesh, image)
+    let mesh = &loaded.mesh;
+    let mut notes = Vec::new();
+    let normals = match (&args.target, &image) {
+        (None, _) => None,
+        (Some(path), Some(Layout::Space(points))) => {
+            let target = load_mesh(path, args.repair, quiet)?.mesh;
+            let (normals, note) = target_normals(&target.mesh, mesh, points, path)?;
+            notes.extend(note);
+            Some(normals)
+        }
+        (Some(_), _) => {
+            bail!("--target applies only to a map into R^3 (MAPPED with positions and no vt)")
+        }
+    };
+    let reference = match (&normals, &image) {
+        (Some(normals), _) => Some(ReferenceNormal::PerFace(normals)),
+        (None, Some(Layout::Space(points))) => {
+            let chosen = ReferenceNormal::for_image(points);
+            notes.extend(source_reference_note(chosen, &args.mesh));
+            Some(chosen)
+        }
+        (None, _) => None,
+    };
+    let scene = Scene::with_reference(mesh, image, reference)
         .with_context(|| format!("drawing {}", args.mesh.display()))?;
+    if !quiet {
+        for note in &notes {
+            eprintln!("note: {note}");
+        }
+    }
     let view = match args.view {
         Some(ViewArg::Uv) => View::Uv,
         Some(ViewArg::ThreeD) => View::Surface,
@@ -111,8 +148,13 @@ pub fn run(args: &RenderArgs, quiet: bool) -> anyhow::Result<()> {
     })?;
     picture.write_png(&args.output)?;
     if !quiet {
+        let judged = match (scene.reference(), &args.target) {
+            (None, _) => String::new(),
+            (Some(_), Some(_)) => ", flips judged against TARGET's normals".to_string(),
+            (Some(name), None) => format!(", flips judged against the {name} normal"),
+        };
         println!(
-            "{} -> {} ({}, {:.3} s)",
+            "{} -> {} ({}, {:.3} s{judged})",
             args.mesh.display(),
             args.output.display(),
             args.size,

@@ -48,6 +48,17 @@ pub enum SolverError {
         #[source]
         error: ConstraintError,
     },
+    /// An error of a plugin's own crate or of a crate core does not know (point
+    /// location, registration's initial map), kept typed as the source: callers can
+    /// `downcast_ref` it.
+    #[error("{solver}: {error}")]
+    Plugin {
+        /// The solver's name.
+        solver: &'static str,
+        /// The error.
+        #[source]
+        error: Box<dyn std::error::Error + Send + Sync>,
+    },
     /// The solve was cancelled.
     #[error("cancelled")]
     Cancelled,

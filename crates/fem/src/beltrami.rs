@@ -14,15 +14,41 @@
 //!   ([`crate::Frame::Face`]): the image values are complex numbers.
 //! - Surface to surface in R^3 ([`surface_map`]), intrinsically (Wong-Zhao 2014,
 //!   eq. 4.7-4.9): the image's tangent vectors `f_x`, `f_y` in R^3 are laid isometrically in
-//!   the plane of the image's own tangent frame, oriented by a reference normal (the target
-//!   surface's normal where known, else the source normal); `mu` is then the planar
-//!   coefficient in the source frame. A different image frame rotates `f_z` and `f_zbar`
-//!   alike and leaves `mu` unchanged.
+//!   the plane of the image's own tangent frame, oriented by a reference normal stated by
+//!   a [`ReferenceNormal`]; `mu` is then the planar coefficient in the source frame. A
+//!   different image frame rotates `f_z` and `f_zbar` alike and leaves `mu` unchanged.
+//!
+//! # Orientation of an image in R^3
+//!
+//! A map's image cannot be the reference for its own orientation (a folded region turns
+//! its own normals over with it), so the normal that decides whether a point is flipped
+//! is always stated from outside, by [`ReferenceNormal`]: `+z` for an image in the plane
+//! z = 0, the radial direction for an image on a sphere about the origin, the source's
+//! normal for an image close to the source, or one normal per face (a target surface's
+//! normals at the image, `beltrami_spatial::SurfaceIndex::face_reference_normals`).
+//!
+//! [`image_derivatives`] is the one kernel every measure of a map into R^3 goes through.
+//! With `m = f_x x f_y` (the image's vector area element) and `N` the reference normal:
+//!
+//! ```text
+//! n   = m / |m|      if m . N > 0        (oriented as the reference: not flipped)
+//! n   = -m / |m|     if m . N <= 0       (turned against it, or orthogonal: flipped)
+//! e_1 = f_x / |f_x|,   e_2 = n x e_1     (the image frame, Wong-Zhao eq. 4.7)
+//! F_x = |f_x|,         F_y = f_y . e_1 + i f_y . e_2     (eq. 4.8)
+//! f_z = (F_x - i F_y) / 2,   f_zbar = (F_x + i F_y) / 2,   mu = f_zbar / f_z   (eq. 4.9)
+//! ```
+//!
+//! The Jacobian `|f_z|^2 - |f_zbar|^2 = |f_x| (f_y . e_2) = m . n` is then `|m| > 0` on
+//! the reference's side and `-|m| < 0` against it: a point is flipped exactly when
+//! `m . N <= 0` (`|mu| > 1`). Where the image collapses (`m = 0`: a segment or a point),
+//! `f_x` and `f_y` are laid on the real axis, `|mu| = 1` and the Jacobian is 0 (flipped).
+//! For an image in the plane z = 0 with [`ReferenceNormal::Plane`] this is the planar
+//! coefficient of [`planar_map`] with `f = x + i y`.
 
 use beltrami_mesh::{FaceId, Point3, Vector3};
 use num_complex::Complex64;
 
-use crate::{Elements, FemError};
+use crate::{Elements, FemError, QuadraturePoint};
 
 /// Largest `|mu|` reported where `f_z` vanishes but `f_zbar` does not (an
 /// anti-conformal point), so that statistics stay finite.
@@ -147,20 +173,158 @@ pub fn spatial_derivatives(
         .collect())
 }
 
+/// Where the normal that decides the orientation of a map's image in R^3 comes from
+/// (module docs, "Orientation of an image in R^3"). The image's own normals are never
+/// the reference: a fold turns them over with it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ReferenceNormal<'a> {
+    /// The image lies in the plane z = 0: the reference is `+z`, the orientation of the
+    /// planar frame (a map given as positions `(x, y, 0)` is measured as the planar map
+    /// `x + i y`).
+    Plane,
+    /// The image lies on a sphere about the origin: the reference at a quadrature point
+    /// is the direction of its image point `sum_k N_k f_k` (outward), as the sphere
+    /// initialization uses.
+    Radial,
+    /// The source's own normal at the quadrature point (the normal of its tangent
+    /// frame): for images close to the source, such as maps of a surface into itself.
+    Source,
+    /// One normal per face (by face id), e.g. a target surface's normals at the image
+    /// (`beltrami_spatial::SurfaceIndex::face_reference_normals`). Need not be unit.
+    PerFace(&'a [Vector3<f64>]),
+}
+
+impl ReferenceNormal<'_> {
+    /// The name in reports: `plane`, `radial`, `source` or `per-face`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ReferenceNormal::Plane => "plane",
+            ReferenceNormal::Radial => "radial",
+            ReferenceNormal::Source => "source",
+            ReferenceNormal::PerFace(_) => "per-face",
+        }
+    }
+
+    /// The reference normal at quadrature point `q`, whose image is `image_point` (not
+    /// normalized; only its direction matters). [`ReferenceNormal::PerFace`] must hold a
+    /// normal for `q.face` ([`surface_map`] checks the length).
+    pub fn at(&self, q: &QuadraturePoint, image_point: &Point3<f64>) -> Vector3<f64> {
+        match self {
+            ReferenceNormal::Plane => Vector3::z(),
+            ReferenceNormal::Radial => image_point.coords,
+            ReferenceNormal::Source => q.frame.normal,
+            ReferenceNormal::PerFace(normals) => normals[q.face.idx()],
+        }
+    }
+
+    /// The reference for a map's `image` (one point per vertex) when no target surface
+    /// is known: [`ReferenceNormal::Plane`] when every image point lies in the plane
+    /// z = 0 (`|z| <= 1e-12` times the diagonal of the image's bounding box, as
+    /// [`crate::element::is_planar`]), else [`ReferenceNormal::Radial`] when every point
+    /// lies on one sphere about the origin (`| |p| - r | <= 1e-6 r`, `r > 0` the mean of
+    /// `|p|`), else [`ReferenceNormal::Source`] (right only for images close to the
+    /// source: give a target surface's normals with [`ReferenceNormal::PerFace`]
+    /// otherwise).
+    pub fn for_image(image: &[Point3<f64>]) -> ReferenceNormal<'static> {
+        let (lo, hi) = image.iter().fold(
+            (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(&p.coords), hi.sup(&p.coords)),
+        );
+        let diagonal = if image.is_empty() {
+            0.0
+        } else {
+            (hi - lo).norm()
+        };
+        if image.iter().all(|p| p.z.abs() <= 1e-12 * diagonal) {
+            return ReferenceNormal::Plane;
+        }
+        let radius = image.iter().map(|p| p.coords.norm()).sum::<f64>() / image.len().max(1) as f64;
+        if radius > 0.0
+            && image
+                .iter()
+                .all(|p| (p.coords.norm() - radius).abs() <= 1e-6 * radius)
+        {
+            return ReferenceNormal::Radial;
+        }
+        ReferenceNormal::Source
+    }
+}
+
+/// The unit normal of the plane spanned by `u` and `v`, turned to the side of
+/// `reference`: `m / |m|` with `m = u x v` when `m . reference > 0`, else `-m / |m|`
+/// (the orientation rule of the module docs); `None` when `m = 0`.
+#[inline]
+pub fn oriented_normal(
+    u: &Vector3<f64>,
+    v: &Vector3<f64>,
+    reference: &Vector3<f64>,
+) -> Option<Vector3<f64>> {
+    let m = u.cross(v);
+    if m.norm_squared() > 0.0 {
+        let m = m.normalize();
+        Some(if m.dot(reference) > 0.0 { m } else { -m })
+    } else {
+        None
+    }
+}
+
+/// The derivatives at one point of a map into R^3 whose derivatives along the source
+/// frame axes are `dx = df(e1)` and `dy = df(e2)`, in the image frame oriented by
+/// `reference` (Wong-Zhao 2014 eq. 4.7-4.9; the formulas are in the module docs): the
+/// Jacobian is positive where `(dx x dy) . reference > 0`, negative (flipped, `|mu| > 1`)
+/// where it is `<= 0`, and 0 with `|mu| = 1` where the image collapses (`dx x dy = 0`).
+pub fn image_derivatives(
+    dx: &Vector3<f64>,
+    dy: &Vector3<f64>,
+    reference: &Vector3<f64>,
+) -> PointDerivatives {
+    let len = dx.norm();
+    let Some(normal) = oriented_normal(dx, dy, reference) else {
+        // The image has no area here (a segment or a point): lay it on the real axis;
+        // |mu| = 1 and the Jacobian is zero.
+        let fy = if len > 0.0 {
+            dy.dot(dx) / len
+        } else {
+            dy.norm()
+        };
+        return PointDerivatives::from_xy(Complex64::new(len, 0.0), Complex64::new(fy, 0.0));
+    };
+    let e1 = dx / len;
+    let e2 = normal.cross(&e1);
+    PointDerivatives::from_xy(
+        Complex64::new(len, 0.0),
+        Complex64::new(dy.dot(&e1), dy.dot(&e2)),
+    )
+}
+
 /// Derivatives of a surface-to-surface map `image` (one point of R^3 per vertex) at every
-/// quadrature point, intrinsically (Wong-Zhao eq. 4.7-4.9; see the module docs).
+/// quadrature point, intrinsically ([`image_derivatives`] with the reference normal of
+/// `reference` at each point; Wong-Zhao eq. 4.7-4.9, see the module docs). Use a source
+/// frame of [`crate::Frame::Face`] for surfaces.
 ///
-/// `reference_normals` gives, per face, the normal the image's orientation is judged
-/// against (e.g. the target surface's normal at the image); `None` uses the source
-/// normal at each point. Use a source frame of [`crate::Frame::Face`] for surfaces.
+/// Fails with [`FemError::Length`] for a wrong number of image points or of
+/// [`ReferenceNormal::PerFace`] normals, and with [`FemError::NonFinite`] for a
+/// non-finite image point or normal.
 pub fn surface_map(
     elements: &Elements,
     vertex_count: usize,
     image: &[Point3<f64>],
-    reference_normals: Option<&[Vector3<f64>]>,
+    reference: ReferenceNormal<'_>,
 ) -> Result<Vec<PointDerivatives>, FemError> {
-    if let Some(n) = reference_normals {
-        check_len("reference normals", elements.face_count(), n.len())?;
+    if let ReferenceNormal::PerFace(normals) = reference {
+        check_len("reference normals", elements.face_count(), normals.len())?;
+        if let Some(index) = normals
+            .iter()
+            .position(|n| !n.iter().all(|x| x.is_finite()))
+        {
+            return Err(FemError::NonFinite {
+                what: "reference normal",
+                index,
+            });
+        }
     }
     let d = spatial_derivatives(elements, vertex_count, image)?;
     Ok(elements
@@ -168,29 +332,16 @@ pub fn surface_map(
         .iter()
         .zip(d)
         .map(|(q, SpatialDerivatives { dx, dy })| {
-            let reference = reference_normals.map_or(q.frame.normal, |n| n[q.face.idx()]);
-            let m = dx.cross(&dy);
-            let normal = if m.dot(&reference) >= 0.0 { m } else { -m };
-            let len = dx.norm();
-            if normal.norm() == 0.0 {
-                // The image has no area here (a segment or a point): lay it on the real
-                // axis; |mu| = 1 and the Jacobian is zero.
-                let fy = if len > 0.0 {
-                    dy.dot(&dx) / len
-                } else {
-                    dy.norm()
-                };
-                return PointDerivatives::from_xy(
-                    Complex64::new(len, 0.0),
-                    Complex64::new(fy, 0.0),
-                );
-            }
-            let e1 = dx / len;
-            let e2 = normal.normalize().cross(&e1);
-            PointDerivatives::from_xy(
-                Complex64::new(len, 0.0),
-                Complex64::new(dy.dot(&e1), dy.dot(&e2)),
-            )
+            let point = if matches!(reference, ReferenceNormal::Radial) {
+                elements
+                    .nodes(q.face)
+                    .iter()
+                    .zip(&q.shape)
+                    .fold(Point3::origin(), |p, (v, &n)| p + image[v.idx()].coords * n)
+            } else {
+                Point3::origin()
+            };
+            image_derivatives(&dx, &dy, &reference.at(q, &point))
         })
         .collect())
 }

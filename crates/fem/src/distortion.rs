@@ -19,10 +19,10 @@
 //! [`measure_planar`] and [`measure_surface`] go from a mesh and the images of its
 //! vertices to a [`Distortion`]: the field, the flags and the statistics.
 
-use beltrami_mesh::{FaceId, Mesh, Point3, Vector3};
+use beltrami_mesh::{FaceId, Mesh, Point3};
 use num_complex::Complex64;
 
-use crate::beltrami::{self, PointDerivatives};
+use crate::beltrami::{self, PointDerivatives, ReferenceNormal};
 use crate::{BeltramiField, Elements, FemError, Frame};
 
 /// A histogram of `|mu|` over faces: [`Histogram::BINS`] bins of width
@@ -202,50 +202,24 @@ pub fn measure_planar(
 }
 
 /// The distortion of a map of a surface into R^3, `image[v]` the image of vertex `v`,
-/// measured intrinsically in the face frames ([`beltrami::surface_map`]).
+/// measured intrinsically in the face frames ([`beltrami::surface_map`]), its orientation
+/// judged against `reference` ([`ReferenceNormal`]: `Plane` for an image in the plane
+/// z = 0, `Radial` for one on a sphere about the origin, `Source` for an image close to
+/// the source, `PerFace` for a target surface's normals at the image;
+/// [`ReferenceNormal::for_image`] chooses among the first three). A face is flipped when
+/// one of its quadrature points has `m . N <= 0`, `m` the image's area element and `N`
+/// the reference normal there.
 ///
-/// `reference_normals`, one per face, are the normals the image's orientation is judged
-/// against (the target surface's normal at the image of each face); `None` judges it
-/// against the source normals, which suits images close to the source. Fails like
-/// [`Elements::new`] (degenerate face) and [`beltrami::surface_map`] (wrong length,
-/// non-finite image).
+/// Fails like [`Elements::new`] (degenerate face) and [`beltrami::surface_map`] (wrong
+/// length, non-finite image or normal).
 pub fn measure_surface(
     mesh: &Mesh,
     image: &[Point3<f64>],
-    reference_normals: Option<&[Vector3<f64>]>,
+    reference: ReferenceNormal<'_>,
 ) -> Result<Distortion, FemError> {
     let elements = Elements::new(mesh, Frame::Face)?;
-    let derivatives =
-        beltrami::surface_map(&elements, mesh.vertex_count(), image, reference_normals)?;
+    let derivatives = beltrami::surface_map(&elements, mesh.vertex_count(), image, reference)?;
     Distortion::from_derivatives(&elements, &derivatives)
-}
-
-/// Per face, the normal a map's image is judged against when no target surface is
-/// known: the sum, over the face's corners, of the image's own vertex normals (each the
-/// sum of the vector areas `(Y_1 - Y_0) x (Y_2 - Y_0) / 2` of the image faces around the
-/// vertex; quads by their diagonals). Where the image is an embedding these agree with
-/// every image face; a face folded over its neighbours points against them. Unlike the
-/// source normals, this suits images of any shape (a registration onto another surface).
-pub fn image_normals(mesh: &Mesh, image: &[Point3<f64>]) -> Vec<Vector3<f64>> {
-    let face_area = |f: FaceId| -> Vector3<f64> {
-        let (v, n) = mesh.face_vertex_array(f);
-        let p = |k: usize| image[v[k].idx()];
-        if n == 3 {
-            (p(1) - p(0)).cross(&(p(2) - p(0))) / 2.0
-        } else {
-            (p(2) - p(0)).cross(&(p(3) - p(1))) / 2.0
-        }
-    };
-    let mut vertex = vec![Vector3::zeros(); mesh.vertex_count()];
-    for f in mesh.faces() {
-        let a = face_area(f);
-        for v in mesh.face_vertices(f) {
-            vertex[v.idx()] += a;
-        }
-    }
-    mesh.faces()
-        .map(|f| mesh.face_vertices(f).map(|v| vertex[v.idx()]).sum())
-        .collect()
 }
 
 /// `|mu - target|` over the faces, weighted by the face areas (the sums of the

@@ -23,6 +23,7 @@ pub mod operators;
 pub mod quaternion;
 pub mod solve;
 
+pub use beltrami::ReferenceNormal;
 pub use distortion::{Distortion, DistortionStats, Histogram, MuError};
 pub use dof::{DofConstraints, DofError, DofMap, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};

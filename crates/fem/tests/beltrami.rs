@@ -2,7 +2,8 @@
 //! frames, surface-to-surface and quaternionic coefficients.
 
 use beltrami_fem::beltrami::{
-    face_mu, flipped_faces, planar_map, point_mu, rotate_frame, surface_map,
+    MU_CAP, ReferenceNormal, face_mu, flipped_faces, image_derivatives, planar_map, point_mu,
+    rotate_frame, surface_map,
 };
 use beltrami_fem::quaternion::quaternionic_mu;
 use beltrami_fem::{Elements, Frame};
@@ -183,7 +184,15 @@ fn quaternionic_intrinsic_and_planar_mu_agree_on_a_plane() {
         let elements = Elements::new(&surface, Frame::Face).unwrap();
         let intrinsic = face_mu(
             &elements,
-            &point_mu(&surface_map(&elements, surface.vertex_count(), &image, None).unwrap()),
+            &point_mu(
+                &surface_map(
+                    &elements,
+                    surface.vertex_count(),
+                    &image,
+                    ReferenceNormal::Source,
+                )
+                .unwrap(),
+            ),
         );
         let quaternionic = face_mu(
             &elements,
@@ -231,7 +240,7 @@ fn identity_and_similarities_of_curved_surfaces_are_conformal() {
                 &elements,
                 mesh.vertex_count(),
                 &image,
-                Some(&target_normals),
+                ReferenceNormal::PerFace(&target_normals),
             )
             .unwrap();
             let worst = point_mu(&d).iter().map(|m| m.norm()).fold(0.0, f64::max);
@@ -275,7 +284,13 @@ fn a_stretch_on_a_tilted_plane_has_the_analytic_mu_and_reflections_flip() {
         })
         .collect();
     let elements = Elements::new(&surface, Frame::Face).unwrap();
-    let d = surface_map(&elements, surface.vertex_count(), &image, None).unwrap();
+    let d = surface_map(
+        &elements,
+        surface.vertex_count(),
+        &image,
+        ReferenceNormal::Source,
+    )
+    .unwrap();
     let mu = face_mu(&elements, &point_mu(&d));
     for f in surface.faces() {
         // The face frame of the tilted face is the rotated face frame of the flat one.
@@ -292,18 +307,138 @@ fn a_stretch_on_a_tilted_plane_has_the_analytic_mu_and_reflections_flip() {
         .iter()
         .map(|p| rotation * Point3::new(p.x, -p.y, 0.0) + shift)
         .collect();
-    let d = surface_map(&elements, surface.vertex_count(), &mirrored, None).unwrap();
+    let d = surface_map(
+        &elements,
+        surface.vertex_count(),
+        &mirrored,
+        ReferenceNormal::Source,
+    )
+    .unwrap();
     assert!(flipped_faces(&elements, &d).iter().all(|&f| f));
     let opposite: Vec<Vector3<f64>> = surface.faces().map(|f| -surface.face_normal(f)).collect();
     let d = surface_map(
         &elements,
         surface.vertex_count(),
         &mirrored,
-        Some(&opposite),
+        ReferenceNormal::PerFace(&opposite),
     )
     .unwrap();
     assert!(flipped_faces(&elements, &d).iter().all(|&f| !f));
     assert!(point_mu(&d).iter().all(|m| m.norm() < 1e-12));
+}
+
+#[test]
+fn the_kernel_judges_a_reflection_by_the_reference_normal() {
+    // z -> conj z: f_x = (1, 0, 0), f_y = (0, -1, 0), so m = f_x x f_y = -z.
+    let (dx, dy) = (Vector3::x(), -Vector3::y());
+    let up = image_derivatives(&dx, &dy, &Vector3::z());
+    assert!(up.jacobian() < 0.0, "{up:?}");
+    assert_eq!(up.fz, Complex64::new(0.0, 0.0));
+    assert_eq!(up.mu().norm(), MU_CAP);
+    // Seen from below the same image is the identity: conformal, Jacobian 1.
+    let down = image_derivatives(&dx, &dy, &-Vector3::z());
+    assert!((down.jacobian() - 1.0).abs() < 1e-15, "{down:?}");
+    assert_eq!(down.mu(), Complex64::new(0.0, 0.0));
+    // A scale of the reference does not matter; one orthogonal to the image flips it.
+    let far = image_derivatives(&dx, &dy, &(-1e-9 * Vector3::z()));
+    assert_eq!(far, down);
+    assert!(image_derivatives(&dx, &dy, &Vector3::x()).jacobian() < 0.0);
+    // The identity with reference +z; a collapsed image: |mu| = 1, Jacobian 0.
+    let identity = image_derivatives(&dx, &Vector3::y(), &Vector3::z());
+    assert!(identity.jacobian() > 0.0 && identity.mu().norm() == 0.0);
+    let collapsed = image_derivatives(&dx, &(2.0 * dx), &Vector3::z());
+    assert_eq!(collapsed.jacobian(), 0.0);
+    assert!((collapsed.mu().norm() - 1.0).abs() < 1e-15);
+    assert_eq!(
+        image_derivatives(&Vector3::zeros(), &Vector3::zeros(), &Vector3::z())
+            .mu()
+            .norm(),
+        1.0
+    );
+}
+
+#[test]
+fn radial_reference_judges_maps_onto_a_sphere() {
+    // A half turn of the sphere about z is a rigid motion: conformal and orientation
+    // preserving. Judged radially no face flips; judged against the source normals the
+    // faces near the equator, whose images point the other way, would.
+    // Triangles, and quads (a cube's sides pushed onto the sphere: bilinear patches).
+    let mut quads = cube_sphere(6);
+    for p in &mut quads.positions {
+        *p = Point3::from(p.coords.normalize());
+    }
+    for soup in [icosphere(3), quads] {
+        let mesh = Mesh::from_soup(&soup).unwrap();
+        let elements = Elements::new(&mesh, Frame::Face).unwrap();
+        let n = mesh.vertex_count();
+        let turned: Vec<Point3<f64>> = mesh
+            .positions()
+            .iter()
+            .map(|p| Point3::new(-p.x, -p.y, p.z))
+            .collect();
+        let d = surface_map(&elements, n, &turned, ReferenceNormal::Radial).unwrap();
+        assert!(flipped_faces(&elements, &d).iter().all(|&f| !f));
+        assert!(point_mu(&d).iter().all(|m| m.norm() < 1e-12));
+        let source = surface_map(&elements, n, &turned, ReferenceNormal::Source).unwrap();
+        let wrong = flipped_faces(&elements, &source)
+            .iter()
+            .filter(|&&f| f)
+            .count();
+        assert!(
+            wrong > mesh.face_count() / 4,
+            "{wrong} of {}",
+            mesh.face_count()
+        );
+        // A reflection x -> -x turns every face inward: all flipped radially.
+        let mirrored: Vec<Point3<f64>> = mesh
+            .positions()
+            .iter()
+            .map(|p| Point3::new(-p.x, p.y, p.z))
+            .collect();
+        let d = surface_map(&elements, n, &mirrored, ReferenceNormal::Radial).unwrap();
+        assert!(flipped_faces(&elements, &d).iter().all(|&f| f));
+        assert!(point_mu(&d).iter().all(|m| m.norm() > 1.0));
+        // The image of the sphere scaled and off the unit radius: still radial.
+        let scaled: Vec<Point3<f64>> = mesh.positions().iter().map(|p| p * 3.0).collect();
+        assert_eq!(ReferenceNormal::for_image(&scaled), ReferenceNormal::Radial);
+        let d = surface_map(&elements, n, &scaled, ReferenceNormal::Radial).unwrap();
+        assert!(flipped_faces(&elements, &d).iter().all(|&f| !f));
+    }
+}
+
+/// A cube `[-1, 1]^3` with `n x n` quads per side, outward.
+fn cube_sphere(n: usize) -> PolygonSoup {
+    let mut soup = PolygonSoup::new(Vec::new());
+    // Each side: a corner and two edge vectors with `u x v` outward.
+    let sides = [
+        (Vector3::new(1.0, -1.0, -1.0), Vector3::y(), Vector3::z()),
+        (Vector3::new(-1.0, -1.0, -1.0), Vector3::z(), Vector3::y()),
+        (Vector3::new(-1.0, 1.0, -1.0), Vector3::z(), Vector3::x()),
+        (Vector3::new(-1.0, -1.0, -1.0), Vector3::x(), Vector3::z()),
+        (Vector3::new(-1.0, -1.0, 1.0), Vector3::x(), Vector3::y()),
+        (Vector3::new(-1.0, -1.0, -1.0), Vector3::y(), Vector3::x()),
+    ];
+    let mut index = std::collections::HashMap::new();
+    for (corner, u, v) in sides {
+        let mut id = |i: usize, j: usize| {
+            let p = corner + u * (2.0 * i as f64 / n as f64) + v * (2.0 * j as f64 / n as f64);
+            let key = p.map(|x| (x * n as f64).round() as i64);
+            *index.entry((key.x, key.y, key.z)).or_insert_with(|| {
+                soup.positions.push(Point3::from(p));
+                (soup.positions.len() - 1) as u32
+            })
+        };
+        let mut faces = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        for f in faces {
+            soup.push_face(&f);
+        }
+    }
+    soup
 }
 
 #[test]

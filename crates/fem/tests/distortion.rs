@@ -1,7 +1,7 @@
 //! Distortion statistics: formulas by hand, affine maps (constant mu), flipped faces.
 
 use beltrami_fem::distortion::{measure_planar, measure_surface};
-use beltrami_fem::{DistortionStats, FemError, Frame, Histogram};
+use beltrami_fem::{DistortionStats, FemError, Frame, Histogram, ReferenceNormal};
 use beltrami_mesh::primitives::{Cells, grid, icosphere, torus};
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector3, VertexId};
 use num_complex::Complex64;
@@ -158,7 +158,7 @@ fn similarities_of_surfaces_are_conformal() {
             .iter()
             .map(|p| Point3::from(2.5 * (rotation * p.coords) + Vector3::new(1.0, -2.0, 0.5)))
             .collect();
-        let d = measure_surface(&mesh, &image, None).unwrap();
+        let d = measure_surface(&mesh, &image, ReferenceNormal::Source).unwrap();
         assert_eq!(d.field.frame, Frame::Face);
         assert_eq!(d.stats.flipped, 0);
         assert!(d.stats.mu_max < 1e-12, "{}", d.stats.mu_max);
@@ -175,6 +175,89 @@ fn reflect(p: Complex64, a: Complex64, b: Complex64) -> Complex64 {
 fn signed_area(map: &[Complex64], v: &[VertexId]) -> f64 {
     let (a, b, c) = (map[v[0].idx()], map[v[1].idx()], map[v[2].idx()]);
     0.5 * ((b - a).conj() * (c - a)).im
+}
+
+#[test]
+fn a_planar_map_as_positions_judged_by_the_plane_is_the_planar_map() {
+    // A smooth map with a fold: past x = 0.6 the image turns back with half the speed
+    // (f = 0.6 - (x - 0.6) / 2 + i y there, |mu| = 3), so the faces beyond are flipped.
+    for cells in [Cells::Triangles, Cells::Quads] {
+        let mesh = jittered(16, cells, 0.3, 7);
+        let map: Vec<Complex64> = mesh
+            .positions()
+            .iter()
+            .map(|p| {
+                let x = if p.x > 0.6 {
+                    0.6 - 0.5 * (p.x - 0.6)
+                } else {
+                    p.x
+                };
+                let z = Complex64::new(x, p.y);
+                z + 0.2 * z * z
+            })
+            .collect();
+        let image: Vec<Point3<f64>> = map.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect();
+        assert_eq!(ReferenceNormal::for_image(&image), ReferenceNormal::Plane);
+        let planar = measure_planar(&mesh, &map, Frame::Face).unwrap();
+        let spatial = measure_surface(&mesh, &image, ReferenceNormal::Plane).unwrap();
+        assert_eq!(spatial.field.frame, Frame::Face);
+        assert_eq!(spatial.flipped, planar.flipped, "{cells:?}");
+        let flips = planar.stats.flipped;
+        assert!(flips > mesh.face_count() / 5, "{cells:?}: {flips} flips");
+        for f in 0..mesh.face_count() {
+            let (a, b) = (planar.field.mu[f], spatial.field.mu[f]);
+            assert!(
+                (a - b).norm() <= 1e-12 * a.norm().max(1.0),
+                "{cells:?} face {f}: planar {a}, positions {b}"
+            );
+        }
+        assert_eq!(spatial.stats.histogram, planar.stats.histogram);
+        assert!((spatial.stats.mu_max - planar.stats.mu_max).abs() <= 1e-12 * planar.stats.mu_max);
+        // Judged against the source normals (+z here) the answer is the same; the
+        // image's own orientation is never asked.
+        let source = measure_surface(&mesh, &image, ReferenceNormal::Source).unwrap();
+        assert_eq!(source.flipped, planar.flipped);
+    }
+}
+
+#[test]
+fn the_reference_is_chosen_from_the_image() {
+    let mesh = Mesh::from_soup(&icosphere(2)).unwrap();
+    let sphere = mesh.positions().to_vec();
+    assert_eq!(ReferenceNormal::for_image(&sphere), ReferenceNormal::Radial);
+    let moved: Vec<Point3<f64>> = sphere
+        .iter()
+        .map(|p| p + Vector3::new(0.0, 0.0, 0.5))
+        .collect();
+    assert_eq!(ReferenceNormal::for_image(&moved), ReferenceNormal::Source);
+    let mut bumped = sphere.clone();
+    bumped[3] *= 1.0 + 1e-5;
+    assert_eq!(ReferenceNormal::for_image(&bumped), ReferenceNormal::Source);
+    bumped[3] = sphere[3] * (1.0 + 1e-7);
+    assert_eq!(ReferenceNormal::for_image(&bumped), ReferenceNormal::Radial);
+    let flat: Vec<Point3<f64>> = sphere.iter().map(|p| Point3::new(p.x, p.y, 0.0)).collect();
+    assert_eq!(ReferenceNormal::for_image(&flat), ReferenceNormal::Plane);
+    let tilted: Vec<Point3<f64>> = flat
+        .iter()
+        .map(|p| Point3::new(p.x, p.y, 1e-3 * p.x))
+        .collect();
+    assert_eq!(ReferenceNormal::for_image(&tilted), ReferenceNormal::Source);
+    assert_eq!(ReferenceNormal::Plane.name(), "plane");
+    assert_eq!(ReferenceNormal::Radial.name(), "radial");
+    assert_eq!(ReferenceNormal::Source.name(), "source");
+    assert_eq!(ReferenceNormal::PerFace(&[]).name(), "per-face");
+    // One normal per face, finite.
+    let short = vec![Vector3::z(); 3];
+    assert!(matches!(
+        measure_surface(&mesh, &sphere, ReferenceNormal::PerFace(&short)),
+        Err(FemError::Length { got: 3, .. })
+    ));
+    let mut nan = vec![Vector3::z(); mesh.face_count()];
+    nan[5].x = f64::NAN;
+    assert!(matches!(
+        measure_surface(&mesh, &sphere, ReferenceNormal::PerFace(&nan)),
+        Err(FemError::NonFinite { index: 5, .. })
+    ));
 }
 
 #[test]
@@ -213,11 +296,11 @@ fn a_reflected_vertex_flips_its_faces() {
     // The same map seen as a map of a surface into R^3, judged against the source
     // normals: the same faces flip.
     let image: Vec<Point3<f64>> = map.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect();
-    let s = measure_surface(&mesh, &image, None).unwrap();
+    let s = measure_surface(&mesh, &image, ReferenceNormal::Source).unwrap();
     assert_eq!(s.flipped, d.flipped);
     // Judged against normals pointing down instead, every other face is flipped.
     let down = vec![-Vector3::z(); mesh.face_count()];
-    let s = measure_surface(&mesh, &image, Some(&down)).unwrap();
+    let s = measure_surface(&mesh, &image, ReferenceNormal::PerFace(&down)).unwrap();
     assert!(s.flipped.iter().zip(&d.flipped).all(|(a, b)| a != b));
 }
 

@@ -3,7 +3,7 @@
 //! crate.
 
 use beltrami_fem::distortion::{self, Distortion, DistortionStats};
-use beltrami_fem::{Frame, element};
+use beltrami_fem::{Frame, ReferenceNormal, element};
 use beltrami_mesh::{HalfedgeId, Mesh, Point3, PolygonSoup, Vector2};
 
 use crate::RenderError;
@@ -150,6 +150,7 @@ pub struct Scene<'a> {
     planar_source: bool,
     image: Option<Layout>,
     distortion: Option<FaceDistortion>,
+    reference: Option<&'static str>,
 }
 
 impl<'a> Scene<'a> {
@@ -158,26 +159,41 @@ impl<'a> Scene<'a> {
     /// ([`Layout::Space`], a map into R^3). The map is measured here (per-face `|mu|`
     /// and flips, in the global frame for a mesh in the plane z = 0, in the face frames
     /// otherwise), which costs about as much as loading the mesh. A map into R^3 is
-    /// judged flipped against the radial direction when its image lies on a sphere
-    /// about the origin (the `sphere` solver's output), else against the image's own
-    /// vertex normals ([`distortion::image_normals`]: right for images of any shape, a
-    /// registration onto another surface included).
+    /// judged against the reference normal [`ReferenceNormal::for_image`] chooses from
+    /// its image: `+z` in the plane z = 0, the radial direction on a sphere about the
+    /// origin (the `sphere` solver's output), else the source normals, which suit only
+    /// images close to the source: give a target's normals with
+    /// [`Scene::with_reference`] otherwise.
     ///
     /// Fails for a mesh without faces and when the measure fails (a degenerate face).
     pub fn new(mesh: &'a Mesh, image: Option<Layout>) -> Result<Self, RenderError> {
+        Self::with_reference(mesh, image, None)
+    }
+
+    /// [`Scene::new`] with the reference normal a map into R^3 is judged against
+    /// (`None`: [`ReferenceNormal::for_image`]; a map into the plane is always judged
+    /// in the plane, and `reference` is not used).
+    ///
+    /// Fails like [`Scene::new`], and for a [`ReferenceNormal::PerFace`] without one
+    /// finite normal per face.
+    pub fn with_reference(
+        mesh: &'a Mesh,
+        image: Option<Layout>,
+        reference: Option<ReferenceNormal<'_>>,
+    ) -> Result<Self, RenderError> {
         if mesh.face_count() == 0 {
             return Err(RenderError::EmptyMesh);
         }
         let planar_source = element::is_planar(mesh);
-        let distortion = match &image {
-            None => None,
+        let (distortion, reference) = match &image {
+            None => (None, None),
             Some(Layout::Space(points)) => {
-                let normals = sphere_normals(mesh, points)
-                    .unwrap_or_else(|| distortion::image_normals(mesh, points));
-                Some(FaceDistortion::from_measured(
-                    mesh,
-                    distortion::measure_surface(mesh, points, Some(&normals))?,
-                ))
+                let reference = reference.unwrap_or_else(|| ReferenceNormal::for_image(points));
+                let measured = distortion::measure_surface(mesh, points, reference)?;
+                (
+                    Some(FaceDistortion::from_measured(mesh, measured)),
+                    Some(reference.name()),
+                )
             }
             Some(Layout::Plane(corners)) => {
                 let frame = if planar_source {
@@ -185,7 +201,10 @@ impl<'a> Scene<'a> {
                 } else {
                     Frame::Face
                 };
-                Some(measure_plane(mesh, corners, frame)?)
+                (
+                    Some(measure_plane(mesh, corners, frame)?),
+                    Some(ReferenceNormal::Plane.name()),
+                )
             }
         };
         Ok(Self {
@@ -193,7 +212,15 @@ impl<'a> Scene<'a> {
             planar_source,
             image,
             distortion,
+            reference,
         })
+    }
+
+    /// The name of the reference normal the map's flips were judged against
+    /// ([`ReferenceNormal::name`]: `plane` for a map into the plane), or `None` without
+    /// a map.
+    pub fn reference(&self) -> Option<&'static str> {
+        self.reference
     }
 
     /// The mesh.
@@ -215,29 +242,6 @@ impl<'a> Scene<'a> {
     pub fn distortion(&self) -> Option<&FaceDistortion> {
         self.distortion.as_ref()
     }
-}
-
-/// The outward radial directions at the face images when every image point lies on one
-/// sphere about the origin (relative tolerance 1e-6), else `None`.
-fn sphere_normals(mesh: &Mesh, points: &[Point3<f64>]) -> Option<Vec<beltrami_mesh::Vector3<f64>>> {
-    let radius = points.iter().map(|p| p.coords.norm()).sum::<f64>() / points.len().max(1) as f64;
-    let on_sphere = radius > 0.0
-        && points
-            .iter()
-            .all(|p| (p.coords.norm() - radius).abs() <= 1e-6 * radius);
-    if !on_sphere {
-        return None;
-    }
-    Some(
-        mesh.faces()
-            .map(|f| {
-                let sum: beltrami_mesh::Vector3<f64> =
-                    mesh.face_vertices(f).map(|v| points[v.idx()].coords).sum();
-                let n = sum.norm();
-                if n > 0.0 { sum / n } else { sum }
-            })
-            .collect(),
-    )
 }
 
 /// Measures a map into the plane given per corner: through the vertices when there are

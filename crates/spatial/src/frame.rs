@@ -127,6 +127,46 @@ impl SurfaceIndex<'_> {
         Ok(TangentFrame::at(self.mesh(), self.vertex_normals(), point))
     }
 
+    /// Per face of `source`, the normal a map of `source` onto the indexed (target) mesh
+    /// is judged against: with `images[v]` the image of source vertex `v` located on the
+    /// target, the sum over the face's corners of the target's interpolated normal at the
+    /// corner's image,
+    ///
+    /// ```text
+    /// N_f = sum_{v in f} n(images[v])        (n: [`interpolated_normal`], unit)
+    /// ```
+    ///
+    /// (not normalized). This is the reference of
+    /// `beltrami_fem::ReferenceNormal::PerFace` for registrations and for maps measured
+    /// against a target: a face is flipped where its image's area element points against
+    /// `N_f` (for a quad, at any of its quadrature points).
+    ///
+    /// Fails with [`SpatialError::LengthMismatch`] unless there is one image per source
+    /// vertex, and with [`SpatialError::InBatch`] naming the first image that is not a
+    /// point of the indexed mesh.
+    pub fn face_reference_normals(
+        &self,
+        source: &Mesh,
+        images: &[SurfacePoint],
+    ) -> Result<Vec<Vector3<f64>>, SpatialError> {
+        if images.len() != source.vertex_count() {
+            return Err(SpatialError::LengthMismatch {
+                what: "images of the source vertices",
+                expected: source.vertex_count(),
+                found: images.len(),
+            });
+        }
+        let at_vertex = images
+            .iter()
+            .enumerate()
+            .map(|(i, p)| self.normal(p).map_err(|e| e.in_batch(i)))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(source
+            .faces()
+            .map(|f| source.face_vertices(f).map(|v| at_vertex[v.idx()]).sum())
+            .collect())
+    }
+
     /// The interpolated unit normal at `point` (see the module docs). Fails if `point`
     /// does not belong to the indexed mesh.
     pub fn normal(&self, point: &SurfacePoint) -> Result<Vector3<f64>, SpatialError> {

@@ -381,6 +381,45 @@ fn walks_land_on_warped_quads_and_spheres() {
 }
 
 #[test]
+fn face_reference_normals_sum_the_normals_at_the_corners_images() {
+    // A coarse sphere (the source) mapped onto a finer one (the target) by locating its
+    // vertices there: the reference of each source face is the sum of the target's
+    // normals at its corners' images, pointing outward like the face.
+    let source = build(&icosphere(1));
+    let target = build(&icosphere(3));
+    let index = SurfaceIndex::new(&target).unwrap();
+    let images: Vec<SurfacePoint> = index
+        .locate_all(source.positions())
+        .unwrap()
+        .into_iter()
+        .map(|l| l.point)
+        .collect();
+    let normals = index.face_reference_normals(&source, &images).unwrap();
+    assert_eq!(normals.len(), source.face_count());
+    for f in source.faces() {
+        let expected: Vector3<f64> = source
+            .face_vertices(f)
+            .map(|v| index.normal(&images[v.idx()]).unwrap())
+            .sum();
+        assert_eq!(normals[f.idx()], expected);
+        // Three unit normals within about 40 degrees of one another.
+        assert!(normals[f.idx()].norm() > 2.5, "{}", normals[f.idx()].norm());
+        assert!(normals[f.idx()].normalize().dot(&source.face_normal(f)) > 0.95);
+    }
+    // One image per source vertex, each a point of the target.
+    assert!(matches!(
+        index.face_reference_normals(&source, &images[1..]),
+        Err(SpatialError::LengthMismatch { .. })
+    ));
+    let mut bad = images.clone();
+    bad[4] = SurfacePoint::in_triangle(FaceId(target.face_count() as u32), [1.0, 0.0, 0.0]);
+    assert!(matches!(
+        index.face_reference_normals(&source, &bad),
+        Err(SpatialError::InBatch { index: 4, .. })
+    ));
+}
+
+#[test]
 fn frames_are_orthonormal_and_tangent() {
     let meshes: Vec<Mesh> = vec![
         build(&icosphere(2)),

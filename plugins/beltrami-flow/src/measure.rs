@@ -2,24 +2,32 @@
 //! Beltrami coefficient, flips and the error the flow decreases.
 //!
 //! For a P1 face `T` of the source (one quadrature point, tangent frame `(e1, e2)` of
-//! the source elements) and its image triangle `Y_0 Y_1 Y_2` on the target, the image
-//! frame is `(r, s, n)`: `r` along `Y_1 - Y_0`, `n` the triangle's normal turned to the
-//! side of the target's normals at its vertices (summed), `s = n x r` (Wong-Zhao 2014, Appendix:
-//! "local isometric coordinates (r, s) on each image face"). With
+//! the source elements) and its image triangle `Y_0 Y_1 Y_2` on the target, the
+//! reference normal is `N_T = sum_k n(Y_k)`, the target's normals at its vertices'
+//! images summed (for a target mesh the rule of
+//! `beltrami_spatial::SurfaceIndex::face_reference_normals`). The image frame is
+//! `(r, s, n)`: `r` along `Y_1 - Y_0`, `n` the triangle's unit normal turned to the side
+//! of `N_T` by the fem rule ([`beltrami_fem::beltrami::oriented_normal`]: against it, or
+//! orthogonal to it, `n` is minus the triangle's normal), `s = n x r` (Wong-Zhao 2014,
+//! Appendix: "local isometric coordinates (r, s) on each image face"). With
 //! `f_x = sum_k Y_k d_x N_k` and `f_y = sum_k Y_k d_y N_k` in R^3,
 //!
 //! ```text
 //! F_x = f_x . r + i f_x . s,   F_y = f_y . r + i f_y . s,
-//! f_z = (F_x - i F_y) / 2,     f_zbar = (F_x + i F_y) / 2,     mu = f_zbar / f_z,
+//! f_z = (F_x - i F_y) / 2,     f_zbar = (F_x + i F_y) / 2,     mu = f_zbar / f_z.
 //! ```
 //!
-//! and the face is flipped when `|f_z|^2 - |f_zbar|^2 <= 0` (the image triangle turns
-//! against the target's normal, or is degenerate). `mu` does not depend on the choice of
-//! `r` (a rotation of the image frame multiplies `f_z` and `f_zbar` by one unit number);
-//! `f_z` does, and the flow uses it in the same image frame as its own unknowns.
+//! The face is flipped when the fem kernel
+//! ([`beltrami_fem::beltrami::image_derivatives`] of `f_x`, `f_y` and `N_T`) has a
+//! Jacobian `<= 0` (the image triangle turns against the target's normal, or is
+//! degenerate): the same decision as `beltrami_fem::distortion::measure_surface` with
+//! `ReferenceNormal::PerFace` of these sums, face by face. `mu` does not depend on the
+//! choice of `r` (a rotation of the image frame multiplies `f_z` and `f_zbar` by one
+//! unit number); `f_z` does, and the flow uses it in the same image frame as its own
+//! unknowns.
 
 use beltrami_fem::Elements;
-use beltrami_fem::beltrami::PointDerivatives;
+use beltrami_fem::beltrami::{PointDerivatives, image_derivatives, oriented_normal};
 use beltrami_mesh::{FaceId, Point3, Vector2, Vector3, VertexId};
 use num_complex::Complex64;
 
@@ -34,6 +42,8 @@ pub struct ImageFace {
     pub s: Vector3<f64>,
     /// The image triangle's vertices in `(r, s)` coordinates (the first at the origin).
     pub local: [Vector2<f64>; 3],
+    /// Whether the fem kernel finds the image flipped or degenerate (module docs).
+    flipped: bool,
 }
 
 impl ImageFace {
@@ -42,9 +52,10 @@ impl ImageFace {
         self.derivatives.mu()
     }
 
-    /// Whether the image is flipped or degenerate.
+    /// Whether the image is flipped or degenerate: the Jacobian of the fem kernel
+    /// [`image_derivatives`] is `<= 0` (module docs).
     pub fn flipped(&self) -> bool {
-        self.derivatives.jacobian() <= 0.0
+        self.flipped
     }
 }
 
@@ -55,7 +66,7 @@ pub(crate) fn triangle(elements: &Elements, f: FaceId) -> [VertexId; 3] {
 }
 
 /// The image face of `f` under the map `image`, oriented by the sum of the target's
-/// normals `normals` at its vertices' images.
+/// normals `normals` at its vertices' images (module docs).
 pub fn image_face(
     elements: &Elements,
     normals: &[Vector3<f64>],
@@ -66,19 +77,15 @@ pub fn image_face(
     let nodes = triangle(elements, f);
     let [a, b, c] = nodes.map(|v| image[v.idx()]);
     let (e1, e2) = (b - a, c - a);
-    let summed: Vector3<f64> = nodes.iter().map(|v| normals[v.idx()]).sum();
-    let reference = if summed.norm_squared() > 0.0 {
-        summed.normalize()
-    } else {
-        normals[nodes[0].idx()]
-    };
-    let m = e1.cross(&e2);
-    let n = if m.norm_squared() > 0.0 {
-        let m = m.normalize();
-        if m.dot(&reference) >= 0.0 { m } else { -m }
-    } else {
-        reference
-    };
+    let reference: Vector3<f64> = nodes.iter().map(|v| normals[v.idx()]).sum();
+    let n = oriented_normal(&e1, &e2, &reference).unwrap_or_else(|| {
+        // A degenerate image triangle: any plane will do for the frame.
+        if reference.norm_squared() > 0.0 {
+            reference.normalize()
+        } else {
+            normals[nodes[0].idx()]
+        }
+    });
     let r = {
         let t = e1 - n * n.dot(&e1);
         if t.norm_squared() > 0.0 {
@@ -103,6 +110,7 @@ pub fn image_face(
             Vector2::new(e1.dot(&r), e1.dot(&s)),
             Vector2::new(e2.dot(&r), e2.dot(&s)),
         ],
+        flipped: image_derivatives(&fx, &fy, &reference).jacobian() <= 0.0,
     }
 }
 

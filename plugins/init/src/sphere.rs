@@ -84,9 +84,10 @@
 //! # Distortion
 //!
 //! The report's `mu` is measured intrinsically
-//! ([`beltrami_fem::distortion::measure_surface`]) with the radial direction `m / |m|` at
-//! each image face as the reference normal; its flipped count is that of the inward
-//! faces above (together with any Gauss point the measure finds flipped). The map is an
+//! ([`beltrami_fem::distortion::measure_surface`]) with [`ReferenceNormal::Radial`] (the
+//! direction of the image point at each quadrature point) as the reference normal; its
+//! flipped count is that of the inward faces above (together with any Gauss point the
+//! measure finds flipped). The map is an
 //! initialization, bijective up to the rare flips above but not conformal. The stretch is
 //! largest near the removed face's corners (a full turn around them is squeezed into the
 //! polygon's corner angle) and on long protrusions, which Tutte embeddings shrink
@@ -99,6 +100,7 @@ use beltrami_core::{
     Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, THREADS, Target,
     TargetKind, Topology, Weights, topology,
 };
+use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
 use nalgebra::Matrix3;
@@ -242,11 +244,10 @@ impl Solver for Sphere {
 
         let (inward, distortion) = context.stage("distortion", &mut report, || {
             let inward = inward_faces(mesh, &image);
-            let radial: Vec<Vector3<f64>> = mesh
-                .faces()
-                .map(|f| radial_direction(mesh, &image, f))
-                .collect();
-            Ok((inward, measure_surface(mesh, &image, Some(&radial))?))
+            Ok((
+                inward,
+                measure_surface(mesh, &image, ReferenceNormal::Radial)?,
+            ))
         })?;
         let flipped = inward
             .iter()

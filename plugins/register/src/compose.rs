@@ -17,6 +17,8 @@
 //! polyhedron that is star-shaped about the origin, instead of by the closest point,
 //! which is not injective near edges.
 
+use beltrami_fem::ReferenceNormal;
+use beltrami_fem::distortion::measure_surface;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
 
@@ -103,41 +105,22 @@ fn radial(domain: &Mesh, direction: &Vector3<f64>, start: FaceId) -> Option<Surf
     None
 }
 
-/// The number of source faces whose image is flipped: the image triangle through the
-/// images of its vertices (for a quad, any of the four triangles `012`, `023`, `013`,
-/// `123`) has a normal with a non-positive component along the sum of the target's
-/// interpolated vertex normals at the images of its corners. A collapsed image counts
-/// as flipped.
+/// The number of source faces whose image is flipped on the target: the map measured
+/// by `beltrami_fem::distortion::measure_surface` with the target's normals at the
+/// images as the reference ([`SurfaceIndex::face_reference_normals`]: per face, the sum
+/// of the target's interpolated vertex normals at the images of its corners). A face is
+/// flipped where the image's area element at one of its quadrature points has a
+/// non-positive component along that normal (the fem kernel
+/// `beltrami_fem::beltrami::image_derivatives`): a triangle by its image triangle, a
+/// quad by its four Gauss points (not by its four corner triangles). A collapsed image
+/// counts as flipped. `beltrami distortion SOURCE OUT --target TARGET` counts the same.
 pub(crate) fn count_flips(
     source: &Mesh,
     target_index: &SurfaceIndex<'_>,
     points: &[SurfacePoint],
     positions: &[Point3<f64>],
 ) -> Result<usize, RegisterError> {
-    let normals = points
-        .iter()
-        .map(|p| target_index.normal(p))
-        .collect::<Result<Vec<_>, _>>()?;
-    let inward = |corners: [usize; 3]| {
-        let [i, j, k] = corners;
-        let n = (positions[j] - positions[i]).cross(&(positions[k] - positions[i]));
-        n.dot(&(normals[i] + normals[j] + normals[k])) <= 0.0
-    };
-    let mut flipped = 0;
-    for f in source.faces() {
-        let (v, degree) = source.face_vertex_array(f);
-        let v = v.map(|x| x.idx());
-        let bad = if degree == 3 {
-            inward([v[0], v[1], v[2]])
-        } else {
-            inward([v[0], v[1], v[2]])
-                || inward([v[0], v[2], v[3]])
-                || inward([v[0], v[1], v[3]])
-                || inward([v[1], v[2], v[3]])
-        };
-        if bad {
-            flipped += 1;
-        }
-    }
-    Ok(flipped)
+    let normals = target_index.face_reference_normals(source, points)?;
+    let measured = measure_surface(source, positions, ReferenceNormal::PerFace(&normals))?;
+    Ok(measured.stats.flipped)
 }

@@ -1,7 +1,7 @@
 //! Errors of the initial bijection.
 
 use beltrami_core::SolverError;
-use beltrami_fem::SolveError;
+use beltrami_fem::{FemError, SolveError};
 use beltrami_init::boundary::BoundaryError;
 use beltrami_init::weights::WeightError;
 use beltrami_mesh::{CutError, MeshError, VertexId};
@@ -124,4 +124,7 @@ pub enum RegisterError {
     /// Point location failed.
     #[error("point location: {0}")]
     Spatial(#[from] SpatialError),
+    /// Measuring the initial map failed (a degenerate source face).
+    #[error("measuring the initial map: {0}")]
+    Measure(#[from] FemError),
 }

@@ -65,10 +65,12 @@ pub struct InitialMap {
     /// What was done, in words: the loops cut along (per mesh, lengths and input vertex
     /// indices), the alignment and the landmarks it honours, the flips.
     pub notes: Vec<String>,
-    /// Source faces whose image is flipped: the triangle through the images of its
-    /// corners (for a quad, any of its four corner triangles) has a normal pointing
-    /// against (or orthogonal to) the target's interpolated vertex normals at those
-    /// images. Zero for a bijective map between well-shaped meshes.
+    /// Source faces whose image is flipped: at a quadrature point (a triangle's image
+    /// triangle; a quad's four Gauss points, not its corner triangles) the image's area
+    /// element points against (or is orthogonal to) the sum of the target's interpolated
+    /// vertex normals at the images of the face's corners
+    /// ([`SurfaceIndex::face_reference_normals`] with the fem kernel). Zero for a
+    /// bijective map between well-shaped meshes.
     pub flipped: usize,
 }
 

@@ -4,11 +4,10 @@ use beltrami_core::{
     Accepts, ConstraintKind, Context, Element, GoalKind, Map, OptionSpec, Position, Problem,
     Report, Settings, Solution, Solver, SolverError, Target, TargetKind, Topology,
 };
+use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
 use beltrami_flow::BeltramiFlow;
-use beltrami_mesh::Vector3;
 use beltrami_spatial::SurfaceIndex;
-use beltrami_spatial::frame::interpolated_normal;
 
 use crate::{Landmark, LandmarkTarget, check_topology, initial_map};
 
@@ -116,33 +115,29 @@ impl Solver for Register {
         let marks = landmarks(problem)?;
         let mut report = Report::new(NAME);
         let initial = context.stage("initial map", &mut report, || {
-            initial_map(source, target, &marks).map_err(|e| SolverError::InvalidInput {
+            initial_map(source, target, &marks).map_err(|e| SolverError::Plugin {
                 solver: NAME,
-                message: e.to_string(),
+                error: Box::new(e),
             })
         })?;
         report.notes.extend(initial.notes.iter().cloned());
-        // The initial map's distortion, judged against the target's normals.
-        let index = SurfaceIndex::new(target).map_err(|e| SolverError::InvalidInput {
+        // The initial map's distortion, judged against the target's normals at the images
+        // (the rule of `beltrami distortion --target` and of the flow).
+        let index = SurfaceIndex::new(target).map_err(|e| SolverError::Plugin {
             solver: NAME,
-            message: format!("the target mesh: {e}"),
+            error: Box::new(e),
         })?;
-        let normals: Vec<Vector3<f64>> = source
-            .faces()
-            .map(|f| {
-                source
-                    .face_vertices(f)
-                    .map(|v| {
-                        interpolated_normal(
-                            target,
-                            index.vertex_normals(),
-                            &initial.points[v.idx()],
-                        )
-                    })
-                    .sum::<Vector3<f64>>()
-            })
-            .collect();
-        let start = measure_surface(source, &initial.positions, Some(&normals))?;
+        let normals = index
+            .face_reference_normals(source, &initial.points)
+            .map_err(|e| SolverError::Plugin {
+                solver: NAME,
+                error: Box::new(e),
+            })?;
+        let start = measure_surface(
+            source,
+            &initial.positions,
+            ReferenceNormal::PerFace(&normals),
+        )?;
         let mut flow = problem.clone();
         flow.initial = Some(Map::OnMesh(initial.points));
         let mut solution = BeltramiFlow.solve(&flow, context)?;
