@@ -14,6 +14,7 @@
 
 pub mod assembly;
 pub mod beltrami;
+pub mod boundary;
 pub mod distortion;
 pub mod dof;
 pub mod element;
@@ -23,6 +24,7 @@ pub mod operators;
 pub mod quaternion;
 pub mod solve;
 
+pub use boundary::{BoundaryError, BoundaryMap};
 pub use distortion::{Distortion, DistortionStats, Histogram, MuError};
 pub use dof::{DofConstraints, DofError, DofMap, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};

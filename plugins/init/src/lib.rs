@@ -6,7 +6,7 @@
 //! sphere. They are ends in themselves and the initial maps of every iterative solver.
 //!
 //! - [`Tutte`] (`tutte`): the boundary goes onto a convex curve (circle, unit square,
-//!   convex polygon; [`boundary`]) and every interior vertex is a weighted mean of its
+//!   convex polygon; [`beltrami_fem::boundary`]) and every interior vertex is a weighted mean of its
 //!   neighbours, `sum_j w_ij (x_i - x_j) = 0`, with uniform weights `w_ij = 1`
 //!   (W. T. Tutte, "How to draw a graph", Proc. London Math. Soc. 13, 1963) or Floater's
 //!   mean-value weights `w_ij = (tan(a/2) + tan(b/2)) / |p_i - p_j|` (M. S. Floater,
@@ -50,7 +50,6 @@
 //! assert_eq!(solution.report.flipped(), Some(0));
 //! ```
 
-pub mod boundary;
 pub mod harmonic;
 pub mod lscm;
 pub mod sphere;

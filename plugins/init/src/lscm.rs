@@ -26,6 +26,7 @@ use beltrami_core::{
     Context, Map, PlanarBoundary, Position, Problem, Report, Solution, Solver, SolverError, Target,
     topology,
 };
+use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::operators::{apply, complex_derivatives};
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::VertexId;
@@ -180,7 +181,7 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
     let one = Complex64::new(1.0, 0.0);
     let pinned: Vec<(VertexId, Complex64)> = match given.len() {
         0 => {
-            let (a, b) = crate::boundary::far_boundary_pair(mesh);
+            let (a, b) = far_boundary_pair(mesh);
             vec![(a, zero), (b, one)]
         }
         1 => {

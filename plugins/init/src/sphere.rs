@@ -17,9 +17,10 @@
 //!    default, uniform on request) and the `n` boundary vertices on the corners of a
 //!    regular `n`-gon (equilateral triangle or square) inscribed in the circle of radius
 //!    `R`. The corners are placed counter-clockwise in loop order, the mirror of the
-//!    usual clockwise placement of [`crate::boundary`], so the faces run clockwise in the
-//!    plane: seen from below, as the projection below needs. Tutte's theorem (Floater's
-//!    for mean-value weights) makes this a bijection onto the polygon for triangles.
+//!    usual clockwise placement of [`beltrami_fem::boundary`], so the faces run
+//!    clockwise in the plane: seen from below, as the projection below needs. Tutte's
+//!    theorem (Floater's for mean-value weights) makes this a bijection onto the polygon
+//!    for triangles.
 //! 3. **Projection.** The inverse stereographic projection from the north pole,
 //!
 //!    ```text
@@ -98,12 +99,12 @@ use beltrami_core::{
     Context, Goal, Map, Problem, Progress, Report, Solution, Solver, SolverError, Target, Weights,
     topology,
 };
+use beltrami_fem::BoundaryMap;
 use beltrami_fem::distortion::measure_surface;
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
 use nalgebra::Matrix3;
 use num_complex::Complex64;
 
-use crate::boundary::BoundaryMap;
 use crate::solve_options;
 use crate::tutte::WeightedMeanSystem;
 use crate::weights::{EdgeWeights, WeightError};

@@ -19,8 +19,8 @@
 //! Tutte (1963) for uniform weights and Floater (2003) for any positive weights: if the
 //! boundary goes onto a convex polygon, in order, the map is a bijection onto its interior
 //! (no flipped faces), except for faces whose vertices all land on one straight side,
-//! which collapse ([`crate::boundary`]: collapsed faces). [`Tutte`] accepts uniform
-//! (default) and mean-value weights; the cotangent weights belong to
+//! which collapse ([`beltrami_fem::boundary::collapsed_faces`]). [`Tutte`] accepts
+//! uniform (default) and mean-value weights; the cotangent weights belong to
 //! [`crate::Harmonic`], which shares this module's machinery.
 
 use beltrami_core::{
@@ -28,6 +28,7 @@ use beltrami_core::{
     topology,
 };
 use beltrami_fem::SolveError;
+use beltrami_fem::boundary::{self, BoundaryError, BoundaryMap};
 use beltrami_fem::solve::solve_spd;
 use beltrami_mesh::VertexId;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -37,7 +38,6 @@ use faer::sparse::{FaerError, SparseColMat, Triplet};
 use faer::{Conj, Mat, Par};
 use num_complex::Complex64;
 
-use crate::boundary::{self, BoundaryError, BoundaryMap};
 use crate::weights::{EdgeWeights, WeightError};
 use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
 

@@ -3,8 +3,7 @@
 //! parameter positions as vertices.
 
 use beltrami_core::Weights;
-use beltrami_fem::SolveOptions;
-use beltrami_init::boundary::BoundaryMap;
+use beltrami_fem::{BoundaryMap, SolveOptions};
 use beltrami_init::tutte::WeightedMeanSystem;
 use beltrami_init::weights::EdgeWeights;
 use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, VertexId};
