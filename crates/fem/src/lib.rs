@@ -23,6 +23,7 @@ pub mod field;
 pub mod operators;
 pub mod quaternion;
 pub mod solve;
+pub mod weights;
 
 pub use boundary::{BoundaryError, BoundaryMap};
 pub use distortion::{Distortion, DistortionStats, Histogram, MuError};
@@ -31,3 +32,4 @@ pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
 pub use field::{BeltramiField, FieldError};
 pub use solve::{LeastSquaresSolver, Preconditioned, SolveError, SolveOptions, SpdSolver};
+pub use weights::{EdgeWeights, WeightError};

@@ -54,17 +54,16 @@ pub mod harmonic;
 pub mod lscm;
 pub mod sphere;
 pub mod tutte;
-pub mod weights;
 
 pub use harmonic::Harmonic;
 pub use lscm::Lscm;
 pub use sphere::Sphere;
 pub use tutte::Tutte;
 
-use beltrami_core::{Context, Goal, Problem, Report, SolverError};
+use beltrami_core::{Context, Goal, Problem, Report, SolverError, Weights};
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::distortion::{Distortion, measure_planar};
-use beltrami_fem::{Elements, Frame, SolveOptions};
+use beltrami_fem::{EdgeWeights, Elements, Frame, SolveOptions, WeightError};
 use beltrami_mesh::Mesh;
 use num_complex::Complex64;
 
@@ -107,6 +106,16 @@ fn check_goal_and_curves(solver: &'static str, problem: &Problem<'_>) -> Result<
         ));
     }
     Ok(())
+}
+
+/// The edge weights of `kind` on `mesh`: [`EdgeWeights::uniform`],
+/// [`EdgeWeights::mean_value`] or [`EdgeWeights::cotangent`].
+fn edge_weights(mesh: &Mesh, kind: Weights) -> Result<EdgeWeights, WeightError> {
+    match kind {
+        Weights::Uniform => Ok(EdgeWeights::uniform(mesh)),
+        Weights::MeanValue => EdgeWeights::mean_value(mesh),
+        Weights::Cotan => EdgeWeights::cotangent(mesh),
+    }
 }
 
 /// The solve options of the problem's parameters.

@@ -99,15 +99,14 @@ use beltrami_core::{
     Context, Goal, Map, Problem, Progress, Report, Solution, Solver, SolverError, Target, Weights,
     topology,
 };
-use beltrami_fem::BoundaryMap;
 use beltrami_fem::distortion::measure_surface;
+use beltrami_fem::{BoundaryMap, WeightError};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
 use nalgebra::Matrix3;
 use num_complex::Complex64;
 
-use crate::solve_options;
 use crate::tutte::WeightedMeanSystem;
-use crate::weights::{EdgeWeights, WeightError};
+use crate::{edge_weights, solve_options};
 
 /// The Tutte embedding of the mesh minus one face, inverse stereographic projection and
 /// Moebius centering (module docs): an initial map of a closed genus-0 mesh onto the
@@ -180,7 +179,7 @@ impl Solver for Sphere {
         ));
 
         let (planar, negative) = context.stage("tutte", &mut report, || {
-            let weights = EdgeWeights::new(&punctured, kind).map_err(|e| match e {
+            let weights = edge_weights(&punctured, kind).map_err(|e| match e {
                 WeightError::Fem(e) => SolverError::Fem(e),
                 e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
                     solver: NAME,

@@ -27,9 +27,9 @@ use beltrami_core::{
     Context, Map, PlanarBoundary, Problem, Report, Solution, Solver, SolverError, Target, Weights,
     topology,
 };
-use beltrami_fem::SolveError;
 use beltrami_fem::boundary::{self, BoundaryError, BoundaryMap};
 use beltrami_fem::solve::solve_spd;
+use beltrami_fem::{EdgeWeights, SolveError, WeightError};
 use beltrami_mesh::VertexId;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::LuError;
@@ -38,8 +38,7 @@ use faer::sparse::{FaerError, SparseColMat, Triplet};
 use faer::{Conj, Mat, Par};
 use num_complex::Complex64;
 
-use crate::weights::{EdgeWeights, WeightError};
-use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
+use crate::{NOT_A_DISK, check_goal_and_curves, edge_weights, measure, solve_options};
 
 /// The weighted-mean system of a fixed boundary (module docs): `L_II x_I = b`, with one
 /// right-hand side column for the real and one for the imaginary parts.
@@ -390,7 +389,7 @@ impl FixedBoundary {
         let boundary = context.stage("boundary", &mut report, || self.prepare(problem))?;
         let kind = self.weights(problem);
         let (weights, system) = context.stage("assembly", &mut report, || {
-            let weights = EdgeWeights::new(mesh, kind).map_err(|e| match e {
+            let weights = edge_weights(mesh, kind).map_err(|e| match e {
                 WeightError::Fem(e) => SolverError::Fem(e),
                 e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
                     solver,

@@ -1,8 +1,7 @@
 //! Errors of the initial bijection.
 
 use beltrami_core::SolverError;
-use beltrami_fem::{BoundaryError, SolveError};
-use beltrami_init::weights::WeightError;
+use beltrami_fem::{BoundaryError, SolveError, WeightError};
 use beltrami_mesh::{CutError, MeshError, VertexId};
 use beltrami_spatial::SpatialError;
 use thiserror::Error;
