@@ -23,6 +23,7 @@ pub mod field;
 pub mod operators;
 pub mod quaternion;
 pub mod solve;
+pub mod weighted_mean;
 pub mod weights;
 
 pub use boundary::{BoundaryError, BoundaryMap};
@@ -32,4 +33,5 @@ pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
 pub use field::{BeltramiField, FieldError};
 pub use solve::{LeastSquaresSolver, Preconditioned, SolveError, SolveOptions, SpdSolver};
+pub use weighted_mean::WeightedMeanSystem;
 pub use weights::{EdgeWeights, WeightError};

@@ -6,13 +6,13 @@
 //! sphere. They are ends in themselves and the initial maps of every iterative solver.
 //!
 //! - [`Tutte`] (`tutte`): the boundary goes onto a convex curve (circle, unit square,
-//!   convex polygon; [`beltrami_fem::boundary`]) and every interior vertex is a weighted mean of its
-//!   neighbours, `sum_j w_ij (x_i - x_j) = 0`, with uniform weights `w_ij = 1`
-//!   (W. T. Tutte, "How to draw a graph", Proc. London Math. Soc. 13, 1963) or Floater's
-//!   mean-value weights `w_ij = (tan(a/2) + tan(b/2)) / |p_i - p_j|` (M. S. Floater,
-//!   "Mean value coordinates", CAGD 20, 2003). With a convex boundary and positive
-//!   weights the map is bijective (Tutte's theorem, extended by Floater, "One-to-one
-//!   piecewise linear mappings over triangulations", Math. Comp. 72, 2003).
+//!   convex polygon; [`beltrami_fem::boundary`]) and every interior vertex is a weighted
+//!   mean of its neighbours, `sum_j w_ij (x_i - x_j) = 0`, with uniform weights
+//!   `w_ij = 1` (W. T. Tutte, "How to draw a graph", Proc. London Math. Soc. 13, 1963)
+//!   or Floater's mean-value weights `w_ij = (tan(a/2) + tan(b/2)) / |p_i - p_j|`
+//!   (M. S. Floater, "Mean value coordinates", CAGD 20, 2003). With a convex boundary
+//!   and positive weights the map is bijective (Tutte's theorem, extended by Floater,
+//!   "One-to-one piecewise linear mappings over triangulations", Math. Comp. 72, 2003).
 //! - [`Harmonic`] (`harmonic`): the same boundaries, cotangent weights
 //!   `w_ij = (cot a_ij + cot b_ij) / 2` (U. Pinkall and K. Polthier, "Computing discrete
 //!   minimal surfaces and their conjugates", Experimental Math. 2, 1993), i.e. the

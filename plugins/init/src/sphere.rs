@@ -13,7 +13,7 @@
 //!    is a disk whose single boundary loop is the outline of `r`; it keeps every vertex,
 //!    so vertex ids do not change.
 //! 2. **Tutte.** The disk goes into the plane with every interior vertex at a weighted
-//!    mean of its neighbours ([`crate::tutte::WeightedMeanSystem`]; mean-value weights by
+//!    mean of its neighbours ([`beltrami_fem::WeightedMeanSystem`]; mean-value weights by
 //!    default, uniform on request) and the `n` boundary vertices on the corners of a
 //!    regular `n`-gon (equilateral triangle or square) inscribed in the circle of radius
 //!    `R`. The corners are placed counter-clockwise in loop order, the mirror of the
@@ -100,12 +100,11 @@ use beltrami_core::{
     topology,
 };
 use beltrami_fem::distortion::measure_surface;
-use beltrami_fem::{BoundaryMap, WeightError};
+use beltrami_fem::{BoundaryMap, WeightError, WeightedMeanSystem};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
 use nalgebra::Matrix3;
 use num_complex::Complex64;
 
-use crate::tutte::WeightedMeanSystem;
 use crate::{edge_weights, solve_options};
 
 /// The Tutte embedding of the mesh minus one face, inverse stereographic projection and

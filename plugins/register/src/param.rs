@@ -2,8 +2,7 @@
 //! length along boundary paths, and meshes with the connectivity of a mesh and the
 //! parameter positions as vertices.
 
-use beltrami_fem::{BoundaryMap, EdgeWeights, SolveOptions, WeightError};
-use beltrami_init::tutte::WeightedMeanSystem;
+use beltrami_fem::{BoundaryMap, EdgeWeights, SolveOptions, WeightError, WeightedMeanSystem};
 use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, VertexId};
 use num_complex::Complex64;
 
