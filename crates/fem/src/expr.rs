@@ -19,11 +19,12 @@
 //! Whitespace is ignored. Errors ([`ExprError`]) give the 1-based column (in
 //! characters) of the problem.
 
-use beltrami_fem::element::check_planar;
-use beltrami_fem::{BeltramiField, FemError, Frame};
 use beltrami_mesh::Mesh;
 use num_complex::Complex64;
 use thiserror::Error;
+
+use crate::element::check_planar;
+use crate::{BeltramiField, FemError, Frame};
 
 /// Why an expression could not be parsed. Columns are 1-based, in characters.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
