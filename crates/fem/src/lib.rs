@@ -8,6 +8,12 @@
 //! patterns, affine DOF maps for constraints, and constrained least-squares solves that
 //! reuse their symbolic factorization.
 //!
+//! The numerics the solver plugins share live here too: boundary maps of disk meshes
+//! onto a circle, square or convex polygon ([`boundary`]), the edge weights of linear
+//! maps (uniform, mean-value, cotangent; [`weights`]), the weighted-mean (Tutte) system
+//! of a fixed boundary ([`weighted_mean`]), and Beltrami coefficients given as
+//! expressions of `z` ([`expr`]).
+//!
 //! Conventions (see `docs/conventions.md`): `f_z = (f_x - i f_y) / 2`,
 //! `f_zbar = (f_x + i f_y) / 2`, `mu = f_zbar / f_z`; derivatives are taken in the tangent
 //! frame of each quadrature point ([`Frame`]).

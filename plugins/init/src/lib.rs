@@ -39,6 +39,12 @@
 //! Their reports carry the timings of each stage, the per-face Beltrami coefficient and
 //! its statistics (flipped faces included), and notes on flips.
 //!
+//! The numerics behind them that other solvers share are in `beltrami-fem`: the boundary
+//! maps ([`beltrami_fem::boundary`]), the edge weights ([`beltrami_fem::weights`]) and
+//! the weighted-mean system ([`beltrami_fem::weighted_mean`]). This crate holds the
+//! solvers: their capability checks, the choice of boundary and weights from the
+//! problem, and their reports.
+//!
 //! ```
 //! use beltrami_core::{Context, PlanarBoundary, Problem, Solver, Target};
 //! use beltrami_init::Tutte;
