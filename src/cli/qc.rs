@@ -12,8 +12,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use beltrami_core::{Constraint, Goal, Map, OptionValue, PlanarBoundary, Problem, Target};
-use beltrami_fem::BeltramiField;
-use beltrami_lsqc::Expr;
+use beltrami_fem::{BeltramiField, Expr};
 use beltrami_mesh::io::read;
 use beltrami_mesh::{BuildOptions, Mesh};
 use clap::{ArgGroup, Args, ValueEnum};

@@ -88,7 +88,7 @@ pub use constraint::{
 pub use error::SolverError;
 pub use map::{Map, SurfacePoint};
 pub use options::{OptionError, OptionKind, OptionSpec, OptionValue, Options, Settings, THREADS};
-pub use problem::{Goal, PlanarBoundary, Position, Problem, Target, Weights};
+pub use problem::{Goal, PlanarBoundary, Position, Problem, Target};
 pub use registry::Registry;
 pub use report::Report;
 pub use solution::{

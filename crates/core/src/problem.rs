@@ -90,17 +90,6 @@ pub enum Position {
     Spatial(Point3<f64>),
 }
 
-/// Edge weights of linear initializations.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Weights {
-    /// Every neighbour counts the same (Tutte's barycentric embedding).
-    Uniform,
-    /// Floater's mean-value weights (positive on any mesh).
-    MeanValue,
-    /// Cotangent weights (harmonic; may be negative on obtuse meshes).
-    Cotan,
-}
-
 /// A mapping problem.
 #[derive(Debug, Clone)]
 pub struct Problem<'a> {

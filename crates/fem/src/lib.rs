@@ -8,25 +8,39 @@
 //! patterns, affine DOF maps for constraints, and constrained least-squares solves that
 //! reuse their symbolic factorization.
 //!
+//! The numerics the solver plugins share live here too: boundary maps of disk meshes
+//! onto a circle, square or convex polygon ([`boundary`]), the edge weights of linear
+//! maps (uniform, mean-value, cotangent; [`weights`]), the weighted-mean (Tutte) system
+//! of a fixed boundary ([`weighted_mean`]), and Beltrami coefficients given as
+//! expressions of `z` ([`expr`]).
+//!
 //! Conventions (see `docs/conventions.md`): `f_z = (f_x - i f_y) / 2`,
 //! `f_zbar = (f_x + i f_y) / 2`, `mu = f_zbar / f_z`; derivatives are taken in the tangent
 //! frame of each quadrature point ([`Frame`]).
 
 pub mod assembly;
 pub mod beltrami;
+pub mod boundary;
 pub mod distortion;
 pub mod dof;
 pub mod element;
 mod error;
+pub mod expr;
 pub mod field;
 pub mod operators;
 pub mod quaternion;
 pub mod solve;
+pub mod weighted_mean;
+pub mod weights;
 
 pub use beltrami::ReferenceNormal;
+pub use boundary::{BoundaryError, BoundaryMap};
 pub use distortion::{Distortion, DistortionStats, Histogram, MuError};
 pub use dof::{DofConstraints, DofError, DofMap, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
+pub use expr::{Expr, ExprError};
 pub use field::{BeltramiField, FieldError};
 pub use solve::{LeastSquaresSolver, Preconditioned, SolveError, SolveOptions, SpdSolver};
+pub use weighted_mean::WeightedMeanSystem;
+pub use weights::{EdgeWeights, WeightError};

@@ -7,9 +7,10 @@
 //! ```
 //!
 //! `K` the stiffness matrix, over the interior vertices with the boundary fixed. Its
-//! stationarity condition is the weighted-mean system of [`crate::tutte`] with the
-//! cotangent weights `w_ij = -K_ij` (Pinkall-Polthier 1993; on triangles
-//! `(cot a_ij + cot b_ij) / 2`), solved by sparse Cholesky.
+//! stationarity condition is the weighted-mean system ([`beltrami_fem::weighted_mean`])
+//! with the cotangent weights `w_ij = -K_ij` (Pinkall-Polthier 1993; on triangles
+//! `(cot a_ij + cot b_ij) / 2`), solved by sparse Cholesky; the solver is
+//! [`crate::tutte`]'s with other weights.
 //!
 //! Since `E_D = A + 2 integral |f_zbar|^2` with `A` the image area, which the boundary
 //! fixes, the harmonic map is also the least-squares conformal map for that boundary.

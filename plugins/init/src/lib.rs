@@ -6,13 +6,13 @@
 //! sphere. They are ends in themselves and the initial maps of every iterative solver.
 //!
 //! - [`Tutte`] (`tutte`): the boundary goes onto a convex curve (circle, unit square,
-//!   convex polygon; [`boundary`]) and every interior vertex is a weighted mean of its
-//!   neighbours, `sum_j w_ij (x_i - x_j) = 0`, with uniform weights `w_ij = 1`
-//!   (W. T. Tutte, "How to draw a graph", Proc. London Math. Soc. 13, 1963) or Floater's
-//!   mean-value weights `w_ij = (tan(a/2) + tan(b/2)) / |p_i - p_j|` (M. S. Floater,
-//!   "Mean value coordinates", CAGD 20, 2003). With a convex boundary and positive
-//!   weights the map is bijective (Tutte's theorem, extended by Floater, "One-to-one
-//!   piecewise linear mappings over triangulations", Math. Comp. 72, 2003).
+//!   convex polygon; [`beltrami_fem::boundary`]) and every interior vertex is a weighted
+//!   mean of its neighbours, `sum_j w_ij (x_i - x_j) = 0`, with uniform weights
+//!   `w_ij = 1` (W. T. Tutte, "How to draw a graph", Proc. London Math. Soc. 13, 1963)
+//!   or Floater's mean-value weights `w_ij = (tan(a/2) + tan(b/2)) / |p_i - p_j|`
+//!   (M. S. Floater, "Mean value coordinates", CAGD 20, 2003). With a convex boundary
+//!   and positive weights the map is bijective (Tutte's theorem, extended by Floater,
+//!   "One-to-one piecewise linear mappings over triangulations", Math. Comp. 72, 2003).
 //! - [`Harmonic`] (`harmonic`): the same boundaries, cotangent weights
 //!   `w_ij = (cot a_ij + cot b_ij) / 2` (U. Pinkall and K. Polthier, "Computing discrete
 //!   minimal surfaces and their conjugates", Experimental Math. 2, 1993), i.e. the
@@ -39,6 +39,12 @@
 //! Their reports carry the timings of each stage, the per-face Beltrami coefficient and
 //! its statistics (flipped faces included), and notes on flips.
 //!
+//! The numerics behind them that other solvers share are in `beltrami-fem`: the boundary
+//! maps ([`beltrami_fem::boundary`]), the edge weights ([`beltrami_fem::weights`]) and
+//! the weighted-mean system ([`beltrami_fem::weighted_mean`]). This crate holds the
+//! solvers: their capability checks, the choice of boundary and weights from the
+//! problem, and their reports.
+//!
 //! ```
 //! use beltrami_core::{Context, PlanarBoundary, Problem, Solver, Target};
 //! use beltrami_init::Tutte;
@@ -50,12 +56,10 @@
 //! assert_eq!(solution.metrics.flipped(), Some(0));
 //! ```
 
-pub mod boundary;
 pub mod harmonic;
 pub mod lscm;
 pub mod sphere;
 pub mod tutte;
-pub mod weights;
 
 pub use harmonic::Harmonic;
 pub use lscm::Lscm;
@@ -63,11 +67,11 @@ pub use sphere::Sphere;
 pub use tutte::Tutte;
 
 use beltrami_core::{
-    Context, Goal, Metrics, OptionKind, OptionSpec, Problem, Report, Settings, SolverError, Weights,
+    Context, Goal, Metrics, OptionKind, OptionSpec, Problem, Report, Settings, SolverError,
 };
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::distortion::{Distortion, measure_planar};
-use beltrami_fem::{Elements, Frame, SolveOptions};
+use beltrami_fem::{EdgeWeights, Elements, Frame, SolveOptions, WeightError};
 use beltrami_mesh::Mesh;
 use num_complex::Complex64;
 
@@ -112,6 +116,16 @@ fn check_goal_and_curves(solver: &'static str, problem: &Problem<'_>) -> Result<
     Ok(())
 }
 
+/// The edge weights of `kind` on `mesh`: [`EdgeWeights::uniform`],
+/// [`EdgeWeights::mean_value`] or [`EdgeWeights::cotangent`].
+fn edge_weights(mesh: &Mesh, kind: Weights) -> Result<EdgeWeights, WeightError> {
+    match kind {
+        Weights::Uniform => Ok(EdgeWeights::uniform(mesh)),
+        Weights::MeanValue => EdgeWeights::mean_value(mesh),
+        Weights::Cotan => EdgeWeights::cotangent(mesh),
+    }
+}
+
 /// The solve options of the settings' `threads`.
 fn solve_options(settings: &Settings) -> SolveOptions {
     SolveOptions {
@@ -131,6 +145,18 @@ const fn weights_option(
         kind: OptionKind::Choice { default, choices },
         help,
     }
+}
+
+/// Edge weights of the linear maps, as the `weights` option names them (`uniform`,
+/// `mean-value`, `cotan`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Weights {
+    /// Every neighbour counts the same (Tutte's barycentric embedding).
+    Uniform,
+    /// Floater's mean-value weights (positive on any mesh).
+    MeanValue,
+    /// Cotangent weights (harmonic; may be negative on obtuse meshes).
+    Cotan,
 }
 
 /// The edge weights named by the `weights` option.

@@ -27,6 +27,7 @@ use beltrami_core::{
     PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver, SolverError, THREADS,
     Target, TargetKind, Topology, topology,
 };
+use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::operators::{apply, complex_derivatives};
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::VertexId;
@@ -211,7 +212,7 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
     let one = Complex64::new(1.0, 0.0);
     let pinned: Vec<(VertexId, Complex64)> = match given.len() {
         0 => {
-            let (a, b) = crate::boundary::far_boundary_pair(mesh);
+            let (a, b) = far_boundary_pair(mesh);
             vec![(a, zero), (b, one)]
         }
         1 => {

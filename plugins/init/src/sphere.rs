@@ -13,13 +13,14 @@
 //!    is a disk whose single boundary loop is the outline of `r`; it keeps every vertex,
 //!    so vertex ids do not change.
 //! 2. **Tutte.** The disk goes into the plane with every interior vertex at a weighted
-//!    mean of its neighbours ([`crate::tutte::WeightedMeanSystem`]; mean-value weights by
+//!    mean of its neighbours ([`beltrami_fem::WeightedMeanSystem`]; mean-value weights by
 //!    default, uniform on request) and the `n` boundary vertices on the corners of a
 //!    regular `n`-gon (equilateral triangle or square) inscribed in the circle of radius
 //!    `R`. The corners are placed counter-clockwise in loop order, the mirror of the
-//!    usual clockwise placement of [`crate::boundary`], so the faces run clockwise in the
-//!    plane: seen from below, as the projection below needs. Tutte's theorem (Floater's
-//!    for mean-value weights) makes this a bijection onto the polygon for triangles.
+//!    usual clockwise placement of [`beltrami_fem::boundary`], so the faces run
+//!    clockwise in the plane: seen from below, as the projection below needs. Tutte's
+//!    theorem (Floater's for mean-value weights) makes this a bijection onto the polygon
+//!    for triangles.
 //! 3. **Projection.** The inverse stereographic projection from the north pole,
 //!
 //!    ```text
@@ -98,18 +99,16 @@ use std::f64::consts::{PI, TAU};
 use beltrami_core::{
     Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
     Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, THREADS, Target,
-    TargetKind, Topology, Weights, topology,
+    TargetKind, Topology, topology,
 };
 use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
+use beltrami_fem::{BoundaryMap, WeightError, WeightedMeanSystem};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
 use nalgebra::Matrix3;
 use num_complex::Complex64;
 
-use crate::boundary::BoundaryMap;
-use crate::solve_options;
-use crate::tutte::WeightedMeanSystem;
-use crate::weights::{EdgeWeights, WeightError};
+use crate::{Weights, edge_weights, solve_options};
 
 /// The Tutte embedding of the mesh minus one face, inverse stereographic projection and
 /// Moebius centering (module docs): an initial map of a closed genus-0 mesh onto the
@@ -211,7 +210,7 @@ impl Solver for Sphere {
         ));
 
         let (planar, negative) = context.stage("tutte", &mut report, || {
-            let weights = EdgeWeights::new(&punctured, kind).map_err(|e| match e {
+            let weights = edge_weights(&punctured, kind).map_err(|e| match e {
                 WeightError::Fem(e) => SolverError::Fem(e),
                 e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
                     solver: NAME,

@@ -4,8 +4,8 @@
 mod common;
 
 use beltrami_core::{Context, PlanarBoundary, Problem, Solver, SolverError, Target};
+use beltrami_fem::EdgeWeights;
 use beltrami_init::Harmonic;
-use beltrami_init::weights::EdgeWeights;
 use beltrami_mesh::primitives::{Cells, icosphere};
 use beltrami_mesh::{Mesh, PolygonSoup};
 use common::{

@@ -43,7 +43,8 @@
 //! included) in the field's frame, the final `E_mu`, and a note with `|mu - target|`
 //! (area-weighted RMS and sup, [`beltrami_fem::MuError`]).
 //!
-//! [`expr`] parses coefficients given as expressions of `z` (`0.6*z`, `0.3+0.3i`).
+//! Coefficients given as expressions of `z` (`0.6*z`, `0.3+0.3i`) are parsed and
+//! evaluated at face centroids by [`beltrami_fem::Expr`].
 //!
 //! ```
 //! use beltrami_core::{Context, Goal, PlanarBoundary, Problem, Solver, Target};
@@ -60,10 +61,8 @@
 //! assert_eq!(solution.metrics.flipped(), Some(0));
 //! ```
 
-pub mod expr;
 mod lsqc;
 
-pub use expr::{Expr, ExprError};
 pub use lsqc::{Lsqc, beltrami_operator};
 
 /// Adds [`Lsqc`] to `registry`.

@@ -8,13 +8,13 @@ use beltrami_core::{
 };
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
+use beltrami_fem::boundary::{self, BoundaryError};
 use beltrami_fem::element::check_planar;
 use beltrami_fem::operators::apply;
 use beltrami_fem::{
     BeltramiField, Distortion, DofConstraints, DofMap, Elements, FemError, Frame,
     LeastSquaresSolver, MuError, SolveOptions,
 };
-use beltrami_init::boundary::{self, BoundaryError};
 use beltrami_mesh::{Mesh, VertexId};
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
@@ -281,7 +281,7 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
         }
         None => match pins.as_slice() {
             [] => {
-                let (a, b) = beltrami_init::boundary::far_boundary_pair(mesh);
+                let (a, b) = boundary::far_boundary_pair(mesh);
                 (vec![(a, zero), (b, one)], Some((a, b)))
             }
             [(v, _)] => {

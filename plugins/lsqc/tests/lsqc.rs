@@ -8,10 +8,11 @@ use std::path::Path;
 use beltrami_core::{
     Context, Goal, Map, Pin, PlanarBoundary, Position, Problem, Solver, SolverError, Target,
 };
+use beltrami_fem::Expr;
 use beltrami_fem::MuError;
 use beltrami_fem::{BeltramiField, Elements, FieldError, Frame};
 use beltrami_init::Lscm;
-use beltrami_lsqc::{Expr, Lsqc};
+use beltrami_lsqc::Lsqc;
 use beltrami_mesh::io::read;
 use beltrami_mesh::primitives::{Cells, jittered_grid, torus};
 use beltrami_mesh::subdivision::subdivide;

@@ -25,7 +25,7 @@
 
 use std::f64::consts::TAU;
 
-use beltrami_init::boundary::BoundaryMap;
+use beltrami_fem::BoundaryMap;
 use beltrami_mesh::{BoundaryLoopId, Mesh, Point3, SurfacePoint, VertexId};
 use num_complex::Complex64;
 

@@ -1,9 +1,7 @@
 //! Errors of the initial bijection.
 
 use beltrami_core::SolverError;
-use beltrami_fem::{FemError, SolveError};
-use beltrami_init::boundary::BoundaryError;
-use beltrami_init::weights::WeightError;
+use beltrami_fem::{BoundaryError, FemError, SolveError, WeightError};
 use beltrami_mesh::{CutError, MeshError, VertexId};
 use beltrami_spatial::SpatialError;
 use thiserror::Error;

@@ -2,11 +2,7 @@
 //! length along boundary paths, and meshes with the connectivity of a mesh and the
 //! parameter positions as vertices.
 
-use beltrami_core::Weights;
-use beltrami_fem::SolveOptions;
-use beltrami_init::boundary::BoundaryMap;
-use beltrami_init::tutte::WeightedMeanSystem;
-use beltrami_init::weights::EdgeWeights;
+use beltrami_fem::{BoundaryMap, EdgeWeights, SolveOptions, WeightError, WeightedMeanSystem};
 use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, VertexId};
 use num_complex::Complex64;
 
@@ -15,11 +11,11 @@ use crate::error::{RegisterError, Side};
 /// The Tutte weights used for a mesh: Floater's mean-value weights on triangle meshes
 /// (positive, so the embedding onto a convex boundary is a bijection), uniform weights
 /// when the mesh has quads (mean-value weights can be negative at reflex quad corners).
-pub(crate) fn weights_for(mesh: &Mesh) -> Weights {
+pub(crate) fn weights_for(mesh: &Mesh) -> Result<EdgeWeights, WeightError> {
     if mesh.quad_count() == 0 {
-        Weights::MeanValue
+        EdgeWeights::mean_value(mesh)
     } else {
-        Weights::Uniform
+        Ok(EdgeWeights::uniform(mesh))
     }
 }
 
@@ -30,8 +26,7 @@ pub(crate) fn tutte(
     boundary: &BoundaryMap,
     side: Side,
 ) -> Result<Vec<Complex64>, RegisterError> {
-    let weights = EdgeWeights::new(mesh, weights_for(mesh))
-        .map_err(|error| RegisterError::Weights { side, error })?;
+    let weights = weights_for(mesh).map_err(|error| RegisterError::Weights { side, error })?;
     WeightedMeanSystem::new(&weights, boundary)
         .and_then(|system| system.solve(SolveOptions::default()))
         .map_err(|error| RegisterError::Solve { side, error })

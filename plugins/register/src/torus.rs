@@ -33,7 +33,7 @@
 //! so a landmark set may pair `a` with the target's `b`) with the smallest periodic
 //! distances of the other landmarks to their targets.
 
-use beltrami_init::boundary::BoundaryMap;
+use beltrami_fem::BoundaryMap;
 use beltrami_mesh::{CutMesh, Mesh, Point3, SurfacePoint, VertexId, cut_to_disk};
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;

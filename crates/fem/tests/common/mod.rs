@@ -1,10 +1,14 @@
 //! Helpers shared by the integration tests of beltrami-fem: a reproducible random
-//! generator (no dev-dependency needed) and jittered planar meshes.
+//! generator (no dev-dependency needed), jittered planar meshes and the bundled
+//! hemisphere.
 // Each test binary compiles this module and uses only part of it.
 #![allow(dead_code)]
 
-use beltrami_mesh::Mesh;
+use std::path::Path;
+
+use beltrami_mesh::io::read;
 use beltrami_mesh::primitives::{Cells, jittered_grid};
+use beltrami_mesh::{BuildOptions, Mesh, VertexId};
 use num_complex::Complex64;
 
 /// splitmix64: a reproducible stream of random numbers.
@@ -46,4 +50,25 @@ impl Rng {
 pub fn jittered(n: usize, cells: Cells, amount: f64, seed: u64) -> Mesh {
     Mesh::from_soup(&jittered_grid(n, n, cells, amount, seed))
         .expect("a jittered grid is a valid mesh")
+}
+
+/// The bundled hemisphere (a cap of the unit sphere, 3600 triangles).
+pub fn hemisphere() -> Mesh {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../meshes/disk_hemisphere.obj"
+    );
+    read(Path::new(path), &BuildOptions::default())
+        .expect("the bundled hemisphere reads")
+        .mesh
+}
+
+/// Boundary vertices of the (single) boundary loop.
+pub fn boundary_vertices(mesh: &Mesh) -> Vec<VertexId> {
+    mesh.boundary_loop_list()[0].vertices.clone()
+}
+
+/// `a.re b.im - a.im b.re`.
+pub fn cross(a: Complex64, b: Complex64) -> f64 {
+    a.re * b.im - a.im * b.re
 }

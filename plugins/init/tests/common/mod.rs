@@ -108,7 +108,7 @@ pub fn boundary_vertices(mesh: &Mesh) -> Vec<VertexId> {
 /// The largest `|x_i - sum_j w_ij x_j / sum_j w_ij|` over interior vertices.
 pub fn weighted_mean_error(
     mesh: &Mesh,
-    weights: &beltrami_init::weights::EdgeWeights,
+    weights: &beltrami_fem::EdgeWeights,
     map: &[Complex64],
 ) -> f64 {
     mesh.vertices()

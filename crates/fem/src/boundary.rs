@@ -35,7 +35,8 @@
 //! A face whose vertices all land on one straight side of a polygon has zero area in the
 //! image (a triangle "ear" at a boundary vertex with a single face, for instance). The
 //! circle has no straight sides, so it never collapses a face; for polygons put corners
-//! at such vertices (give the square's corners) or use the circle.
+//! at such vertices (give the square's corners) or use the circle. [`collapsed_faces`]
+//! lists them.
 //!
 //! [`keep`] and [`given`] read fixed boundary values from the source itself (a planar
 //! mesh in z = 0) or from a per-vertex array.
@@ -492,7 +493,7 @@ fn check_convex(corners: &[Complex64]) -> Result<(), BoundaryError> {
 /// Faces whose vertices all lie on the boundary loop between two consecutive corners of
 /// `map` taken as straight sides: they collapse in the image. Corners are the vertices
 /// where the image turns (a circle turns at every vertex, so it has none).
-pub(crate) fn collapsed_faces(mesh: &Mesh, map: &BoundaryMap) -> Vec<FaceId> {
+pub fn collapsed_faces(mesh: &Mesh, map: &BoundaryMap) -> Vec<FaceId> {
     let n = map.vertices.len();
     let mut slot = vec![usize::MAX; mesh.vertex_count()];
     for (k, v) in map.vertices.iter().enumerate() {

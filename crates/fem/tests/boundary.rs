@@ -5,7 +5,7 @@ mod common;
 
 use std::f64::consts::TAU;
 
-use beltrami_init::boundary::{self, BoundaryError, BoundaryMap};
+use beltrami_fem::boundary::{self, BoundaryError, BoundaryMap};
 use beltrami_mesh::primitives::{Cells, grid, icosphere};
 use beltrami_mesh::{Mesh, VertexId};
 use common::{boundary_vertices, cross, hemisphere, jittered};

@@ -23,10 +23,12 @@
 //! `(1/2) integral |grad f|^2` of the P1/Q1 map, so the solution is the discrete harmonic
 //! map. Cotangent and mean-value weights reproduce linear functions on planar meshes
 //! exactly (linear precision); uniform weights do not.
+//!
+//! Each kind has its constructor ([`EdgeWeights::uniform`], [`EdgeWeights::mean_value`],
+//! [`EdgeWeights::cotangent`]); a solver picks the one its parameters ask for.
 
-use beltrami_core::Weights;
-use beltrami_fem::operators::ElementMatrices;
-use beltrami_fem::{Elements, FemError, Frame};
+use crate::operators::ElementMatrices;
+use crate::{Elements, FemError, Frame};
 use beltrami_mesh::{Mesh, VertexId};
 use thiserror::Error;
 
@@ -51,7 +53,8 @@ pub enum WeightError {
 /// Weights `w_ij` of every vertex `i` towards its neighbours `j`, stored row by row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EdgeWeights {
-    kind: Weights,
+    /// `w_ij = w_ji` by construction.
+    symmetric: bool,
     /// Row `i` is `offsets[i]..offsets[i + 1]` of `neighbors` and `values`.
     offsets: Vec<usize>,
     neighbors: Vec<VertexId>,
@@ -59,16 +62,6 @@ pub struct EdgeWeights {
 }
 
 impl EdgeWeights {
-    /// The weights of `kind` ([`EdgeWeights::uniform`], [`EdgeWeights::mean_value`] or
-    /// [`EdgeWeights::cotangent`]).
-    pub fn new(mesh: &Mesh, kind: Weights) -> Result<Self, WeightError> {
-        match kind {
-            Weights::Uniform => Ok(Self::uniform(mesh)),
-            Weights::MeanValue => Self::mean_value(mesh),
-            Weights::Cotan => Self::cotangent(mesh),
-        }
-    }
-
     /// `w_ij = 1` for every edge `ij` (Tutte's barycentric weights).
     pub fn uniform(mesh: &Mesh) -> Self {
         let mut offsets = Vec::with_capacity(mesh.vertex_count() + 1);
@@ -79,7 +72,7 @@ impl EdgeWeights {
             offsets.push(neighbors.len());
         }
         Self {
-            kind: Weights::Uniform,
+            symmetric: true,
             offsets,
             values: vec![1.0; neighbors.len()],
             neighbors,
@@ -92,7 +85,7 @@ impl EdgeWeights {
     ///
     /// Fails with [`WeightError::NonFinite`] at an edge of zero length.
     pub fn mean_value(mesh: &Mesh) -> Result<Self, WeightError> {
-        Self::from_rows(mesh, Weights::MeanValue, |v, row| {
+        Self::from_rows(mesh, false, |v, row| {
             for h in mesh.outgoing_halfedges(v) {
                 let j = mesh.target(h);
                 // corner_angle(h) is the angle at v between h and the other edge of the
@@ -125,7 +118,7 @@ impl EdgeWeights {
         let elements = Elements::new(mesh, Frame::Face)?;
         let stiffness =
             ElementMatrices::new(mesh.vertex_count(), &elements)?.stiffness(&elements)?;
-        Self::from_rows(mesh, Weights::Cotan, |v, row| {
+        Self::from_rows(mesh, true, |v, row| {
             // K is symmetric, so column i holds row i.
             let i = v.idx();
             let rows = stiffness.row_idx_of_col_raw(i);
@@ -149,9 +142,10 @@ impl EdgeWeights {
     }
 
     /// Builds the rows vertex by vertex; `fill(v, row)` appends `(j, w_vj)` to `row`.
+    /// `symmetric` says whether the kind is symmetric by construction.
     fn from_rows(
         mesh: &Mesh,
-        kind: Weights,
+        symmetric: bool,
         mut fill: impl FnMut(VertexId, &mut Vec<(VertexId, f64)>) -> Result<(), WeightError>,
     ) -> Result<Self, WeightError> {
         let mut offsets = Vec::with_capacity(mesh.vertex_count() + 1);
@@ -169,22 +163,17 @@ impl EdgeWeights {
             offsets.push(neighbors.len());
         }
         Ok(Self {
-            kind,
+            symmetric,
             offsets,
             neighbors,
             values,
         })
     }
 
-    /// Which weights these are.
-    pub fn kind(&self) -> Weights {
-        self.kind
-    }
-
     /// True if `w_ij = w_ji` by construction (uniform and cotangent weights), so the
     /// weighted-mean system is symmetric.
     pub fn is_symmetric(&self) -> bool {
-        matches!(self.kind, Weights::Uniform | Weights::Cotan)
+        self.symmetric
     }
 
     /// Number of vertices (rows).

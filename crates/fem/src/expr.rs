@@ -18,12 +18,25 @@
 //! complex: `abs(w) = |w|` (real), `conj(w) = re w - i im w`, `exp(w) = e^w`.
 //! Whitespace is ignored. Errors ([`ExprError`]) give the 1-based column (in
 //! characters) of the problem.
+//!
+//! # Depth
+//!
+//! Parsing and evaluation recurse once per level of nesting, so an expression may nest
+//! at most [`MAX_DEPTH`] levels deep. A level is opened by each `(` (of a parenthesis or
+//! a function call), each sign, each `^`, and each operator of a chain `a + b - c` or
+//! `a * b / c` (the chain is the tree `(a + b) - c`, one level deeper per operator).
+//! Deeper input, such as ten thousand `(`, gets [`ExprError::TooDeep`] with the column
+//! of the token that opens level `MAX_DEPTH + 1`, instead of a stack overflow.
 
-use beltrami_fem::element::check_planar;
-use beltrami_fem::{BeltramiField, FemError, Frame};
 use beltrami_mesh::Mesh;
 use num_complex::Complex64;
 use thiserror::Error;
+
+use crate::element::check_planar;
+use crate::{BeltramiField, FemError, Frame};
+
+/// The deepest nesting [`Expr::parse`] accepts (module docs, "Depth").
+pub const MAX_DEPTH: usize = 64;
 
 /// Why an expression could not be parsed. Columns are 1-based, in characters.
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
@@ -79,6 +92,12 @@ pub enum ExprError {
         /// The name.
         name: String,
     },
+    /// An expression nested more than [`MAX_DEPTH`] levels deep (module docs, "Depth").
+    #[error("column {column}: the expression nests more than {max} levels deep", max = MAX_DEPTH)]
+    TooDeep {
+        /// The `(`, sign, `^` or operator that opens level `MAX_DEPTH + 1`.
+        column: usize,
+    },
 }
 
 /// A function of one complex argument.
@@ -124,7 +143,7 @@ impl Expr {
             return Err(ExprError::Empty);
         }
         let mut parser = Parser { tokens, next: 0 };
-        let expr = parser.expr()?;
+        let expr = parser.expr(0)?;
         let token = parser.peek();
         match token.kind {
             Kind::End => Ok(expr),
@@ -317,7 +336,18 @@ fn tokenize(text: &str) -> Result<Vec<Token>, ExprError> {
     Ok(tokens)
 }
 
-/// Recursive descent over the tokens (module docs).
+/// The depth of a level opened at `column` inside a level of depth `depth`:
+/// `depth + 1`, or [`ExprError::TooDeep`] beyond [`MAX_DEPTH`].
+fn deeper(depth: usize, column: usize) -> Result<usize, ExprError> {
+    if depth < MAX_DEPTH {
+        Ok(depth + 1)
+    } else {
+        Err(ExprError::TooDeep { column })
+    }
+}
+
+/// Recursive descent over the tokens (module docs). Each rule takes the depth of the
+/// level it parses (module docs, "Depth") and passes [`deeper`] levels down.
 struct Parser {
     tokens: Vec<Token>,
     next: usize,
@@ -346,62 +376,74 @@ impl Parser {
         }
     }
 
-    fn expr(&mut self) -> Result<Expr, ExprError> {
-        let mut left = self.term()?;
+    fn expr(&mut self, depth: usize) -> Result<Expr, ExprError> {
+        let mut left = self.term(depth)?;
+        let mut chain = depth;
         loop {
-            match self.peek().kind {
+            let token = self.peek();
+            let column = token.column;
+            match token.kind {
                 Kind::Plus => {
                     self.bump();
-                    left = Expr::Add(Box::new(left), Box::new(self.term()?));
+                    chain = deeper(chain, column)?;
+                    left = Expr::Add(Box::new(left), Box::new(self.term(chain)?));
                 }
                 Kind::Minus => {
                     self.bump();
-                    left = Expr::Sub(Box::new(left), Box::new(self.term()?));
+                    chain = deeper(chain, column)?;
+                    left = Expr::Sub(Box::new(left), Box::new(self.term(chain)?));
                 }
                 _ => return Ok(left),
             }
         }
     }
 
-    fn term(&mut self) -> Result<Expr, ExprError> {
-        let mut left = self.unary()?;
+    fn term(&mut self, depth: usize) -> Result<Expr, ExprError> {
+        let mut left = self.unary(depth)?;
+        let mut chain = depth;
         loop {
-            match self.peek().kind {
+            let token = self.peek();
+            let column = token.column;
+            match token.kind {
                 Kind::Star => {
                     self.bump();
-                    left = Expr::Mul(Box::new(left), Box::new(self.unary()?));
+                    chain = deeper(chain, column)?;
+                    left = Expr::Mul(Box::new(left), Box::new(self.unary(chain)?));
                 }
                 Kind::Slash => {
                     self.bump();
-                    left = Expr::Div(Box::new(left), Box::new(self.unary()?));
+                    chain = deeper(chain, column)?;
+                    left = Expr::Div(Box::new(left), Box::new(self.unary(chain)?));
                 }
                 _ => return Ok(left),
             }
         }
     }
 
-    fn unary(&mut self) -> Result<Expr, ExprError> {
-        match self.peek().kind {
+    fn unary(&mut self, depth: usize) -> Result<Expr, ExprError> {
+        let token = self.peek();
+        let column = token.column;
+        match token.kind {
             Kind::Minus => {
                 self.bump();
-                Ok(Expr::Neg(Box::new(self.unary()?)))
+                Ok(Expr::Neg(Box::new(self.unary(deeper(depth, column)?)?)))
             }
             Kind::Plus => {
                 self.bump();
-                self.unary()
+                self.unary(deeper(depth, column)?)
             }
-            _ => self.power(),
+            _ => self.power(depth),
         }
     }
 
-    fn power(&mut self) -> Result<Expr, ExprError> {
-        let base = self.primary()?;
+    fn power(&mut self, depth: usize) -> Result<Expr, ExprError> {
+        let base = self.primary(depth)?;
         if self.peek().kind != Kind::Caret {
             return Ok(base);
         }
-        self.bump();
+        let caret = self.bump().column;
         let column = self.peek().column;
-        let exponent = self.unary()?;
+        let exponent = self.unary(deeper(depth, caret)?)?;
         let non_integer = |found: String| ExprError::NonIntegerPower { column, found };
         if !exponent.is_constant() {
             return Err(non_integer("an expression of z".into()));
@@ -418,7 +460,7 @@ impl Parser {
         Ok(Expr::Pow(Box::new(base), n.re as i32))
     }
 
-    fn primary(&mut self) -> Result<Expr, ExprError> {
+    fn primary(&mut self, depth: usize) -> Result<Expr, ExprError> {
         let token = self.peek().clone();
         match token.kind {
             Kind::Number(c) => {
@@ -427,7 +469,7 @@ impl Parser {
             }
             Kind::Open => {
                 self.bump();
-                let inner = self.expr()?;
+                let inner = self.expr(deeper(depth, token.column)?)?;
                 self.close(token.column)?;
                 Ok(inner)
             }
@@ -446,7 +488,7 @@ impl Parser {
                         }
                     };
                     let open = self.bump().column;
-                    let argument = Box::new(self.expr()?);
+                    let argument = Box::new(self.expr(deeper(depth, open)?)?);
                     self.close(open)?;
                     return Ok(match function {
                         Function::Conj => Expr::Conj(argument),
@@ -581,5 +623,55 @@ mod tests {
         assert_eq!(err("  "), ExprError::Empty);
         // The message names the column.
         assert!(err("z^0.5").to_string().contains("column 3"));
+    }
+
+    #[test]
+    fn deep_nesting_is_an_error_not_a_stack_overflow() {
+        let err = |text: &str| Expr::parse(text).unwrap_err();
+        let n = 100_000;
+        let too_deep = ExprError::TooDeep {
+            column: MAX_DEPTH + 1,
+        };
+        assert_eq!(
+            err(&("(".repeat(n) + "z" + &")".repeat(n))),
+            too_deep.clone()
+        );
+        assert_eq!(err(&("-".repeat(n) + "z")), too_deep.clone());
+        assert_eq!(err(&("+".repeat(n) + "z")), too_deep);
+        // Function calls: the level opens at the `(` of the 65th `exp(`.
+        assert_eq!(
+            err(&("exp(".repeat(n) + "z" + &")".repeat(n))),
+            ExprError::TooDeep {
+                column: 4 * (MAX_DEPTH + 1)
+            }
+        );
+        // Powers and chains: at the 65th `^`, `+` or `*`.
+        let at_operator = ExprError::TooDeep {
+            column: 2 * (MAX_DEPTH + 1),
+        };
+        assert_eq!(err(&("2^".repeat(n) + "1")), at_operator.clone());
+        assert_eq!(err(&("z+".repeat(n) + "z")), at_operator.clone());
+        assert_eq!(err(&("z*".repeat(n) + "z")), at_operator);
+        assert!(
+            err(&"(".repeat(n))
+                .to_string()
+                .contains(&format!("column {}", MAX_DEPTH + 1))
+        );
+    }
+
+    #[test]
+    fn nesting_at_the_limit_parses() {
+        let z = c(0.3, -0.7);
+        let d = MAX_DEPTH;
+        assert_eq!(value(&("(".repeat(d) + "z" + &")".repeat(d)), z), z);
+        assert_eq!(value(&("-".repeat(d) + "z"), z), z);
+        assert_eq!(value(&("conj(".repeat(d) + "z" + &")".repeat(d)), z), z);
+        assert!(close(
+            value(&("z+".repeat(d) + "z"), z),
+            (d as f64 + 1.0) * z
+        ));
+        assert!(close(value(&("1^".repeat(d) + "1"), z), c(1.0, 0.0)));
+        assert!(Expr::parse(&("(".repeat(d + 1) + "z" + &")".repeat(d + 1))).is_err());
+        assert!(Expr::parse(&("z+".repeat(d + 1) + "z")).is_err());
     }
 }
