@@ -17,8 +17,10 @@
 //! - [`init`]: the initialization solvers (tutte, harmonic, lscm, sphere).
 //! - [`lsqc`]: the least-squares quasiconformal map for a prescribed Beltrami
 //!   coefficient (lsqc).
-//! - [`flow`]: the discrete Beltrami flow (beltrami-flow) onto planar regions, the disk,
-//!   annuli, the sphere and target meshes.
+//! - [`flow_engine`]: the discrete Beltrami flow as an engine that solvers compose
+//!   (target geometries, the flow system, the step search, image-frame measurement).
+//! - [`flow`]: the solver beltrami-flow (initial map, then the engine) onto planar
+//!   regions, the disk, annuli and the sphere.
 //! - [`register`]: surface registration (register): initial bijections by topology,
 //!   then the flow on the target mesh.
 //! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
@@ -36,6 +38,7 @@ pub mod catalog;
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;
 pub use beltrami_flow as flow;
+pub use beltrami_flow_engine as flow_engine;
 pub use beltrami_init as init;
 pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;

@@ -111,7 +111,7 @@ mod tests {
     #[test]
     fn differential_matches_finite_differences() {
         let p = inverse_stereographic(Complex64::new(0.4, -0.7));
-        let [u, v] = crate::target::orthonormal_basis(&p.coords);
+        let [u, v] = beltrami_flow_engine::target::orthonormal_basis(&p.coords);
         for t in [u, v] {
             let h = 1e-6;
             let plus = Point3::from((p.coords + h * t).normalize());

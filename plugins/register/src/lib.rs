@@ -4,7 +4,8 @@
 //! Surface registration: [`Register`] maps a source mesh onto a target mesh of the same
 //! topology, bijectively and as conformally as the constraints allow (or with a
 //! prescribed mu): the initial bijection below, then the discrete Beltrami flow on the
-//! target mesh (`beltrami-flow`, Wong-Zhao 2014, sections 4.5 and 5.4).
+//! target mesh (the engine of `beltrami-flow-engine`, Wong-Zhao 2014, sections 4.5 and
+//! 5.4).
 //!
 //! The initial bijection of surface registration (Wong-Zhao 2014, section 5.4): a map
 //! from every vertex of a source mesh onto a target mesh of the same topology, built by

@@ -6,14 +6,13 @@ use beltrami_core::{
 };
 use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
-use beltrami_flow::BeltramiFlow;
 use beltrami_spatial::SurfaceIndex;
 
 use crate::{Landmark, LandmarkTarget, check_topology, initial_map};
 
 /// Surface registration: the initial bijection of [`initial_map`] (through a common
 /// parameter domain chosen by the topology, aligned by the landmarks), then the discrete
-/// Beltrami flow on the target mesh ([`BeltramiFlow`] with `Target::Mesh`).
+/// Beltrami flow on the target mesh ([`beltrami_flow_engine::solve`] with `Target::Mesh`).
 ///
 /// Reads: `target` (`Mesh` only), `goal` (`Conformal { p >= 2 }` or `Prescribed`),
 /// landmarks (each with a `Position::Spatial` on the target; the vertex is pulled there
@@ -77,7 +76,7 @@ impl Solver for Register {
     }
 
     fn options(&self) -> &'static [OptionSpec] {
-        beltrami_flow::OPTIONS
+        beltrami_flow_engine::OPTIONS
     }
 
     fn check_problem(
@@ -105,7 +104,7 @@ impl Solver for Register {
     fn run(
         &self,
         problem: &Problem<'_>,
-        _settings: &Settings,
+        settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
         let Target::Mesh(target) = &problem.target else {
@@ -140,11 +139,9 @@ impl Solver for Register {
         )?;
         let mut flow = problem.clone();
         flow.initial = Some(Map::OnMesh(initial.points));
-        let mut solution = BeltramiFlow.solve(&flow, context)?;
+        let mut solution =
+            beltrami_flow_engine::solve(&flow, settings, initial.positions, report, context)?;
         solution.metrics.initial_distortion = Some(start.stats);
-        report.timings.append(&mut solution.report.timings);
-        report.notes.append(&mut solution.report.notes);
-        solution.report = report;
         Ok(solution)
     }
 }

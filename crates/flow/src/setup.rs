@@ -1,111 +1,41 @@
 //! Setting up a flow: the initial map, the target geometry, the role of every vertex,
 //! the pins and the landmark goals.
 
-use beltrami_core::{
-    Constraint, Context, Map, Output, PlanarBoundary, Problem, Solver, SolverError, Target,
-};
-use beltrami_fem::element::is_planar;
-use beltrami_init::{Sphere, Tutte};
+use beltrami_core::{Constraint, Map, PlanarBoundary, Problem, SolverError, Target};
 use beltrami_mesh::{Mesh, Point3, VertexId};
 
 use crate::mesh_target::TargetCurve;
 use crate::target::{Annulus, PlaneRegion, Role, Side, UnitDisk, UnitSphere};
-use crate::validate::{ON_TARGET, annulus_of, invalid, unsupported};
+use crate::validate::{invalid, unsupported};
 
 /// Boundary vertices whose boundary turns by less than this (radians) slide along a
 /// straight side of a planar region; the others are corners and stay.
 const CORNER_ANGLE: f64 = 1e-6;
 
-/// The map the flow starts from, as points of R^3 (z = 0 for planar targets).
-/// `threads` is passed to the initialization's factorizations.
-pub(crate) fn initial_map(
-    problem: &Problem<'_>,
-    threads: usize,
-) -> Result<Vec<Point3<f64>>, SolverError> {
-    let mesh = problem.source;
-    if let Some(map) = &problem.initial {
-        return Ok(match (map, &problem.target) {
-            (Map::Planar(z), _) => z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect(),
-            (Map::Spatial(p), _) => p.clone(),
-            (Map::OnMesh(points), Target::Mesh(target)) => points
-                .iter()
-                .enumerate()
-                .map(|(v, p)| {
-                    p.validate(target)
-                        .map(|()| p.position(target))
-                        .map_err(|e| invalid(format!("the initial map at vertex {v}: {e}")))
-                })
-                .collect::<Result<_, _>>()?,
-            (Map::OnMesh(_), _) => {
-                return Err(unsupported(
-                    "an initial map on a mesh needs that mesh as the target",
-                ));
-            }
-        });
-    }
-    let planar_points = |output: Output| match output {
-        Output::Map(Map::Planar(z)) => Ok(z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect()),
-        _ => Err(invalid("the initial map is not planar")),
+/// The images of a given initial map (`problem.initial`) as points of R^3 (`z = 0` for a
+/// planar map; a map on a target mesh at its surface points), or `None` without one.
+pub fn given_initial(problem: &Problem<'_>) -> Result<Option<Vec<Point3<f64>>>, SolverError> {
+    let Some(map) = &problem.initial else {
+        return Ok(None);
     };
-    let identity = || {
-        mesh.positions()
+    Ok(Some(match (map, &problem.target) {
+        (Map::Planar(z), _) => z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect(),
+        (Map::Spatial(p), _) => p.clone(),
+        (Map::OnMesh(points), Target::Mesh(target)) => points
             .iter()
-            .map(|p| Point3::new(p.x, p.y, 0.0))
-            .collect()
-    };
-    let mut init = Problem::new(mesh, problem.target.clone());
-    init.options
-        .set("threads", beltrami_core::OptionValue::Int(threads));
-    match &problem.target {
-        Target::Plane(PlanarBoundary::Keep) => Ok(identity()),
-        Target::Plane(b @ (PlanarBoundary::Square { .. } | PlanarBoundary::Polygon(_))) => {
-            init.target = Target::Plane(b.clone());
-            planar_points(Tutte.solve(&init, &mut Context::new())?.output)
+            .enumerate()
+            .map(|(v, p)| {
+                p.validate(target)
+                    .map(|()| p.position(target))
+                    .map_err(|e| invalid(format!("the initial map at vertex {v}: {e}")))
+            })
+            .collect::<Result<_, _>>()?,
+        (Map::OnMesh(_), _) => {
+            return Err(unsupported(
+                "an initial map on a mesh needs that mesh as the target",
+            ));
         }
-        Target::Plane(_) | Target::Disk => {
-            let on_circle = is_planar(mesh)
-                && mesh.boundary_loop_list()[0]
-                    .vertices
-                    .iter()
-                    .all(|&v| (mesh.position(v).coords.xy().norm() - 1.0).abs() <= ON_TARGET);
-            if on_circle {
-                return Ok(identity());
-            }
-            init.target = Target::Plane(PlanarBoundary::Circle);
-            planar_points(Tutte.solve(&init, &mut Context::new())?.output)
-        }
-        Target::Annulus { inner_radius } => {
-            let (r0, _) = annulus_of(mesh)?;
-            let r = inner_radius.unwrap_or(r0);
-            // Radial stretch of [r0, 1] onto [r, 1]: a homeomorphism onto the target.
-            Ok(mesh
-                .positions()
-                .iter()
-                .map(|p| {
-                    let rho = p.coords.xy().norm();
-                    let new = r + (rho - r0) * (1.0 - r) / (1.0 - r0);
-                    let s = if rho > 0.0 { new / rho } else { 1.0 };
-                    Point3::new(p.x * s, p.y * s, 0.0)
-                })
-                .collect())
-        }
-        Target::Sphere => {
-            let on_sphere = mesh
-                .positions()
-                .iter()
-                .all(|p| (p.coords.norm() - 1.0).abs() <= ON_TARGET);
-            if on_sphere {
-                return Ok(mesh.positions().to_vec());
-            }
-            match Sphere.solve(&init, &mut Context::new())?.output {
-                Output::Map(Map::Spatial(p)) => Ok(p),
-                _ => Err(invalid(
-                    "the sphere initialization did not give points of R^3",
-                )),
-            }
-        }
-        _ => Err(unsupported("no initial map for this target")),
-    }
+    }))
 }
 
 /// The target geometry, ready for the flow.

@@ -13,7 +13,7 @@ use crate::NAME;
 
 /// How far (relative) a vertex may be off the unit circle or sphere for the source to be
 /// taken as already on the target.
-pub(crate) const ON_TARGET: f64 = 1e-9;
+pub const ON_TARGET: f64 = 1e-9;
 
 /// The goal, checked: the frame `mu` is measured in, the target per face and `p`.
 pub(crate) struct CheckedGoal {
@@ -216,7 +216,7 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
 
 /// The inner radius of a planar annulus source centred at 0, and which boundary loop is
 /// the outer one (index in `boundary_loop_list`).
-pub(crate) fn annulus_of(mesh: &Mesh) -> Result<(f64, usize), SolverError> {
+pub fn annulus_of(mesh: &Mesh) -> Result<(f64, usize), SolverError> {
     let loops = mesh.boundary_loop_list();
     let radii: Vec<(f64, f64)> = loops
         .iter()

@@ -1,0 +1,382 @@
+//! Running the flow on a problem from an initial map: what every solver that flows a
+//! map on a target composes ([`solve`]), with its options ([`OPTIONS`]) and what it
+//! accepts ([`ACCEPTS`]).
+
+use beltrami_core::{
+    Accepts, AnnulusRadius, ConstraintKind, Context, Element, Extras, GoalKind, Map, Metrics,
+    OptionKind, OptionSpec, Output, Problem, Report, Settings, Solution, SolverError, THREADS,
+    Target, TargetKind, Topology,
+};
+use beltrami_fem::{BeltramiField, DistortionStats, Elements, Frame, MuError, SolveOptions};
+use beltrami_mesh::{Point3, VertexId};
+use beltrami_spatial::SurfaceIndex;
+use num_complex::Complex64;
+
+use crate::flow::{self, FlowOptions, FlowRun, Stop};
+use crate::measure::Objective;
+use crate::mesh_target::MeshTarget;
+use crate::setup::{Domain, curve_roles, diagonal, domain, goals, mesh_roles, pins, region_roles};
+use crate::system::FlowSystem;
+use crate::target::{INNER, OUTER, Role, TargetGeometry};
+use crate::validate::{invalid, validate};
+
+/// The flow's options.
+pub const OPTIONS: &[OptionSpec] = &[
+    OptionSpec {
+        name: "tolerance",
+        kind: OptionKind::Float {
+            default: 1e-6,
+            min: 0.0,
+            max: 1.0,
+        },
+        help: "stop when the largest vertex update is below this, relative to the target's size",
+    },
+    OptionSpec {
+        name: "max-iters",
+        kind: OptionKind::Int {
+            default: 500,
+            min: 0,
+            max: 1_000_000,
+        },
+        help: "flow steps at most",
+    },
+    OptionSpec {
+        name: "max-move",
+        kind: OptionKind::Float {
+            default: 0.05,
+            min: 1e-9,
+            max: 1.0,
+        },
+        help: "on a target mesh, the largest vertex move tried in one step, relative to the target's bounding-box diagonal",
+    },
+    OptionSpec {
+        name: "min-step",
+        kind: OptionKind::Float {
+            default: 8.881_784_197_001_252e-16,
+            min: 0.0,
+            max: 1.0,
+        },
+        help: "the smallest step size tried (2^-50: below it a step is lost in rounding)",
+    },
+    THREADS,
+];
+
+/// What the flow accepts.
+pub const ACCEPTS: Accepts = Accepts {
+    elements: &[Element::Triangle],
+    topologies: &[
+        Topology::Disk,
+        Topology::Annulus,
+        Topology::Sphere,
+        Topology::Torus,
+    ],
+    targets: &[
+        TargetKind::PlaneKeep,
+        TargetKind::PlaneCircle,
+        TargetKind::PlaneSquare,
+        TargetKind::PlanePolygon,
+        TargetKind::Disk,
+        TargetKind::Annulus,
+        TargetKind::Sphere,
+        TargetKind::Mesh,
+    ],
+    goals: &[
+        GoalKind::Conformal,
+        GoalKind::ConformalLp,
+        GoalKind::Prescribed,
+    ],
+    constraints: &[
+        ConstraintKind::Hold,
+        ConstraintKind::Landmark,
+        ConstraintKind::OpenCurve,
+    ],
+};
+
+/// Flows `initial` (the images of the source's vertices in R^3: `z = 0` for planar
+/// targets; on the target for the sphere and target meshes) on `problem`'s target
+/// towards its goal, and measures the result. `report` receives the stage timings and
+/// notes (a solver's own stages before this one stay first).
+///
+/// Reads: `goal` (`Conformal { p >= 2 }` or `Prescribed(field)`), `target`
+/// (`Plane(Keep | Square | Polygon | Circle)`, `Disk`, `Annulus`, `Sphere`, `Mesh` with
+/// `problem.initial` a map onto it, open feature curves and landmarks), pins without
+/// positions (held where `initial` puts them) and the options ([`OPTIONS`], resolved in
+/// `settings`). Checks the problem first ([`crate::validate()`]).
+pub fn solve(
+    problem: &Problem<'_>,
+    settings: &Settings,
+    initial: Vec<Point3<f64>>,
+    mut report: Report,
+    context: &mut Context<'_>,
+) -> Result<Solution, SolverError> {
+    let goal = validate(problem)?;
+    let mesh = problem.source;
+    let mut metrics = Metrics::default();
+    let mut extras = Extras::default();
+    let elements = context.stage("elements", &mut report, || {
+        Ok(Elements::new(mesh, goal.frame)?)
+    })?;
+    if initial.len() != mesh.vertex_count() {
+        return Err(invalid(format!(
+            "the initial map has {} images for {} vertices",
+            initial.len(),
+            mesh.vertex_count()
+        )));
+    }
+    let threads = settings.int("threads");
+    let objective = Objective {
+        areas: (0..mesh.face_count())
+            .map(|f| elements.face_points(beltrami_mesh::FaceId(f as u32))[0].weight)
+            .collect(),
+        sigma: goal.sigma.clone(),
+        p: goal.p,
+    };
+    let options = SolveOptions {
+        threads,
+        ..SolveOptions::default()
+    };
+    let planar = !matches!(problem.target, Target::Sphere);
+    let runner = Runner {
+        elements: &elements,
+        objective: &objective,
+        problem,
+        settings,
+        options,
+    };
+    let input = |v: VertexId| mesh.vertex_map().to_input(v);
+    let pins = pins(problem, &initial);
+    let given = problem.constraints.pins().count() + problem.constraints.landmarks().count();
+    if given == 0 && !pins.is_empty() {
+        let names: Vec<String> = pins.iter().map(|&v| input(v).to_string()).collect();
+        report.notes.push(format!(
+                "pinned vertices {} (input indices) where the initial map puts them, to fix the target's conformal automorphisms",
+                names.join(", ")
+            ));
+    }
+    if let Target::Mesh(target) = &problem.target {
+        let index = context.stage("target index", &mut report, || {
+            SurfaceIndex::new(target).map_err(|e| invalid(format!("the target mesh: {e}")))
+        })?;
+        let (curves, roles) = mesh_roles(problem, target, &initial, &pins)?;
+        let geometry = MeshTarget::new(&index, curves);
+        let scale = diagonal(target.positions());
+        let run = runner.run(
+            geometry.clone(),
+            roles,
+            initial,
+            scale,
+            context,
+            (&mut report, &mut metrics),
+        )?;
+        let points = geometry.locate_all(&run.image)?;
+        let (_, faces_mu, flipped) = run.finish(false);
+        return finish_solution(
+            (report, metrics, extras),
+            goal.frame,
+            &objective,
+            faces_mu,
+            &flipped,
+            Map::OnMesh(points),
+        );
+    }
+    let domain = domain(problem, &initial)?;
+    let image = initial;
+    let outcome = match domain {
+        Domain::Region(g) => {
+            let scale = diagonal(&image);
+            let roles = region_roles(mesh, &g, &image, &pins);
+            runner
+                .run(g, roles, image, scale, context, (&mut report, &mut metrics))?
+                .finish(planar)
+        }
+        Domain::Disk(g) => {
+            let roles = curve_roles(mesh, &pins, |_| 0);
+            runner
+                .run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?
+                .finish(planar)
+        }
+        Domain::Annulus(g, outer) => {
+            let roles = curve_roles(mesh, &pins, |l| if l == outer { OUTER } else { INNER });
+            let run = runner.run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?;
+            if g.free_inner {
+                extras.annulus_radius = Some(AnnulusRadius {
+                    radius: run.target.inner_radius,
+                    initial: g.inner_radius,
+                });
+            }
+            run.finish(planar)
+        }
+        Domain::Sphere(g) => {
+            let roles = curve_roles(mesh, &pins, |_| 0);
+            runner
+                .run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?
+                .finish(planar)
+        }
+    };
+    let (map, faces_mu, flipped) = outcome;
+    finish_solution(
+        (report, metrics, extras),
+        goal.frame,
+        &objective,
+        faces_mu,
+        &flipped,
+        map,
+    )
+}
+
+/// The solution with its measured `mu`, statistics, `|mu - target|` for a prescribed
+/// goal, and a note on remaining flips.
+fn finish_solution(
+    (mut report, mut metrics, extras): (Report, Metrics, Extras),
+    frame: Frame,
+    objective: &Objective,
+    faces_mu: Vec<Complex64>,
+    flipped: &[bool],
+    map: Map,
+) -> Result<Solution, SolverError> {
+    let stats = DistortionStats::new(&faces_mu, &objective.areas, flipped)?;
+    if stats.flipped > 0 {
+        report.notes.push(format!(
+            "{} faces are flipped: the initial map had flips the flow could not remove",
+            stats.flipped
+        ));
+    }
+    let zero;
+    let sigma = match &objective.sigma {
+        Some(sigma) => sigma,
+        None => {
+            zero = vec![Complex64::default(); faces_mu.len()];
+            &zero
+        }
+    };
+    metrics.mu_error = Some(MuError::from_areas(&objective.areas, &faces_mu, sigma)?);
+    metrics.mu = Some(BeltramiField::new(frame, faces_mu));
+    metrics.distortion = Some(stats);
+    Ok(Solution {
+        output: Output::Map(map),
+        metrics,
+        extras,
+        report,
+    })
+}
+
+/// What every flow run of one solve shares.
+struct Runner<'a, 'p> {
+    elements: &'a Elements,
+    objective: &'a Objective,
+    problem: &'a Problem<'p>,
+    settings: &'a Settings,
+    options: SolveOptions,
+}
+
+impl Runner<'_, '_> {
+    /// Runs the flow on `target` from `image` with `roles` (tolerances relative to
+    /// `scale`) and records its history in `report`.
+    fn run<G: TargetGeometry>(
+        &self,
+        target: G,
+        roles: Vec<Role>,
+        image: Vec<Point3<f64>>,
+        scale: f64,
+        context: &mut Context<'_>,
+        (report, metrics): (&mut Report, &mut Metrics),
+    ) -> Result<FlowRun<G>, SolverError> {
+        let (elements, objective, problem, settings, options) = (
+            self.elements,
+            self.objective,
+            self.problem,
+            self.settings,
+            self.options,
+        );
+        let mut system = context.stage("symbolic", report, || {
+            FlowSystem::new(elements, &target, &image, roles, options)
+        })?;
+        let flow_options = FlowOptions {
+            tolerance: settings.float("tolerance") * scale,
+            max_iterations: settings.int("max-iters"),
+            solve: options,
+            max_move: if matches!(problem.target, Target::Mesh(_)) {
+                settings.float("max-move") * scale
+            } else {
+                f64::INFINITY
+            },
+            min_step: settings.float("min-step"),
+        };
+        let run = report.time("flow", || {
+        flow::run(
+            elements,
+            target,
+            &mut system,
+            image,
+            &goals(problem),
+            objective,
+            flow_options,
+            context,
+        )
+    })
+    .map_err(|e| match e {
+        SolverError::Solve(beltrami_fem::SolveError::Singular { .. } | beltrami_fem::SolveError::NotPositiveDefinite { .. }) => invalid(
+            "the flow is not determined: pin more vertices (disk: one interior and one boundary vertex; annulus: one boundary vertex; sphere: three vertices)",
+        ),
+        e => e,
+    })?;
+        report
+            .timings
+            .push(("flow: solves".into(), run.solve_seconds));
+        report
+            .timings
+            .push(("flow: steps".into(), run.step_seconds));
+        metrics.iterations = run.iterations();
+        metrics.factorizations = Some(run.factorizations);
+        metrics.cg_iterations = Some(run.cg_iterations);
+        metrics.energy_history = run.energy_history.clone();
+        metrics.step_sizes = run.step_sizes.clone();
+        metrics.stop = Some(match run.stop {
+            Stop::Converged => beltrami_core::Stop::Converged {
+                tolerance: flow_options.tolerance,
+            },
+            Stop::Stalled => beltrami_core::Stop::Stalled,
+            Stop::IterationLimit => beltrami_core::Stop::IterationLimit,
+            Stop::Cancelled => beltrami_core::Stop::Cancelled,
+        });
+        report.notes.push(match run.stop {
+        Stop::Converged => format!(
+            "converged after {} iterations: largest vertex update below {:.1e}",
+            run.iterations(),
+            flow_options.tolerance
+        ),
+        Stop::Stalled => format!(
+            "stopped after {} iterations: no step above the tolerance decreased the error further",
+            run.iterations()
+        ),
+        Stop::IterationLimit => format!(
+            "stopped at the iteration limit ({}) before converging",
+            run.iterations()
+        ),
+        Stop::Cancelled => format!(
+            "cancelled after {} iterations: the map is the best one so far",
+            run.iterations()
+        ),
+    });
+        Ok(run)
+    }
+}
+
+impl<G> FlowRun<G> {
+    /// The map, the per-face `mu` and flip flags.
+    fn finish(self, planar: bool) -> (Map, Vec<Complex64>, Vec<bool>) {
+        let mu = self.faces.iter().map(|f| f.mu()).collect();
+        let flipped = self.faces.iter().map(|f| f.flipped()).collect();
+        let map = if planar {
+            Map::Planar(
+                self.image
+                    .iter()
+                    .map(|p| Complex64::new(p.x, p.y))
+                    .collect(),
+            )
+        } else {
+            Map::Spatial(self.image)
+        };
+        (map, mu, flipped)
+    }
+}
