@@ -32,10 +32,11 @@ fn dependencies(manifest: &Path) -> Vec<String> {
             inside = line == "[dependencies]";
             continue;
         }
-        if inside && let Some((name, _)) = line.split_once(['.', '=', ' ']) {
-            if !name.is_empty() {
-                out.push(name.to_string());
-            }
+        if inside
+            && let Some((name, _)) = line.split_once(['.', '=', ' '])
+            && !name.is_empty()
+        {
+            out.push(name.to_string());
         }
     }
     out
