@@ -26,6 +26,9 @@
 //! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
 //!   |mu| histograms as PNG.
 //!
+//! [`mapped`] reads maps given as mesh files (connectivity check, texture seams, target
+//! normals at the image).
+//!
 //! [`registry`] returns every solver shipped with this package; [`catalog`] describes
 //! each as data (accepts and options), for `beltrami solvers --json` and scripts.
 //! `docs/adding-a-solver.md` walks through writing one.
@@ -34,6 +37,7 @@
 //! README for its commands.
 
 pub mod catalog;
+pub mod mapped;
 
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;

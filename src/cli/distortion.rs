@@ -7,14 +7,13 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, anyhow, bail};
+use anyhow::{Context, bail};
+use beltrami::mapped;
 use beltrami_fem::distortion::{self, Distortion, Histogram};
 use beltrami_fem::{Frame, ReferenceNormal, element};
-use beltrami_mesh::io::{self, LoadedMesh};
-use beltrami_mesh::{BuildOptions, Mesh, Point3, Repair, SurfacePoint, Vector3, VertexId};
-use beltrami_spatial::SurfaceIndex;
+use beltrami_mesh::io::LoadedMesh;
+use beltrami_mesh::{Mesh, Point3, Vector3, VertexId};
 use clap::Args;
-use num_complex::Complex64;
 use serde_json::json;
 
 use super::load::load_mesh;
@@ -52,7 +51,7 @@ pub struct DistortionArgs {
 pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
     let quiet = quiet || args.json;
     let source = load_mesh(&args.source, args.repair, quiet)?.mesh;
-    let mapped = load_mapped(&args.mapped, args.repair)?;
+    let mapped = read_mapped(&args.mapped, args.repair)?;
     let mesh = &source.mesh;
     let to_mapped = correspondence(mesh, &mapped.mesh, &args.source, &args.mapped)?;
     let planar_source = element::is_planar(mesh);
@@ -74,13 +73,9 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
                 args.mapped.display()
             );
         }
-        let uv = mapped
-            .vertex_uvs()
-            .ok_or_else(|| seam_error(&mapped, &args.mapped))?;
-        let map: Vec<Complex64> = to_mapped
-            .iter()
-            .map(|v| Complex64::new(uv[v.idx()].x, uv[v.idx()].y))
-            .collect();
+        let map = mapped::planar_images(&mapped, &to_mapped)
+            .with_context(|| format!("{} has", args.mapped.display()))?
+            .unwrap_or_default();
         let measured = distortion::measure_planar(mesh, &map, frame).with_context(measuring)?;
         (
             MapKind::Planar,
@@ -88,7 +83,7 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
             measured,
         )
     } else {
-        let image: Vec<Point3<f64>> = to_mapped.iter().map(|&v| mapped.mesh.position(v)).collect();
+        let image = mapped::spatial_images(&mapped.mesh, &to_mapped);
         let (reference, measured) = match &args.target {
             Some(path) => {
                 let target = load_mesh(path, args.repair, quiet)?.mesh;
@@ -153,118 +148,6 @@ impl MapKind {
     }
 }
 
-/// Reads MAPPED. Its positions are the map's image (or do not matter, for a map given by
-/// texture coordinates), so they must not change its connectivity: a face collapsed by
-/// the map is a measurement (`|mu| = 1`, flipped), not a defect. So no face counts as
-/// degenerate by its area and no vertices are merged; with `--repair`, faces with a
-/// repeated vertex and duplicate faces are dropped, as in SOURCE.
-pub(super) fn load_mapped(path: &Path, repair: bool) -> anyhow::Result<LoadedMesh> {
-    let options = BuildOptions {
-        // The threshold `tolerance * diagonal^2` is then -inf (or NaN): no area is below.
-        degenerate_area_tolerance: f64::NEG_INFINITY,
-        repair: Repair {
-            drop_degenerate_faces: repair,
-            drop_duplicate_faces: repair,
-            merge_coincident_vertices: false,
-        },
-    };
-    Ok(io::read(path, &options)?)
-}
-
-/// For every SOURCE vertex, the MAPPED vertex with the same input index, after checking
-/// that both meshes have the same faces with the same input vertex indices (in order).
-pub(super) fn correspondence(
-    source: &Mesh,
-    mapped: &Mesh,
-    source_path: &Path,
-    mapped_path: &Path,
-) -> anyhow::Result<Vec<VertexId>> {
-    let names = || {
-        format!(
-            "{} does not have the connectivity of {}",
-            mapped_path.display(),
-            source_path.display()
-        )
-    };
-    if source.face_count() != mapped.face_count() {
-        bail!(
-            "{}: it has {} faces, the source has {}",
-            names(),
-            mapped.face_count(),
-            source.face_count()
-        );
-    }
-    let (source_map, mapped_map) = (source.vertex_map(), mapped.vertex_map());
-    let mut to_mapped = vec![None; source.vertex_count()];
-    for f in source.faces() {
-        // Input indices of MAPPED's corners, read as SOURCE vertices (this also accepts
-        // vertices that a repair merged in SOURCE).
-        let same = source.face_to_input(f) == mapped.face_to_input(f)
-            && source.face_degree(f) == mapped.face_degree(f)
-            && source
-                .face_vertices(f)
-                .zip(mapped.face_vertices(f))
-                .all(|(v, w)| source_map.from_input(mapped_map.to_input(w)) == Some(v));
-        if !same {
-            let a: Vec<usize> = source
-                .face_vertices(f)
-                .map(|v| source_map.to_input(v))
-                .collect();
-            let b: Vec<usize> = mapped
-                .face_vertices(f)
-                .map(|v| mapped_map.to_input(v))
-                .collect();
-            bail!(
-                "{}: face {} has vertices {a:?} in the source but face {} of the map has \
-                 {b:?} (0-based input indices)",
-                names(),
-                source.face_to_input(f),
-                mapped.face_to_input(f)
-            );
-        }
-        for (v, w) in source.face_vertices(f).zip(mapped.face_vertices(f)) {
-            to_mapped[v.idx()] = Some(w);
-        }
-    }
-    // Every mesh vertex lies on a face (the builder leaves out unreferenced ones).
-    to_mapped
-        .into_iter()
-        .collect::<Option<Vec<_>>>()
-        .ok_or_else(|| anyhow!("{}: a source vertex lies on no face", names()))
-}
-
-/// The error for a map whose texture coordinates have seams, naming the first vertex
-/// (input index) with two different `vt`.
-fn seam_error(mapped: &LoadedMesh, path: &Path) -> anyhow::Error {
-    let mesh = &mapped.mesh;
-    let mut first = vec![None; mesh.vertex_count()];
-    let seam = mapped.corner_uvs.as_ref().and_then(|corner| {
-        mesh.faces()
-            .flat_map(|f| mesh.face_halfedges(f))
-            .find_map(|h| {
-                let v = mesh.origin(h);
-                match first[v.idx()] {
-                    None => {
-                        first[v.idx()] = Some(corner[h.idx()]);
-                        None
-                    }
-                    Some(uv) if uv != corner[h.idx()] => Some(v),
-                    Some(_) => None,
-                }
-            })
-    });
-    let at = seam.map_or_else(String::new, |v| {
-        format!(
-            " (vertex {} has two different vt)",
-            mesh.vertex_map().to_input(v)
-        )
-    });
-    anyhow!(
-        "{} has texture seams{at}: a map into the plane needs one vt per vertex",
-        path.display()
-    )
-}
-
 /// The reference normal flips were judged against, for the reports.
 #[derive(Debug, Clone, Copy)]
 enum Reference {
@@ -313,37 +196,48 @@ pub(super) fn source_reference_note(
     })
 }
 
-/// Per face of `source`, the normal of `target` at its image (the reference of
-/// [`ReferenceNormal::PerFace`]): every image point located on `target` by its exact
-/// closest point ([`SurfaceIndex::locate_all`]), then
-/// [`SurfaceIndex::face_reference_normals`], the rule `register` judges its maps by.
-/// Also a note when images lie farther from `target` than its mean face size.
+/// Reads MAPPED ([`mapped::read_mapped`]: no area threshold, no merged vertices).
+pub(super) fn read_mapped(path: &Path, repair: bool) -> anyhow::Result<LoadedMesh> {
+    Ok(mapped::read_mapped(path, repair)?)
+}
+
+/// [`mapped::correspondence`], with both file names in the error.
+pub(super) fn correspondence(
+    source: &Mesh,
+    mapped: &Mesh,
+    source_path: &Path,
+    mapped_path: &Path,
+) -> anyhow::Result<Vec<VertexId>> {
+    mapped::correspondence(source, mapped).with_context(|| {
+        format!(
+            "{} does not have the connectivity of {}",
+            mapped_path.display(),
+            source_path.display()
+        )
+    })
+}
+
+/// TARGET's normals at the image ([`mapped::target_normals`]) and a note when image
+/// vertices lie farther from TARGET than its mean face size.
 pub(super) fn target_normals(
     target: &Mesh,
     source: &Mesh,
     image: &[Point3<f64>],
     target_path: &Path,
 ) -> anyhow::Result<(Vec<Vector3<f64>>, Option<String>)> {
-    let context = || format!("locating the map's image on {}", target_path.display());
-    let index = SurfaceIndex::new(target).with_context(context)?;
-    let located = index.locate_all(image).with_context(context)?;
-    let face_size = (target.total_area() / target.face_count() as f64).sqrt();
-    let (far, farthest) = located
-        .iter()
-        .filter(|l| l.distance > face_size)
-        .fold((0, 0.0), |(n, d), l| (n + 1, l.distance.max(d)));
-    let note = (far > 0).then(|| {
+    let found = mapped::target_normals(target, source, image)
+        .with_context(|| format!("locating the map's image on {}", target_path.display()))?;
+    let note = (found.far > 0).then(|| {
         format!(
-            "{far} image vertices lie farther than a mean face size ({face_size:.3e}) from \
-             {}, up to {farthest:.3e}: is it the surface the map lands on?",
-            target_path.display()
+            "{} image vertices lie farther than a mean face size ({:.3e}) from {}, up to \
+             {:.3e}: is it the surface the map lands on?",
+            found.far,
+            found.face_size,
+            target_path.display(),
+            found.farthest
         )
     });
-    let points: Vec<SurfacePoint> = located.into_iter().map(|l| l.point).collect();
-    let normals = index
-        .face_reference_normals(source, &points)
-        .with_context(context)?;
-    Ok((normals, note))
+    Ok((found.normals, note))
 }
 
 fn print_report(

@@ -3,11 +3,11 @@
 
 use std::path::Path;
 
+use beltrami_mesh::Vector2;
 use beltrami_mesh::io::LoadedMesh;
-use beltrami_mesh::{Point3, Vector2};
 use beltrami_render::Layout;
 
-use super::distortion::{correspondence, load_mapped};
+use super::distortion::{correspondence, read_mapped};
 use super::load::load_mesh;
 
 /// MESH and the image of the map on it, if there is one: MAPPED's texture coordinates
@@ -23,7 +23,7 @@ pub fn load_map(
     let mesh = &loaded.mesh;
     let image = match map_path {
         Some(path) => {
-            let mapped = load_mapped(path, repair)?;
+            let mapped = read_mapped(path, repair)?;
             let to_mapped = correspondence(mesh, &mapped.mesh, mesh_path, path)?;
             match &mapped.corner_uvs {
                 Some(uv) => {
@@ -38,8 +38,7 @@ pub fn load_map(
                     Some(Layout::plane(mesh, corners)?)
                 }
                 None => {
-                    let points: Vec<Point3<f64>> =
-                        to_mapped.iter().map(|&v| mapped.mesh.position(v)).collect();
+                    let points = beltrami::mapped::spatial_images(&mapped.mesh, &to_mapped);
                     Some(Layout::space(mesh, points)?)
                 }
             }
