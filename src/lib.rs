@@ -28,10 +28,17 @@
 //! each as data (accepts and options), for `beltrami solvers --json` and scripts.
 //! `docs/adding-a-solver.md` walks through writing one.
 //!
-//! The `beltrami` binary built from this package is the command-line front end; see the
-//! README for its commands.
+//! The files and reports around a solve, for every front end:
+//!
+//! - [`landmarks`]: the landmarks file of registration (`v`, `p` and `c` lines), parsed
+//!   with errors naming the line, and turned into constraints.
+//!
+//! The `beltrami` binary built from this package is the command-line front end (it
+//! parses arguments, calls this library and prints); see the README for its commands.
+#![warn(missing_docs)]
 
 pub mod catalog;
+pub mod landmarks;
 
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;

@@ -6,15 +6,13 @@ use std::io::Write as _;
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
-use beltrami_core::{
-    Constraint, Curve, Goal, Landmark, Map, OptionValue, Output, Position, Problem, Target,
-};
+use beltrami::landmarks::Landmarks;
+use beltrami_core::{Goal, Map, OptionValue, Output, Problem, Target};
 use beltrami_fem::BeltramiField;
 use beltrami_mesh::io;
 use clap::Args;
 use serde_json::json;
 
-use super::landmarks::{self, LandmarkGoal};
 use super::load::load_mesh;
 use super::mapping;
 
@@ -71,24 +69,10 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         None => Goal::Conformal { p: args.p },
     };
     if let Some(path) = &args.landmarks {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read the landmarks {}", path.display()))?;
-        let parsed = landmarks::parse(path, &text, source, target)?;
-        problem.constraints.extend(parsed.points.iter().map(|l| {
-            Constraint::Landmark(Landmark {
-                vertex: l.source,
-                position: Position::Spatial(match l.goal {
-                    LandmarkGoal::Vertex(w) => target.position(w),
-                    LandmarkGoal::Point(p) => p,
-                }),
-            })
-        }));
-        problem.constraints.extend(
-            parsed
-                .curves
-                .into_iter()
-                .map(|c| Constraint::Curve(Curve::open(c.source, c.target))),
-        );
+        let marks = Landmarks::read(path, source, target)?;
+        problem
+            .constraints
+            .extend(marks.constraints(target).iter().cloned());
     }
     problem.options = mapping::solver_options(
         solver,
