@@ -32,6 +32,7 @@
 //!
 //! - [`landmarks`]: the landmarks file of registration (`v`, `p` and `c` lines), parsed
 //!   with errors naming the line, and turned into constraints.
+//! - [`report`]: a solution as a JSON object (the `--report` of the mapping commands).
 //!
 //! The `beltrami` binary built from this package is the command-line front end (it
 //! parses arguments, calls this library and prints); see the README for its commands.
@@ -39,6 +40,7 @@
 
 pub mod catalog;
 pub mod landmarks;
+pub mod report;
 
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;

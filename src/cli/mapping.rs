@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
+use beltrami::report;
 use beltrami_core::{Context, Map, OptionValue, Options, Pin, Problem, Progress, Solution, Solver};
 use beltrami_mesh::io::{self, Format, VertexAttributes};
 use beltrami_mesh::{Mesh, Vector2};
@@ -269,47 +270,20 @@ pub fn write_map(output: &Path, mesh: &Mesh, solution: &Solution) -> anyhow::Res
     Ok(())
 }
 
-/// The JSON report keys every mapping command writes: solver, files, seconds,
-/// iterations, flipped faces and |mu| statistics, energy history, timings, notes.
+/// The JSON report of a mapping command: the solution's keys
+/// ([`beltrami::report::solution_json`]) and the input mesh, the output file and the
+/// wall-clock seconds of the solve.
 pub fn report_json(
     mesh: &Path,
     output: &Path,
     solution: &Solution,
     seconds: f64,
 ) -> JsonMap<String, Value> {
-    let (r, m, x) = (&solution.report, &solution.metrics, &solution.extras);
-    let d = m.distortion.as_ref();
-    let value = json!({
-        "solver": r.solver,
-        "mesh": mesh.display().to_string(),
-        "output": output.display().to_string(),
-        "seconds": seconds,
-        "iterations": m.iterations,
-        "stop": m.stop.as_ref().map(|s| s.name()),
-        "flipped": d.map(|d| d.flipped),
-        "mu_mean": d.map(|d| d.mu_mean),
-        "mu_max": d.map(|d| d.mu_max),
-        "mu_std": d.map(|d| d.mu_std),
-        "mu_l2": d.map(|d| d.mu_l2),
-        "initial_flipped": m.initial_distortion.as_ref().map(|d| d.flipped),
-        "initial_mu_mean": m.initial_distortion.as_ref().map(|d| d.mu_mean),
-        "initial_mu_max": m.initial_distortion.as_ref().map(|d| d.mu_max),
-        "mu_error": m.mu_error.as_ref().map(|e| json!({
-            "rms": e.rms, "l2_squared": e.l2_squared, "sup": e.sup, "sup_face": e.sup_face.idx(),
-        })),
-        "k": m.k,
-        "factorizations": m.factorizations,
-        "cg_iterations": m.cg_iterations,
-        "annulus_radius": x.annulus_radius.map(|a| a.radius),
-        "energy_history": m.energy_history,
-        "step_sizes": m.step_sizes,
-        "timings": r.timings.iter().map(|(k, v)| json!({"stage": k, "seconds": v})).collect::<Vec<_>>(),
-        "notes": r.notes,
-    });
-    match value {
-        Value::Object(map) => map,
-        _ => JsonMap::new(),
-    }
+    let mut report = report::solution_json(solution);
+    report.insert("mesh".into(), json!(mesh.display().to_string()));
+    report.insert("output".into(), json!(output.display().to_string()));
+    report.insert("seconds".into(), json!(seconds));
+    report
 }
 
 /// Writes the report to `--report` (atomically) and prints it with `--json`; otherwise

@@ -254,16 +254,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             "prescribed mu".into()
         }),
     );
-    report.insert("mu_error_l2".into(), json!(error.as_ref().map(|e| e.rms)));
-    report.insert(
-        "mu_error_l2_squared".into(),
-        json!(error.as_ref().map(|e| e.l2_squared)),
-    );
-    report.insert("mu_error_sup".into(), json!(error.as_ref().map(|e| e.sup)));
-    report.insert(
-        "mu_error_sup_face".into(),
-        json!(error.as_ref().map(|e| e.sup_face.idx())),
-    );
+    report.extend(beltrami::report::mu_error_keys(error.as_ref()));
     let mut extra: Vec<String> = error
         .iter()
         .map(|e| {

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use beltrami::landmarks::Landmarks;
+use beltrami::report;
 use beltrami_core::{Goal, Map, OptionValue, Output, Problem, Target};
 use beltrami_fem::BeltramiField;
 use beltrami_mesh::io;
@@ -120,16 +121,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
 
     let mut report = mapping::report_json(&args.source, &args.output, &spatial, seconds);
     report.insert("target".into(), json!(args.target.display().to_string()));
-    let steps = solution.metrics.iterations.max(1) as f64;
-    let per_step: f64 = solution
-        .report
-        .timings
-        .iter()
-        .filter(|(n, _)| n == "flow: solves" || n == "flow: steps")
-        .map(|(_, s)| s)
-        .sum::<f64>()
-        / steps;
-    report.insert("seconds_per_step".into(), json!(per_step));
+    let per_step = report::seconds_per_step(&solution).unwrap_or(0.0);
     let extra = vec![format!(
         "iterations      {} ({per_step:.3} s per step)",
         solution.metrics.iterations
