@@ -32,6 +32,8 @@
 //!
 //! - [`landmarks`]: the landmarks file of registration (`v`, `p` and `c` lines), parsed
 //!   with errors naming the line, and turned into constraints.
+//! - [`map_file`]: a solution's map as a mesh file on the source's connectivity
+//!   (texture coordinates or positions; glTF with `|mu|` colors).
 //! - [`report`]: a solution as a JSON object (the `--report` of the mapping commands).
 //!
 //! The `beltrami` binary built from this package is the command-line front end (it
@@ -40,6 +42,7 @@
 
 pub mod catalog;
 pub mod landmarks;
+pub mod map_file;
 pub mod report;
 
 pub use beltrami_core as core;

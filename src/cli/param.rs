@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use beltrami::map_file;
 use beltrami_core::{Constraint, OptionValue, PlanarBoundary, Problem, Target};
 use clap::{Args, ValueEnum};
 
@@ -99,8 +100,8 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    mapping::write_map(&args.output, mesh, &solution)?;
-    mapping::write_png(args.common.png.as_deref(), mesh, &solution)?;
+    map_file::write(&args.output, mesh, &solution, None)?;
+    mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
     let report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     mapping::finish(
         report,

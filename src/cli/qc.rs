@@ -11,6 +11,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
+use beltrami::map_file;
 use beltrami_core::{Constraint, Goal, Map, OptionValue, PlanarBoundary, Problem, Target};
 use beltrami_fem::BeltramiField;
 use beltrami_lsqc::Expr;
@@ -238,8 +239,8 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     if let (Some(Map::Spatial(_)), false) = (solution.map(), args.target == TargetArg::Sphere) {
         bail!("{} gave points in space for a planar target", solver.name());
     }
-    mapping::write_map(&args.output, mesh, &solution)?;
-    mapping::write_png(args.common.png.as_deref(), mesh, &solution)?;
+    map_file::write(&args.output, mesh, &solution, None)?;
+    mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
 
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     report.insert(

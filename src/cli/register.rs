@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use beltrami::landmarks::Landmarks;
-use beltrami::report;
-use beltrami_core::{Goal, Map, OptionValue, Output, Problem, Target};
+use beltrami::{map_file, report};
+use beltrami_core::{Goal, Map, OptionValue, Problem, Target};
 use beltrami_fem::BeltramiField;
 use beltrami_mesh::io;
 use clap::Args;
@@ -94,14 +94,11 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    let Some(Map::OnMesh(points)) = solution.map() else {
-        bail!("the register solver did not give points on the target mesh");
-    };
-    let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
-    let mut spatial = solution.clone();
-    spatial.output = Output::Map(Map::Spatial(positions));
-    mapping::write_map(&args.output, source, &spatial)?;
+    map_file::write(&args.output, source, &solution, Some(target))?;
     if let Some(path) = &args.correspondence {
+        let Some(Map::OnMesh(points)) = solution.map() else {
+            bail!("the register solver did not give points on the target mesh");
+        };
         io::write_atomically(path, |w| {
             for p in points {
                 writeln!(
@@ -117,9 +114,9 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         })
         .with_context(|| format!("cannot write the correspondence {}", path.display()))?;
     }
-    mapping::write_png(args.common.png.as_deref(), source, &spatial)?;
+    mapping::write_png(args.common.png.as_deref(), source, &solution, Some(target))?;
 
-    let mut report = mapping::report_json(&args.source, &args.output, &spatial, seconds);
+    let mut report = mapping::report_json(&args.source, &args.output, &solution, seconds);
     report.insert("target".into(), json!(args.target.display().to_string()));
     let per_step = report::seconds_per_step(&solution).unwrap_or(0.0);
     let extra = vec![format!(
@@ -131,7 +128,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         args.common.report.as_deref(),
         args.common.json,
         quiet,
-        (&args.source, &args.output, &spatial, seconds),
+        (&args.source, &args.output, &solution, seconds),
         &extra,
     )
 }
