@@ -32,6 +32,8 @@
 //!
 //! - [`landmarks`]: the landmarks file of registration (`v`, `p` and `c` lines), parsed
 //!   with errors naming the line, and turned into constraints.
+//! - [`correspondence`]: the correspondence file of registration (`face b0 b1 b2` per
+//!   source vertex), written atomically and read back.
 //! - [`map_file`]: a solution's map as a mesh file on the source's connectivity
 //!   (texture coordinates or positions; glTF with `|mu|` colors).
 //! - [`report`]: a solution as a JSON object (the `--report` of the mapping commands).
@@ -41,6 +43,7 @@
 #![warn(missing_docs)]
 
 pub mod catalog;
+pub mod correspondence;
 pub mod landmarks;
 pub mod map_file;
 pub mod report;

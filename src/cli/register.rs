@@ -2,15 +2,13 @@
 //! and as conformal as the constraints allow (or with a prescribed mu), by an initial
 //! bijection through a common parameter domain and the Beltrami flow on the target mesh.
 
-use std::io::Write as _;
 use std::path::PathBuf;
 
-use anyhow::{Context as _, bail};
+use anyhow::bail;
 use beltrami::landmarks::Landmarks;
-use beltrami::{map_file, report};
+use beltrami::{correspondence, map_file, report};
 use beltrami_core::{Goal, Map, OptionValue, Problem, Target};
 use beltrami_fem::BeltramiField;
-use beltrami_mesh::io;
 use clap::Args;
 use serde_json::json;
 
@@ -99,20 +97,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         let Some(Map::OnMesh(points)) = solution.map() else {
             bail!("the register solver did not give points on the target mesh");
         };
-        io::write_atomically(path, |w| {
-            for p in points {
-                writeln!(
-                    w,
-                    "{} {} {} {}",
-                    target.face_to_input(p.face),
-                    p.coords[0],
-                    p.coords[1],
-                    p.coords[2]
-                )?;
-            }
-            Ok(())
-        })
-        .with_context(|| format!("cannot write the correspondence {}", path.display()))?;
+        correspondence::write(path, source, target, points)?;
     }
     mapping::write_png(args.common.png.as_deref(), source, &solution, Some(target))?;
 
