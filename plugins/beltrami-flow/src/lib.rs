@@ -33,6 +33,7 @@ pub mod target;
 mod validate;
 
 pub use solver::{ACCEPTS, BeltramiFlow, OPTIONS};
+pub use validate::annulus_inner_radius;
 
 /// The solver's name.
 pub const NAME: &str = "beltrami-flow";
