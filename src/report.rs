@@ -5,17 +5,16 @@
 //! # Keys
 //!
 //! Values a solver did not compute are `null` (or empty arrays). `|mu|` statistics are
-//! those of [`beltrami_fem::DistortionStats`]; `mu` is measured in the frame of the
-//! solve (global for planar sources, face frames on surfaces).
+//! those of [`beltrami_fem::DistortionStats`] ([`beltrami_core::Metrics`]).
 //!
 //! | key | value |
 //! |---|---|
 //! | `solver` | the solver's name |
 //! | `iterations` | iterations done (0 for direct solvers) |
 //! | `stop` | why an iterative solver stopped: `converged`, `stalled`, `iteration-limit`, `cancelled` |
-//! | `flipped`, `mu_mean`, `mu_max`, `mu_std`, `mu_l2` | flipped faces and `|mu|` statistics of the result |
+//! | `flipped`, `mu_mean`, `mu_max`, `mu_std`, `mu_l2` | flipped faces and statistics of \|mu\| of the result |
 //! | `initial_flipped`, `initial_mu_mean`, `initial_mu_max` | the same for the map an iterative solver started from |
-//! | `mu_error` | `{rms, l2_squared, sup, sup_face}`: `|mu - target|` for a prescribed `mu` ([`beltrami_fem::MuError`]; `sup_face` a face id) |
+//! | `mu_error` | `{rms, l2_squared, sup, sup_face}`: \|mu - target\| for a prescribed `mu` ([`beltrami_fem::MuError`]; `sup_face` a face id) |
 //! | `k` | the dilatation of an extremal map |
 //! | `factorizations`, `cg_iterations` | numeric factorizations, and conjugate-gradient iterations of steps that reused one |
 //! | `annulus_radius` | the free inner radius of an annulus target |
