@@ -419,6 +419,15 @@ mod tests {
                 "at least two",
             ),
             (
+                "v 0 1\nv 0 2\n",
+                2,
+                LineError::TwoLandmarks {
+                    index: 0,
+                    first_line: 1,
+                },
+                "two landmarks",
+            ),
+            (
                 "v 0 1\n# again\np 0 0 0 0\n",
                 3,
                 LineError::TwoLandmarks {
