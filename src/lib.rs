@@ -26,18 +26,32 @@
 //! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
 //!   |mu| histograms as PNG.
 //!
-//! [`mapped`] reads maps given as mesh files (connectivity check, texture seams, target
-//! normals at the image).
-//!
 //! [`registry`] returns every solver shipped with this package; [`catalog`] describes
 //! each as data (accepts and options), for `beltrami solvers --json` and scripts.
 //! `docs/adding-a-solver.md` walks through writing one.
 //!
-//! The `beltrami` binary built from this package is the command-line front end; see the
-//! README for its commands.
+//! The files and reports around a solve, for every front end:
+//!
+//! - [`landmarks`]: the landmarks file of registration (`v`, `p` and `c` lines), parsed
+//!   with errors naming the line, and turned into constraints.
+//! - [`correspondence`]: the correspondence file of registration (`face b0 b1 b2` per
+//!   source vertex), written atomically and read back.
+//! - [`map_file`]: a solution's map as a mesh file on the source's connectivity
+//!   (texture coordinates or positions; glTF with `|mu|` colors).
+//! - [`report`]: a solution as a JSON object (the `--report` of the mapping commands).
+//! - [`mapped`]: maps given as mesh files, read back (connectivity check, texture
+//!   seams, a target surface's normals at the image).
+//!
+//! The `beltrami` binary built from this package is the command-line front end (it
+//! parses arguments, calls this library and prints); see the README for its commands.
+#![warn(missing_docs)]
 
 pub mod catalog;
+pub mod correspondence;
+pub mod landmarks;
+pub mod map_file;
 pub mod mapped;
+pub mod report;
 
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;

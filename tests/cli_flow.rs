@@ -278,3 +278,28 @@ fn generate_writes_the_paper_meshes() {
     assert!(!run.status.success());
     assert!(text(&run.stderr).contains("--inner"));
 }
+
+#[test]
+fn the_plane_target_keeps_the_inputs_region_unless_told_otherwise() {
+    // beltrami-flow takes no free boundary: `--target plane` keeps the input's own
+    // planar region by default, and a free boundary asked for is refused by its check.
+    let dir = tempfile::tempdir().unwrap();
+    let disk = dir.path().join("disk.obj");
+    let run = beltrami(&["generate", "disk", "--level", "2", "-o", s(&disk)]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("report.json");
+    let flow = ["qc", s(&disk), "--solver", "beltrami-flow", "--conformal"];
+    let run = beltrami(&[&flow[..], &["-o", s(&out), "--report", s(&report)]].concat());
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert_eq!(read_json(&report)["flipped"], 0);
+    let out = dir.path().join("free.obj");
+    let run = beltrami(&[&flow[..], &["--boundary", "free", "-o", s(&out)]].concat());
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("use lsqc"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!out.exists());
+}

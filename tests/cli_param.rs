@@ -573,3 +573,36 @@ fn param_and_solvers_have_help() {
         assert!(text(&out.stdout).contains("Usage"), "{args:?}");
     }
 }
+
+#[test]
+fn the_sphere_solver_maps_onto_the_sphere_unless_a_boundary_is_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = dir.path().join("sphere.obj");
+    let out = beltrami(&["generate", "sphere", "--level", "2", "-o", s(&sphere)]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let output = dir.path().join("out.obj");
+    param(&[s(&sphere), "--solver", "sphere", "-o", s(&output)]);
+    for p in read_obj(&output).positions {
+        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        assert!((r - 1.0).abs() < 1e-9, "|p| = {r}");
+    }
+    // A planar boundary goes to the solver as asked, and it refuses it.
+    let output = dir.path().join("circle.obj");
+    let out = beltrami(&[
+        "param",
+        s(&sphere),
+        "--solver",
+        "sphere",
+        "--boundary",
+        "circle",
+        "-o",
+        s(&output),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("maps onto the unit sphere"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!output.exists());
+}

@@ -1,14 +1,16 @@
 //! What every mapping command shares: the output-format check, pins, the solve with a
-//! late progress bar, writing the map, the JSON report and the summary.
+//! late progress bar, the picture, the JSON report and the summary.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
-use beltrami_core::{Context, Map, OptionValue, Options, Pin, Problem, Progress, Solution, Solver};
-use beltrami_mesh::io::{self, Format, VertexAttributes};
-use beltrami_mesh::{Mesh, Vector2};
-use beltrami_render::{Layout, Scene, Style, check_png_path, viridis};
+use beltrami::map_file::{self, Image};
+use beltrami::report;
+use beltrami_core::{Context, OptionValue, Options, Pin, Problem, Progress, Solution, Solver};
+use beltrami_mesh::Mesh;
+use beltrami_mesh::io::{self, Format};
+use beltrami_render::{Layout, Scene, Style, check_png_path};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::{Map as JsonMap, Value, json};
 
@@ -214,18 +216,22 @@ pub fn png_path(text: &str) -> Result<PathBuf, String> {
 
 /// With `--png`, writes the picture of the result: source and image side by side,
 /// faces colored by |mu|, with the color bar and the legend (the picture is made only
-/// when asked, after the solve).
-pub fn write_png(png: Option<&Path>, mesh: &Mesh, solution: &Solution) -> anyhow::Result<()> {
+/// when asked, after the solve). `target` is the target mesh of a map onto one.
+pub fn write_png(
+    png: Option<&Path>,
+    mesh: &Mesh,
+    solution: &Solution,
+    target: Option<&Mesh>,
+) -> anyhow::Result<()> {
     let Some(path) = png else {
         return Ok(());
     };
-    let image = match solution.map() {
-        Some(Map::Planar(z)) => {
-            let uv: Vec<Vector2<f64>> = z.iter().map(|z| Vector2::new(z.re, z.im)).collect();
-            Layout::plane_from_vertices(mesh, &uv)?
-        }
-        Some(Map::Spatial(p)) => Layout::space(mesh, p.clone())?,
-        _ => bail!("--png draws planar and spatial maps only"),
+    let Some(map) = solution.map() else {
+        bail!("--png draws maps of the source's vertices only");
+    };
+    let image = match map_file::image(mesh, map, target)? {
+        Image::Uv(uv) => Layout::plane_from_vertices(mesh, &uv)?,
+        Image::Positions(p) => Layout::space(mesh, p)?,
     };
     let scene = Scene::new(mesh, Some(image))?;
     beltrami_render::render(&scene, &Style::default())?
@@ -234,82 +240,20 @@ pub fn write_png(png: Option<&Path>, mesh: &Mesh, solution: &Solution) -> anyhow
     Ok(())
 }
 
-/// Writes the map of `solution` on `mesh`'s connectivity: a planar map as one texture
-/// coordinate per vertex, a spatial map as the positions; glTF output also gets the
-/// per-vertex |mu| (mean over the incident faces) as viridis colors.
-pub fn write_map(output: &Path, mesh: &Mesh, solution: &Solution) -> anyhow::Result<()> {
-    let glb = matches!(Format::from_path(output), Some(Format::Glb | Format::Gltf));
-    let colors: Option<Vec<[f32; 3]>> = match (&solution.metrics.mu, glb) {
-        (Some(field), true) => Some(
-            mesh.vertices()
-                .map(|v| {
-                    let (sum, n) = mesh.vertex_faces(v).fold((0.0, 0usize), |(s, n), f| {
-                        (s + field.mu[f.idx()].norm(), n + 1)
-                    });
-                    viridis(if n > 0 { sum / n as f64 } else { 0.0 })
-                })
-                .collect(),
-        ),
-        _ => None,
-    };
-    let uv: Vec<Vector2<f64>>;
-    let mut attributes = VertexAttributes {
-        colors: colors.as_deref(),
-        ..Default::default()
-    };
-    match solution.map() {
-        Some(Map::Planar(z)) => {
-            uv = z.iter().map(|z| Vector2::new(z.re, z.im)).collect();
-            attributes.uvs = Some(&uv);
-        }
-        Some(Map::Spatial(p)) => attributes.positions = Some(p),
-        _ => bail!("this command writes planar and spatial maps only"),
-    }
-    io::write(output, mesh, &attributes)?;
-    Ok(())
-}
-
-/// The JSON report keys every mapping command writes: solver, files, seconds,
-/// iterations, flipped faces and |mu| statistics, energy history, timings, notes.
+/// The JSON report of a mapping command: the solution's keys
+/// ([`beltrami::report::solution_json`]) and the input mesh, the output file and the
+/// wall-clock seconds of the solve.
 pub fn report_json(
     mesh: &Path,
     output: &Path,
     solution: &Solution,
     seconds: f64,
 ) -> JsonMap<String, Value> {
-    let (r, m, x) = (&solution.report, &solution.metrics, &solution.extras);
-    let d = m.distortion.as_ref();
-    let value = json!({
-        "solver": r.solver,
-        "mesh": mesh.display().to_string(),
-        "output": output.display().to_string(),
-        "seconds": seconds,
-        "iterations": m.iterations,
-        "stop": m.stop.as_ref().map(|s| s.name()),
-        "flipped": d.map(|d| d.flipped),
-        "mu_mean": d.map(|d| d.mu_mean),
-        "mu_max": d.map(|d| d.mu_max),
-        "mu_std": d.map(|d| d.mu_std),
-        "mu_l2": d.map(|d| d.mu_l2),
-        "initial_flipped": m.initial_distortion.as_ref().map(|d| d.flipped),
-        "initial_mu_mean": m.initial_distortion.as_ref().map(|d| d.mu_mean),
-        "initial_mu_max": m.initial_distortion.as_ref().map(|d| d.mu_max),
-        "mu_error": m.mu_error.as_ref().map(|e| json!({
-            "rms": e.rms, "l2_squared": e.l2_squared, "sup": e.sup, "sup_face": e.sup_face.idx(),
-        })),
-        "k": m.k,
-        "factorizations": m.factorizations,
-        "cg_iterations": m.cg_iterations,
-        "annulus_radius": x.annulus_radius.map(|a| a.radius),
-        "energy_history": m.energy_history,
-        "step_sizes": m.step_sizes,
-        "timings": r.timings.iter().map(|(k, v)| json!({"stage": k, "seconds": v})).collect::<Vec<_>>(),
-        "notes": r.notes,
-    });
-    match value {
-        Value::Object(map) => map,
-        _ => JsonMap::new(),
-    }
+    let mut report = report::solution_json(solution);
+    report.insert("mesh".into(), json!(mesh.display().to_string()));
+    report.insert("output".into(), json!(output.display().to_string()));
+    report.insert("seconds".into(), json!(seconds));
+    report
 }
 
 /// Writes the report to `--report` (atomically) and prints it with `--json`; otherwise

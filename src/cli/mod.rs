@@ -7,7 +7,6 @@ mod generate;
 mod histogram;
 mod info;
 mod interrupt;
-mod landmarks;
 mod load;
 mod mapping;
 mod param;

@@ -2,7 +2,8 @@
 
 use std::path::PathBuf;
 
-use beltrami_core::{Constraint, OptionValue, PlanarBoundary, Problem, Target};
+use beltrami::map_file;
+use beltrami_core::{Constraint, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind};
 use clap::{Args, ValueEnum};
 
 use super::load::load_mesh;
@@ -38,8 +39,9 @@ pub struct ParamArgs {
     /// Solver name (`beltrami solvers` lists them): tutte, harmonic, lscm, sphere.
     #[arg(long)]
     pub solver: String,
-    /// Boundary of the parameter domain (default: circle for tutte and harmonic, free
-    /// for lscm).
+    /// Boundary of the parameter domain (default: the first of these the solver takes:
+    /// circle for tutte and harmonic, free for lscm; the sphere solver maps onto the
+    /// unit sphere without it).
     #[arg(long, value_enum)]
     pub boundary: Option<BoundaryArg>,
     /// Edge weights (tutte: uniform or mean-value; harmonic: cotan).
@@ -57,20 +59,28 @@ pub struct ParamArgs {
     pub common: mapping::CommonArgs,
 }
 
-fn target_of(args: &ParamArgs) -> anyhow::Result<Target<'static>> {
-    if args.solver == "sphere" {
-        return Ok(Target::Sphere);
+/// The target: the unit sphere for a solver that maps only onto it, when no
+/// `--boundary` is given; otherwise the plane with the boundary of `--boundary`, by
+/// default the first of circle, square and free the solver takes, in the order of its
+/// accepted targets (a solver that cannot take the boundary refuses it in its check).
+fn target_of(args: &ParamArgs, solver: &dyn Solver) -> Target<'static> {
+    let accepts = solver.accepts();
+    if args.boundary.is_none() && accepts.targets == [TargetKind::Sphere] {
+        return Target::Sphere;
     }
-    let default = if args.solver == "lscm" {
-        BoundaryArg::Free
-    } else {
-        BoundaryArg::Circle
-    };
-    Ok(Target::Plane(match args.boundary.unwrap_or(default) {
-        BoundaryArg::Circle => PlanarBoundary::Circle,
-        BoundaryArg::Square => PlanarBoundary::Square { corners: None },
-        BoundaryArg::Free => PlanarBoundary::Free,
-    }))
+    let first = accepts.targets.iter().find_map(|kind| match kind {
+        TargetKind::PlaneCircle => Some(BoundaryArg::Circle),
+        TargetKind::PlaneSquare => Some(BoundaryArg::Square),
+        TargetKind::PlaneFree => Some(BoundaryArg::Free),
+        _ => None,
+    });
+    Target::Plane(
+        match args.boundary.or(first).unwrap_or(BoundaryArg::Circle) {
+            BoundaryArg::Circle => PlanarBoundary::Circle,
+            BoundaryArg::Square => PlanarBoundary::Square { corners: None },
+            BoundaryArg::Free => PlanarBoundary::Free,
+        },
+    )
 }
 
 pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
@@ -80,7 +90,7 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
 
-    let mut problem = Problem::new(mesh, target_of(args)?);
+    let mut problem = Problem::new(mesh, target_of(args, solver));
     let weights = args.weights.map(|w| {
         OptionValue::Choice(
             match w {
@@ -99,8 +109,8 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    mapping::write_map(&args.output, mesh, &solution)?;
-    mapping::write_png(args.common.png.as_deref(), mesh, &solution)?;
+    map_file::write(&args.output, mesh, &solution, None)?;
+    mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
     let report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     mapping::finish(
         report,

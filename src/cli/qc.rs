@@ -11,7 +11,10 @@
 use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
-use beltrami_core::{Constraint, Goal, Map, OptionValue, PlanarBoundary, Problem, Target};
+use beltrami::map_file;
+use beltrami_core::{
+    Constraint, Goal, Map, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind,
+};
 use beltrami_fem::{BeltramiField, Expr};
 use beltrami_mesh::io::read;
 use beltrami_mesh::{BuildOptions, Mesh};
@@ -26,8 +29,9 @@ use super::pins::PinSpec;
 /// Where `--target` maps to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum TargetArg {
-    /// The plane: lsqc with the boundary of `--boundary`; beltrami-flow onto the input's
-    /// own planar region (boundary sliding along its straight sides, corners fixed).
+    /// The plane, with the boundary condition of `--boundary` (beltrami-flow keeps the
+    /// input's own planar region: boundary sliding along its straight sides, corners
+    /// fixed).
     Plane,
     /// The unit disk (boundary sliding on the circle).
     Disk,
@@ -38,7 +42,7 @@ pub enum TargetArg {
     Sphere,
 }
 
-/// Boundary conditions of `--boundary` (lsqc, plane target).
+/// Boundary conditions of `--boundary` (plane target).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum QcBoundaryArg {
     /// Keep the input's own boundary positions (a mesh in the plane z = 0).
@@ -73,9 +77,10 @@ pub struct QcArgs {
     /// Where the map goes.
     #[arg(long, value_enum, default_value = "plane")]
     pub target: TargetArg,
-    /// lsqc's boundary condition on the plane.
-    #[arg(long, value_enum, default_value = "free")]
-    pub boundary: QcBoundaryArg,
+    /// The boundary condition of `--target plane` [default: free for solvers that take a
+    /// free boundary (lsqc), else keep].
+    #[arg(long, value_enum)]
+    pub boundary: Option<QcBoundaryArg>,
     /// With `--boundary given`: a mesh of the same vertices whose texture coordinates
     /// (or, without them, x and y) give the boundary positions.
     #[arg(long = "boundary-map")]
@@ -162,36 +167,36 @@ fn boundary_map(path: &std::path::Path, mesh: &Mesh) -> anyhow::Result<Vec<Compl
     })
 }
 
-/// The target of `--target` (and `--boundary`, `--free-radius`).
-fn target_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<Target<'static>> {
+/// The target of `--target` (and `--boundary`, `--free-radius`). `--target plane` is
+/// the plane with the boundary condition of `--boundary` for every solver (a solver that
+/// cannot take it refuses it in its check); without `--boundary`, a free boundary when
+/// the solver takes one, else the input's own.
+fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<Target<'static>> {
     Ok(match args.target {
-        TargetArg::Plane if args.solver == "lsqc" => Target::Plane(match args.boundary {
-            QcBoundaryArg::Keep => PlanarBoundary::Keep,
-            QcBoundaryArg::Free => PlanarBoundary::Free,
-            QcBoundaryArg::Given => {
-                let Some(path) = &args.boundary_map else {
-                    bail!("--boundary given needs --boundary-map FILE");
-                };
-                PlanarBoundary::Given(boundary_map(path, mesh)?)
-            }
-        }),
-        TargetArg::Plane => Target::Plane(PlanarBoundary::Keep),
+        TargetArg::Plane => {
+            let free = solver.accepts().targets.contains(&TargetKind::PlaneFree);
+            let default = if free {
+                QcBoundaryArg::Free
+            } else {
+                QcBoundaryArg::Keep
+            };
+            Target::Plane(match args.boundary.unwrap_or(default) {
+                QcBoundaryArg::Keep => PlanarBoundary::Keep,
+                QcBoundaryArg::Free => PlanarBoundary::Free,
+                QcBoundaryArg::Given => {
+                    let Some(path) = &args.boundary_map else {
+                        bail!("--boundary given needs --boundary-map FILE");
+                    };
+                    PlanarBoundary::Given(boundary_map(path, mesh)?)
+                }
+            })
+        }
         TargetArg::Disk => Target::Disk,
         TargetArg::Annulus => Target::Annulus {
             inner_radius: if args.free_radius {
                 None
             } else {
-                let loops = mesh.boundary_loop_list();
-                loops
-                    .iter()
-                    .map(|l| {
-                        l.vertices
-                            .iter()
-                            .map(|&v| mesh.position(v).coords.xy().norm())
-                            .sum::<f64>()
-                            / l.vertices.len() as f64
-                    })
-                    .min_by(f64::total_cmp)
+                beltrami_flow_engine::annulus_inner_radius(mesh)
             },
         },
         TargetArg::Sphere => Target::Sphere,
@@ -206,7 +211,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     let mesh = &loaded.mesh.mesh;
     let (goal, field) = goal_of(args, mesh)?;
 
-    let mut problem = Problem::new(mesh, target_of(args, mesh)?);
+    let mut problem = Problem::new(mesh, target_of(args, mesh, solver)?);
     problem.goal = goal;
     problem.constraints.extend(
         mapping::resolve_pins(&args.pins, mesh)?
@@ -237,8 +242,8 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     if let (Some(Map::Spatial(_)), false) = (solution.map(), args.target == TargetArg::Sphere) {
         bail!("{} gave points in space for a planar target", solver.name());
     }
-    mapping::write_map(&args.output, mesh, &solution)?;
-    mapping::write_png(args.common.png.as_deref(), mesh, &solution)?;
+    map_file::write(&args.output, mesh, &solution, None)?;
+    mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
 
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     report.insert(
@@ -253,16 +258,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             "prescribed mu".into()
         }),
     );
-    report.insert("mu_error_l2".into(), json!(error.as_ref().map(|e| e.rms)));
-    report.insert(
-        "mu_error_l2_squared".into(),
-        json!(error.as_ref().map(|e| e.l2_squared)),
-    );
-    report.insert("mu_error_sup".into(), json!(error.as_ref().map(|e| e.sup)));
-    report.insert(
-        "mu_error_sup_face".into(),
-        json!(error.as_ref().map(|e| e.sup_face.idx())),
-    );
+    report.extend(beltrami::report::mu_error_keys(error.as_ref()));
     let mut extra: Vec<String> = error
         .iter()
         .map(|e| {

@@ -2,19 +2,16 @@
 //! and as conformal as the constraints allow (or with a prescribed mu), by an initial
 //! bijection through a common parameter domain and the Beltrami flow on the target mesh.
 
-use std::io::Write as _;
 use std::path::PathBuf;
 
-use anyhow::{Context as _, bail};
-use beltrami_core::{
-    Constraint, Curve, Goal, Landmark, Map, OptionValue, Output, Position, Problem, Target,
-};
+use anyhow::bail;
+use beltrami::landmarks::Landmarks;
+use beltrami::{correspondence, map_file, report};
+use beltrami_core::{Goal, Map, OptionValue, Problem, Target};
 use beltrami_fem::BeltramiField;
-use beltrami_mesh::io;
 use clap::Args;
 use serde_json::json;
 
-use super::landmarks::{self, LandmarkGoal};
 use super::load::load_mesh;
 use super::mapping;
 
@@ -71,24 +68,10 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         None => Goal::Conformal { p: args.p },
     };
     if let Some(path) = &args.landmarks {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read the landmarks {}", path.display()))?;
-        let parsed = landmarks::parse(path, &text, source, target)?;
-        problem.constraints.extend(parsed.points.iter().map(|l| {
-            Constraint::Landmark(Landmark {
-                vertex: l.source,
-                position: Position::Spatial(match l.goal {
-                    LandmarkGoal::Vertex(w) => target.position(w),
-                    LandmarkGoal::Point(p) => p,
-                }),
-            })
-        }));
-        problem.constraints.extend(
-            parsed
-                .curves
-                .into_iter()
-                .map(|c| Constraint::Curve(Curve::open(c.source, c.target))),
-        );
+        let marks = Landmarks::read(path, source, target)?;
+        problem
+            .constraints
+            .extend(marks.constraints(target).iter().cloned());
     }
     problem.options = mapping::solver_options(
         solver,
@@ -109,43 +92,18 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    let Some(Map::OnMesh(points)) = solution.map() else {
-        bail!("the register solver did not give points on the target mesh");
-    };
-    let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
-    let mut spatial = solution.clone();
-    spatial.output = Output::Map(Map::Spatial(positions));
-    mapping::write_map(&args.output, source, &spatial)?;
+    map_file::write(&args.output, source, &solution, Some(target))?;
     if let Some(path) = &args.correspondence {
-        io::write_atomically(path, |w| {
-            for p in points {
-                writeln!(
-                    w,
-                    "{} {} {} {}",
-                    target.face_to_input(p.face),
-                    p.coords[0],
-                    p.coords[1],
-                    p.coords[2]
-                )?;
-            }
-            Ok(())
-        })
-        .with_context(|| format!("cannot write the correspondence {}", path.display()))?;
+        let Some(Map::OnMesh(points)) = solution.map() else {
+            bail!("the register solver did not give points on the target mesh");
+        };
+        correspondence::write(path, source, target, points)?;
     }
-    mapping::write_png(args.common.png.as_deref(), source, &spatial)?;
+    mapping::write_png(args.common.png.as_deref(), source, &solution, Some(target))?;
 
-    let mut report = mapping::report_json(&args.source, &args.output, &spatial, seconds);
+    let mut report = mapping::report_json(&args.source, &args.output, &solution, seconds);
     report.insert("target".into(), json!(args.target.display().to_string()));
-    let steps = solution.metrics.iterations.max(1) as f64;
-    let per_step: f64 = solution
-        .report
-        .timings
-        .iter()
-        .filter(|(n, _)| n == "flow: solves" || n == "flow: steps")
-        .map(|(_, s)| s)
-        .sum::<f64>()
-        / steps;
-    report.insert("seconds_per_step".into(), json!(per_step));
+    let per_step = report::seconds_per_step(&solution).unwrap_or(0.0);
     let extra = vec![format!(
         "iterations      {} ({per_step:.3} s per step)",
         solution.metrics.iterations
@@ -155,7 +113,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         args.common.report.as_deref(),
         args.common.json,
         quiet,
-        (&args.source, &args.output, &spatial, seconds),
+        (&args.source, &args.output, &solution, seconds),
         &extra,
     )
 }

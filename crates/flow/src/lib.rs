@@ -35,7 +35,7 @@ mod validate;
 
 pub use run::{ACCEPTS, OPTIONS, solve};
 pub use setup::given_initial;
-pub use validate::{ON_TARGET, annulus_of};
+pub use validate::{ON_TARGET, annulus_inner_radius, annulus_of};
 
 /// The name errors and reports of the flow carry (the solver `beltrami-flow`).
 pub const NAME: &str = "beltrami-flow";

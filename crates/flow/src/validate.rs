@@ -244,3 +244,46 @@ pub fn annulus_of(mesh: &Mesh) -> Result<(f64, usize), SolverError> {
     }
     Ok((r, outer))
 }
+
+/// The inner radius of the annulus target `r <= |z| <= 1` that keeps the shape of
+/// `mesh`, a planar annulus centred at the origin (`beltrami qc --target annulus`
+/// without `--free-radius`): per boundary loop the mean distance of its vertices from
+/// the origin in the x-y plane, the smallest over the loops. `None` for a mesh without
+/// boundary loops. The solver's own check then requires both loops on their circles.
+pub fn annulus_inner_radius(mesh: &Mesh) -> Option<f64> {
+    mesh.boundary_loop_list()
+        .iter()
+        .map(|l| {
+            l.vertices
+                .iter()
+                .map(|&v| mesh.position(v).coords.xy().norm())
+                .sum::<f64>()
+                / l.vertices.len() as f64
+        })
+        .min_by(f64::total_cmp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use beltrami_mesh::primitives;
+
+    #[test]
+    fn the_inner_radius_is_the_innermost_loops_mean_radius() {
+        let annulus = Mesh::from_soup(&primitives::annulus(0.4, 3, 24)).unwrap();
+        let r = annulus_inner_radius(&annulus).unwrap();
+        assert!((r - 0.4).abs() < 1e-12, "{r}");
+        assert!((annulus_of(&annulus).unwrap().0 - r).abs() < 1e-12);
+        // Scaled by 2 and moved off the x-y plane: radii in the x-y plane, about the origin.
+        let mut soup = primitives::annulus(0.4, 3, 24);
+        for p in &mut soup.positions {
+            p.x *= 2.0;
+            p.y *= 2.0;
+            p.z = 5.0;
+        }
+        let r = annulus_inner_radius(&Mesh::from_soup(&soup).unwrap()).unwrap();
+        assert!((r - 0.8).abs() < 1e-12, "{r}");
+        let sphere = Mesh::from_soup(&primitives::octahedral_sphere(1)).unwrap();
+        assert_eq!(annulus_inner_radius(&sphere), None);
+    }
+}

@@ -1,0 +1,203 @@
+//! A [`Solution`] as a JSON object: what the solve measured, for scripts and batch runs
+//! (the `--report` and `--json` output of the mapping commands, which add the file
+//! names and the wall-clock seconds).
+//!
+//! # Keys
+//!
+//! Values a solver did not compute are `null` (or empty arrays). `|mu|` statistics are
+//! those of [`beltrami_fem::DistortionStats`] ([`beltrami_core::Metrics`]).
+//!
+//! | key | value |
+//! |---|---|
+//! | `solver` | the solver's name |
+//! | `iterations` | iterations done (0 for direct solvers) |
+//! | `stop` | why an iterative solver stopped: `converged`, `stalled`, `iteration-limit`, `cancelled` |
+//! | `flipped`, `mu_mean`, `mu_max`, `mu_std`, `mu_l2` | flipped faces and statistics of \|mu\| of the result |
+//! | `initial_flipped`, `initial_mu_mean`, `initial_mu_max` | the same for the map an iterative solver started from |
+//! | `mu_error` | `{rms, l2_squared, sup, sup_face}`: \|mu - target\| for a prescribed `mu` ([`beltrami_fem::MuError`]; `sup_face` a face id) |
+//! | `k` | the dilatation of an extremal map |
+//! | `factorizations`, `cg_iterations` | numeric factorizations, and conjugate-gradient iterations of steps that reused one |
+//! | `annulus_radius` | the free inner radius of an annulus target |
+//! | `energy_history`, `step_sizes` | per iteration |
+//! | `seconds_per_step` | [`seconds_per_step`] |
+//! | `timings` | `[{stage, seconds}]` in the order they happened |
+//! | `notes` | remarks for people (prose) |
+//!
+//! [`mu_error_keys`] gives the flat `mu_error_*` keys of `beltrami qc`'s report.
+
+use beltrami_core::Solution;
+use beltrami_fem::MuError;
+use serde_json::{Map as JsonMap, Value, json};
+
+/// The stages whose time makes up an iteration of the Beltrami flow (its linear solves
+/// and its step searches), as recorded in [`beltrami_core::Report::timings`].
+const STEP_STAGES: [&str; 2] = ["flow: solves", "flow: steps"];
+
+/// The seconds per iteration of an iterative solve: the time recorded under the flow's
+/// iteration stages (`flow: solves` and `flow: steps`) divided by the iterations;
+/// `None` when no iteration was done or those stages were not timed.
+pub fn seconds_per_step(solution: &Solution) -> Option<f64> {
+    let iterations = solution.metrics.iterations;
+    let timings = &solution.report;
+    let seconds: Vec<f64> = STEP_STAGES
+        .iter()
+        .filter_map(|s| timings.timing(s))
+        .collect();
+    if iterations == 0 || seconds.is_empty() {
+        return None;
+    }
+    Some(seconds.iter().sum::<f64>() / iterations as f64)
+}
+
+/// The JSON object of `solution` (the keys of the module docs).
+pub fn solution_json(solution: &Solution) -> JsonMap<String, Value> {
+    let (r, m, x) = (&solution.report, &solution.metrics, &solution.extras);
+    let d = m.distortion.as_ref();
+    let initial = m.initial_distortion.as_ref();
+    let value = json!({
+        "solver": r.solver,
+        "iterations": m.iterations,
+        "stop": m.stop.as_ref().map(|s| s.name()),
+        "flipped": d.map(|d| d.flipped),
+        "mu_mean": d.map(|d| d.mu_mean),
+        "mu_max": d.map(|d| d.mu_max),
+        "mu_std": d.map(|d| d.mu_std),
+        "mu_l2": d.map(|d| d.mu_l2),
+        "initial_flipped": initial.map(|d| d.flipped),
+        "initial_mu_mean": initial.map(|d| d.mu_mean),
+        "initial_mu_max": initial.map(|d| d.mu_max),
+        "mu_error": m.mu_error.as_ref().map(|e| json!({
+            "rms": e.rms, "l2_squared": e.l2_squared, "sup": e.sup, "sup_face": e.sup_face.idx(),
+        })),
+        "k": m.k,
+        "factorizations": m.factorizations,
+        "cg_iterations": m.cg_iterations,
+        "annulus_radius": x.annulus_radius.map(|a| a.radius),
+        "energy_history": m.energy_history,
+        "step_sizes": m.step_sizes,
+        "seconds_per_step": seconds_per_step(solution),
+        "timings": r.timings.iter().map(|(k, v)| json!({"stage": k, "seconds": v})).collect::<Vec<_>>(),
+        "notes": r.notes,
+    });
+    match value {
+        Value::Object(map) => map,
+        _ => JsonMap::new(),
+    }
+}
+
+/// The flat keys `beltrami qc` reports beside `mu_error`: `mu_error_l2` (the RMS),
+/// `mu_error_l2_squared`, `mu_error_sup` and `mu_error_sup_face` (a face id), each
+/// `null` without an error.
+pub fn mu_error_keys(error: Option<&MuError>) -> JsonMap<String, Value> {
+    let mut keys = JsonMap::new();
+    keys.insert("mu_error_l2".into(), json!(error.map(|e| e.rms)));
+    keys.insert(
+        "mu_error_l2_squared".into(),
+        json!(error.map(|e| e.l2_squared)),
+    );
+    keys.insert("mu_error_sup".into(), json!(error.map(|e| e.sup)));
+    keys.insert(
+        "mu_error_sup_face".into(),
+        json!(error.map(|e| e.sup_face.idx())),
+    );
+    keys
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use beltrami_core::{Context, Goal, Map, PlanarBoundary, Problem, Report, Target};
+    use beltrami_fem::{BeltramiField, Frame};
+    use beltrami_mesh::Mesh;
+    use beltrami_mesh::primitives::{Cells, jittered_grid};
+    use num_complex::Complex64;
+
+    /// lsqc on an irregular planar grid with the input's boundary kept and a constant
+    /// prescribed mu: the map cannot meet it everywhere, so the error is not zero. Also
+    /// the map of [`crate::map_file`]'s tests.
+    pub(crate) fn lsqc_solution() -> (Mesh, Solution) {
+        let mesh = Mesh::from_soup(&jittered_grid(6, 6, Cells::Triangles, 0.2, 7)).unwrap();
+        let mut problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Keep));
+        problem.goal = Goal::Prescribed(BeltramiField::new(
+            Frame::Global,
+            vec![Complex64::new(0.2, 0.1); mesh.face_count()],
+        ));
+        let registry = crate::registry();
+        let solver = registry.get("lsqc").unwrap();
+        let solution = solver.solve(&problem, &mut Context::new()).unwrap();
+        (mesh, solution)
+    }
+
+    #[test]
+    fn an_lsqc_solution_reports_its_metrics() {
+        let (_, solution) = lsqc_solution();
+        let json = solution_json(&solution);
+        let (m, d) = (&solution.metrics, solution.metrics.distortion.unwrap());
+        assert_eq!(json["solver"], "lsqc");
+        assert_eq!(json["iterations"], 0);
+        assert_eq!(json["stop"], Value::Null);
+        assert_eq!(json["flipped"], d.flipped);
+        assert_eq!(json["mu_mean"], d.mu_mean);
+        assert_eq!(json["mu_max"], d.mu_max);
+        assert_eq!(json["mu_std"], d.mu_std);
+        assert_eq!(json["mu_l2"], d.mu_l2);
+        assert_eq!(json["initial_mu_mean"], Value::Null);
+        let error = m.mu_error.unwrap();
+        assert!(error.rms > 0.0 && error.sup >= error.rms);
+        assert_eq!(
+            json["mu_error"],
+            json!({
+                "rms": error.rms,
+                "l2_squared": error.l2_squared,
+                "sup": error.sup,
+                "sup_face": error.sup_face.idx(),
+            })
+        );
+        assert_eq!(json["k"], Value::Null);
+        assert_eq!(json["annulus_radius"], Value::Null);
+        assert_eq!(json["seconds_per_step"], Value::Null);
+        let stages: Vec<&str> = json["timings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|t| t["stage"].as_str().unwrap())
+            .collect();
+        let expected: Vec<&str> = solution
+            .report
+            .timings
+            .iter()
+            .map(|(s, _)| s.as_str())
+            .collect();
+        assert_eq!(stages, expected);
+        assert!(stages.contains(&"solve"));
+        assert_eq!(json["notes"], json!(solution.report.notes));
+        // The whole object is valid JSON text (no NaN or infinity).
+        let text = Value::Object(json).to_string();
+        assert!(serde_json::from_str::<Value>(&text).is_ok());
+
+        let flat = mu_error_keys(m.mu_error.as_ref());
+        assert_eq!(flat["mu_error_l2"], error.rms);
+        assert_eq!(flat["mu_error_l2_squared"], error.l2_squared);
+        assert_eq!(flat["mu_error_sup"], error.sup);
+        assert_eq!(flat["mu_error_sup_face"], error.sup_face.idx());
+        assert!(mu_error_keys(None).values().all(Value::is_null));
+        assert_eq!(mu_error_keys(None).len(), 4);
+    }
+
+    #[test]
+    fn seconds_per_step_divides_the_flow_stages_by_the_iterations() {
+        let mut report = Report::new("beltrami-flow");
+        report.timings = vec![
+            ("initial map".into(), 5.0),
+            ("flow: solves".into(), 1.5),
+            ("flow: steps".into(), 0.5),
+        ];
+        let mut solution = Solution::from_map(Map::Planar(Vec::new()), report);
+        assert_eq!(seconds_per_step(&solution), None);
+        solution.metrics.iterations = 4;
+        assert_eq!(seconds_per_step(&solution), Some(0.5));
+        assert_eq!(solution_json(&solution)["seconds_per_step"], 0.5);
+        solution.report.timings.truncate(1);
+        assert_eq!(seconds_per_step(&solution), None);
+    }
+}
