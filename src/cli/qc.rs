@@ -111,16 +111,12 @@ pub struct QcArgs {
     pub common: mapping::CommonArgs,
 }
 
-/// The goal of `--mu`, `--mu-expr` or `--conformal`, and the field it prescribes (zero
-/// for the conformal goal, in the frame the error is measured in).
-fn goal_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<(Goal, Option<BeltramiField>)> {
+/// The goal of `--mu`, `--mu-expr` or `--conformal`.
+fn goal_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<Goal> {
     if args.conformal {
-        return Ok((
-            Goal::Conformal {
-                p: args.p.unwrap_or(2.0),
-            },
-            None,
-        ));
+        return Ok(Goal::Conformal {
+            p: args.p.unwrap_or(2.0),
+        });
     }
     if args.p.is_some() {
         bail!("--p is the exponent of --conformal; a prescribed mu has no exponent");
@@ -141,7 +137,7 @@ fn goal_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<(Goal, Option<BeltramiF
             })?
         }
     };
-    Ok((Goal::Prescribed(field.clone()), Some(field)))
+    Ok(Goal::Prescribed(field))
 }
 
 /// The planar map of `--boundary-map`: its texture coordinates, or its x and y.
@@ -209,7 +205,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     let solver = registry.get(&args.solver)?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
-    let (goal, field) = goal_of(args, mesh)?;
+    let goal = goal_of(args, mesh)?;
 
     let mut problem = Problem::new(mesh, target_of(args, mesh, solver)?);
     problem.goal = goal;
@@ -238,7 +234,6 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
     let error = solution.metrics.mu_error;
-    let _ = &field;
     if let (Some(Map::Spatial(_)), false) = (solution.map(), args.target == TargetArg::Sphere) {
         bail!("{} gave points in space for a planar target", solver.name());
     }
