@@ -58,6 +58,37 @@ pub enum MappedError {
     },
 }
 
+/// Why a planar map could not be read from a mesh file.
+#[derive(Debug, Error)]
+pub enum ReadMapError {
+    /// The file could not be read as a mesh.
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    /// It is not a map of the source.
+    #[error(transparent)]
+    Map(#[from] MappedError),
+}
+
+/// The planar map in a mesh file with `source`'s faces: its texture coordinates, or,
+/// without them, the `x + i y` of its positions (a planar map written as positions).
+/// The file is read as [`read_mapped`] reads it and matched face by face
+/// ([`correspondence`]).
+pub fn read_planar(
+    path: &Path,
+    source: &Mesh,
+    repair: bool,
+) -> Result<Vec<Complex64>, ReadMapError> {
+    let mapped = read_mapped(path, repair)?;
+    let to_mapped = correspondence(source, &mapped.mesh)?;
+    Ok(match planar_images(&mapped, &to_mapped)? {
+        Some(map) => map,
+        None => spatial_images(&mapped.mesh, &to_mapped)
+            .iter()
+            .map(|p| Complex64::new(p.x, p.y))
+            .collect(),
+    })
+}
+
 /// Reads a map's mesh file. Its positions are the map's image (or do not matter, for a
 /// map given by texture coordinates), so they must not change its connectivity: a face
 /// collapsed by the map is a measurement (`|mu| = 1`, flipped), not a defect. So no face
@@ -259,6 +290,38 @@ mod tests {
         let e = correspondence(&mesh, &turned).unwrap_err();
         assert!(matches!(e, MappedError::Face { source_face: 4, .. }), "{e}");
         assert!(e.to_string().contains("face 4 has vertices"), "{e}");
+    }
+
+    #[test]
+    fn a_planar_map_reads_back_from_vt_and_from_positions() {
+        use beltrami_mesh::Vector2;
+        use beltrami_mesh::io::{VertexAttributes, write};
+        let mesh = square();
+        let f = |p: &Point3<f64>| Complex64::new(2.0 * p.x + 0.5 * p.y, -p.x + p.y);
+        let map: Vec<Complex64> = mesh.positions().iter().map(f).collect();
+        let dir = tempfile::tempdir().unwrap();
+        let uv: Vec<Vector2<f64>> = map.iter().map(|z| Vector2::new(z.re, z.im)).collect();
+        let with_vt = dir.path().join("vt.obj");
+        let attributes = VertexAttributes {
+            uvs: Some(&uv),
+            ..Default::default()
+        };
+        write(&with_vt, &mesh, &attributes).unwrap();
+        assert_eq!(read_planar(&with_vt, &mesh, false).unwrap(), map);
+        let positions: Vec<Point3<f64>> =
+            map.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect();
+        let as_positions = dir.path().join("v.obj");
+        let attributes = VertexAttributes {
+            positions: Some(&positions),
+            ..Default::default()
+        };
+        write(&as_positions, &mesh, &attributes).unwrap();
+        assert_eq!(read_planar(&as_positions, &mesh, false).unwrap(), map);
+        let coarse = Mesh::from_soup(&grid(2, 2, Cells::Triangles)).unwrap();
+        assert!(matches!(
+            read_planar(&as_positions, &coarse, false),
+            Err(ReadMapError::Map(MappedError::FaceCount { .. }))
+        ));
     }
 
     #[test]

@@ -53,13 +53,7 @@ impl PinSpec {
                 map.from_input(i)
                     .with_context(|| format!("--pin v{i}: vertex {i} is used by no face"))
             }
-            PinSpec::Near(p) => mesh
-                .vertices()
-                .min_by(|&a, &b| {
-                    let (da, db) = ((mesh.position(a) - p).norm(), (mesh.position(b) - p).norm());
-                    da.total_cmp(&db)
-                })
-                .context("the mesh has no vertices"),
+            PinSpec::Near(p) => mesh.nearest_vertex(&p).context("the mesh has no vertices"),
         }
     }
 }

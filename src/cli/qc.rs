@@ -16,8 +16,7 @@ use beltrami_core::{
     Constraint, Goal, Map, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind,
 };
 use beltrami_fem::{BeltramiField, Expr};
-use beltrami_mesh::io::read;
-use beltrami_mesh::{BuildOptions, Mesh};
+use beltrami_mesh::Mesh;
 use clap::{ArgGroup, Args, ValueEnum};
 use num_complex::Complex64;
 use serde_json::json;
@@ -140,27 +139,10 @@ fn goal_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<Goal> {
     Ok(Goal::Prescribed(field))
 }
 
-/// The planar map of `--boundary-map`: its texture coordinates, or its x and y.
+/// The planar map of `--boundary-map` ([`beltrami::mapped::read_planar`]).
 fn boundary_map(path: &std::path::Path, mesh: &Mesh) -> anyhow::Result<Vec<Complex64>> {
-    let loaded = read(path, &BuildOptions::default())
-        .with_context(|| format!("--boundary-map {}", path.display()))?;
-    let other = &loaded.mesh;
-    if other.vertex_count() != mesh.vertex_count() {
-        bail!(
-            "--boundary-map {} has {} vertices, the mesh {}",
-            path.display(),
-            other.vertex_count(),
-            mesh.vertex_count()
-        );
-    }
-    Ok(match loaded.vertex_uvs() {
-        Some(uv) => uv.iter().map(|t| Complex64::new(t.x, t.y)).collect(),
-        None => other
-            .positions()
-            .iter()
-            .map(|p| Complex64::new(p.x, p.y))
-            .collect(),
-    })
+    beltrami::mapped::read_planar(path, mesh, false)
+        .with_context(|| format!("--boundary-map {}", path.display()))
 }
 
 /// The target of `--target` (and `--boundary`, `--free-radius`). `--target plane` is

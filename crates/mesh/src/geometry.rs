@@ -107,6 +107,19 @@ impl Mesh {
         area
     }
 
+    /// The vertex nearest to `point` (Euclidean distance; the first of equal ones), or
+    /// `None` for a mesh without vertices. A linear scan: for many queries build a
+    /// `beltrami_spatial::SurfaceIndex` instead.
+    pub fn nearest_vertex(&self, point: &Point3<f64>) -> Option<VertexId> {
+        self.vertices().min_by(|&a, &b| {
+            let (da, db) = (
+                (self.position(a) - point).norm_squared(),
+                (self.position(b) - point).norm_squared(),
+            );
+            da.total_cmp(&db)
+        })
+    }
+
     /// Sum of all face areas.
     pub fn total_area(&self) -> f64 {
         self.faces().map(|f| self.face_area(f)).sum()

@@ -757,3 +757,22 @@ fn subdivision_keeps_topology_and_area_and_quarters_faces() {
         }
     }
 }
+
+#[test]
+fn nearest_vertex_is_the_closest_one() {
+    let mesh = Mesh::from_soup(&beltrami_mesh::primitives::grid(4, 4, Cells::Triangles)).unwrap();
+    for v in mesh.vertices() {
+        let p = mesh.position(v) + beltrami_mesh::Vector3::new(1e-3, -1e-3, 0.5);
+        assert_eq!(mesh.nearest_vertex(&p), Some(v));
+    }
+    let far = Point3::new(1e6, -1e6, 0.0);
+    let expected = mesh
+        .vertices()
+        .min_by(|&a, &b| {
+            (mesh.position(a) - far)
+                .norm()
+                .total_cmp(&(mesh.position(b) - far).norm())
+        })
+        .unwrap();
+    assert_eq!(mesh.nearest_vertex(&far), Some(expected));
+}
