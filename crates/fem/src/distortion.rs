@@ -167,15 +167,7 @@ impl Distortion {
         }
         let mu = beltrami::face_mu(elements, &beltrami::point_mu(derivatives));
         let flipped = beltrami::flipped_faces(elements, derivatives);
-        let areas: Vec<f64> = (0..elements.face_count())
-            .map(|f| {
-                elements
-                    .face_points(FaceId(f as u32))
-                    .iter()
-                    .map(|q| q.weight)
-                    .sum()
-            })
-            .collect();
+        let areas = elements.face_areas();
         let stats = DistortionStats::new(&mu, &areas, &flipped)?;
         Ok(Self {
             field: BeltramiField::new(elements.frame(), mu),
@@ -246,15 +238,7 @@ impl MuError {
         measured: &[Complex64],
         target: &[Complex64],
     ) -> Result<Self, FemError> {
-        let areas: Vec<f64> = (0..elements.face_count())
-            .map(|f| {
-                elements
-                    .face_points(FaceId(f as u32))
-                    .iter()
-                    .map(|q| q.weight)
-                    .sum()
-            })
-            .collect();
+        let areas = elements.face_areas();
         Self::from_areas(&areas, measured, target)
     }
 

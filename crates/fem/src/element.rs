@@ -262,6 +262,19 @@ impl Elements {
         self.offsets[f.idx()] as usize..self.offsets[f.idx() + 1] as usize
     }
 
+    /// Per face, its area as the quadrature sees it: the sum of its points' weights
+    /// (exact for triangles; the bilinear area for quads).
+    pub fn face_areas(&self) -> Vec<f64> {
+        (0..self.face_count())
+            .map(|f| {
+                self.face_points(FaceId(f as u32))
+                    .iter()
+                    .map(|q| q.weight)
+                    .sum()
+            })
+            .collect()
+    }
+
     /// The quadrature points of face `f` (1 for a triangle, 4 for a quad).
     pub fn face_points(&self, f: FaceId) -> &[QuadraturePoint] {
         &self.points[self.face_points_range(f)]
