@@ -1,6 +1,6 @@
 //! Errors of solvers.
 
-use beltrami_fem::{DofError, FemError, FieldError, SolveError};
+use beltrami_fem::{BoundaryError, DofError, FemError, FieldError, SolveError, WeightError};
 use beltrami_mesh::MeshError;
 use thiserror::Error;
 
@@ -35,6 +35,25 @@ pub enum SolverError {
         name: String,
         /// The registered names, comma-separated.
         available: String,
+    },
+    /// A boundary map cannot be built from the problem (a non-convex polygon, a pin off
+    /// the boundary, corners out of order, ...).
+    #[error("{solver}: {error}")]
+    Boundary {
+        /// The solver's name.
+        solver: &'static str,
+        /// What is wrong, naming the vertex or corner.
+        #[source]
+        error: BoundaryError,
+    },
+    /// Edge weights cannot be computed (a non-finite weight, naming the edge).
+    #[error("{solver}: {error}")]
+    Weights {
+        /// The solver's name.
+        solver: &'static str,
+        /// What is wrong.
+        #[source]
+        error: WeightError,
     },
     /// An option value was refused (unknown name, wrong type, out of range).
     #[error(transparent)]

@@ -212,9 +212,9 @@ impl Solver for Sphere {
         let (planar, negative) = context.stage("tutte", &mut report, || {
             let weights = edge_weights(&punctured, kind).map_err(|e| match e {
                 WeightError::Fem(e) => SolverError::Fem(e),
-                e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
+                error @ WeightError::NonFinite { .. } => SolverError::Weights {
                     solver: NAME,
-                    message: e.to_string(),
+                    error,
                 },
             })?;
             let boundary = hole_boundary(&punctured, radius);

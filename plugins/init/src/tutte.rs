@@ -145,10 +145,7 @@ impl FixedBoundary {
         topology::require_disk(solver, mesh, NOT_A_DISK)?;
         check_goal_and_curves(solver, problem)?;
         let start = self.start_vertex(problem)?;
-        let invalid = |e: BoundaryError| SolverError::InvalidInput {
-            solver,
-            message: e.to_string(),
-        };
+        let invalid = |error: BoundaryError| SolverError::Boundary { solver, error };
         match &problem.target {
             Target::Disk | Target::Plane(PlanarBoundary::Circle) => boundary::circle(mesh, start),
             Target::Plane(PlanarBoundary::Square { corners }) => {
@@ -244,10 +241,7 @@ impl FixedBoundary {
         let (weights, system) = context.stage("assembly", &mut report, || {
             let weights = edge_weights(mesh, kind).map_err(|e| match e {
                 WeightError::Fem(e) => SolverError::Fem(e),
-                e @ WeightError::NonFinite { .. } => SolverError::InvalidInput {
-                    solver,
-                    message: e.to_string(),
-                },
+                error @ WeightError::NonFinite { .. } => SolverError::Weights { solver, error },
             })?;
             let system = WeightedMeanSystem::new(&weights, &boundary)?;
             Ok((weights, system))

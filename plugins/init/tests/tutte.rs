@@ -371,11 +371,16 @@ fn invalid_boundaries_name_the_culprit() {
         let mut problem = Problem::new(&mesh, Target::Plane(target));
         problem.constraints = pins.into();
         match Tutte.check(&problem) {
-            Err(SolverError::InvalidInput { solver, message }) => {
+            Err(e @ SolverError::Boundary { solver, .. }) => {
                 assert_eq!(solver, "tutte");
-                message
+                // The typed boundary error is kept as the source.
+                assert!(
+                    std::error::Error::source(&e)
+                        .is_some_and(|s| s.is::<beltrami_fem::BoundaryError>())
+                );
+                e.to_string()
             }
-            other => panic!("expected InvalidInput, got {other:?}"),
+            other => panic!("expected a boundary error, got {other:?}"),
         }
     };
     let dart = vec![

@@ -244,12 +244,16 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
                 BoundaryError::NotPlanar { vertex, z } => unsupported(format!(
                     "keeping the boundary needs a source in the plane z = 0, but vertex {vertex} has z = {z:e}; give the boundary (a map) or leave it free"
                 )),
-                e => invalid(e.to_string()),
+                error => SolverError::Boundary {
+                    solver: NAME,
+                    error,
+                },
             })?)
         }
-        Target::Plane(PlanarBoundary::Given(values)) => {
-            Some(boundary::given(mesh, values).map_err(|e| invalid(e.to_string()))?)
-        }
+        Target::Plane(PlanarBoundary::Given(values)) => Some(
+            boundary::given(mesh, values)
+                .map_err(|error| SolverError::Boundary { solver: NAME, error })?,
+        ),
         Target::Plane(_) => {
             return Err(unsupported(
                 "lsqc keeps the source's boundary, takes a given boundary map or leaves the boundary free; map the boundary first (tutte, harmonic) and pass it as a given boundary"
