@@ -14,9 +14,9 @@
 //!
 //! | topology | common domain | alignment |
 //! |---|---|---|
-//! | disk (one boundary loop) | the target's Tutte disk ([`disk`](crate::disk)) | boundary rotation |
-//! | closed genus 0 | the unit sphere ([`sphere`](crate::sphere)) | rotation or Moebius transformation |
-//! | closed genus 1 | the square `[0, 1]^2` glued periodically ([`torus`](crate::torus)) | symmetry of the square |
+//! | disk (one boundary loop) | the target's Tutte disk (module `disk`) | boundary rotation |
+//! | closed genus 0 | the unit sphere (module `sphere`) | rotation or Moebius transformation |
+//! | closed genus 1 | the square `[0, 1]^2` glued periodically (module `torus`) | symmetry of the square |
 //!
 //! Other topologies (genus 2 and more, several boundary loops, several components) are
 //! refused by [`check_topology`] before any work, as are meshes of different topologies.
