@@ -550,10 +550,11 @@ impl<T: Scalar> DofBuilder<T> {
     pub fn free(&mut self, nodes: &[VertexId]) -> Result<Range<usize>, DofError> {
         let first = self.unknowns();
         for c in 0..self.dim {
-            let axis = (0..self.dim).map(|k| T::from_f64(if k == c { 1.0 } else { 0.0 }));
-            let axis: Vec<T> = axis.collect();
-            let declared = self.declare(nodes.iter().map(|&node| (node, &axis[..])), Some(c));
-            if let Err(e) = declared {
+            let start = self.members.len();
+            let pushed = nodes
+                .iter()
+                .try_for_each(|&node| self.push_member(node, None, Some(c)));
+            if let Err(e) = self.close(start, pushed) {
                 self.truncate(first);
                 return Err(e);
             }
@@ -573,7 +574,7 @@ impl<T: Scalar> DofBuilder<T> {
         members: impl IntoIterator<Item = (VertexId, D)>,
     ) -> Result<usize, DofError> {
         let j = self.unknowns();
-        self.declare(members, None)?;
+        self.declare(members)?;
         Ok(j)
     }
 
@@ -592,7 +593,7 @@ impl<T: Scalar> DofBuilder<T> {
         check_value(node, "origin", self.dim, origin)?;
         let first = self.unknowns();
         for direction in directions {
-            if let Err(e) = self.declare([(node, direction)], None) {
+            if let Err(e) = self.declare([(node, direction)]) {
                 self.truncate(first);
                 return Err(e);
             }
@@ -601,47 +602,69 @@ impl<T: Scalar> DofBuilder<T> {
         Ok(first..self.unknowns())
     }
 
-    /// Appends one unknown with `members`, all along `axis` if given; on error the
+    /// Appends one unknown moving `members` along their directions; on error the
     /// builder is unchanged.
     fn declare<D: AsRef<[T]>>(
         &mut self,
         members: impl IntoIterator<Item = (VertexId, D)>,
+    ) -> Result<(), DofError> {
+        let start = self.members.len();
+        let pushed = members.into_iter().try_for_each(|(node, direction)| {
+            self.push_member(node, Some(direction.as_ref()), None)
+        });
+        self.close(start, pushed)
+    }
+
+    /// Appends a member of the unknown being declared: along `direction`, or along the
+    /// coordinate axis `axis` when `direction` is `None`.
+    fn push_member(
+        &mut self,
+        node: VertexId,
+        direction: Option<&[T]>,
         axis: Option<usize>,
     ) -> Result<(), DofError> {
-        let dof = self.unknowns();
-        let start = self.members.len();
-        let add = || {
-            for (node, direction) in members {
-                let i = check_node(node, self.n_nodes)?;
-                let direction = direction.as_ref();
+        let i = check_node(node, self.n_nodes)?;
+        match direction {
+            Some(direction) => {
                 check_value(node, "direction", self.dim, direction)?;
-                self.members.push(Member { node: i, axis });
                 self.directions.extend_from_slice(direction);
             }
-            let mut nodes: Vec<usize> = self.members[start..].iter().map(|m| m.node).collect();
-            if nodes.is_empty() {
-                return Err(DofError::NoNodes { dof });
+            None => self.directions.extend(
+                (0..self.dim).map(|k| T::from_f64(if Some(k) == axis { 1.0 } else { 0.0 })),
+            ),
+        }
+        self.members.push(Member { node: i, axis });
+        Ok(())
+    }
+
+    /// Ends the declaration of the unknown whose members start at `start`: checks that it
+    /// moves a node and no node twice, then records it; on error (or an error `pushed`
+    /// while adding the members) forgets its members.
+    fn close(&mut self, start: usize, pushed: Result<(), DofError>) -> Result<(), DofError> {
+        let dof = self.unknowns();
+        let checked = pushed.and_then(|()| match self.members.len() - start {
+            0 => Err(DofError::NoNodes { dof }),
+            1 => Ok(()),
+            _ => {
+                let mut nodes: Vec<usize> = self.members[start..].iter().map(|m| m.node).collect();
+                nodes.sort_unstable();
+                match nodes.windows(2).find(|w| w[0] == w[1]) {
+                    Some(w) => Err(DofError::RepeatedNode {
+                        node: VertexId::from_usize(w[0]),
+                        dof,
+                    }),
+                    None => Ok(()),
+                }
             }
-            nodes.sort_unstable();
-            match nodes.windows(2).find(|w| w[0] == w[1]) {
-                Some(w) => Err(DofError::RepeatedNode {
-                    node: VertexId::from_usize(w[0]),
-                    dof,
-                }),
-                None => Ok(()),
-            }
-        };
-        match add() {
-            Ok(()) => {
-                self.member_ptr.push(self.members.len());
-                Ok(())
-            }
-            Err(e) => {
+        });
+        match checked {
+            Ok(()) => self.member_ptr.push(self.members.len()),
+            Err(_) => {
                 self.members.truncate(start);
                 self.directions.truncate(self.dim * start);
-                Err(e)
             }
         }
+        checked
     }
 
     /// Forgets the unknowns from `unknowns` on.
@@ -654,7 +677,7 @@ impl<T: Scalar> DofBuilder<T> {
 
     /// The DOF map: `K` (module docs), `x0`, and the terms of every node. Errors:
     /// [`DofError::DependentDirections`] for a node whose directions are dependent.
-    pub fn build(&self) -> Result<DofMap<T>, DofError> {
+    pub fn build(self) -> Result<DofMap<T>, DofError> {
         let (dim, n_nodes, n) = (self.dim, self.n_nodes, self.unknowns());
         // Terms node by node, each node's in increasing order of their unknowns: a
         // counting sort of the members, visited unknown by unknown.
@@ -704,8 +727,13 @@ impl<T: Scalar> DofBuilder<T> {
         // K column by column, the rows of a column in increasing node order.
         let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0);
-        let mut row_idx = Vec::new();
-        let mut values = Vec::new();
+        let nnz = self
+            .members
+            .iter()
+            .map(|m| if m.axis.is_some() { 1 } else { dim })
+            .sum();
+        let mut row_idx = Vec::with_capacity(nnz);
+        let mut values = Vec::with_capacity(nnz);
         let mut dof_nodes = Vec::with_capacity(n);
         let mut row_entries = vec![0u8; dim * n_nodes];
         let mut column: Vec<usize> = Vec::new();
@@ -740,7 +768,7 @@ impl<T: Scalar> DofBuilder<T> {
             dof_nodes,
             diagonal: row_entries.iter().all(|&r| r <= 1),
             k: SparseColMat::new(symbolic, values),
-            x0: self.x0.clone(),
+            x0: self.x0,
         })
     }
 }
@@ -939,6 +967,30 @@ impl<T: Scalar> DofMap<T> {
         Ok(self.term_ptr[i]..self.term_ptr[i + 1])
     }
 
+    /// The terms of `node` with their indices, `(t, term)`, in increasing order of their
+    /// unknowns.
+    pub fn node_terms(
+        &self,
+        node: VertexId,
+    ) -> Result<impl Iterator<Item = (usize, DofTerm<'_, T>)> + '_, DofError> {
+        let range = self.terms(node)?;
+        Ok(range.map(|t| {
+            (
+                t,
+                DofTerm {
+                    dof: self.terms[t].dof,
+                    direction: &self.directions[self.dim * t..self.dim * (t + 1)],
+                },
+            )
+        }))
+    }
+
+    /// The directions of all terms, `dim` components each, term after term (term `t` at
+    /// `dim t..dim (t + 1)`): for loops over many terms whose indices they hold.
+    pub fn directions(&self) -> &[T] {
+        &self.directions
+    }
+
     /// Term `t` (`None` if `t` is not a term): its unknown and its direction.
     pub fn term(&self, t: usize) -> Option<DofTerm<'_, T>> {
         let info = self.terms.get(t)?;
@@ -960,15 +1012,21 @@ impl<T: Scalar> DofMap<T> {
             term: t,
             terms: self.terms.len(),
         })?;
-        // The node whose terms hold t.
-        let node = VertexId::from_usize(self.term_ptr.partition_point(|&p| p <= t) - 1);
-        if info.axis.is_some() {
-            return Err(DofError::AxisDirection {
-                node,
-                dof: info.dof,
-            });
+        if info.axis.is_some()
+            || direction.len() != self.dim
+            || !direction.iter().all(|v| v.finite())
+        {
+            // The node whose terms hold t, to name it (looked up on errors only: hot
+            // loops call this for every term).
+            let node = VertexId::from_usize(self.term_ptr.partition_point(|&p| p <= t) - 1);
+            if info.axis.is_some() {
+                return Err(DofError::AxisDirection {
+                    node,
+                    dof: info.dof,
+                });
+            }
+            check_value(node, "direction", self.dim, direction)?;
         }
-        check_value(node, "direction", self.dim, direction)?;
         let dim = self.dim;
         self.directions[dim * t..dim * (t + 1)].copy_from_slice(direction);
         self.k.val_mut()[info.slot..info.slot + dim].copy_from_slice(direction);

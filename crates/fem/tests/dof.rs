@@ -188,7 +188,14 @@ fn k_stores_every_component_of_a_direction_and_one_per_axis() {
     );
     let t = dofs.terms(v(6)).unwrap().start + 1;
     assert_eq!(dofs.term(t).unwrap().direction, &S6);
+    assert_eq!(&dofs.directions()[3 * t..3 * t + 3], &S6);
     assert!(dofs.term(1000).is_none());
+    let node6: Vec<(usize, usize)> = dofs
+        .node_terms(v(6))
+        .unwrap()
+        .map(|(t, term)| (t, term.dof))
+        .collect();
+    assert_eq!(node6, vec![(t - 1, 9), (t, 10)]);
     // The nodes of each unknown, and the smallest one.
     let nodes: Vec<VertexId> = dofs.unknown_nodes(10).unwrap().collect();
     assert_eq!(nodes, vec![v(5), v(6)]);
