@@ -1138,16 +1138,18 @@ impl<T: Scalar> DofMap<T> {
             }
         }
         if self.diagonal {
-            let mut norm_sqr = vec![0.0; n];
             let k = self.k.as_ref();
-            for (j, norm) in norm_sqr.iter_mut().enumerate() {
-                *norm = k.val_of_col(j).iter().map(|v| v.norm_sqr()).sum();
+            let norm_sqr: Vec<f64> = (0..n)
+                .map(|j| k.val_of_col(j).iter().map(|v| v.norm_sqr()).sum())
+                .collect();
+            // A column refilled to zero leaves K^H K singular: the factorization below
+            // reports it.
+            if norm_sqr.iter().all(|&norm| norm > 0.0) {
+                for (yj, norm) in y.iter_mut().zip(&norm_sqr) {
+                    *yj *= T::from_f64(1.0 / norm);
+                }
+                return Ok(y);
             }
-            for (yj, norm) in y.iter_mut().zip(&norm_sqr) {
-                // Every column of K has an entry of a direction checked nonzero at build.
-                *yj *= T::from_f64(1.0 / norm);
-            }
-            return Ok(y);
         }
         // K^H K (lower triangle), node by node over the pairs of its terms (increasing
         // unknowns, so the pair (a, b), b <= a, is below the diagonal).

@@ -354,6 +354,15 @@ fn refilled_directions_and_origins_change_k_and_expand_not_the_pattern() {
     }
     assert_eq!(dofs.term(terms.start).unwrap().direction, &u);
 
+    // A line refilled to a zero direction: reduce reports the rank deficiency.
+    let mut line = DofBuilder::<f64>::new(2, 2).unwrap();
+    line.free(&[v(0)]).unwrap();
+    line.span(v(1), &[0.0; 2], [[1.0, 0.0]]).unwrap();
+    let mut line = line.build().unwrap();
+    assert!(line.reduce(&[1.0; 4]).is_ok());
+    line.set_direction(2, &[0.0; 2]).unwrap();
+    assert!(matches!(line.reduce(&[1.0; 4]), Err(DofError::Reduce(_))));
+
     // Errors: a free node's axis, a term out of range, wrong components, NaN.
     let axis = dofs.terms(v(3)).unwrap().start;
     assert_eq!(
