@@ -36,7 +36,7 @@ pub mod weights;
 pub use beltrami::ReferenceNormal;
 pub use boundary::{BoundaryError, BoundaryMap};
 pub use distortion::{Distortion, DistortionStats, Histogram, MuError};
-pub use dof::{DofConstraints, DofError, DofMap, NodeDof};
+pub use dof::{DofBuilder, DofConstraints, DofError, DofMap, DofTerm, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
 pub use expr::{Expr, ExprError};

@@ -21,9 +21,10 @@
 //! the values of `A` into them, and the symbolic factorization are computed once, at
 //! construction; [`LeastSquaresSolver::solve`] only refills values (iterative solvers
 //! call it every step with new values in the same pattern). No sparse-sparse product
-//! is formed: every row of `K` has at most one nonzero, so `B` is a remap of the entries
-//! of `A`, and `B^H W B` is summed row by row of `B` into precomputed positions
-//! (`normal` module: formulas and construction of the maps).
+//! is formed: a row of `K` has one entry per term of its node (at most one for the maps
+//! of `DofConstraints`, a few in general), so each entry of `A` scatters into a few
+//! precomputed entries of `B`, and `B^H W B` is summed row by row of `B` into
+//! precomputed positions (`normal` module: formulas and construction of the maps).
 //!
 //! The normal equations square the condition number of `W^(1/2) A K`; they are the
 //! right tool here because finite-element energies are well scaled, and the factor is

@@ -229,6 +229,7 @@ pub fn run<G: TargetGeometry>(
     let mut energy_history = vec![energy];
     let (mut step_sizes, mut updates) = (Vec::new(), Vec::new());
     let (mut weights, mut rho) = (Vec::new(), Vec::new());
+    let mut flow = Flow::default();
     let (mut trial, mut trial_faces, mut trial_normals) = (Vec::new(), Vec::new(), Vec::new());
     let report = |context: &mut Context<'_>, done: usize, energy: f64| {
         context.report(&Progress {
@@ -260,9 +261,9 @@ pub fn run<G: TargetGeometry>(
                     prescribed[v] = d - normals[v] * normals[v].dot(&d);
                 }
             }
-            system.set_prescribed(&prescribed);
+            system.set_prescribed(&prescribed)?;
         }
-        let flow = system.solve(&target, &image, &normals, &faces, &weights, &rho)?;
+        system.solve(&target, &image, &normals, &faces, &weights, &rho, &mut flow)?;
         solve_seconds += clock.elapsed().as_secs_f64();
         let clock = Instant::now();
         let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);

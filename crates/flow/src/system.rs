@@ -1,35 +1,46 @@
 //! The least-squares flow system: unknowns, pattern and normal equations.
 //!
 //! The flow `V` is piecewise linear on the image mesh, `V_i = sum_k c_ik b_ik` at vertex
-//! `i` with real unknowns `c_ik` along directions `b_ik` in R^3 (two tangent directions
-//! of the target for a [`Role::Free`] vertex, the curve tangent for a [`Role::Curve`]
-//! vertex, none for a [`Role::Fixed`] one — the tangent directions are
-//! [`orthonormal_basis`] of the target's normal at the image; plus, for a curve with a free offset, one
-//! unknown shared by all its vertices along the offset direction). On image face `T`,
-//! with frame `(r, s)` and the image triangle's shape-function gradients `grad N_k` in
-//! that frame,
+//! `i` with real unknowns `c_ik` along directions `b_ik` in R^3: two tangent directions
+//! of the target for a [`Role::Free`] vertex ([`orthonormal_basis`] of the target's
+//! normal at the image), the curve tangent for a [`Role::Curve`] vertex, none for a
+//! [`Role::Fixed`] one; plus, for a curve with a free offset, one unknown shared by all
+//! its vertices, each moved along the curve's offset direction at its image. These are
+//! the terms of a DOF map `V = K c + V0` of nodes in R^3 ([`beltrami_fem::dof`]), whose
+//! origins `V0` are the prescribed flow of fixed vertices pulled towards a goal (zero
+//! otherwise). The unknowns and the pattern of `K` are built once; the directions move
+//! with the image and are refilled in place every step.
+//!
+//! On image face `T`, with frame `(r, s)` and the image triangle's shape-function
+//! gradients `grad N_k` in that frame,
 //!
 //! ```text
 //! V_zbar(T) = sum_k g_k (V_k . r + i V_k . s),    g_k = (d_r N_k + i d_s N_k) / 2,
 //! ```
 //!
-//! so `V_zbar(T) = sum_a beta_a c_a` is real-linear in the unknowns, with complex
-//! coefficients `beta_a = g_k (b . r + i b . s)`. The flow minimizes (Wong-Zhao 2014,
-//! eq. 4.4 and Appendix eq. 6.1-6.9, with the weights of [`crate::flow`])
+//! so `V_zbar(T) = sum_a beta_a c_a + sum_k g_k (V0_k . r + i V0_k . s)` is real-linear
+//! in the unknowns, with complex coefficients `beta_a = sum_(k, b) g_k (b . r + i b . s)`
+//! over the terms `c_a b` of the face's vertices `k` that carry unknown `a` (one term for
+//! a vertex's own unknown, up to three for a shared offset). The flow minimizes
+//! (Wong-Zhao 2014, eq. 4.4 and Appendix eq. 6.1-6.9, with the weights of
+//! [`crate::flow`])
 //!
 //! ```text
 //! E_V(c) = sum_T w_T |V_zbar(T) - rho_T|^2,
 //! ```
 //!
-//! through its normal equations `sum_b Re(conj(beta_a) beta_b) c_b = Re(conj(beta_a) rho)`,
-//! summed face by face into a matrix whose pattern (which unknowns share a face) never
-//! changes: the pattern and the symbolic Cholesky factorization are built once.
+//! through its normal equations `sum_b Re(conj(beta_a) beta_b) c_b = Re(conj(beta_a) rho')`
+//! (`rho' = rho_T` minus the known part of the origins): `K^T A^T W A K` of the DOF map,
+//! with `A` the rows `V_zbar(T)`, summed face by face without forming `A` or `K`. The
+//! matrix's pattern (which unknowns share a face) never changes: the pattern, the
+//! positions of each face's entries in it and the symbolic Cholesky factorization are
+//! built once, and every step refills the values in place.
 
 use beltrami_core::SolverError;
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::solve::amd_order;
-use beltrami_fem::{Elements, SolveOptions, SpdSolver};
-use beltrami_mesh::{FaceId, Point3, Vector3};
+use beltrami_fem::{DofBuilder, DofMap, Elements, SolveOptions, SpdSolver};
+use beltrami_mesh::{FaceId, Point3, Vector3, VertexId};
 use faer::MatMut;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
@@ -37,36 +48,43 @@ use num_complex::Complex64;
 use crate::measure::{ImageFace, triangle};
 use crate::target::{Role, TargetGeometry, orthonormal_basis};
 
-/// Most distinct unknowns of one face: two per vertex and one shared offset per vertex.
-const MAX_LOCAL: usize = 9;
-
-/// Where a local unknown of a face comes from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Source {
-    /// Unknown `index` (0 or 1) of face vertex `k`.
-    Vertex { k: u8, index: u8 },
-    /// The offset of `curve`, shared by the face vertices on it.
-    Offset { curve: usize },
+/// One term of a face: face vertex `k` contributes `g_k (b . r + i b . s)` to the
+/// coefficient of local unknown `local`, `b` the direction of term `term` of the DOF map.
+#[derive(Debug, Clone, Copy)]
+struct FaceTerm {
+    k: u8,
+    local: u8,
+    term: u32,
 }
 
 /// The unknowns of the flow and the factorization of its normal equations.
 pub struct FlowSystem {
     roles: Vec<Role>,
-    /// First unknown of each vertex (its count is given by its role).
-    first: Vec<usize>,
+    /// `V = K c + V0` on the vertices, in R^3 (module docs): the unknowns, their
+    /// directions (refilled every step) and the prescribed flow `V0` of fixed vertices.
+    dofs: DofMap<f64>,
     /// The shared offset unknown of each curve, if the curve has one.
     offset: Vec<Option<usize>>,
     /// Per face, its vertices.
     faces: Vec<[usize; 3]>,
-    /// Per face, its distinct unknowns and where each comes from.
-    local: Vec<([(usize, Source); MAX_LOCAL], u8)>,
-    n: usize,
+    /// The distinct unknowns of face `f` are `local[local_ptr[f]..local_ptr[f + 1]]`.
+    local_ptr: Vec<usize>,
+    local: Vec<usize>,
+    /// The terms of face `f` are `face_terms[term_ptr[f]..term_ptr[f + 1]]`.
+    term_ptr: Vec<usize>,
+    face_terms: Vec<FaceTerm>,
+    /// The coefficients `beta` of one face (scratch, as long as the longest local list).
+    beta: Vec<Complex64>,
     /// The normal matrix (lower triangle), refilled in place every step.
     matrix: SparseColMat<usize, f64>,
     /// Per local entry (in assembly order), its index in the matrix's values.
     slots: Vec<usize>,
     solver: SpdSolver<f64>,
     rhs: Vec<f64>,
+    /// A copy of `rhs` for the conjugate-gradient attempt (scratch).
+    trial: Vec<f64>,
+    /// `V` as a full nodal vector of the DOF map (scratch).
+    flow: Vec<f64>,
     /// Steps to solve directly before trying to reuse the factorization again.
     skip_reuse: usize,
     /// How many steps the next failed reuse makes the solver skip (doubling after each
@@ -77,12 +95,8 @@ pub struct FlowSystem {
     factorizations: usize,
     /// Conjugate-gradient iterations so far (steps solved with a kept factorization).
     cg_iterations: usize,
-    /// The known flow of the fixed vertices that are pulled towards a goal (zero for
-    /// the others): it moves them, and the rest of the flow follows.
-    prescribed: Vec<Vector3<f64>>,
-    /// The unknowns' directions of every vertex at the current image (refilled by each
-    /// solve, so each is computed once per step).
-    directions: Vec<[Vector3<f64>; 2]>,
+    /// Whether a fixed vertex has a nonzero prescribed flow (an origin of the map).
+    prescribed: bool,
 }
 
 /// Relative residual at which a step solved by conjugate gradients with a kept
@@ -96,7 +110,7 @@ const CG_ITERATIONS: usize = 4;
 impl std::fmt::Debug for FlowSystem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("FlowSystem")
-            .field("unknowns", &self.n)
+            .field("unknowns", &self.dofs.reduced_len())
             .field("entries", &self.slots.len())
             .field("factorizations", &self.factorizations)
             .finish_non_exhaustive()
@@ -104,7 +118,7 @@ impl std::fmt::Debug for FlowSystem {
 }
 
 /// The flow of one step: a vector per vertex and an offset per curve.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Flow {
     /// `V_i` in R^3.
     pub vertex: Vec<Vector3<f64>>,
@@ -112,17 +126,18 @@ pub struct Flow {
     pub offset: Vec<f64>,
 }
 
-fn unknowns_of(role: Role) -> usize {
-    match role {
-        Role::Free => 2,
-        Role::Curve(_) => 1,
-        Role::Fixed => 0,
-    }
-}
+/// The coordinate axes, the directions the DOF map is built with; every solve refills
+/// them with the directions of the current image before assembling.
+const AXES: [[f64; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 
 impl FlowSystem {
     /// The unknowns for `roles` (one per source vertex) on `target`, and the symbolic
     /// factorization of the normal equations. Fails when no vertex can move.
+    ///
+    /// The DOF map declares, vertex by vertex, two unknowns for a free vertex and one
+    /// for a curve vertex, then one unknown per curve with a free offset (in the order
+    /// its first vertex comes) moving every vertex of the curve: the offsets come after
+    /// all vertex unknowns, and each vertex's own unknowns come before its offset.
     pub fn new<G: TargetGeometry>(
         elements: &Elements,
         target: &G,
@@ -130,11 +145,15 @@ impl FlowSystem {
         roles: Vec<Role>,
         options: SolveOptions,
     ) -> Result<Self, SolverError> {
-        let mut first = Vec::with_capacity(roles.len());
-        let mut n = 0;
-        for &role in &roles {
-            first.push(n);
-            n += unknowns_of(role);
+        let mut builder = DofBuilder::<f64>::new(roles.len(), 3)?;
+        let origin = [0.0; 3];
+        for (v, &role) in roles.iter().enumerate() {
+            let count = match role {
+                Role::Free => 2,
+                Role::Curve(_) => 1,
+                Role::Fixed => 0,
+            };
+            builder.span(VertexId::from_usize(v), &origin, &AXES[..count])?;
         }
         let mut offset = vec![None; target.curve_count()];
         for (&role, p) in roles.iter().zip(image) {
@@ -142,65 +161,82 @@ impl FlowSystem {
                 && offset[c].is_none()
                 && target.curve_offset_direction(c, p).is_some()
             {
-                offset[c] = Some(n);
-                n += 1;
+                let members = roles
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &r)| r == role)
+                    .map(|(v, _)| (VertexId::from_usize(v), AXES[1]));
+                offset[c] = Some(builder.unknown(members)?);
             }
         }
-        let faces: Vec<[usize; 3]> = (0..elements.face_count())
-            .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
-            .collect();
-        let mut local = Vec::with_capacity(faces.len());
-        let mut positions = Vec::new();
-        for face in &faces {
-            let mut list = [(0, Source::Offset { curve: 0 }); MAX_LOCAL];
-            let mut m = 0;
-            for (k, &v) in face.iter().enumerate() {
-                let role = roles[v];
-                for index in 0..unknowns_of(role) {
-                    list[m] = (
-                        first[v] + index,
-                        Source::Vertex {
-                            k: k as u8,
-                            index: index as u8,
-                        },
-                    );
-                    m += 1;
-                }
-                if let Role::Curve(c) = role
-                    && let Some(o) = offset[c]
-                    && !list[..m].iter().any(|&(d, _)| d == o)
-                {
-                    list[m] = (o, Source::Offset { curve: c });
-                    m += 1;
-                }
-            }
-            for a in 0..m {
-                for b in 0..=a {
-                    let (da, db) = (list[a].0, list[b].0);
-                    positions.push((da.max(db), da.min(db)));
-                }
-            }
-            local.push((list, m as u8));
-        }
+        let dofs = builder.build()?;
+        let n = dofs.reduced_len();
         if n == 0 {
             return Err(SolverError::InvalidInput {
                 solver: crate::NAME,
                 message: "every vertex is fixed: there is nothing to flow".into(),
             });
         }
+        let faces: Vec<[usize; 3]> = (0..elements.face_count())
+            .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
+            .collect();
+        // The local unknowns of each face in the order its vertices' terms name them
+        // (each vertex's own unknowns, then an offset not met yet), and its terms.
+        let (mut local_ptr, mut local) = (vec![0], Vec::new());
+        let (mut term_ptr, mut face_terms) = (vec![0], Vec::new());
+        let mut positions = Vec::new();
+        for face in &faces {
+            let start = local.len();
+            for (k, &v) in face.iter().enumerate() {
+                for (term, t) in dofs.node_terms(VertexId::from_usize(v))? {
+                    let at = match local[start..].iter().position(|&d| d == t.dof) {
+                        Some(at) => at,
+                        None => {
+                            local.push(t.dof);
+                            local.len() - start - 1
+                        }
+                    };
+                    let term = u32::try_from(term).map_err(|_| SolverError::InvalidInput {
+                        solver: crate::NAME,
+                        message: format!("{term} flow terms exceed the u32 index range"),
+                    })?;
+                    // At most three vertices with two terms each: the casts are exact.
+                    face_terms.push(FaceTerm {
+                        k: k as u8,
+                        local: at as u8,
+                        term,
+                    });
+                }
+            }
+            let list = &local[start..];
+            for a in 0..list.len() {
+                for b in 0..=a {
+                    let (da, db) = (list[a], list[b]);
+                    positions.push((da.max(db), da.min(db)));
+                }
+            }
+            local_ptr.push(local.len());
+            term_ptr.push(face_terms.len());
+        }
+        let longest = local_ptr.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0);
         let pattern = Pattern::new(n, n, &positions)?;
         let slots = pattern.value_slots(&positions)?;
         let matrix = pattern.assemble(&vec![0.0; positions.len()])?;
-        let order = block_order(&faces, &roles, &first, n)?;
+        let order = block_order(&faces, &dofs)?;
         let solver = SpdSolver::with_order(pattern.symbolic().as_ref(), &order, options)?;
         Ok(Self {
             roles,
-            first,
+            flow: vec![0.0; dofs.full_len()],
+            dofs,
             offset,
             faces,
+            local_ptr,
             local,
-            n,
+            term_ptr,
+            face_terms,
+            beta: vec![Complex64::default(); longest],
             rhs: vec![0.0; n],
+            trial: vec![0.0; n],
             matrix,
             slots,
             solver,
@@ -208,17 +244,25 @@ impl FlowSystem {
             backoff: 1,
             factorizations: 0,
             cg_iterations: 0,
-            prescribed: Vec::new(),
-            directions: Vec::new(),
+            prescribed: false,
         })
     }
 
     /// Sets the known flow of fixed vertices (one vector per vertex, read at
-    /// [`Role::Fixed`] vertices only; empty: none). Their known part of `V_zbar` moves to
-    /// the right-hand side, `rho_T - sum_fixed g_k (V_k . r + i V_k . s)`.
-    pub fn set_prescribed(&mut self, prescribed: &[Vector3<f64>]) {
-        self.prescribed.clear();
-        self.prescribed.extend_from_slice(prescribed);
+    /// [`Role::Fixed`] vertices only; missing entries: zero): the origins `V0` of the
+    /// DOF map. Their known part of `V_zbar` moves to the right-hand side,
+    /// `rho_T - sum_fixed g_k (V_k . r + i V_k . s)`.
+    pub fn set_prescribed(&mut self, prescribed: &[Vector3<f64>]) -> Result<(), SolverError> {
+        self.prescribed = false;
+        for (v, &role) in self.roles.iter().enumerate() {
+            if role == Role::Fixed {
+                let value = prescribed.get(v).copied().unwrap_or_else(Vector3::zeros);
+                self.dofs
+                    .set_origin(VertexId::from_usize(v), value.as_slice())?;
+                self.prescribed |= value != Vector3::zeros();
+            }
+        }
+        Ok(())
     }
 
     /// The role of every vertex.
@@ -228,11 +272,17 @@ impl FlowSystem {
 
     /// The number of real unknowns.
     pub fn unknowns(&self) -> usize {
-        self.n
+        self.dofs.reduced_len()
+    }
+
+    /// The DOF map of the flow, `V = K c + V0` (directions of the last solve).
+    pub fn dofs(&self) -> &DofMap<f64> {
+        &self.dofs
     }
 
     /// The minimizer of `E_V` for per-face weights `w_T` and targets `rho_T` on the image
-    /// faces `faces` of `image`.
+    /// faces `faces` of `image`, written into `flow`.
+    #[allow(clippy::too_many_arguments)]
     pub fn solve<G: TargetGeometry>(
         &mut self,
         target: &G,
@@ -241,55 +291,37 @@ impl FlowSystem {
         faces: &[ImageFace],
         weights: &[f64],
         rho: &[Complex64],
-    ) -> Result<Flow, SolverError> {
-        self.directions.clear();
-        self.directions.extend(
-            self.roles
-                .iter()
-                .zip(image.iter().zip(normals))
-                .map(|(&role, (p, n))| directions(target, role, p, n)),
-        );
+        flow: &mut Flow,
+    ) -> Result<(), SolverError> {
+        self.refill_directions(target, image, normals)?;
         self.rhs.iter_mut().for_each(|r| *r = 0.0);
         let values = self.matrix.val_mut();
         values.iter_mut().for_each(|v| *v = 0.0);
+        let (x0, directions) = (self.dofs.x0(), self.dofs.directions());
         let mut at = 0;
         for (f, face) in faces.iter().enumerate() {
-            let (list, m) = &self.local[f];
-            let m = *m as usize;
+            let list = &self.local[self.local_ptr[f]..self.local_ptr[f + 1]];
+            let m = list.len();
             let g = dzbar_coefficients(face);
             let w = if g.is_some() { weights[f] } else { 0.0 };
             let g = g.unwrap_or_default();
-            let mut beta = [Complex64::default(); MAX_LOCAL];
-            for (a, &(_, source)) in list[..m].iter().enumerate() {
-                beta[a] = match source {
-                    Source::Vertex { k, index } => {
-                        let v = self.faces[f][k as usize];
-                        let b = self.directions[v][index as usize];
-                        g[k as usize] * along(face, &b)
-                    }
-                    Source::Offset { curve } => {
-                        let mut sum = Complex64::default();
-                        for (&v, gk) in self.faces[f].iter().zip(&g) {
-                            if self.roles[v] == Role::Curve(curve)
-                                && let Some(b) = target.curve_offset_direction(curve, &image[v])
-                            {
-                                sum += gk * along(face, &b);
-                            }
-                        }
-                        sum
-                    }
-                };
+            let beta = &mut self.beta[..m];
+            beta.iter_mut().for_each(|b| *b = Complex64::default());
+            for t in &self.face_terms[self.term_ptr[f]..self.term_ptr[f + 1]] {
+                let b = &directions[3 * t.term as usize..3 * t.term as usize + 3];
+                beta[t.local as usize] += g[t.k as usize] * along(face, b);
             }
             let mut known = rho[f];
-            if !self.prescribed.is_empty() {
+            if self.prescribed {
                 for (&v, gk) in self.faces[f].iter().zip(&g) {
-                    if self.roles[v] == Role::Fixed && self.prescribed[v] != Vector3::zeros() {
-                        known -= gk * along(face, &self.prescribed[v]);
+                    let v0 = &x0[3 * v..3 * v + 3];
+                    if v0.iter().any(|&c| c != 0.0) {
+                        known -= gk * along(face, v0);
                     }
                 }
             }
             for a in 0..m {
-                self.rhs[list[a].0] += w * (beta[a].conj() * known).re;
+                self.rhs[list[a]] += w * (beta[a].conj() * known).re;
                 for b in 0..=a {
                     values[self.slots[at]] += w * (beta[a].conj() * beta[b]).re;
                     at += 1;
@@ -297,31 +329,53 @@ impl FlowSystem {
             }
         }
         self.solve_normal_equations()?;
-        let mut flow = Flow {
-            vertex: vec![Vector3::zeros(); self.roles.len()],
-            offset: vec![0.0; self.offset.len()],
-        };
-        for (c, o) in self.offset.iter().enumerate() {
-            if let Some(o) = o {
-                flow.offset[c] = self.rhs[*o];
+        self.dofs.expand_into(&self.rhs, &mut self.flow)?;
+        flow.vertex.clear();
+        flow.vertex.extend(
+            self.flow
+                .chunks_exact(3)
+                .map(|v| Vector3::new(v[0], v[1], v[2])),
+        );
+        flow.offset.clear();
+        flow.offset
+            .extend(self.offset.iter().map(|o| o.map_or(0.0, |o| self.rhs[o])));
+        Ok(())
+    }
+
+    /// States the directions of the current image in the DOF map: the tangent basis of
+    /// the target's normal at a free vertex ([`orthonormal_basis`]), the curve tangent at
+    /// a curve vertex, and the curve's offset direction there (zero where the target
+    /// has none).
+    fn refill_directions<G: TargetGeometry>(
+        &mut self,
+        target: &G,
+        image: &[Point3<f64>],
+        normals: &[Vector3<f64>],
+    ) -> Result<(), SolverError> {
+        for (v, (&role, (p, normal))) in
+            self.roles.iter().zip(image.iter().zip(normals)).enumerate()
+        {
+            let first = self.dofs.terms(VertexId::from_usize(v))?.start;
+            match role {
+                Role::Free => {
+                    for (t, b) in orthonormal_basis(normal).iter().enumerate() {
+                        self.dofs.set_direction(first + t, b.as_slice())?;
+                    }
+                }
+                Role::Curve(c) => {
+                    let tangent = target.curve_tangent(c, p);
+                    self.dofs.set_direction(first, tangent.as_slice())?;
+                    if self.offset[c].is_some() {
+                        let b = target
+                            .curve_offset_direction(c, p)
+                            .unwrap_or_else(Vector3::zeros);
+                        self.dofs.set_direction(first + 1, b.as_slice())?;
+                    }
+                }
+                Role::Fixed => {}
             }
         }
-        for (v, &role) in self.roles.iter().enumerate() {
-            let mut vec = Vector3::zeros();
-            for index in 0..unknowns_of(role) {
-                vec += self.rhs[self.first[v] + index] * self.directions[v][index];
-            }
-            if let Role::Curve(c) = role
-                && let Some(b) = target.curve_offset_direction(c, &image[v])
-            {
-                vec += flow.offset[c] * b;
-            }
-            if role == Role::Fixed && !self.prescribed.is_empty() {
-                vec = self.prescribed[v];
-            }
-            flow.vertex[v] = vec;
-        }
-        Ok(flow)
+        Ok(())
     }
 }
 
@@ -338,17 +392,17 @@ impl FlowSystem {
     /// 1, 2, 4, .. steps factor directly.
     fn solve_normal_equations(&mut self) -> Result<(), SolverError> {
         if self.factorizations > 0 && self.skip_reuse == 0 {
-            let mut x = self.rhs.clone();
+            self.trial.copy_from_slice(&self.rhs);
             let outcome = self.solver.solve_preconditioned(
                 self.matrix.as_ref(),
-                &mut x,
+                &mut self.trial,
                 CG_TOLERANCE,
                 CG_ITERATIONS,
             )?;
             self.cg_iterations += outcome.iterations;
             if outcome.converged {
                 self.backoff = 1;
-                self.rhs = x;
+                std::mem::swap(&mut self.rhs, &mut self.trial);
                 return Ok(());
             }
             self.skip_reuse = self.backoff;
@@ -366,16 +420,13 @@ impl FlowSystem {
 }
 
 /// An elimination order of the unknowns: AMD on the graph of the vertices (an edge per
-/// triangle side), each vertex's unknowns together, the shared offsets last (they couple
-/// to a whole curve). Ordering the vertex graph is about four times cheaper than the
-/// unknowns' graph, and keeps each vertex's pair in one supernode.
-fn block_order(
-    faces: &[[usize; 3]],
-    roles: &[Role],
-    first: &[usize],
-    n: usize,
-) -> Result<Vec<usize>, SolverError> {
-    let nv = roles.len();
+/// triangle side), the unknowns that move one vertex only with their vertex, the shared
+/// ones (offsets, coupled to a whole curve) last in increasing order. Ordering the
+/// vertex graph is about four times cheaper than the unknowns' graph, and keeps each
+/// vertex's pair in one supernode.
+fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<Vec<usize>, SolverError> {
+    let nv = dofs.n_nodes();
+    let n = dofs.reduced_len();
     let mut positions = Vec::with_capacity(nv + 3 * faces.len());
     positions.extend((0..nv).map(|v| (v, v)));
     for f in faces {
@@ -386,33 +437,26 @@ fn block_order(
     }
     let graph = Pattern::new(nv, nv, &positions)?;
     let vertices = amd_order(graph.symbolic().as_ref())?;
+    let shared: Vec<bool> = (0..n)
+        .map(|j| dofs.unknown_nodes(j).is_some_and(|nodes| nodes.count() > 1))
+        .collect();
     let mut order = Vec::with_capacity(n);
     for v in vertices {
-        order.extend(first[v]..first[v] + unknowns_of(roles[v]));
+        for (_, t) in dofs.node_terms(VertexId::from_usize(v))? {
+            if !shared[t.dof] {
+                order.push(t.dof);
+            }
+        }
     }
-    let vertex_unknowns = order.len();
-    order.extend(vertex_unknowns..n);
+    order.extend((0..n).filter(|&j| shared[j]));
     Ok(order)
 }
 
-/// The directions of the unknowns of a vertex with `role` at `p`, where the target's
-/// normal is `normal` (unused entries zero).
-fn directions<G: TargetGeometry>(
-    target: &G,
-    role: Role,
-    p: &Point3<f64>,
-    normal: &Vector3<f64>,
-) -> [Vector3<f64>; 2] {
-    match role {
-        Role::Free => orthonormal_basis(normal),
-        Role::Curve(c) => [target.curve_tangent(c, p), Vector3::zeros()],
-        Role::Fixed => [Vector3::zeros(); 2],
-    }
-}
-
-/// A vector of R^3 as the complex number of its components along the face's `(r, s)`.
+/// A vector of R^3 (three components) as the complex number of its components along
+/// the face's `(r, s)`.
 #[inline]
-fn along(face: &ImageFace, b: &Vector3<f64>) -> Complex64 {
+fn along(face: &ImageFace, b: &[f64]) -> Complex64 {
+    let b = Vector3::new(b[0], b[1], b[2]);
     Complex64::new(b.dot(&face.r), b.dot(&face.s))
 }
 
@@ -432,4 +476,91 @@ fn dzbar_coefficients(face: &ImageFace) -> Option<[Complex64; 3]> {
         let e = q[(k + 2) % 3] - q[(k + 1) % 3];
         0.5 * Complex64::new(-e.y, e.x) / d
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::measure::image_faces;
+    use crate::target::{Annulus, INNER, OUTER};
+    use beltrami_fem::Frame;
+    use beltrami_mesh::{Mesh, primitives};
+
+    /// The annulus `0.4 <= |z| <= 1` with a free inner radius, one vertex of the outer
+    /// circle fixed: the flow's unknowns as a DOF map, and one solve.
+    #[test]
+    fn the_flow_is_a_dof_map_with_a_shared_radius() {
+        let mesh = Mesh::from_soup(&primitives::annulus(0.4, 3, 12)).unwrap();
+        let elements = Elements::new(&mesh, Frame::Global).unwrap();
+        let image = mesh.positions().to_vec();
+        let radius = |p: &Point3<f64>| p.x.hypot(p.y);
+        let mut roles: Vec<Role> = image
+            .iter()
+            .map(|p| match radius(p) {
+                r if (r - 1.0).abs() < 1e-9 => Role::Curve(OUTER),
+                r if (r - 0.4).abs() < 1e-9 => Role::Curve(INNER),
+                _ => Role::Free,
+            })
+            .collect();
+        let pin = roles.iter().position(|&r| r == Role::Curve(OUTER)).unwrap();
+        roles[pin] = Role::Fixed;
+        let target = Annulus {
+            inner_radius: 0.4,
+            free_inner: true,
+        };
+        let options = SolveOptions::default();
+        let mut system =
+            FlowSystem::new(&elements, &target, &image, roles.clone(), options).unwrap();
+        let count = |role: Role| roles.iter().filter(|&&r| r == role).count();
+        let (free, outer, inner) = (
+            count(Role::Free),
+            count(Role::Curve(OUTER)),
+            count(Role::Curve(INNER)),
+        );
+        assert_eq!(outer, 11);
+        assert_eq!(inner, 12);
+        let n = system.unknowns();
+        assert_eq!(n, 2 * free + outer + inner + 1);
+        // The radius is the last unknown and moves every inner vertex.
+        let dofs = system.dofs();
+        let on_inner: Vec<VertexId> = (0..roles.len())
+            .filter(|&v| roles[v] == Role::Curve(INNER))
+            .map(VertexId::from_usize)
+            .collect();
+        assert_eq!(
+            dofs.unknown_nodes(n - 1).unwrap().collect::<Vec<_>>(),
+            on_inner
+        );
+        assert_eq!(dofs.terms(VertexId::from_usize(pin)).unwrap().len(), 0);
+
+        // One step towards mu = 0.2 everywhere: inner vertices move by their tangent
+        // and the common radial offset, outer ones along the circle, the fixed one by
+        // its prescribed flow.
+        let normals = vec![Vector3::z(); image.len()];
+        let mut faces = Vec::new();
+        image_faces(&elements, &normals, &image, &mut faces);
+        let weights = vec![1.0; faces.len()];
+        let rho = vec![Complex64::new(0.2, 0.0); faces.len()];
+        let pulled = Vector3::new(0.0, 0.01, 0.0);
+        let mut prescribed = vec![Vector3::zeros(); image.len()];
+        prescribed[pin] = pulled;
+        system.set_prescribed(&prescribed).unwrap();
+        let mut flow = Flow::default();
+        system
+            .solve(&target, &image, &normals, &faces, &weights, &rho, &mut flow)
+            .unwrap();
+        let offset = flow.offset[INNER];
+        assert!(offset.abs() > 1e-6, "the radius did not move: {offset}");
+        assert_eq!(flow.offset[OUTER], 0.0);
+        for (v, p) in image.iter().enumerate() {
+            let radial = Vector3::new(p.x, p.y, 0.0) / radius(p);
+            let along_radius = flow.vertex[v].dot(&radial);
+            match roles[v] {
+                Role::Curve(INNER) => assert!((along_radius - offset).abs() < 1e-14),
+                Role::Curve(_) => assert!(along_radius.abs() < 1e-14),
+                Role::Fixed => assert_eq!(flow.vertex[v], pulled),
+                Role::Free => assert_eq!(flow.vertex[v].z, 0.0),
+            }
+        }
+    }
 }

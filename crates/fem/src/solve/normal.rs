@@ -16,19 +16,24 @@
 //!
 //! # `B` without a product
 //!
-//! Every row `l` of `K` has at most one nonzero `K[l, j(l)] = k_l` (module docs of
-//! [`crate::dof`]), so
+//! Row `l` of `K` (component `c` of node `i`) has one entry `K[l, j]` per term of node `i`
+//! that stores component `c` (module docs of [`crate::dof`]): none for a fixed node, one
+//! for the maps of `DofConstraints`, a few in general (a node in a tangent plane of R^3,
+//! a node moved by a shared offset). So
 //!
 //! ```text
-//! B[i, j] = sum_{l : j(l) = j} A[i, l] k_l:
+//! B[i, j] = sum_l A[i, l] K[l, j]:
 //! ```
 //!
-//! each entry `A[i, l]` adds `A[i, l] k_l` into the single entry `B[i, j(l)]`, or into
-//! none when node unknown `l` is fixed. Several entries of a row of `A` add into one
-//! entry of `B` when their columns share a reduced unknown (shared nodes, the two
-//! components of a sliding node). The symbolic phase records, for every entry of `A`,
-//! the entry of `B` it adds into (`b_target`); the numeric refill of `B` is one pass
-//! over the values of `A`.
+//! each entry `A[i, l]` adds `A[i, l] K[l, j]` into the entry `B[i, j]` of every `j` of
+//! row `l` of `K`, and into none when node unknown `l` is fixed. Several products add into
+//! one entry of `B` when their columns of `A` share a reduced unknown (shared nodes, the
+//! components of a sliding node, a shared offset). The symbolic phase records, for every
+//! pair (entry of `A`, entry of its row of `K`), in the order of the numeric pass (columns
+//! `l` of `A`, their entries, then the entries of row `l` of `K`), the entry of `B` it
+//! adds into (`b_target`); the numeric refill of `B` is one pass over the values of `A`.
+//! The values of `K` are copied row by row at construction (the solver's map does not
+//! change).
 //!
 //! # `N` without a product
 //!
@@ -107,8 +112,8 @@ fn try_vec<X: Clone>(len: usize, value: X) -> Result<Vec<X>, FaerError> {
 
 /// The scatter maps of one pattern of `A` (module docs).
 struct Maps<I> {
-    /// For each stored entry of `A` (index into its values), the entry of `B` it adds
-    /// into; unused for the entries of fixed columns.
+    /// For each pair (entry of `A`, entry of its row of `K`), in the order of the numeric
+    /// pass (module docs), the entry of `B` it adds into.
     b_target: Vec<I>,
     /// `B` row by row (`m + 1` pointers) ...
     b_row_ptr: Vec<I>,
@@ -129,9 +134,10 @@ enum AnyMaps {
 
 /// `N = B^H W B` (lower triangle) and `g = B^H W r`, with their symbolic structure.
 pub(super) struct NormalEquations<T: Scalar> {
-    /// For each column `l` of `A` (row of `K`): `K[l, j(l)]`, or `None` when the node
-    /// unknown is fixed.
-    k_coef: Vec<Option<T>>,
+    /// `K` row by row: the entries of row `l` (column `l` of `A`) are
+    /// `k_values[k_row_ptr[l]..k_row_ptr[l + 1]]`, in increasing column order.
+    k_row_ptr: Vec<usize>,
+    k_values: Vec<T>,
     maps: AnyMaps,
     /// Values of `B`, row by row.
     b_values: Vec<T>,
@@ -159,21 +165,39 @@ impl<T: Scalar> NormalEquations<T> {
         narrow: bool,
     ) -> Result<Self, SolveError> {
         let (m, n) = (a.nrows(), dofs.reduced_len());
-        // Row l of K as (j(l), k_l): K has at most one entry per row.
+        // K row by row (a transpose of its columns, each row's columns increasing).
         let k = dofs.k();
-        let mut k_row: Vec<Option<(usize, T)>> = vec![None; a.ncols()];
+        let mut k_row_ptr = vec![0usize; a.ncols() + 1];
+        for &l in k.row_idx() {
+            k_row_ptr[l + 1] += 1;
+        }
+        for l in 0..a.ncols() {
+            k_row_ptr[l + 1] += k_row_ptr[l];
+        }
+        let mut next = k_row_ptr[..a.ncols()].to_vec();
+        let zero = T::from_f64(0.0);
+        let mut k_col = vec![0usize; k.row_idx().len()];
+        let mut k_values = vec![zero; k.row_idx().len()];
         for j in 0..n {
-            for (l, &coef) in k.row_idx_of_col(j).zip(k.val_of_col(j)) {
-                k_row[l] = Some((j, coef));
+            for (&l, &coef) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
+                k_col[next[l]] = j;
+                k_values[next[l]] = coef;
+                next[l] += 1;
             }
         }
-        // Entries of each row of A that reach B: they bound the entries of B and the
-        // pairs of each row, hence every index the maps store.
+        drop(next);
+        let k_rows = KRows {
+            ptr: &k_row_ptr,
+            col: &k_col,
+        };
+        // Products of each row of A that reach B: they bound the entries of B, the
+        // targets and the pairs of each row, hence every index the maps store.
         let mut row_len = vec![0usize; m];
-        for (l, kl) in k_row.iter().enumerate() {
-            if kl.is_some() {
+        for l in 0..a.ncols() {
+            let r = k_rows.len(l);
+            if r > 0 {
                 for i in a.row_idx_of_col(l) {
-                    row_len[i] += 1;
+                    row_len[i] += r;
                 }
             }
         }
@@ -183,19 +207,19 @@ impl<T: Scalar> NormalEquations<T> {
             .ok_or(FaerError::IndexOverflow)?;
         let bound = pair_bound.max(a.row_idx().len()).max(m).max(n);
         let (maps, pattern) = if narrow && fits_u32(bound) {
-            let (maps, pattern) = Maps::<u32>::new(a, &k_row, &row_len, dofs)?;
+            let (maps, pattern) = Maps::<u32>::new(a, k_rows, &row_len, dofs)?;
             (AnyMaps::Narrow(maps), pattern)
         } else {
-            let (maps, pattern) = Maps::<usize>::new(a, &k_row, &row_len, dofs)?;
+            let (maps, pattern) = Maps::<usize>::new(a, k_rows, &row_len, dofs)?;
             (AnyMaps::Wide(maps), pattern)
         };
         let b_len = match &maps {
             AnyMaps::Narrow(maps) => maps.b_col.len(),
             AnyMaps::Wide(maps) => maps.b_col.len(),
         };
-        let zero = T::from_f64(0.0);
         Ok(Self {
-            k_coef: k_row.iter().map(|kl| kl.map(|(_, coef)| coef)).collect(),
+            k_row_ptr,
+            k_values,
             maps,
             b_values: try_vec(b_len, zero)?,
             values: try_vec(pattern.row_idx().len(), zero)?,
@@ -227,10 +251,30 @@ impl<T: Scalar> NormalEquations<T> {
             values: &mut self.values,
             rhs,
         };
+        let k = (&self.k_row_ptr[..], &self.k_values[..]);
         match &self.maps {
-            AnyMaps::Narrow(maps) => maps.assemble(&self.k_coef, a, weights, residual, out),
-            AnyMaps::Wide(maps) => maps.assemble(&self.k_coef, a, weights, residual, out),
+            AnyMaps::Narrow(maps) => maps.assemble(k, a, weights, residual, out),
+            AnyMaps::Wide(maps) => maps.assemble(k, a, weights, residual, out),
         }
+    }
+}
+
+/// The pattern of `K` row by row: the columns of row `l` are `col[ptr[l]..ptr[l + 1]]`.
+#[derive(Clone, Copy)]
+struct KRows<'a> {
+    ptr: &'a [usize],
+    col: &'a [usize],
+}
+
+impl KRows<'_> {
+    /// The reduced unknowns of row `l` of `K`.
+    fn row(&self, l: usize) -> &[usize] {
+        &self.col[self.ptr[l]..self.ptr[l + 1]]
+    }
+
+    /// The number of entries of row `l`.
+    fn len(&self, l: usize) -> usize {
+        self.ptr[l + 1] - self.ptr[l]
     }
 }
 
@@ -242,19 +286,20 @@ struct Output<'a, T> {
 }
 
 impl<I: Index> Maps<I> {
-    /// The maps and the lower pattern of `N` (module docs). `k_row[l]` is row `l` of
-    /// `K`, `row_len[i]` the number of entries of row `i` of `A` in non-fixed columns.
+    /// The maps and the lower pattern of `N` (module docs). `k_rows` is the pattern of
+    /// `K` row by row, `row_len[i]` the number of products (entry of row `i` of `A`, entry
+    /// of its row of `K`).
     fn new<T: Scalar>(
         a: SymbolicSparseColMatRef<'_, usize>,
-        k_row: &[Option<(usize, T)>],
+        k_rows: KRows<'_>,
         row_len: &[usize],
         dofs: &DofMap<T>,
     ) -> Result<(Self, SymbolicSparseColMat<usize>), SolveError> {
         let (m, n) = (a.nrows(), dofs.reduced_len());
 
-        // The reduced columns of the entries of A reaching B, row by row; each row is
-        // then sorted and its repeated columns merged in place, which leaves the
-        // columns of B row by row in the same buffer (merging only moves entries left).
+        // The reduced columns of the products reaching B, row by row; each row is then
+        // sorted and its repeated columns merged in place, which leaves the columns of B
+        // row by row in the same buffer (merging only moves entries left).
         let mut a_row_end = try_vec(m, 0usize)?;
         let mut total = 0;
         for (end, &r) in a_row_end.iter_mut().zip(row_len) {
@@ -263,9 +308,9 @@ impl<I: Index> Maps<I> {
         }
         let mut b_col = try_vec(total, I::new(0))?;
         let mut next: Vec<usize> = a_row_end.iter().zip(row_len).map(|(e, r)| e - r).collect();
-        for (l, kl) in k_row.iter().enumerate() {
-            if let Some((j, _)) = *kl {
-                for i in a.row_idx_of_col(l) {
+        for l in 0..a.ncols() {
+            for i in a.row_idx_of_col(l) {
+                for &j in k_rows.row(l) {
                     b_col[next[i]] = I::new(j);
                     next[i] += 1;
                 }
@@ -305,15 +350,18 @@ impl<I: Index> Maps<I> {
         b_col.truncate(end);
         b_col.shrink_to_fit();
 
-        // The entry of B each entry of A adds into: its reduced column within its row.
-        let mut b_target = try_vec(a.row_idx().len(), I::new(0))?;
-        for (l, kl) in k_row.iter().enumerate() {
-            if let Some((j, _)) = *kl {
-                let j = I::new(j);
-                for (k, i) in a.col_range(l).zip(a.row_idx_of_col(l)) {
-                    let (start, end) = (b_row_ptr[i].get(), b_row_ptr[i + 1].get());
+        // The entry of B each product adds into: its reduced column within its row, in
+        // the order of the numeric pass.
+        let mut b_target = try_vec(total, I::new(0))?;
+        let mut target = 0;
+        for l in 0..a.ncols() {
+            for i in a.row_idx_of_col(l) {
+                let (start, end) = (b_row_ptr[i].get(), b_row_ptr[i + 1].get());
+                for &j in k_rows.row(l) {
+                    let j = I::new(j);
                     let p = b_col[start..end].partition_point(|&c| c < j);
-                    b_target[k] = I::new(start + p);
+                    b_target[target] = I::new(start + p);
+                    target += 1;
                 }
             }
         }
@@ -404,10 +452,11 @@ impl<I: Index> Maps<I> {
         ))
     }
 
-    /// The numeric phase of [`NormalEquations::assemble`].
+    /// The numeric phase of [`NormalEquations::assemble`]; `k` is `K` row by row
+    /// (pointers and values).
     fn assemble<T: Scalar>(
         &self,
-        k_coef: &[Option<T>],
+        (k_row_ptr, k_values): (&[usize], &[T]),
         a: SparseColMatRef<'_, usize, T>,
         weights: Option<&[f64]>,
         residual: &[T],
@@ -420,13 +469,19 @@ impl<I: Index> Maps<I> {
             rhs,
         } = out;
 
-        // B = A K: entry k of A adds A_k k_l into its target.
+        // B = A K: entry k of A (column l) adds A_k K[l, j] into the target of each
+        // entry of row l of K.
         b_values.fill(zero);
         let (a_pattern, a_values) = (a.symbolic(), a.val());
-        for (l, coef) in k_coef.iter().enumerate() {
-            if let Some(coef) = *coef {
-                for k in a_pattern.col_range(l) {
-                    b_values[self.b_target[k].get()] += a_values[k] * coef;
+        let mut targets = self.b_target.iter();
+        for l in 0..a_pattern.ncols() {
+            let k_row = &k_values[k_row_ptr[l]..k_row_ptr[l + 1]];
+            if k_row.is_empty() {
+                continue;
+            }
+            for &a_k in &a_values[a_pattern.col_range(l)] {
+                for (&coef, target) in k_row.iter().zip(targets.by_ref()) {
+                    b_values[target.get()] += a_k * coef;
                 }
             }
         }
@@ -460,7 +515,7 @@ impl<I: Index> Maps<I> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dof::DofConstraints;
+    use crate::dof::{DofBuilder, DofConstraints};
     use beltrami_mesh::VertexId;
     use faer::Mat;
     use faer::sparse::{SparseColMat, Triplet};
@@ -589,5 +644,30 @@ mod tests {
     fn scatter_maps_reproduce_the_dense_normal_equations_complex() {
         let dofs = DofMap::complex(8, &constraints()).unwrap();
         check(&dofs, |s| Complex64::new(noise(s), noise(s)));
+    }
+
+    /// A general map, several entries per row of `K`: node 1 in a plane spanned by two
+    /// oblique directions, node 4 on a line and, with node 6, moved by an offset along
+    /// different directions, node 0 fixed, the others free.
+    #[test]
+    fn scatter_maps_reproduce_the_dense_normal_equations_with_general_bases() {
+        let mut b = DofBuilder::<f64>::new(8, 2).unwrap();
+        b.origin(VertexId(0), &[1.0, 2.0]).unwrap();
+        b.span(VertexId(1), &[0.5, 0.0], [[1.0, 0.5], [-0.3, 1.0]])
+            .unwrap();
+        for i in [2, 3, 5, 7] {
+            b.free(&[VertexId(i)]).unwrap();
+        }
+        b.span(VertexId(4), &[0.0, 1.0], [[0.6, 0.8]]).unwrap();
+        b.unknown([(VertexId(4), [0.8, -0.6]), (VertexId(6), [1.0, 1.0])])
+            .unwrap();
+        let dofs = b.build().unwrap();
+        let k = dofs.k();
+        let row_entries = (0..dofs.reduced_len())
+            .flat_map(|j| k.row_idx_of_col_raw(j).iter().copied())
+            .filter(|&row| row == 8)
+            .count();
+        assert_eq!(row_entries, 2);
+        check(&dofs, noise);
     }
 }
