@@ -12,7 +12,7 @@ use beltrami_mesh::{BuildOptions, Mesh, Point3};
 use beltrami_spatial::SurfaceIndex;
 
 mod common;
-use common::{beltrami, s, text};
+use common::{beltrami, s, shared_meshes, text};
 
 fn read(path: &Path) -> Mesh {
     io::read(path, &BuildOptions::default()).unwrap().mesh
@@ -269,18 +269,10 @@ fn mismatched_topologies_fail_before_any_work() {
 
 #[test]
 fn kitten_onto_the_modified_tori() {
-    let kitten = Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/meshes/g1_kitten.obj"
-    ));
-    if !kitten.exists() {
-        writeln!(
-            std::io::stderr(),
-            "SKIPPED kitten_onto_the_modified_tori: ../shared/meshes is absent"
-        )
-        .unwrap();
+    let Some(shared) = shared_meshes("kitten_onto_the_modified_tori") else {
         return;
-    }
+    };
+    let kitten = &shared.join("g1_kitten.obj");
     let dir = tempfile::tempdir().unwrap();
     for (shape, p) in [("torus1", "2"), ("torus1", "3"), ("torus2", "4")] {
         let target = dir.path().join(format!("{shape}.obj"));
@@ -296,15 +288,9 @@ fn kitten_onto_the_modified_tori() {
 
 #[test]
 fn real_genus_zero_and_disk_pairs() {
-    let shared = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"));
-    if !shared.exists() {
-        writeln!(
-            std::io::stderr(),
-            "SKIPPED real_genus_zero_and_disk_pairs: ../shared/meshes is absent"
-        )
-        .unwrap();
+    let Some(shared) = shared_meshes("real_genus_zero_and_disk_pairs") else {
         return;
-    }
+    };
     // The initial maps have 6 and 2 flipped faces (chords across curved parts of the
     // target); the flow removes them.
     for (source, target) in [
@@ -378,15 +364,11 @@ fn distortion_against_the_target_agrees_with_the_registration() {
 fn distortion_against_the_target_agrees_with_a_registration_that_keeps_a_flip() {
     // Coarse onto fine: the flow keeps a flipped face or so; the counts agree whatever
     // they are.
-    let shared = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"));
-    if !shared.exists() {
-        writeln!(
-            std::io::stderr(),
-            "SKIPPED distortion_against_the_target_agrees_with_a_registration_that_keeps_a_flip: ../shared/meshes is absent"
-        )
-        .unwrap();
+    let Some(shared) =
+        shared_meshes("distortion_against_the_target_agrees_with_a_registration_that_keeps_a_flip")
+    else {
         return;
-    }
+    };
     distortion_agrees_with_register(
         "disk_hemisphere onto disk_human_face",
         &shared.join("disk_hemisphere.obj"),

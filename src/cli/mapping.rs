@@ -188,7 +188,7 @@ pub fn solve(
     problem: &Problem<'_>,
     progress: ProgressStyleArg,
 ) -> anyhow::Result<(Solution, f64)> {
-    solver.check(problem)?;
+    let settings = solver.check(problem)?;
     let mut bar = LateBar::new(progress == ProgressStyleArg::Bar);
     let start = Instant::now();
     let solution = {
@@ -201,7 +201,7 @@ pub fn solve(
                 }
             })
             .with_cancel_flag(super::interrupt::cancel_flag());
-        solver.solve(problem, &mut context)
+        solver.run(problem, &settings, &mut context)
     };
     bar.finish();
     Ok((solution?, start.elapsed().as_secs_f64()))

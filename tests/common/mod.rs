@@ -23,3 +23,20 @@ pub fn text(bytes: &[u8]) -> String {
 pub fn s(p: &Path) -> &str {
     p.to_str().expect("test paths are UTF-8")
 }
+
+/// `../shared/meshes` beside the repository, or `None` after printing `SKIPPED` with the
+/// test's name (a user's fresh clone has no `../shared`; CI has it).
+pub fn shared_meshes(test: &str) -> Option<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        use std::io::Write as _;
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED {test}: {} not found; the shared-mesh tests need ../shared beside the repo",
+            dir.display()
+        );
+        None
+    }
+}

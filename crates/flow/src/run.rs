@@ -125,9 +125,7 @@ pub fn solve(
     }
     let threads = settings.int("threads");
     let objective = Objective {
-        areas: (0..mesh.face_count())
-            .map(|f| elements.face_points(beltrami_mesh::FaceId(f as u32))[0].weight)
-            .collect(),
+        areas: elements.face_areas(),
         sigma: goal.sigma.clone(),
         p: goal.p,
     };

@@ -17,8 +17,8 @@
 //! polyhedron that is star-shaped about the origin, instead of by the closest point,
 //! which is not injective near edges.
 
-use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
+use beltrami_fem::{DistortionStats, ReferenceNormal};
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
 
@@ -105,7 +105,7 @@ fn radial(domain: &Mesh, direction: &Vector3<f64>, start: FaceId) -> Option<Surf
     None
 }
 
-/// The number of source faces whose image is flipped on the target: the map measured
+/// The distortion of the map on the target (`|mu|` statistics and flipped faces): the map measured
 /// by `beltrami_fem::distortion::measure_surface` with the target's normals at the
 /// images as the reference ([`SurfaceIndex::face_reference_normals`]: per face, the sum
 /// of the target's interpolated vertex normals at the images of its corners). A face is
@@ -114,13 +114,13 @@ fn radial(domain: &Mesh, direction: &Vector3<f64>, start: FaceId) -> Option<Surf
 /// `beltrami_fem::beltrami::image_derivatives`): a triangle by its image triangle, a
 /// quad by its four Gauss points (not by its four corner triangles). A collapsed image
 /// counts as flipped. `beltrami distortion SOURCE OUT --target TARGET` counts the same.
-pub(crate) fn count_flips(
+pub(crate) fn distortion(
     source: &Mesh,
     target_index: &SurfaceIndex<'_>,
     points: &[SurfacePoint],
     positions: &[Point3<f64>],
-) -> Result<usize, RegisterError> {
+) -> Result<DistortionStats, RegisterError> {
     let normals = target_index.face_reference_normals(source, points)?;
     let measured = measure_surface(source, positions, ReferenceNormal::PerFace(&normals))?;
-    Ok(measured.stats.flipped)
+    Ok(measured.stats)
 }

@@ -30,7 +30,7 @@
 //! let map = initial_map(&source, &target, &[]).unwrap();
 //! assert_eq!(map.topology, Topology::Sphere);
 //! assert_eq!(map.points.len(), source.vertex_count());
-//! assert_eq!(map.flipped, 0);
+//! assert_eq!(map.flipped(), 0);
 //! ```
 //!
 //! See `docs/register.md` for the conventions, the choice of loops and the timings.
@@ -45,6 +45,7 @@ mod sphere;
 mod topology;
 mod torus;
 
+use beltrami_fem::DistortionStats;
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
 
@@ -66,13 +67,20 @@ pub struct InitialMap {
     /// What was done, in words: the loops cut along (per mesh, lengths and input vertex
     /// indices), the alignment and the landmarks it honours, the flips.
     pub notes: Vec<String>,
-    /// Source faces whose image is flipped: at a quadrature point (a triangle's image
-    /// triangle; a quad's four Gauss points, not its corner triangles) the image's area
-    /// element points against (or is orthogonal to) the sum of the target's interpolated
-    /// vertex normals at the images of the face's corners
-    /// ([`SurfaceIndex::face_reference_normals`] with the fem kernel). Zero for a
-    /// bijective map between well-shaped meshes.
-    pub flipped: usize,
+    /// The map's distortion on the target: `|mu|` statistics and flipped faces, judged
+    /// against the sum of the target's interpolated vertex normals at the images of each
+    /// face's corners ([`SurfaceIndex::face_reference_normals`] with the fem kernel; a
+    /// face is flipped where, at a quadrature point, the image's area element points
+    /// against or orthogonal to it). No flips for a bijective map between well-shaped
+    /// meshes.
+    pub distortion: DistortionStats,
+}
+
+impl InitialMap {
+    /// The number of source faces whose image is flipped (`distortion.flipped`).
+    pub fn flipped(&self) -> usize {
+        self.distortion.flipped
+    }
 }
 
 /// The initial bijection from `source` onto `target` (crate docs): both meshes onto a
@@ -118,7 +126,8 @@ pub fn initial_map(
             ));
         }
     }
-    let flipped = compose::count_flips(source, &target_index, &points, &positions)?;
+    let distortion = compose::distortion(source, &target_index, &points, &positions)?;
+    let flipped = distortion.flipped;
     notes.push(format!(
         "{flipped} of {} source faces flipped on the target",
         source.face_count()
@@ -134,7 +143,7 @@ pub fn initial_map(
         positions,
         topology,
         notes,
-        flipped,
+        distortion,
     })
 }
 

@@ -4,9 +4,6 @@ use beltrami_core::{
     Accepts, ConstraintKind, Context, Element, GoalKind, Map, OptionSpec, Position, Problem,
     Report, Settings, Solution, Solver, SolverError, Target, TargetKind, Topology,
 };
-use beltrami_fem::ReferenceNormal;
-use beltrami_fem::distortion::measure_surface;
-use beltrami_spatial::SurfaceIndex;
 
 use crate::{Landmark, LandmarkTarget, check_topology, initial_map};
 
@@ -120,28 +117,13 @@ impl Solver for Register {
             })
         })?;
         report.notes.extend(initial.notes.iter().cloned());
-        // The initial map's distortion, judged against the target's normals at the images
-        // (the rule of `beltrami distortion --target` and of the flow).
-        let index = SurfaceIndex::new(target).map_err(|e| SolverError::Plugin {
-            solver: NAME,
-            error: Box::new(e),
-        })?;
-        let normals = index
-            .face_reference_normals(source, &initial.points)
-            .map_err(|e| SolverError::Plugin {
-                solver: NAME,
-                error: Box::new(e),
-            })?;
-        let start = measure_surface(
-            source,
-            &initial.positions,
-            ReferenceNormal::PerFace(&normals),
-        )?;
         let mut flow = problem.clone();
         flow.initial = Some(Map::OnMesh(initial.points));
         let mut solution =
             beltrami_flow_engine::solve(&flow, settings, initial.positions, report, context)?;
-        solution.metrics.initial_distortion = Some(start.stats);
+        // Judged against the target's normals at the images (the rule of `beltrami
+        // distortion --target` and of the flow), when the initial map was built.
+        solution.metrics.initial_distortion = Some(initial.distortion);
         Ok(solution)
     }
 }

@@ -72,7 +72,7 @@ fn disk_onto_disk_has_no_flips() {
     let map = initial_map(&source, &target, &[]).unwrap();
     assert_eq!(map.topology, Topology::Disk);
     check_on_target(&source, &target, &map);
-    assert_eq!(map.flipped, 0, "{:?}", map.notes);
+    assert_eq!(map.flipped(), 0, "{:?}", map.notes);
     // Boundary onto boundary.
     let index = SurfaceIndex::new(&target).unwrap();
     for v in source.vertices().filter(|&v| source.is_boundary_vertex(v)) {
@@ -93,7 +93,7 @@ fn bundled_hemisphere_onto_planar_disk() {
     let target = mesh(&primitives::disk(6));
     let map = initial_map(&source, &target, &[]).unwrap();
     check_on_target(&source, &target, &map);
-    assert_eq!(map.flipped, 0, "{:?}", map.notes);
+    assert_eq!(map.flipped(), 0, "{:?}", map.notes);
 }
 
 #[test]
@@ -116,7 +116,7 @@ fn disk_boundary_landmark_lands_exactly() {
     }];
     let map = initial_map(&source, &target, &landmarks).unwrap();
     check_on_target(&source, &target, &map);
-    assert_eq!(map.flipped, 0);
+    assert_eq!(map.flipped(), 0);
     assert_eq!(map.positions[s.idx()], target.position(t));
     // An interior source vertex cannot go onto the boundary.
     let inner = source
@@ -157,7 +157,11 @@ fn human_face_onto_hand() {
     check_on_target(&source, &target, &map);
     let _ = writeln!(std::io::stderr(), "face onto hand: {:?}", map.notes);
     // Real meshes: a handful of flips (reported in the notes) are tolerated.
-    assert!(map.flipped * 1000 <= source.face_count(), "{:?}", map.notes);
+    assert!(
+        map.flipped() * 1000 <= source.face_count(),
+        "{:?}",
+        map.notes
+    );
 }
 
 fn ellipsoid(level: usize) -> Mesh {
@@ -175,7 +179,7 @@ fn sphere_onto_ellipsoid_has_no_flips() {
     let map = initial_map(&source, &target, &[]).unwrap();
     assert_eq!(map.topology, Topology::Sphere);
     check_on_target(&source, &target, &map);
-    assert_eq!(map.flipped, 0, "{:?}", map.notes);
+    assert_eq!(map.flipped(), 0, "{:?}", map.notes);
 }
 
 #[test]
@@ -198,7 +202,7 @@ fn sphere_landmarks_land_exactly() {
             };
             assert_eq!(map.positions[l.source.idx()], target.position(t));
         }
-        assert_eq!(map.flipped, 0, "{count} landmarks: {:?}", map.notes);
+        assert_eq!(map.flipped(), 0, "{count} landmarks: {:?}", map.notes);
     }
     // A point target.
     let p = Point3::new(0.3, 0.9, 0.1);
@@ -242,19 +246,27 @@ fn spot_onto_bunny() {
     let _ = writeln!(
         std::io::stderr(),
         "spot onto bunny: {} flips; {:?}",
-        map.flipped,
+        map.flipped(),
         map.notes
     );
-    assert!(map.flipped * 500 <= source.face_count(), "{:?}", map.notes);
+    assert!(
+        map.flipped() * 500 <= source.face_count(),
+        "{:?}",
+        map.notes
+    );
     let sphere = mesh(&primitives::icosphere(4));
     let map = initial_map(&source, &sphere, &[]).unwrap();
     check_on_target(&source, &sphere, &map);
     let _ = writeln!(
         std::io::stderr(),
         "spot onto icosphere: {} flips",
-        map.flipped
+        map.flipped()
     );
-    assert!(map.flipped * 1000 <= source.face_count(), "{:?}", map.notes);
+    assert!(
+        map.flipped() * 1000 <= source.face_count(),
+        "{:?}",
+        map.notes
+    );
 }
 
 fn torus(nu: usize, nv: usize) -> Mesh {
@@ -269,7 +281,7 @@ fn torus_onto_modified_tori_has_no_flips_and_names_its_loops() {
         let map = initial_map(&source, &target, &[]).unwrap();
         assert_eq!(map.topology, Topology::Torus);
         check_on_target(&source, &target, &map);
-        assert_eq!(map.flipped, 0, "{:?}", map.notes);
+        assert_eq!(map.flipped(), 0, "{:?}", map.notes);
         // The loops: a around the tube on both (shortest paired with shortest).
         let loops: Vec<&String> = map.notes.iter().filter(|n| n.contains(" loop ")).collect();
         assert_eq!(loops.len(), 4, "{:?}", map.notes);
@@ -290,7 +302,7 @@ fn torus_landmarks_and_identity() {
         target: LandmarkTarget::Vertex(VertexId(0)),
     }];
     let map = initial_map(&m, &m, &landmarks).unwrap();
-    assert_eq!(map.flipped, 0);
+    assert_eq!(map.flipped(), 0);
     for v in m.vertices() {
         assert!(
             (map.positions[v.idx()] - m.position(v)).norm() < 1e-9,
@@ -311,7 +323,7 @@ fn torus_landmarks_and_identity() {
     let map = initial_map(&m, &target, &landmarks).unwrap();
     check_on_target(&m, &target, &map);
     assert_eq!(map.positions[3], target.position(VertexId(100)));
-    assert_eq!(map.flipped, 0, "{:?}", map.notes);
+    assert_eq!(map.flipped(), 0, "{:?}", map.notes);
 }
 
 #[test]
@@ -324,7 +336,11 @@ fn kitten_onto_modified_tori() {
         let map = initial_map(&source, &target, &[]).unwrap();
         check_on_target(&source, &target, &map);
         let _ = writeln!(std::io::stderr(), "kitten onto {kind:?}: {:?}", map.notes);
-        assert!(map.flipped * 1000 <= source.face_count(), "{:?}", map.notes);
+        assert!(
+            map.flipped() * 1000 <= source.face_count(),
+            "{:?}",
+            map.notes
+        );
     }
 }
 
