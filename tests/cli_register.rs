@@ -308,10 +308,10 @@ fn real_genus_zero_and_disk_pairs() {
 /// Registers `source` onto `target` (no assertion on the result), then measures the
 /// output with `beltrami distortion SOURCE OUT --target TARGET --json`: the flipped
 /// faces and the largest |mu| agree with the register report's final distortion.
-fn distortion_agrees_with_register(name: &str, source: &Path, target: &Path) {
+fn distortion_agrees_with_register(name: &str, source: &Path, target: &Path, extra: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let (out, report) = (dir.path().join("out.obj"), dir.path().join("report.json"));
-    let run = beltrami(&[
+    let mut args = vec![
         "register",
         s(source),
         s(target),
@@ -319,7 +319,9 @@ fn distortion_agrees_with_register(name: &str, source: &Path, target: &Path) {
         s(&out),
         "--report",
         s(&report),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let run = beltrami(&args);
     assert!(run.status.success(), "{}", text(&run.stderr));
     let registered = json(&report);
     let run = beltrami(&[
@@ -357,6 +359,7 @@ fn distortion_against_the_target_agrees_with_the_registration() {
         "spot onto blob",
         Path::new("meshes/spot.obj"),
         Path::new("meshes/blob.obj"),
+        &[],
     );
 }
 
@@ -373,7 +376,97 @@ fn distortion_against_the_target_agrees_with_a_registration_that_keeps_a_flip() 
         "disk_hemisphere onto disk_human_face",
         &shared.join("disk_hemisphere.obj"),
         &shared.join("disk_human_face.obj"),
+        &["--allow-flips"],
     );
+}
+
+#[test]
+fn a_registration_with_flips_fails_naming_them_unless_allowed() {
+    let Some(shared) = shared_meshes("a_registration_with_flips_fails_naming_them_unless_allowed")
+    else {
+        return;
+    };
+    // Coarse onto fine: faces of the hemisphere span folds of the face (nostrils). The
+    // promise is a bijection at exit 0; a flip that remains is an error naming the faces,
+    // and the map is written only with --allow-flips.
+    let (source, target) = (
+        shared.join("disk_hemisphere.obj"),
+        shared.join("disk_human_face.obj"),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (out, report) = (dir.path().join("out.obj"), dir.path().join("report.json"));
+    let args = |extra: &'static [&'static str]| {
+        let mut args = vec![
+            "register".to_string(),
+            s(&source).to_string(),
+            s(&target).to_string(),
+            "-o".to_string(),
+            s(&out).to_string(),
+            "--report".to_string(),
+            s(&report).to_string(),
+        ];
+        args.extend(extra.iter().map(|a| a.to_string()));
+        args
+    };
+    let strict: Vec<String> = args(&[]);
+    let run = beltrami(&strict.iter().map(String::as_str).collect::<Vec<_>>());
+    if run.status.success() {
+        assert_eq!(json(&report)["flipped"], 0, "exit 0 promises no flip");
+        return;
+    }
+    let message = text(&run.stderr);
+    assert!(message.contains("flipped on the target"), "{message}");
+    assert!(message.contains("input indices"), "{message}");
+    assert!(message.contains("--allow-flips"), "{message}");
+    assert_eq!(
+        message.matches("flipped on the target").count(),
+        1,
+        "{message}"
+    );
+    assert!(!out.exists(), "a failed registration writes no map");
+    let allowed: Vec<String> = args(&["--allow-flips"]);
+    let run = beltrami(&allowed.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let r = json(&report);
+    assert!(r["flipped"].as_u64().unwrap() > 0, "{r}");
+    let notes = r["notes"].to_string();
+    assert!(notes.contains("kept as asked"), "{notes}");
+    assert!(out.exists());
+}
+
+#[test]
+fn coarse_and_fine_generated_disks_both_ways() {
+    // Nothing pins a disk sliding on a target mesh's boundary: the flow's normal
+    // equations are singular along the disk's Moebius motions unless damped.
+    let dir = tempfile::tempdir().unwrap();
+    let (coarse, fine) = (dir.path().join("d2.obj"), dir.path().join("d3.obj"));
+    for (level, path) in [("2", &coarse), ("3", &fine)] {
+        let run = beltrami(&["generate", "disk", "--level", level, "-o", s(path), "-q"]);
+        assert!(run.status.success(), "{}", text(&run.stderr));
+    }
+    for (source, target) in [(&coarse, &fine), (&fine, &coarse)] {
+        let out = dir.path().join("out.obj");
+        let report = dir.path().join("report.json");
+        let run = beltrami(&[
+            "register",
+            s(source),
+            s(target),
+            "-o",
+            s(&out),
+            "--report",
+            s(&report),
+        ]);
+        assert!(run.status.success(), "{}", text(&run.stderr));
+        let r = json(&report);
+        assert_eq!(r["flipped"], 0, "{r}");
+        let mean = r["mu_mean"].as_f64().unwrap();
+        assert!(mean < 0.05, "{}: mean |mu| {mean}", s(source));
+        let target_mesh = read(target);
+        let index = SurfaceIndex::new(&target_mesh).unwrap();
+        for p in read(&out).positions() {
+            assert!(index.locate(p).unwrap().distance < 1e-9);
+        }
+    }
 }
 
 #[test]

@@ -41,6 +41,10 @@ pub struct RegisterArgs {
     /// Threads for the sparse factorizations [default: 1].
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Write the map even if flipped faces remain after the flow (they are named in the
+    /// notes); without it such a registration fails, naming them, and writes nothing.
+    #[arg(long = "allow-flips")]
+    pub allow_flips: bool,
     /// Output mesh: the source's vertices and faces, every vertex at its image on the
     /// target (so `beltrami distortion SOURCE OUT` measures the map).
     #[arg(short, long)]
@@ -87,6 +91,11 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
                 Some(OptionValue::Int(100)),
             ),
             ("threads", args.threads.map(OptionValue::Int), None),
+            (
+                "allow-flips",
+                args.allow_flips.then_some(OptionValue::Bool(true)),
+                None,
+            ),
         ],
         &args.common,
     );

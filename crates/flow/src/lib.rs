@@ -31,6 +31,7 @@ mod run;
 mod setup;
 pub mod system;
 pub mod target;
+pub mod untangle;
 mod validate;
 
 pub use run::{ACCEPTS, OPTIONS, solve};

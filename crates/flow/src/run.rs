@@ -13,11 +13,12 @@ use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
 use crate::flow::{self, FlowOptions, FlowRun, Stop};
-use crate::measure::Objective;
+use crate::measure::{ImageFace, Objective};
 use crate::mesh_target::MeshTarget;
 use crate::setup::{Domain, curve_roles, diagonal, domain, goals, mesh_roles, pins, region_roles};
 use crate::system::FlowSystem;
 use crate::target::{INNER, OUTER, Role, TargetGeometry};
+use crate::untangle::untangle;
 use crate::validate::{invalid, validate};
 
 /// The flow's options.
@@ -158,14 +159,46 @@ pub fn solve(
         let (curves, roles) = mesh_roles(problem, target, &initial, &pins)?;
         let geometry = MeshTarget::new(&index, curves);
         let scale = diagonal(target.positions());
-        let run = runner.run(
+        let mut run = runner.run(
             geometry.clone(),
-            roles,
+            roles.clone(),
             initial,
             scale,
             context,
             (&mut report, &mut metrics),
         )?;
+        for _ in 0..UNTANGLE_RESTARTS {
+            if !run.faces.iter().any(ImageFace::flipped) || context.is_cancelled() {
+                break;
+            }
+            let mut image = run.image.clone();
+            let mut normals: Vec<_> = image.iter().map(|p| geometry.normal(p)).collect();
+            let mut faces = run.faces.clone();
+            let done = untangle(
+                &elements,
+                &geometry,
+                &roles,
+                &mut image,
+                &mut normals,
+                &mut faces,
+                UNTANGLE_ROUNDS,
+            );
+            report.notes.push(format!(
+                "untangled {} flipped faces to {} by moving {} vertices into the kernels of their stars",
+                done.before, done.after, done.moves
+            ));
+            if done.after >= done.before {
+                break;
+            }
+            run = runner.run(
+                geometry.clone(),
+                roles.clone(),
+                image,
+                scale,
+                context,
+                (&mut report, &mut metrics),
+            )?;
+        }
         let points = geometry.locate_all(&run.image)?;
         let (_, faces_mu, flipped) = run.finish(false);
         return finish_solution(
@@ -258,6 +291,18 @@ fn finish_solution(
     })
 }
 
+/// The relative damping of flows on a target mesh ([`FlowSystem::set_damping`]): there
+/// nothing the user can pin fixes the target's conformal automorphisms (registration
+/// gives no default pins), and a step along them must stay finite.
+const MESH_DAMPING: f64 = 1e-9;
+
+/// How often flips left by the flow on a target mesh are untangled
+/// ([`crate::untangle`]) and the flow restarted.
+const UNTANGLE_RESTARTS: usize = 3;
+
+/// Rounds of one untangling.
+const UNTANGLE_ROUNDS: usize = 8;
+
 /// What every flow run of one solve shares.
 struct Runner<'a, 'p> {
     elements: &'a Elements,
@@ -289,6 +334,9 @@ impl Runner<'_, '_> {
         let mut system = context.stage("symbolic", report, || {
             FlowSystem::new(elements, &target, &image, roles, options)
         })?;
+        if matches!(problem.target, Target::Mesh(_)) {
+            system.set_damping(MESH_DAMPING);
+        }
         let flow_options = FlowOptions {
             tolerance: settings.float("tolerance") * scale,
             max_iterations: settings.int("max-iters"),
@@ -324,11 +372,12 @@ impl Runner<'_, '_> {
         report
             .timings
             .push(("flow: steps".into(), run.step_seconds));
-        metrics.iterations = run.iterations();
-        metrics.factorizations = Some(run.factorizations);
-        metrics.cg_iterations = Some(run.cg_iterations);
-        metrics.energy_history = run.energy_history.clone();
-        metrics.step_sizes = run.step_sizes.clone();
+        // A restarted flow (after untangling) continues the history of the first.
+        metrics.iterations += run.iterations();
+        metrics.factorizations = Some(metrics.factorizations.unwrap_or(0) + run.factorizations);
+        metrics.cg_iterations = Some(metrics.cg_iterations.unwrap_or(0) + run.cg_iterations);
+        metrics.energy_history.extend(&run.energy_history);
+        metrics.step_sizes.extend(&run.step_sizes);
         metrics.stop = Some(match run.stop {
             Stop::Converged => beltrami_core::Stop::Converged {
                 tolerance: flow_options.tolerance,

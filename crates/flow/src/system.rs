@@ -97,6 +97,10 @@ pub struct FlowSystem {
     cg_iterations: usize,
     /// Whether a fixed vertex has a nonzero prescribed flow (an origin of the map).
     prescribed: bool,
+    /// Per unknown, the index of its diagonal entry in the matrix's values.
+    diagonal: Vec<usize>,
+    /// The damping `lambda / mean(diag)` of [`FlowSystem::set_damping`] (zero: none).
+    damping: f64,
 }
 
 /// Relative residual at which a step solved by conjugate gradients with a kept
@@ -219,8 +223,11 @@ impl FlowSystem {
             term_ptr.push(face_terms.len());
         }
         let longest = local_ptr.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0);
+        let faces_end = positions.len();
+        positions.extend((0..n).map(|i| (i, i)));
         let pattern = Pattern::new(n, n, &positions)?;
-        let slots = pattern.value_slots(&positions)?;
+        let mut slots = pattern.value_slots(&positions)?;
+        let diagonal = slots.split_off(faces_end);
         let matrix = pattern.assemble(&vec![0.0; positions.len()])?;
         let order = block_order(&faces, &dofs)?;
         let solver = SpdSolver::with_order(pattern.symbolic().as_ref(), &order, options)?;
@@ -245,7 +252,21 @@ impl FlowSystem {
             factorizations: 0,
             cg_iterations: 0,
             prescribed: false,
+            diagonal,
+            damping: 0.0,
         })
+    }
+
+    /// Damps every later solve: the step minimizes `E_V(c) + lambda |c|^2` with
+    /// `lambda = relative * mean(diag)` of the normal matrix, a Levenberg-Marquardt
+    /// step. It makes the normal equations definite when nothing fixes the target's
+    /// conformal automorphisms (a disk sliding on a target mesh's boundary with no pin:
+    /// its Moebius motions have `V_zbar ~ 0` and a singular or indefinite matrix in
+    /// rounding), and picks the step of least length along them. A fixed point of the
+    /// flow does not move: the damped step vanishes exactly where the undamped one does
+    /// (both where the right-hand side does).
+    pub fn set_damping(&mut self, relative: f64) {
+        self.damping = relative;
     }
 
     /// Sets the known flow of fixed vertices (one vector per vertex, read at
@@ -326,6 +347,14 @@ impl FlowSystem {
                     values[self.slots[at]] += w * (beta[a].conj() * beta[b]).re;
                     at += 1;
                 }
+            }
+        }
+        if self.damping > 0.0 {
+            let mean =
+                self.diagonal.iter().map(|&d| values[d]).sum::<f64>() / self.diagonal.len() as f64;
+            let lambda = self.damping * mean;
+            for &d in &self.diagonal {
+                values[d] += lambda;
             }
         }
         self.solve_normal_equations()?;

@@ -124,3 +124,36 @@ pub(crate) fn distortion(
     let measured = measure_surface(source, positions, ReferenceNormal::PerFace(&normals))?;
     Ok(measured.stats)
 }
+
+/// The source faces whose image is flipped against the target's normals (the rule of
+/// [`distortion`]), each with the largest angle in degrees between the target's face
+/// normals at its corners' images: near 180 when the face's corners land on the two
+/// sides of a fold of the target that is finer than the source face.
+pub(crate) fn flipped_faces(
+    source: &Mesh,
+    target_index: &SurfaceIndex<'_>,
+    points: &[SurfacePoint],
+    positions: &[Point3<f64>],
+) -> Result<Vec<(FaceId, f64)>, RegisterError> {
+    let normals = target_index.face_reference_normals(source, points)?;
+    let measured = measure_surface(source, positions, ReferenceNormal::PerFace(&normals))?;
+    let target = target_index.mesh();
+    Ok(source
+        .faces()
+        .zip(&measured.flipped)
+        .filter(|&(_, &flipped)| flipped)
+        .map(|(f, _)| {
+            let corners: Vec<_> = source
+                .face_vertices(f)
+                .map(|v| target.face_normal(points[v.idx()].face))
+                .collect();
+            let mut widest: f64 = 0.0;
+            for (i, a) in corners.iter().enumerate() {
+                for b in &corners[i + 1..] {
+                    widest = widest.max(a.angle(b).to_degrees());
+                }
+            }
+            (f, widest)
+        })
+        .collect())
+}

@@ -125,4 +125,17 @@ pub enum RegisterError {
     /// Measuring the initial map failed (a degenerate source face).
     #[error("measuring the initial map: {0}")]
     Measure(#[from] FemError),
+    /// Flipped faces remain after the flow and its untangling, and the solve was not
+    /// asked to allow them.
+    #[error(
+        "{count} source faces are flipped on the target after the flow (input indices {faces}); {why}. Refine the source where they are, add landmarks, or allow the flips (`--allow-flips`, option `allow-flips`) to keep the map"
+    )]
+    Flipped {
+        /// How many faces are flipped.
+        count: usize,
+        /// The first of them (input indices), as a list.
+        faces: String,
+        /// Why, from the target's normals at the faces' corners.
+        why: String,
+    },
 }

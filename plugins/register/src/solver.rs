@@ -1,11 +1,16 @@
 //! [`Register`]: the solver behind `beltrami register` (crate docs).
 
-use beltrami_core::{
-    Accepts, ConstraintKind, Context, Element, GoalKind, Map, OptionSpec, Position, Problem,
-    Report, Settings, Solution, Solver, SolverError, Target, TargetKind, Topology,
-};
+use std::sync::LazyLock;
 
-use crate::{Landmark, LandmarkTarget, check_topology, initial_map};
+use beltrami_core::{
+    Accepts, ConstraintKind, Context, Element, GoalKind, Map, OptionKind, OptionSpec, Position,
+    Problem, Report, Settings, Solution, Solver, SolverError, Target, TargetKind, Topology,
+};
+use beltrami_mesh::{Mesh, Point3, SurfacePoint};
+use beltrami_spatial::SurfaceIndex;
+
+use crate::compose::flipped_faces;
+use crate::{Landmark, LandmarkTarget, RegisterError, check_topology, initial_map};
 
 /// Surface registration: the initial bijection of [`initial_map`] (through a common
 /// parameter domain chosen by the topology, aligned by the landmarks), then the discrete
@@ -17,6 +22,10 @@ use crate::{Landmark, LandmarkTarget, check_topology, initial_map};
 /// fixed, sliding between), and the flow's options. The map is `Map::OnMesh`. The
 /// metrics have the initial map's `|mu|` statistics and the flow's history; the notes
 /// the loops cut along and the alignment.
+///
+/// A registration promises a bijection: when flipped faces remain after the flow and
+/// its untangling, the solve fails with [`RegisterError::Flipped`] naming them and
+/// why, unless the option `allow-flips` is set (then the notes name them).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Register;
 
@@ -33,6 +42,76 @@ const ACCEPTS: Accepts = Accepts {
     ],
     constraints: &[ConstraintKind::Landmark, ConstraintKind::OpenCurve],
 };
+
+/// The flow's options and `allow-flips`.
+static OPTIONS: LazyLock<Vec<OptionSpec>> = LazyLock::new(|| {
+    let mut options = beltrami_flow_engine::OPTIONS.to_vec();
+    options.push(OptionSpec {
+        name: "allow-flips",
+        kind: OptionKind::Bool { default: false },
+        help: "keep a map that still has flipped faces after the flow (they are named in the notes) instead of failing",
+    });
+    options
+});
+
+/// Most flipped faces named in an error or a note.
+const NAMED_FLIPS: usize = 10;
+
+/// The flipped faces of the map `points` (with `positions`) of `source` on the target
+/// of `index`, as an error, or as a note when `allowed`.
+fn judge_flips(
+    source: &Mesh,
+    index: &SurfaceIndex<'_>,
+    points: &[SurfacePoint],
+    positions: &[Point3<f64>],
+    allowed: bool,
+    report: &mut Report,
+) -> Result<(), RegisterError> {
+    let flipped = flipped_faces(source, index, points, positions)?;
+    if flipped.is_empty() {
+        return Ok(());
+    }
+    let names: Vec<String> = flipped
+        .iter()
+        .take(NAMED_FLIPS)
+        .map(|&(f, _)| source.face_to_input(f).to_string())
+        .collect();
+    let more = if flipped.len() > NAMED_FLIPS {
+        ", .."
+    } else {
+        ""
+    };
+    let folds = flipped
+        .iter()
+        .filter(|&&(_, angle)| angle > FOLD_DEGREES)
+        .count();
+    let widest = flipped.iter().map(|&(_, a)| a).fold(0.0, f64::max);
+    let why = if folds > 0 {
+        format!(
+            "{folds} of them have corners on target faces whose normals differ by more than {FOLD_DEGREES} degrees (up to {widest:.0}): the target folds within one source face there, finer than the source resolves"
+        )
+    } else {
+        format!(
+            "the target's normals at their corners differ by at most {widest:.0} degrees: the flow found no step that removes them"
+        )
+    };
+    let error = RegisterError::Flipped {
+        count: flipped.len(),
+        faces: format!("{}{more}", names.join(", ")),
+        why,
+    };
+    if allowed {
+        report
+            .notes
+            .push(format!("kept as asked (allow-flips): {error}"));
+        Ok(())
+    } else {
+        Err(error)
+    }
+}
+
+/// Corners whose target normals differ by more than this lie across a fold.
+const FOLD_DEGREES: f64 = 90.0;
 
 fn unsupported(message: impl Into<String>) -> SolverError {
     SolverError::Unsupported {
@@ -73,7 +152,7 @@ impl Solver for Register {
     }
 
     fn options(&self) -> &'static [OptionSpec] {
-        beltrami_flow_engine::OPTIONS
+        &OPTIONS
     }
 
     fn check_problem(
@@ -124,6 +203,25 @@ impl Solver for Register {
         // Judged against the target's normals at the images (the rule of `beltrami
         // distortion --target` and of the flow), when the initial map was built.
         solution.metrics.initial_distortion = Some(initial.distortion);
+        if solution.metrics.flipped().unwrap_or(0) > 0
+            && let Some(Map::OnMesh(points)) = solution.map().cloned()
+        {
+            let plugin = |error: RegisterError| SolverError::Plugin {
+                solver: NAME,
+                error: Box::new(error),
+            };
+            let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
+            let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
+            judge_flips(
+                source,
+                &index,
+                &points,
+                &positions,
+                settings.flag("allow-flips"),
+                &mut solution.report,
+            )
+            .map_err(plugin)?;
+        }
         Ok(solution)
     }
 }
