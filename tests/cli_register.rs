@@ -525,3 +525,42 @@ fn spot_onto_a_sphere_mesh() {
         assert!(p.coords.norm() <= 1.0 + 1e-12 && p.coords.norm() > 0.9);
     }
 }
+
+#[test]
+fn contradictory_landmarks_and_curves_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let disk = dir.path().join("d3.obj");
+    let run = beltrami(&["generate", "disk", "--level", "3", "-o", s(&disk), "-q"]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let cases = [
+        // Two source vertices onto one target vertex.
+        ("v 0 5\nv 1 5\n", "same target point as landmark 0"),
+        // A point nowhere near the unit disk.
+        ("p 0 100 100 100\n", "from the target, more than 5%"),
+        // Disjoint source chains onto target chains that cross at vertex 11.
+        (
+            "c 0,1,2 10,11,12\nc 5,6,7 20,11,21\n",
+            "feature curves 0 and 1 meet at target vertex v11 but not on the source",
+        ),
+    ];
+    for (landmarks, expected) in cases {
+        let file = dir.path().join("landmarks.txt");
+        std::fs::write(&file, landmarks).unwrap();
+        let out = dir.path().join("out.obj");
+        let run = beltrami(&[
+            "register",
+            s(&disk),
+            s(&disk),
+            "-o",
+            s(&out),
+            "--landmarks",
+            s(&file),
+            "--progress-lines",
+        ]);
+        let message = text(&run.stderr);
+        assert!(!run.status.success(), "{landmarks:?} was accepted");
+        assert!(message.contains(expected), "{landmarks:?}: {message}");
+        assert!(!message.contains("initial map"), "work started: {message}");
+        assert!(!out.exists());
+    }
+}

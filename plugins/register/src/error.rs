@@ -125,6 +125,22 @@ pub enum RegisterError {
     /// Measuring the initial map failed (a degenerate source face).
     #[error("measuring the initial map: {0}")]
     Measure(#[from] FemError),
+    /// Two feature curves that meet on one mesh and not on the other.
+    #[error(
+        "feature curves {first} and {second} meet at {side} vertex {vertex} but not on the {other}: a bijection maps meeting curves to meeting curves"
+    )]
+    Curves {
+        /// The first curve (index among the curves).
+        first: usize,
+        /// The second curve.
+        second: usize,
+        /// The mesh on which they meet.
+        side: &'static str,
+        /// A vertex on both.
+        vertex: VertexId,
+        /// The mesh on which they do not.
+        other: &'static str,
+    },
     /// Flipped faces remain after the flow and its untangling, and the solve was not
     /// asked to allow them.
     #[error(

@@ -174,6 +174,10 @@ impl Solver for Register {
             }
         }
         landmarks(problem)?;
+        crate::consistency::check(problem, target).map_err(|error| SolverError::Plugin {
+            solver: NAME,
+            error: Box::new(error),
+        })?;
         Ok(())
     }
 
