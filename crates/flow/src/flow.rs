@@ -31,7 +31,9 @@
 //!    `Y' = P(Y + t V)` (each vertex projected back onto the target by its role) has no
 //!    more flipped faces than `Y` and a smaller `E`.
 //! 4. Stop when the largest vertex update `t max_i |V_i|` is below the tolerance, or no
-//!    step above it decreases `E`, or the iteration limit is reached, or the solve is
+//!    step above it decreases `E`, or (conformal goals, whose `E` has the near-fold
+//!    barrier) `E` fell by less than [`FLAT_DECREASE`] of itself over the last
+//!    [`FLAT_STEPS`] steps, or the iteration limit is reached, or the solve is
 //!    cancelled (the map so far is returned; every accepted step decreased `E`, so it is
 //!    the best one seen).
 
@@ -51,6 +53,14 @@ use crate::target::{Role, TargetGeometry};
 /// already conformal keep a positive weight.
 const MU_FLOOR: f64 = 1e-3;
 
+/// Accepted steps over which a negligible decrease of the error ends the flow.
+pub const FLAT_STEPS: usize = 5;
+
+/// The relative decrease of the error over [`FLAT_STEPS`] steps below which the flow
+/// ends: near the minimum the near-fold barrier's large weights make the Gauss-Newton
+/// steps tiny, and they would otherwise run to the iteration limit.
+pub const FLAT_DECREASE: f64 = 1e-5;
+
 /// How the iteration ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stop {
@@ -58,6 +68,9 @@ pub enum Stop {
     Converged,
     /// No step above the tolerance decreased the error.
     Stalled,
+    /// The error (with the near-fold barrier: conformal goals only) fell by less than
+    /// [`FLAT_DECREASE`] of itself over the last [`FLAT_STEPS`] accepted steps.
+    Flat,
     /// The iteration limit was reached.
     IterationLimit,
     /// Cancellation was requested.
@@ -140,7 +153,7 @@ fn weights_and_targets(
             1.0
         } else {
             mu.norm().max(MU_FLOOR).powf(objective.p - 2.0)
-        };
+        } + objective.barrier_weight(mu.norm());
         weights.push(objective.areas[f] * shrink * shrink * reweight);
         // 1 / theta = f_z / conj(f_z).
         rho.push(-error * fz / (shrink * fz.conj()));
@@ -315,6 +328,13 @@ pub fn run<G: TargetGeometry>(
         report(context, iteration + 1, energy);
         if t * largest < options.tolerance {
             stop = Stop::Converged;
+            break;
+        }
+        if objective.has_barrier()
+            && let Some(&before) = energy_history.iter().rev().nth(FLAT_STEPS)
+            && before - energy <= FLAT_DECREASE * before
+        {
+            stop = Stop::Flat;
             break;
         }
     }

@@ -127,8 +127,23 @@ pub fn image_faces(
     );
 }
 
+/// `|mu|` above which the near-fold barrier of [`Objective`] acts.
+pub const BARRIER_START: f64 = 0.8;
+
 /// What the flow decreases: `E = sum_T A_T |mu_T - sigma_T|^p` over the source faces
-/// (areas `A_T`), with `sigma = 0` for the conformal goals.
+/// (areas `A_T`), with `sigma = 0` for the conformal goals, plus for those the near-fold
+/// barrier
+///
+/// ```text
+/// B = sum_T A_T b(|mu_T|),    b(m) = ((m - m0) / (1 - m))^2  for m0 < m < 1, else 0,
+/// ```
+///
+/// with `m0` = [`BARRIER_START`]. A face near `|mu| = 1` is a near-fold (its image
+/// nearly collapses onto a segment); an area-weighted `|mu|^p` alone lets the flow drive
+/// a sliver there, since the sliver's area is tiny and the Gauss-Newton weight
+/// `(1 - |mu|^2)^2` of [`crate::flow`] vanishes at the fold. `b` grows without bound at
+/// the fold and is zero on the faces an ordinary map has (a flipped face, `|mu| > 1`, is
+/// kept from multiplying by the flip count of the step search instead).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Objective {
     /// Source face areas.
@@ -139,6 +154,16 @@ pub struct Objective {
     pub p: f64,
 }
 
+/// The near-fold barrier `b(m)` of [`Objective`].
+fn barrier(m: f64) -> f64 {
+    if m > BARRIER_START && m < 1.0 {
+        let b = (m - BARRIER_START) / (1.0 - m);
+        b * b
+    } else {
+        0.0
+    }
+}
+
 impl Objective {
     /// The target coefficient of face `f`.
     #[inline]
@@ -146,15 +171,71 @@ impl Objective {
         self.sigma.as_ref().map_or(Complex64::default(), |s| s[f])
     }
 
-    /// `E` and the number of flipped faces of `faces`.
+    /// Whether the near-fold barrier is part of `E` (the conformal goals).
+    pub fn has_barrier(&self) -> bool {
+        self.sigma.is_none()
+    }
+
+    /// The barrier's Gauss-Newton weight at `|mu| = m`: `b'(m) / (2 m)`, the factor by
+    /// which the face's `|mu|^2` term must be weighted for its gradient to include the
+    /// barrier's (iteratively reweighted least squares, as for `p > 2`); zero where the
+    /// barrier is.
+    pub fn barrier_weight(&self, m: f64) -> f64 {
+        if !(self.has_barrier() && m > BARRIER_START && m < 1.0) {
+            return 0.0;
+        }
+        let gap = 1.0 - m;
+        (m - BARRIER_START) * (1.0 - BARRIER_START) / (m * gap * gap * gap)
+    }
+
+    /// `E` (with the barrier for the conformal goals) and the number of flipped faces of
+    /// `faces`.
     pub fn evaluate(&self, faces: &[ImageFace]) -> (f64, usize) {
         let mut energy = 0.0;
         let mut flipped = 0;
         for (f, face) in faces.iter().enumerate() {
             let d = (face.mu() - self.sigma(f)).norm();
-            energy += self.areas[f] * if self.p == 2.0 { d * d } else { d.powf(self.p) };
+            let mut e = if self.p == 2.0 { d * d } else { d.powf(self.p) };
+            if self.has_barrier() {
+                e += barrier(d);
+            }
+            energy += self.areas[f] * e;
             flipped += usize::from(face.flipped());
         }
         (energy, flipped)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_barrier_weight_is_the_barriers_gauss_newton_weight() {
+        let objective = Objective {
+            areas: vec![1.0],
+            sigma: None,
+            p: 2.0,
+        };
+        // b'(m) / (2 m) by central differences.
+        for m in [0.81, 0.85, 0.9, 0.95, 0.99, 0.999] {
+            let h = 1e-7 * (1.0 - m);
+            let slope = (barrier(m + h) - barrier(m - h)) / (2.0 * h);
+            let expected = slope / (2.0 * m);
+            let got = objective.barrier_weight(m);
+            assert!(
+                (got - expected).abs() <= 1e-6 * expected,
+                "m = {m}: {got} vs {expected}"
+            );
+        }
+        for m in [0.0, 0.5, BARRIER_START, 1.0, 1.5] {
+            assert_eq!(objective.barrier_weight(m), 0.0);
+            assert_eq!(barrier(m), 0.0);
+        }
+        let prescribed = Objective {
+            sigma: Some(vec![Complex64::default()]),
+            ..objective
+        };
+        assert_eq!(prescribed.barrier_weight(0.95), 0.0);
     }
 }

@@ -382,7 +382,7 @@ impl Runner<'_, '_> {
             Stop::Converged => beltrami_core::Stop::Converged {
                 tolerance: flow_options.tolerance,
             },
-            Stop::Stalled => beltrami_core::Stop::Stalled,
+            Stop::Stalled | Stop::Flat => beltrami_core::Stop::Stalled,
             Stop::IterationLimit => beltrami_core::Stop::IterationLimit,
             Stop::Cancelled => beltrami_core::Stop::Cancelled,
         });
@@ -395,6 +395,12 @@ impl Runner<'_, '_> {
         Stop::Stalled => format!(
             "stopped after {} iterations: no step above the tolerance decreased the error further",
             run.iterations()
+        ),
+        Stop::Flat => format!(
+            "stopped after {} iterations: the error fell by less than {:.0e} of itself over the last {} steps",
+            run.iterations(),
+            crate::flow::FLAT_DECREASE,
+            crate::flow::FLAT_STEPS
         ),
         Stop::IterationLimit => format!(
             "stopped at the iteration limit ({}) before converging",
