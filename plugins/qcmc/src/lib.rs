@@ -12,8 +12,11 @@
 //! freely, boundary vertices slide tangentially along their circles (eq. 13-14) and each
 //! inner circle's centre and radius move with its vertices (eq. 17); put the boundary
 //! back onto the moved circles (eq. 15-16); stop when nothing moves more than the
-//! tolerance. Each step takes the largest of `1, 1/2, 1/4, ...` that lowers the energy
-//! and keeps the circles apart and inside the unit disk (the paper takes full steps).
+//! tolerance. Each step takes the largest of `1, 1/2, 1/4, ...` that lowers the energy,
+//! keeps the circles apart and inside the unit disk and flips no more triangles than the
+//! map had (the paper takes full steps; the least-squares optimum of a coarse loop can
+//! fold two boundary vertices past each other, which this forbids: the start is a
+//! bijection, and so is every iterate).
 //!
 //! Normalization of the Moebius freedom (the three real parameters of the disk's
 //! automorphisms, [`moebius`]): the outer loop is the unit circle, the first inner

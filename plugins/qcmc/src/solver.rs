@@ -120,6 +120,14 @@ impl Solver for Qcmc {
         let mu = &field.mu;
         let mut energy = StepSystem::energy(&elements, mu, &state.map);
         metrics.energy_history.push(energy);
+        let triangles: Vec<[usize; 3]> = mesh
+            .faces()
+            .map(|f| {
+                let (v, _) = mesh.face_vertex_array(f);
+                [v[0].idx(), v[1].idx(), v[2].idx()]
+            })
+            .collect();
+        let mut flips = flipped(&triangles, &state.map);
         let iterate = std::time::Instant::now();
         let mut factorizations = 0;
         let stop = loop {
@@ -135,7 +143,7 @@ impl Solver for Qcmc {
             let mut accepted = None;
             for _ in 0..=HALVINGS {
                 let trial = step.apply(&state, t, system.loop_of());
-                if admissible(&trial) {
+                if admissible(&trial) && flipped(&triangles, &trial.map) <= flips {
                     let e = StepSystem::energy(&elements, mu, &trial.map);
                     if e < energy {
                         accepted = Some((trial, e));
@@ -148,6 +156,7 @@ impl Solver for Qcmc {
                 break Stop::Stalled;
             };
             let moved = largest_move(&state, &trial);
+            flips = flipped(&triangles, &trial.map);
             state = trial;
             energy = e;
             metrics.iterations += 1;
@@ -274,6 +283,15 @@ fn admissible(state: &CircleMap) -> bool {
                 .iter()
                 .all(|d| (c.center - d.center).norm() > c.radius + d.radius)
     }) && state.map.iter().all(|z| z.is_finite())
+}
+
+/// Number of triangles whose image turns clockwise (negative signed area): the flips a
+/// step may not add to.
+fn flipped(triangles: &[[usize; 3]], map: &[num_complex::Complex64]) -> usize {
+    triangles
+        .iter()
+        .filter(|[a, b, c]| ((map[*b] - map[*a]).conj() * (map[*c] - map[*a])).im <= 0.0)
+        .count()
 }
 
 /// The largest move of a vertex, centre or radius between two states.
