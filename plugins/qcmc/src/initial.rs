@@ -98,6 +98,19 @@ pub struct CircleMap {
     pub circles: Vec<PlaneCircle>,
 }
 
+impl CircleMap {
+    /// The mirror image `z -> conj(z)` of the map and its circles (the normalization is
+    /// kept: the first inner circle stays centred and `1` stays at `1`).
+    pub fn mirror(&mut self) {
+        for z in &mut self.map {
+            *z = z.conj();
+        }
+        for c in &mut self.circles {
+            c.center = c.center.conj();
+        }
+    }
+}
+
 /// The unit circle.
 pub const UNIT: PlaneCircle = PlaneCircle {
     center: Complex64::new(0.0, 0.0),

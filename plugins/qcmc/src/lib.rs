@@ -24,9 +24,11 @@
 //! centred at 0, and the first vertex of the outer loop is at `1`. The report states the
 //! loop and vertex. For `k = 2` the domain is the concentric annulus `r < |z| < 1`.
 //!
-//! Conventions: `mu = f_zbar / f_z` in the frame of the field (global for a planar mesh,
-//! the face frames on a surface); the outer loop is traversed counter-clockwise by the
-//! map.
+//! Conventions: `mu = f_zbar / f_z` in the frame of the field (the face frames, or the
+//! global frame `z = x + i y` of a mesh in the plane z = 0), and the map preserves the
+//! orientation of that frame: in face frames each image triangle turns like its face
+//! seen from the normal side; in the global frame like the face in the plane (a mesh
+//! listed clockwise in the plane keeps its clockwise turn, and its start is mirrored).
 
 pub mod initial;
 pub mod moebius;

@@ -112,7 +112,6 @@ impl Solver for Qcmc {
             let state = initial_map(mesh, &loops, options)?;
             Ok((elements, state))
         })?;
-        metrics.initial_distortion = Some(measure(mesh, &elements, &state.map)?.stats);
         let mut system = context.stage("assembly", &mut report, || {
             StepSystem::new(&elements, mesh.vertex_count(), &loops, held, options)
         })?;
@@ -120,13 +119,25 @@ impl Solver for Qcmc {
         let mu = &field.mu;
         let mut energy = StepSystem::energy(&elements, mu, &state.map);
         metrics.energy_history.push(energy);
-        let triangles: Vec<[usize; 3]> = mesh
+        // Which way each image triangle must turn: along the face's own orientation
+        // (face frames), or along the source's own turn in the plane (global frame).
+        let triangles: Vec<([usize; 3], f64)> = mesh
             .faces()
             .map(|f| {
                 let (v, _) = mesh.face_vertex_array(f);
-                [v[0].idx(), v[1].idx(), v[2].idx()]
+                let sign = match field.frame {
+                    Frame::Global => mesh.face_vector_area(f).z.signum(),
+                    Frame::Face => 1.0,
+                };
+                ([v[0].idx(), v[1].idx(), v[2].idx()], sign)
             })
             .collect();
+        if triangles.iter().map(|(_, s)| s).sum::<f64>() < 0.0 {
+            // A planar mesh listed clockwise with a field in the global frame: the start
+            // follows the faces' orientation, the energy the plane's; mirror the start.
+            state.mirror();
+        }
+        metrics.initial_distortion = Some(measure(mesh, &elements, &state.map)?.stats);
         let mut flips = flipped(&triangles, &state.map);
         let iterate = std::time::Instant::now();
         let mut factorizations = 0;
@@ -285,12 +296,14 @@ fn admissible(state: &CircleMap) -> bool {
     }) && state.map.iter().all(|z| z.is_finite())
 }
 
-/// Number of triangles whose image turns clockwise (negative signed area): the flips a
-/// step may not add to.
-fn flipped(triangles: &[[usize; 3]], map: &[num_complex::Complex64]) -> usize {
+/// Number of triangles whose image turns against their sign (`+1`: counter-clockwise,
+/// positive signed area): the flips a step may not add to.
+fn flipped(triangles: &[([usize; 3], f64)], map: &[num_complex::Complex64]) -> usize {
     triangles
         .iter()
-        .filter(|[a, b, c]| ((map[*b] - map[*a]).conj() * (map[*c] - map[*a])).im <= 0.0)
+        .filter(|([a, b, c], sign)| {
+            sign * ((map[*b] - map[*a]).conj() * (map[*c] - map[*a])).im <= 0.0
+        })
         .count()
 }
 
