@@ -137,3 +137,57 @@ fn outer_picks_the_loop_on_the_unit_circle() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn qcmc_and_the_flow_find_the_same_annulus_for_a_prescribed_mu() {
+    // k = 2 is the flow's annulus with a free inner radius: for mu = 0.3 z on the annulus
+    // 0.4 <= |z| <= 1 (no closed form), the two methods must agree on the radius, closer
+    // and closer under refinement.
+    let dir = tempfile::tempdir().unwrap();
+    let mut gaps = Vec::new();
+    for level in ["3", "4"] {
+        let mesh = dir.path().join(format!("annulus{level}.obj"));
+        let run = beltrami(&[
+            "generate",
+            "annulus",
+            "--level",
+            level,
+            "--inner",
+            "0.4",
+            "-o",
+            s(&mesh),
+        ]);
+        assert!(run.status.success(), "{}", text(&run.stderr));
+        let radius = |solver: &[&str], key: fn(&serde_json::Value) -> f64| {
+            let out = dir.path().join("out.obj");
+            let report = dir.path().join("report.json");
+            let args = [
+                &["qc", s(&mesh), "--mu-expr", "0.3*z"][..],
+                solver,
+                &["-o", s(&out), "--report", s(&report)],
+            ]
+            .concat();
+            let run = beltrami(&args);
+            assert!(run.status.success(), "{}", text(&run.stderr));
+            let json = read_json(&report);
+            assert_eq!(json["flipped"], 0);
+            key(&json)
+        };
+        let flow = radius(
+            &[
+                "--solver",
+                "beltrami-flow",
+                "--target",
+                "annulus",
+                "--free-radius",
+            ],
+            |j| j["annulus_radius"].as_f64().unwrap(),
+        );
+        let qcmc = radius(&["--solver", "qcmc"], |j| {
+            j["circles"][1]["radius"].as_f64().unwrap()
+        });
+        println!("level {level}: flow {flow:.6}, qcmc {qcmc:.6}");
+        gaps.push((flow - qcmc).abs());
+    }
+    assert!(gaps[0] < 5e-4 && gaps[1] < 0.5 * gaps[0], "{gaps:?}");
+}

@@ -15,8 +15,8 @@
 //! tolerance. Each step takes the largest of `1, 1/2, 1/4, ...` that lowers the energy,
 //! keeps the circles apart and inside the unit disk and flips no more triangles than the
 //! map had (the paper takes full steps; the least-squares optimum of a coarse loop can
-//! fold two boundary vertices past each other, which this forbids: the start is a
-//! bijection, and so is every iterate).
+//! fold two boundary vertices past each other, which this forbids: no iterate has more
+//! flipped triangles than the start).
 //!
 //! Normalization of the Moebius freedom (the three real parameters of the disk's
 //! automorphisms, [`moebius`]): the outer loop is the unit circle, the first inner
