@@ -189,9 +189,8 @@ impl Solver for Qcmc {
         metrics.stop = Some(stop);
         metrics.factorizations = Some(factorizations);
 
-        let distortion = context.stage("distortion", &mut report, || {
-            measure(mesh, &elements, &state.map)
-        })?;
+        // Not a cancellable stage: a cancelled run still returns its map, measured.
+        let distortion = report.time("distortion", || measure(mesh, &elements, &state.map))?;
         if let Goal::Prescribed(_) = &problem.goal {
             metrics.mu_error = Some(MuError::new(&elements, &distortion.field.mu, &field.mu)?);
         }

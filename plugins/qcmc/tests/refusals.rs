@@ -88,3 +88,30 @@ fn either_loop_can_be_the_outer_one() {
         circles[1].radius
     );
 }
+
+#[test]
+fn a_cancelled_run_returns_its_map_so_far() {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let holes = [PlaneCircle {
+        center: Complex64::new(0.3, 0.0),
+        radius: 0.3,
+    }];
+    let mesh = common::circle_domain(&holes, 0.05);
+    let flag = Arc::new(AtomicBool::new(false));
+    let raise = flag.clone();
+    let mut context = Context::new()
+        .with_cancel_flag(flag)
+        .with_progress(move |p| {
+            if p.stage == "iteration" {
+                raise.store(true, Ordering::Relaxed);
+            }
+        });
+    let solution = Qcmc
+        .solve(&Problem::new(&mesh, Target::CircleDomain), &mut context)
+        .unwrap();
+    assert_eq!(solution.metrics.stop, Some(beltrami_core::Stop::Cancelled));
+    assert_eq!(solution.metrics.iterations, 1);
+    assert_eq!(solution.metrics.flipped(), Some(0));
+    assert_eq!(solution.extras.circles.unwrap().len(), 2);
+}
