@@ -267,6 +267,18 @@ fn setup(
             });
         }
     };
+    if !matches!(
+        Topology::of(mesh),
+        Topology::Annulus | Topology::MultiplyConnected
+    ) {
+        return Err(SolverError::Unsupported {
+            solver: NAME,
+            message: format!(
+                "qcmc maps connected genus-0 meshes with two or more boundary loops; this mesh has {}: use tutte, lscm or beltrami-flow for a disk, sphere for a closed genus-0 mesh",
+                beltrami_core::topology::describe(mesh)
+            ),
+        });
+    }
     let outer = settings.int("outer").checked_sub(1);
     let loops = Loops::new(mesh, outer)?;
     Ok((field, loops))

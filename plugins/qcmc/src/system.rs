@@ -91,8 +91,8 @@ impl Step {
             .map(|((g, d), l)| {
                 let moved = g + t * d;
                 match l {
-                    Some(j) if *d != Complex64::new(0.0, 0.0) => circles[*j].project(moved),
-                    _ => moved,
+                    Some(j) => circles[*j].project(moved),
+                    None => moved,
                 }
             })
             .collect();

@@ -33,6 +33,18 @@ fn a_disk_is_refused() {
 }
 
 #[test]
+fn closed_and_higher_genus_meshes_are_refused() {
+    for soup in [
+        primitives::icosphere(1),
+        primitives::torus(12, 8, 2.0, 0.5, primitives::Cells::Triangles),
+    ] {
+        let mesh = Mesh::from_soup(&soup).unwrap();
+        let message = refused(&Problem::new(&mesh, Target::CircleDomain));
+        assert!(message.contains("no boundary"), "{message}");
+    }
+}
+
+#[test]
 fn other_targets_and_exponents_are_refused() {
     let mesh = annulus();
     refused(&Problem::new(&mesh, Target::Disk));
