@@ -23,6 +23,8 @@
 //!   regions, the disk, annuli and the sphere.
 //! - [`register`]: surface registration (register): initial bijections by topology,
 //!   then the flow on the target mesh.
+//! - [`qcmc`]: circle-domain maps of multiply-connected meshes (qcmc, Ho-Lui 2016): the
+//!   unit disk minus disks whose centres and radii are found with the map.
 //! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
 //!   |mu| histograms as PNG.
 //!
@@ -60,6 +62,7 @@ pub use beltrami_flow_engine as flow_engine;
 pub use beltrami_init as init;
 pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
+pub use beltrami_qcmc as qcmc;
 pub use beltrami_register as register;
 pub use beltrami_render as render;
 pub use beltrami_spatial as spatial;
@@ -71,5 +74,6 @@ pub fn registry() -> beltrami_core::Registry {
     beltrami_lsqc::register(&mut registry);
     beltrami_flow::register(&mut registry);
     beltrami_register::register(&mut registry);
+    beltrami_qcmc::register(&mut registry);
     registry
 }

@@ -36,7 +36,7 @@ pub enum WeightsArg {
 pub struct ParamArgs {
     /// Mesh file (.obj, .gltf, .glb).
     pub mesh: PathBuf,
-    /// Solver name (`beltrami solvers` lists them): tutte, harmonic, lscm, sphere.
+    /// Solver name (`beltrami solvers` lists them): tutte, harmonic, lscm, sphere, qcmc.
     #[arg(long)]
     pub solver: String,
     /// Boundary of the parameter domain (default: the first of these the solver takes:
@@ -47,6 +47,10 @@ pub struct ParamArgs {
     /// Edge weights (tutte: uniform or mean-value; harmonic: cotan).
     #[arg(long, value_enum)]
     pub weights: Option<WeightsArg>,
+    /// qcmc: the boundary loop mapped onto the unit circle, by its 0-based index in the
+    /// mesh's boundary-loop order (the report's `loop`) [default: the longest].
+    #[arg(long)]
+    pub outer: Option<usize>,
     /// Pin a vertex: `v12` by its 0-based index, or `x,y[,z]` for the nearest vertex;
     /// repeatable. LSCM's two pins go to (0,0) and (1,0).
     #[arg(long = "pin")]
@@ -67,6 +71,9 @@ fn target_of(args: &ParamArgs, solver: &dyn Solver) -> Target<'static> {
     let accepts = solver.accepts();
     if args.boundary.is_none() && accepts.targets == [TargetKind::Sphere] {
         return Target::Sphere;
+    }
+    if args.boundary.is_none() && accepts.targets == [TargetKind::CircleDomain] {
+        return Target::CircleDomain;
     }
     let first = accepts.targets.iter().find_map(|kind| match kind {
         TargetKind::PlaneCircle => Some(BoundaryArg::Circle),
@@ -101,7 +108,12 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
             .to_string(),
         )
     });
-    problem.options = mapping::solver_options(solver, &[("weights", weights, None)], &args.common);
+    let outer = args.outer.map(|l| OptionValue::Int(l + 1));
+    problem.options = mapping::solver_options(
+        solver,
+        &[("weights", weights, None), ("outer", outer, None)],
+        &args.common,
+    );
     problem.constraints.extend(
         mapping::resolve_pins(&args.pins, mesh)?
             .into_iter()
@@ -111,13 +123,21 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
     map_file::write(&args.output, mesh, &solution, None)?;
     mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
-    let report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
+    let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
+    let mut circles = super::qc::circles(mesh, &solution, &mut report);
+    if let Some(stop) = solution.metrics.stop {
+        circles.push(format!(
+            "iterations      {} ({})",
+            solution.metrics.iterations,
+            stop.name()
+        ));
+    }
     mapping::finish(
         report,
         args.common.report.as_deref(),
         args.common.json,
         quiet,
         (&args.mesh, &args.output, &solution, seconds),
-        &[],
+        &circles,
     )
 }

@@ -57,7 +57,7 @@ pub enum QcBoundaryArg {
 pub struct QcArgs {
     /// Mesh file (.obj, .gltf, .glb).
     pub mesh: PathBuf,
-    /// Solver name: lsqc or beltrami-flow.
+    /// Solver name: lsqc, beltrami-flow or qcmc (onto a circle domain).
     #[arg(long, default_value = "lsqc")]
     pub solver: String,
     /// The Beltrami coefficient per face, in the field format (`# mu frame=... faces=N`).
@@ -88,6 +88,10 @@ pub struct QcArgs {
     /// modulus); by default the input's inner radius is kept.
     #[arg(long = "free-radius")]
     pub free_radius: bool,
+    /// qcmc: the boundary loop mapped onto the unit circle, by its 0-based index in the
+    /// mesh's boundary-loop order (the report's `loop`) [default: the longest].
+    #[arg(long)]
+    pub outer: Option<usize>,
     /// Pin a vertex where it is: `v12` by its 0-based index, or `x,y[,z]` for the
     /// nearest vertex; repeatable.
     #[arg(long = "pin")]
@@ -150,6 +154,9 @@ fn boundary_map(path: &std::path::Path, mesh: &Mesh) -> anyhow::Result<Vec<Compl
 /// cannot take it refuses it in its check); without `--boundary`, a free boundary when
 /// the solver takes one, else the input's own.
 fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<Target<'static>> {
+    if args.target == TargetArg::Plane && solver.accepts().targets == [TargetKind::CircleDomain] {
+        return Ok(Target::CircleDomain);
+    }
     Ok(match args.target {
         TargetArg::Plane => {
             let free = solver.accepts().targets.contains(&TargetKind::PlaneFree);
@@ -210,6 +217,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
                 Some(OptionValue::Int(200)),
             ),
             ("threads", args.threads.map(OptionValue::Int), None),
+            ("outer", args.outer.map(|l| OptionValue::Int(l + 1)), None),
         ],
         &args.common,
     );
@@ -236,15 +244,13 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         }),
     );
     report.extend(beltrami::report::mu_error_keys(error.as_ref()));
-    let mut extra: Vec<String> = error
-        .iter()
-        .map(|e| {
-            format!(
-                "|mu - target|   L2 (RMS) {:.4e}  sup {:.4e} (face {})",
-                e.rms, e.sup, e.sup_face
-            )
-        })
-        .collect();
+    let mut extra = circles(mesh, &solution, &mut report);
+    extra.extend(error.iter().map(|e| {
+        format!(
+            "|mu - target|   L2 (RMS) {:.4e}  sup {:.4e} (face {})",
+            e.rms, e.sup, e.sup_face
+        )
+    }));
     if solution.metrics.iterations > 0 {
         extra.push(format!(
             "iterations      {} (error {:.4e} -> {:.4e})",
@@ -271,4 +277,38 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         (&args.mesh, &args.output, &solution, seconds),
         &extra,
     )
+}
+
+/// The circles of a circle-domain map (`extras.circles`): the report's `circles` (per
+/// loop its index, centre, radius and `deviation`, the largest `| |g - c| - r | / r`
+/// over the loop's images `g`) and a summary line per circle.
+pub(super) fn circles(
+    mesh: &Mesh,
+    solution: &beltrami_core::Solution,
+    report: &mut serde_json::Map<String, serde_json::Value>,
+) -> Vec<String> {
+    let (Some(circles), Some(map)) = (&solution.extras.circles, solution.planar()) else {
+        return Vec::new();
+    };
+    let loops = mesh.boundary_loop_list();
+    let mut lines = Vec::new();
+    let mut values = Vec::new();
+    for c in circles {
+        let deviation = loops.get(c.boundary_loop).map_or(f64::NAN, |l| {
+            l.vertices
+                .iter()
+                .map(|v| ((map[v.idx()] - c.center).norm() - c.radius).abs() / c.radius)
+                .fold(0.0, f64::max)
+        });
+        lines.push(format!(
+            "loop {:<3} circle centre ({:+.6}, {:+.6})  radius {:.6}  deviation {:.1e}",
+            c.boundary_loop, c.center.re, c.center.im, c.radius, deviation
+        ));
+        values.push(json!({
+            "loop": c.boundary_loop, "center": [c.center.re, c.center.im],
+            "radius": c.radius, "deviation": deviation,
+        }));
+    }
+    report.insert("circles".into(), json!(values));
+    lines
 }

@@ -3,6 +3,7 @@
 mod fem;
 mod flow;
 mod load;
+mod qcmc;
 mod render;
 mod spatial;
 
@@ -25,6 +26,9 @@ pub enum BenchKind {
     /// The discrete Beltrami flow against the tables of Wong-Zhao 2014, and the cost of
     /// one flow step on meshes of about 100K faces.
     Flow(flow::FlowArgs),
+    /// The conformal circle-domain map (qcmc) of multiply-connected meshes, stage by
+    /// stage.
+    Qcmc(qcmc::QcmcArgs),
     /// Pictures (scene measure, uv and 3D rasterization, PNG encoding) of generated
     /// grids of up to ~1M triangles.
     Render(render::RenderArgs),
@@ -38,6 +42,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchKind::Load(a) => load::run(a),
         BenchKind::Fem(a) => fem::run(a),
         BenchKind::Flow(a) => flow::run(a),
+        BenchKind::Qcmc(a) => qcmc::run(a),
         BenchKind::Render(a) => render::run(a),
         BenchKind::Spatial(a) => spatial::run(a),
     }
