@@ -795,6 +795,28 @@ pub fn cut_to_disk(mesh: &Mesh) -> Result<CutMesh, CutError> {
     Ok(out)
 }
 
+/// Cuts `mesh` open along the given edges (any set, e.g. a path that slits a closed
+/// genus-0 surface into a disk): every vertex is split into one copy per wedge of faces
+/// between consecutive cut or boundary edges around it, as in [`cut_to_disk`]. Faces
+/// keep their ids, order and first vertex; the returned seam map gives the original
+/// vertex of every vertex of the cut mesh (vertex `v < n` is a copy of `v`).
+///
+/// # Errors
+/// [`CutError::Build`] if the cut mesh fails validation.
+pub fn cut_along(mesh: &Mesh, edges: &[EdgeId]) -> Result<(Mesh, Vec<VertexId>), CutError> {
+    let mut in_cut = vec![false; mesh.edge_count()];
+    for &e in edges {
+        in_cut[e.idx()] = true;
+    }
+    let (soup, to_original) = split_along(mesh, &in_cut);
+    let options = BuildOptions {
+        degenerate_area_tolerance: -1.0,
+        repair: Repair::NONE,
+    };
+    let (cut_mesh, _) = Mesh::build(&soup, &options)?;
+    Ok((cut_mesh, to_original))
+}
+
 /// The polygon soup of `mesh` with every vertex split into one copy per wedge of faces
 /// between consecutive cut edges around it (boundary edges always separate), and the
 /// original vertex of every copy. Copy 0 of vertex `v` keeps the id `v`.

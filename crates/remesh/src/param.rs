@@ -1,0 +1,124 @@
+//! The parameterization of a chart by a registered solver, and the choice of solver by
+//! topology.
+
+use beltrami_core::{
+    Context, PlanarBoundary, Problem, Registry, Solver, Target, TargetKind, topology::describe,
+};
+use beltrami_mesh::{FaceId, Mesh};
+use num_complex::Complex64;
+
+use crate::RemeshError;
+
+/// The planar targets a remeshing can use, in order of preference: a free boundary (the
+/// least distortion), the unit circle, the unit disk, a circle domain, the unit square.
+const PLANAR_TARGETS: [TargetKind; 5] = [
+    TargetKind::PlaneFree,
+    TargetKind::PlaneCircle,
+    TargetKind::Disk,
+    TargetKind::CircleDomain,
+    TargetKind::PlaneSquare,
+];
+
+/// The first target of [`PLANAR_TARGETS`] that `solver` accepts, or an error saying it
+/// does not map into the plane.
+pub fn planar_target(solver: &dyn Solver) -> Result<Target<'static>, RemeshError> {
+    let accepts = solver.accepts();
+    let kind = PLANAR_TARGETS
+        .iter()
+        .find(|k| accepts.targets.contains(k))
+        .ok_or_else(|| RemeshError::Parameterizer {
+            solver: solver.name(),
+            message: format!(
+                "it maps onto {:?}, not into the plane; use `lscm`, `tutte`, `harmonic` or `auto` (a closed genus-0 surface is slit open and mapped to the plane)",
+                accepts.targets
+            ),
+        })?;
+    Ok(match kind {
+        TargetKind::PlaneFree => Target::Plane(PlanarBoundary::Free),
+        TargetKind::PlaneCircle => Target::Plane(PlanarBoundary::Circle),
+        TargetKind::Disk => Target::Disk,
+        TargetKind::CircleDomain => Target::CircleDomain,
+        _ => Target::Plane(PlanarBoundary::Square { corners: None }),
+    })
+}
+
+/// True if `solver` maps several boundary loops onto a circle domain, so that a
+/// multiply connected surface needs no cut.
+pub fn keeps_loops(solver: &dyn Solver) -> bool {
+    solver.accepts().targets.contains(&TargetKind::CircleDomain)
+}
+
+/// The parameterizer `auto` picks for `mesh` among the registered solvers: `qcmc` for a
+/// genus-0 surface with several boundary loops when registered, and `lscm` otherwise
+/// (on a disk as it is, on a closed genus-0 surface after a slit, on every other surface
+/// after a cut to a disk). `fallback` is the solver to retry with when the first
+/// choice's map folds or overlaps: `tutte`, whose convex boundary makes the map
+/// one-to-one (Tutte's theorem).
+pub fn auto<'r>(
+    registry: &'r Registry,
+    mesh: &Mesh,
+) -> Result<(&'r dyn Solver, Option<&'r dyn Solver>), RemeshError> {
+    let components = mesh.components();
+    if components.len() != 1 {
+        return Err(RemeshError::Components {
+            components: components.len(),
+        });
+    }
+    let c = components[0];
+    let fallback = registry.get("tutte").ok();
+    if c.genus == 0
+        && c.boundary_loops > 1
+        && let Ok(qcmc) = registry.get("qcmc")
+    {
+        return Ok((qcmc, fallback));
+    }
+    let lscm = registry.get("lscm").map_err(|error| RemeshError::Solve {
+        solver: "auto",
+        error,
+    })?;
+    Ok((lscm, fallback))
+}
+
+/// Maps `chart` into the plane with `solver` and checks that no face folds over
+/// (non-positive signed area of its image, summed over the triangle fan of a quad).
+pub fn parameterize(
+    chart: &Mesh,
+    solver: &dyn Solver,
+    context: &mut Context<'_>,
+) -> Result<Vec<Complex64>, RemeshError> {
+    let problem = Problem::new(chart, planar_target(solver)?);
+    let solution = solver
+        .solve(&problem, context)
+        .map_err(|error| RemeshError::Solve {
+            solver: solver.name(),
+            error,
+        })?;
+    let uv = solution
+        .planar()
+        .ok_or_else(|| RemeshError::Parameterizer {
+            solver: solver.name(),
+            message: format!(
+                "it returned no planar map of the chart ({})",
+                describe(chart)
+            ),
+        })?
+        .to_vec();
+    let mut flipped = chart.faces().filter(|&f| signed_area(chart, &uv, f) <= 0.0);
+    if let Some(first) = flipped.next() {
+        return Err(RemeshError::Flipped {
+            solver: solver.name(),
+            flipped: 1 + flipped.count(),
+            first,
+        });
+    }
+    Ok(uv)
+}
+
+/// Twice the signed area of the image of face `f`: `sum_i Im(conj(z_i) z_{i+1})` over
+/// its corners (the shoelace formula; positive when counter-clockwise).
+pub fn signed_area(mesh: &Mesh, uv: &[Complex64], f: FaceId) -> f64 {
+    let (v, n) = mesh.face_vertex_array(f);
+    (0..n)
+        .map(|i| (uv[v[i].idx()].conj() * uv[v[(i + 1) % n].idx()]).im)
+        .sum()
+}
