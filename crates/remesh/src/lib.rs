@@ -150,9 +150,16 @@ fn remesh_with(
             .map(|i| p.coords[i] * sizes[chart.to_original[v[i].idx()].idx()])
             .sum::<f64>()
     };
+    let inner: Vec<_> = chart
+        .mesh
+        .vertices()
+        .filter(|&v| !chart.mesh.is_boundary_vertex(v))
+        .map(|v| (uv[v.idx()], chart.mesh.position(v)))
+        .collect();
     let tri = refine::triangulate(
         &domain,
         &samples,
+        &inner,
         &size_at,
         options.min_angle,
         options.max_vertices,

@@ -12,8 +12,23 @@
 //!    "Guaranteed-quality mesh generation for curved surfaces", SoCG 1993). Measuring on
 //!    the surface is what compensates the map's area distortion: where the map shrinks
 //!    the surface by `s`, the parameter edges come out `s` times shorter.
+//!    Then every vertex of the input whose distance to the piecewise linear
+//!    interpolation of the lifted triangulation at its parameter point exceeds
+//!    `DEVIATION h` is inserted itself (both surfaces are piecewise linear over the
+//!    parameter domain, so their distance is largest at a vertex of either or at a
+//!    crossing of their edges): a spike or crease thinner than the edge length is kept
+//!    instead of cut off, which bounds the Hausdorff distance. Such vertices are not
+//!    moved by the smoothing.
 //! 3. spade's refinement with the angle limit, constraint edges kept (a seam must not be
 //!    split on one side only) and outer faces excluded (holes by crossing parity).
+//! 4. Smoothing: a few rounds that move every inner vertex to the mean of the
+//!    parameter centroids of its faces weighted by their *lifted* areas (a Lloyd-type
+//!    relaxation with the surface's area as density, which evens out the lifted
+//!    triangle areas), each followed by a new constrained Delaunay triangulation of the
+//!    moved vertices. A move that would leave the domain is not made.
+//!
+//! Faces of the domain are found by crossing parity: a face is inside when a walk from
+//! the outside to it crosses an odd number of constraint edges.
 //!
 //! `ALPHA` sets where edges stop being split; a Delaunay refinement that stops when no
 //! edge is longer than `ALPHA h` leaves edges between about `ALPHA h / 2` and
@@ -32,10 +47,17 @@ use crate::boundary::BoundarySamples;
 use crate::domain::Domain;
 
 /// Longest lifted edge, relative to the asked length, that is not split.
-const ALPHA: f64 = 1.35;
+const ALPHA: f64 = 1.65;
+
+/// Largest distance, relative to the asked length, between an input vertex and the
+/// interpolated result over its parameter point, before the vertex is inserted.
+const DEVIATION: f64 = 0.2;
 
 /// Size passes at most (each splits every face that is too large).
 const MAX_PASSES: usize = 40;
+
+/// Smoothing rounds.
+const SMOOTHING_ROUNDS: usize = 3;
 
 /// The refined triangulation of the parameter domain, lifted.
 #[derive(Debug, Clone)]
@@ -46,48 +68,45 @@ pub struct Triangulation {
     pub on_chart: Vec<SurfacePoint>,
     /// Per vertex, its position on the surface.
     pub position: Vec<Point3<f64>>,
+    /// Per vertex, the asked edge length there.
+    pub size: Vec<f64>,
     /// The inner faces, counter-clockwise in the parameter domain.
     pub faces: Vec<[u32; 3]>,
     /// Size passes done.
     pub passes: usize,
+    /// Per vertex, whether it is an input vertex inserted to keep a feature.
+    pub pinned: Vec<bool>,
 }
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 /// Triangulates and refines the domain (module docs). `size(p)` is the asked edge
-/// length at surface point `p` of the chart; `min_angle` in degrees.
+/// length at surface point `p` of the chart; `min_angle` in degrees. `inner` lists the
+/// interior vertices of the chart as their parameter point and surface position.
+#[allow(clippy::too_many_arguments)]
 pub fn triangulate(
     domain: &Domain<'_>,
     samples: &BoundarySamples,
+    inner: &[(Complex64, Point3<f64>)],
     size: &impl Fn(&SurfacePoint) -> f64,
     min_angle: f64,
     max_vertices: usize,
     solver: &'static str,
     context: &mut Context<'_>,
 ) -> Result<Triangulation, RemeshError> {
-    let vertices: Vec<Point2<f64>> = samples
-        .points
-        .iter()
-        .map(|z| Point2::new(z.re, z.im))
-        .collect();
-    let mut crossing = false;
-    let mut cdt = Cdt::try_bulk_load_cdt(vertices, samples.edges.clone(), |_| crossing = true)
-        .map_err(|_| RemeshError::Overlap { solver })?;
-    if crossing || cdt.num_vertices() != samples.points.len() {
-        return Err(RemeshError::Overlap { solver });
-    }
+    let mut cdt = load(&samples.points, &samples.edges, solver)?;
     let mut tri = Triangulation {
         uv: Vec::with_capacity(samples.points.len()),
         on_chart: Vec::new(),
         position: Vec::new(),
+        size: Vec::new(),
         faces: Vec::new(),
         passes: 0,
+        pinned: Vec::new(),
     };
     for &z in &samples.points {
         let (point, position) = domain.lift(z)?.ok_or(RemeshError::Overlap { solver })?;
-        tri.uv.push(z);
-        tri.on_chart.push(point);
-        tri.position.push(position);
+        tri.push(z, point, position, size(&point));
     }
     let sin_limit = min_angle.to_radians().sin();
 
@@ -96,23 +115,19 @@ pub fn triangulate(
             return Err(RemeshError::Cancelled);
         }
         tri.passes = pass + 1;
+        let inside = inside_faces(&cdt);
         // (circumradius in the plane, point to insert)
         let mut wanted: Vec<(f64, Complex64)> = Vec::new();
         for face in cdt.inner_faces() {
-            let idx = face.vertices().map(|v| v.fix().index());
-            let centroid = face.center();
-            let centroid = Complex64::new(centroid.x, centroid.y);
-            let Some((at, _)) = domain.lift(centroid)? else {
+            if !inside[face.fix().index()] {
                 continue;
-            };
-            let h = size(&at);
+            }
+            let idx = face.vertices().map(|v| v.fix().index());
+            let h = idx.iter().map(|&i| tri.size[i]).sum::<f64>() / 3.0;
             let p = idx.map(|i| tri.position[i]);
-            let len = [
-                (p[1] - p[0]).norm(),
-                (p[2] - p[1]).norm(),
-                (p[0] - p[2]).norm(),
-            ];
-            let longest = len.iter().copied().fold(0.0, f64::max);
+            let longest = (0..3)
+                .map(|k| (p[(k + 1) % 3] - p[k]).norm())
+                .fold(0.0, f64::max);
             let too_long = longest > ALPHA * h;
             let skinny = longest > 0.5 * h && smallest_sine(&p) < sin_limit;
             if !(too_long || skinny) {
@@ -121,28 +136,32 @@ pub fn triangulate(
             let c = face.circumcenter();
             let c = Complex64::new(c.x, c.y);
             let r = (c - tri.uv[idx[0]]).norm();
-            let inside = c.is_finite() && domain.lift(c)?.is_some();
-            wanted.push((r, if inside { c } else { centroid }));
-        }
-        if wanted.is_empty() {
-            break;
+            let q = if c.is_finite() && domain.lift(c)?.is_some() {
+                c
+            } else {
+                let m = face.center();
+                Complex64::new(m.x, m.y)
+            };
+            wanted.push((r, q));
         }
         wanted.sort_by(|a, b| b.0.total_cmp(&a.0));
-        for (r, q) in wanted {
-            if too_close(&cdt, q, 0.5 * r) {
-                continue;
-            }
-            insert(&mut cdt, &mut tri, domain, q)?;
-            if tri.uv.len() > max_vertices {
-                return Err(RemeshError::TooManyVertices {
-                    limit: max_vertices,
-                });
-            }
+        let mut inserted = insert_all(&mut cdt, &mut tri, domain, size, wanted, false)?;
+        if inserted == 0 {
+            let features = deviating(&cdt, &tri, inner);
+            inserted = insert_all(&mut cdt, &mut tri, domain, size, features, true)?;
+        }
+        if tri.uv.len() > max_vertices {
+            return Err(RemeshError::TooManyVertices {
+                limit: max_vertices,
+            });
+        }
+        if inserted == 0 {
+            break;
         }
     }
 
     let before = cdt.num_vertices();
-    let result = cdt.refine(
+    cdt.refine(
         RefinementParameters::<f64>::new()
             .with_angle_limit(AngleLimit::from_deg(min_angle))
             .keep_constraint_edges()
@@ -155,23 +174,192 @@ pub fn triangulate(
         // spade's new vertices lie inside the domain (no constraint edge is split); a
         // vertex on its boundary up to rounding lifts to the closest domain point.
         let (point, position) = domain.lift_closest(q)?;
-        tri.uv.push(q);
-        tri.on_chart.push(point);
-        tri.position.push(position);
+        tri.push(q, point, position, size(&point));
     }
     if tri.uv.len() > max_vertices {
         return Err(RemeshError::TooManyVertices {
             limit: max_vertices,
         });
     }
-    let excluded: std::collections::HashSet<usize> =
-        result.excluded_faces.iter().map(|f| f.index()).collect();
-    tri.faces = cdt
-        .inner_faces()
-        .filter(|f| !excluded.contains(&f.fix().index()))
-        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
-        .collect();
+
+    let boundary = samples.points.len();
+    for _ in 0..SMOOTHING_ROUNDS {
+        if context.is_cancelled() {
+            return Err(RemeshError::Cancelled);
+        }
+        tri.faces = faces_of(&cdt);
+        smooth(&mut tri, boundary, domain, size)?;
+        cdt = load(&tri.uv, &samples.edges, solver)?;
+    }
+    tri.faces = faces_of(&cdt);
     Ok(tri)
+}
+
+impl Triangulation {
+    fn push(&mut self, q: Complex64, point: SurfacePoint, position: Point3<f64>, size: f64) {
+        self.uv.push(q);
+        self.on_chart.push(point);
+        self.position.push(position);
+        self.size.push(size);
+        self.pinned.push(false);
+    }
+}
+
+/// Inserts the points `(r, q)` in order, each unless a vertex lies within `r / 2` of it
+/// or it falls outside the domain, and lifts them; returns how many were inserted.
+fn insert_all(
+    cdt: &mut Cdt,
+    tri: &mut Triangulation,
+    domain: &Domain<'_>,
+    size: &impl Fn(&SurfacePoint) -> f64,
+    points: Vec<(f64, Complex64)>,
+    pinned: bool,
+) -> Result<usize, RemeshError> {
+    let mut inserted = 0;
+    for (r, q) in points {
+        if too_close(cdt, q, 0.5 * r) {
+            continue;
+        }
+        if let Some((point, position)) = domain.lift(q)?
+            && let Ok(handle) = cdt.insert(Point2::new(q.re, q.im))
+            && handle.index() == tri.uv.len()
+        {
+            tri.push(q, point, position, size(&point));
+            tri.pinned[handle.index()] = pinned;
+            inserted += 1;
+        }
+    }
+    Ok(inserted)
+}
+
+/// Input vertices farther than `DEVIATION h` from the interpolated result at their
+/// parameter point (module docs), as (a radius in the plane for the closeness test,
+/// point), farthest first.
+fn deviating(
+    cdt: &Cdt,
+    tri: &Triangulation,
+    inner: &[(Complex64, Point3<f64>)],
+) -> Vec<(f64, Complex64)> {
+    use spade::PositionInTriangulation as P;
+    let mut out: Vec<(f64, f64, Complex64)> = Vec::new();
+    for &(q, p) in inner {
+        let P::OnFace(f) = cdt.locate(Point2::new(q.re, q.im)) else {
+            continue;
+        };
+        let idx = cdt.face(f).vertices().map(|v| v.fix().index());
+        let z = idx.map(|i| tri.uv[i]);
+        let det = cross(z[1] - z[0], z[2] - z[0]);
+        if det <= 0.0 {
+            continue;
+        }
+        let l1 = cross(q - z[0], z[2] - z[0]) / det;
+        let l2 = cross(z[1] - z[0], q - z[0]) / det;
+        let interpolated = tri.position[idx[0]].coords * (1.0 - l1 - l2)
+            + tri.position[idx[1]].coords * l1
+            + tri.position[idx[2]].coords * l2;
+        let h = idx.iter().map(|&i| tri.size[i]).sum::<f64>() / 3.0;
+        let deviation = (p.coords - interpolated).norm();
+        if deviation > DEVIATION * h {
+            let r = (0..3)
+                .map(|k| (z[k] - q).norm())
+                .fold(f64::INFINITY, f64::min);
+            out.push((deviation / h, r, q));
+        }
+    }
+    out.sort_by(|a, b| b.0.total_cmp(&a.0));
+    out.into_iter().map(|(_, r, q)| (r, q)).collect()
+}
+
+/// `Im(conj(a) b)`, twice the signed area of the triangle `0, a, b`.
+fn cross(a: Complex64, b: Complex64) -> f64 {
+    a.re * b.im - a.im * b.re
+}
+
+/// The constrained Delaunay triangulation of `points` with constraint edges `edges`
+/// (between the first points), vertex `i` being `points[i]`; a crossing constraint or a
+/// repeated point means the map overlaps.
+fn load(
+    points: &[Complex64],
+    edges: &[[usize; 2]],
+    solver: &'static str,
+) -> Result<Cdt, RemeshError> {
+    let vertices: Vec<Point2<f64>> = points.iter().map(|z| Point2::new(z.re, z.im)).collect();
+    let mut crossing = false;
+    let cdt = Cdt::try_bulk_load_cdt(vertices, edges.to_vec(), |_| crossing = true)
+        .map_err(|_| RemeshError::Overlap { solver })?;
+    if crossing || cdt.num_vertices() != points.len() {
+        return Err(RemeshError::Overlap { solver });
+    }
+    Ok(cdt)
+}
+
+/// Per face index of `cdt`, whether the face is inside the domain: a depth-first walk
+/// from the convex hull that flips a parity bit at every constraint edge it crosses.
+fn inside_faces(cdt: &Cdt) -> Vec<bool> {
+    let mut inside = vec![false; cdt.num_all_faces()];
+    let mut seen = vec![false; cdt.num_all_faces()];
+    // (edge with the face to visit on its left, inside-parity of the face across it)
+    let mut stack: Vec<_> = cdt.convex_hull().map(|e| (e.rev(), false)).collect();
+    while let Some((e, across)) = stack.pop() {
+        let Some(face) = e.face().as_inner() else {
+            continue;
+        };
+        let i = face.fix().index();
+        if seen[i] {
+            continue;
+        }
+        seen[i] = true;
+        let parity = across ^ e.is_constraint_edge();
+        inside[i] = parity;
+        stack.push((e.next().rev(), parity));
+        stack.push((e.prev().rev(), parity));
+    }
+    inside
+}
+
+/// The faces of `cdt` inside the domain, as vertex indices, counter-clockwise.
+fn faces_of(cdt: &Cdt) -> Vec<[u32; 3]> {
+    let inside = inside_faces(cdt);
+    cdt.inner_faces()
+        .filter(|f| inside[f.fix().index()])
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+        .collect()
+}
+
+/// One smoothing round (module docs): every vertex after the first `fixed` moves to the
+/// mean of the parameter centroids of its faces weighted by their lifted areas.
+fn smooth(
+    tri: &mut Triangulation,
+    fixed: usize,
+    domain: &Domain<'_>,
+    size: &impl Fn(&SurfacePoint) -> f64,
+) -> Result<(), RemeshError> {
+    let n = tri.uv.len();
+    let mut sum = vec![Complex64::new(0.0, 0.0); n];
+    let mut weight = vec![0.0f64; n];
+    for face in &tri.faces {
+        let [a, b, c] = face.map(|i| i as usize);
+        let (pa, pb, pc) = (tri.position[a], tri.position[b], tri.position[c]);
+        let area = (pb - pa).cross(&(pc - pa)).norm();
+        let centroid = (tri.uv[a] + tri.uv[b] + tri.uv[c]) / 3.0;
+        for i in [a, b, c] {
+            sum[i] += centroid * area;
+            weight[i] += area;
+        }
+    }
+    for i in fixed..n {
+        if weight[i] <= 0.0 || tri.pinned[i] {
+            continue;
+        }
+        let q = sum[i] / weight[i];
+        if let Some((point, position)) = domain.lift(q)? {
+            tri.uv[i] = q;
+            tri.on_chart[i] = point;
+            tri.position[i] = position;
+            tri.size[i] = size(&point);
+        }
+    }
+    Ok(())
 }
 
 /// The smallest sine of the three angles of a triangle in R^3:
@@ -200,25 +388,4 @@ fn too_close(cdt: &Cdt, q: Complex64, radius: f64) -> bool {
         P::OnVertex(_) | P::OnEdge(_) => true,
         P::OutsideOfConvexHull(_) | P::NoTriangulation => true,
     }
-}
-
-/// Inserts `q` (inside the domain) and lifts it.
-fn insert(
-    cdt: &mut Cdt,
-    tri: &mut Triangulation,
-    domain: &Domain<'_>,
-    q: Complex64,
-) -> Result<(), RemeshError> {
-    let Some((point, position)) = domain.lift(q)? else {
-        return Ok(());
-    };
-    let Ok(handle) = cdt.insert(Point2::new(q.re, q.im)) else {
-        return Ok(());
-    };
-    if handle.index() == tri.uv.len() {
-        tri.uv.push(q);
-        tri.on_chart.push(point);
-        tri.position.push(position);
-    }
-    Ok(())
 }

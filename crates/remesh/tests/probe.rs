@@ -51,5 +51,39 @@ fn probe() {
             }
             Err(e) => eprintln!("{name}: ERROR {e}"),
         }
+        if let Ok(r) = remesh(
+            &mesh,
+            &solvers,
+            &RemeshOptions::with_edge_length(l),
+            &mut Context::new(),
+        ) {
+            let m = &r.remeshed.mesh;
+            let (mut bd, mut inner) = (0, 0);
+            let mut worst = vec![];
+            for f in m.faces() {
+                let a = m
+                    .face_halfedges(f)
+                    .map(|h| m.corner_angle(h).to_degrees())
+                    .fold(180.0, f64::min);
+                if a < 20.0 {
+                    if m.face_vertices(f).any(|v| m.is_boundary_vertex(v)) {
+                        bd += 1
+                    } else {
+                        inner += 1
+                    }
+                    worst.push((
+                        a,
+                        m.face_vertices(f)
+                            .map(|v| r.remeshed.on_source[v.idx()].face.0)
+                            .collect::<Vec<_>>(),
+                    ));
+                }
+            }
+            worst.sort_by(|a, b| a.0.total_cmp(&b.0));
+            eprintln!(
+                "  <20: boundary {bd} interior {inner} worst {:?}",
+                &worst[..worst.len().min(4)]
+            );
+        }
     }
 }
