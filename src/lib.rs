@@ -23,6 +23,8 @@
 //!   regions, the disk, annuli and the sphere.
 //! - [`register`]: surface registration (register): initial bijections by topology,
 //!   then the flow on the target mesh.
+//! - [`remesh`]: remeshing through a parameterization (spade's constrained Delaunay
+//!   refinement of the parameter domain with a size field measured on the surface).
 //! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
 //!   |mu| histograms as PNG.
 //!
@@ -61,6 +63,7 @@ pub use beltrami_init as init;
 pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
 pub use beltrami_register as register;
+pub use beltrami_remesh as remesh;
 pub use beltrami_render as render;
 pub use beltrami_spatial as spatial;
 

@@ -103,6 +103,8 @@ pub fn parameterize(
             ),
         })?
         .to_vec();
+    let mut uv = uv;
+    untangle(chart, &mut uv);
     let mut flipped = chart.faces().filter(|&f| signed_area(chart, &uv, f) <= 0.0);
     if let Some(first) = flipped.next() {
         return Err(RemeshError::Flipped {
@@ -112,6 +114,48 @@ pub fn parameterize(
         });
     }
     Ok(uv)
+}
+
+/// Rounds of [`untangle`] at most.
+const UNTANGLE_ROUNDS: usize = 100;
+
+/// Repairs a few folded faces of a map (LSCM folds slivers now and then, mostly along
+/// a free boundary): each round moves every vertex of a folded face and its neighbours,
+/// an interior one to the mean of its neighbours' images (a local Tutte step, which
+/// unfolds where the neighbourhood's boundary is star-shaped around it), a boundary one
+/// to the midpoint of its two boundary neighbours (straightening a folded boundary),
+/// until no face folds or the rounds run out; the caller checks what is left.
+fn untangle(chart: &Mesh, uv: &mut [Complex64]) {
+    for _ in 0..UNTANGLE_ROUNDS {
+        let mut moving: Vec<_> = chart
+            .faces()
+            .filter(|&f| signed_area(chart, uv, f) <= 0.0)
+            .flat_map(|f| chart.face_vertices(f).collect::<Vec<_>>())
+            .flat_map(|v| std::iter::once(v).chain(chart.vertex_neighbors(v)))
+            .collect();
+        if moving.is_empty() {
+            return;
+        }
+        moving.sort_unstable();
+        moving.dedup();
+        for v in moving {
+            if chart.is_boundary_vertex(v) {
+                // Along the boundary: the midpoint of its two boundary neighbours.
+                let h = chart.vertex_halfedge(v);
+                let (a, b) = (chart.target(h), chart.origin(chart.prev(h)));
+                uv[v.idx()] = (uv[a.idx()] + uv[b.idx()]) / 2.0;
+                continue;
+            }
+            let (sum, n) = chart
+                .vertex_neighbors(v)
+                .fold((Complex64::new(0.0, 0.0), 0usize), |(s, n), w| {
+                    (s + uv[w.idx()], n + 1)
+                });
+            if n > 0 {
+                uv[v.idx()] = sum / n as f64;
+            }
+        }
+    }
 }
 
 /// Twice the signed area of the image of face `f`: `sum_i Im(conj(z_i) z_{i+1})` over

@@ -233,8 +233,8 @@ fn insert_all(
 }
 
 /// Input vertices farther than `DEVIATION h` from the interpolated result at their
-/// parameter point (module docs), as (a radius in the plane for the closeness test,
-/// point), farthest first.
+/// parameter point (module docs), as (twice the radius of the closeness test of
+/// [`insert_all`], point), farthest first.
 fn deviating(
     cdt: &Cdt,
     tri: &Triangulation,
