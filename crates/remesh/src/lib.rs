@@ -81,6 +81,9 @@ pub struct Remeshing {
 
 /// Remeshes `mesh` through the first of `parameterizers` whose map is one-to-one (a
 /// later one is tried only when an earlier one folds or overlaps; see the crate docs).
+/// For [`Resolution::Vertices`] it remeshes twice: at the edge length of the
+/// equilateral estimate, then at that length scaled by `sqrt(n / N)` for the `n`
+/// vertices the first run gave.
 ///
 /// # Errors
 /// [`RemeshError::InvalidOption`] for bad options (before any work), and the errors of
@@ -99,6 +102,25 @@ pub fn remesh(
         });
     }
     let edge_length = options.edge_length(mesh.total_area());
+    let first = remesh_at(mesh, parameterizers, options, edge_length, context)?;
+    let Resolution::Vertices(asked) = options.resolution else {
+        return Ok(first);
+    };
+    // The refined mesh is not equilateral, so the first edge length gives another vertex
+    // count `n`; vertex counts scale like `1 / L^2`, so one correction lands close.
+    let n = first.remeshed.mesh.vertex_count() as f64;
+    let corrected = edge_length * (n / asked as f64).sqrt();
+    remesh_at(mesh, parameterizers, options, corrected, context)
+}
+
+/// [`remesh`] at a given edge length.
+fn remesh_at(
+    mesh: &Mesh,
+    parameterizers: &[&dyn Solver],
+    options: &RemeshOptions,
+    edge_length: f64,
+    context: &mut Context<'_>,
+) -> Result<Remeshing, RemeshError> {
     let sizes = size::vertex_sizes(mesh, options.size_field, edge_length);
     let mut notes = Vec::new();
     for (i, solver) in parameterizers.iter().enumerate() {

@@ -15,9 +15,10 @@ pub const MAX_MIN_ANGLE: f64 = 33.8;
 pub enum Resolution {
     /// The edge length on the surface, in the mesh's units.
     EdgeLength(f64),
-    /// About this many vertices: the edge length `L` of an equilateral triangulation
-    /// of the surface's area `A` with `N` vertices, `A = N (sqrt 3 / 2) L^2` (each
-    /// vertex owns two triangles of area `(sqrt 3 / 4) L^2`).
+    /// About this many vertices: first the edge length `L` of an equilateral
+    /// triangulation of the surface's area `A` with `N` vertices, `A = N (sqrt 3 / 2)
+    /// L^2` (each vertex owns two triangles of area `(sqrt 3 / 4) L^2`), then one
+    /// correction by the count that gave (see [`crate::remesh`]).
     Vertices(usize),
 }
 
