@@ -8,7 +8,7 @@ use anyhow::{Context as _, bail};
 use beltrami_core::{Context, Solver};
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_remesh::{Quality, RemeshOptions, Remeshing, Resolution, SizeField};
-use beltrami_render::{Scene, Style};
+use beltrami_render::{ColorBy, Scene, Style, View};
 use clap::{Args, ValueEnum};
 use serde_json::{Value, json};
 
@@ -131,6 +131,8 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     if let Some(path) = &args.png {
         let scene = Scene::new(out, None)?;
         let style = Style {
+            view: View::Surface,
+            color: ColorBy::Plain,
             wire: true,
             ..Style::default()
         };

@@ -11,7 +11,8 @@
 //!    surface with several boundary loops as it is.
 //! 2. **Parameterization** ([`param`]): the solver's map of the chart into the plane
 //!    (free boundary, circle, disk, circle domain or square, whichever it accepts
-//!    first); a face with non-positive image area is refused.
+//!    first); a face with non-positive image area is refused. A mesh that lies in a
+//!    plane is its own parameterization, uncut.
 //! 3. **Boundary** ([`boundary`]): every surface curve on the boundary of the domain
 //!    (boundary loops, both copies of each cut curve) is sampled once at the asked
 //!    spacing on the surface; copies of one seam point become one vertex.
@@ -65,7 +66,8 @@ pub use quality::Quality;
 pub struct Remeshing {
     /// The new mesh and each of its vertices' point on the input.
     pub remeshed: Remeshed,
-    /// The parameterizer that was used.
+    /// The parameterizer that was used, or `plane` for a planar mesh, which is its own
+    /// parameterization ([`param::in_plane`]).
     pub parameterizer: &'static str,
     /// How the surface was opened for it.
     pub opening: Opening,
@@ -122,6 +124,16 @@ fn remesh_at(
     context: &mut Context<'_>,
 ) -> Result<Remeshing, RemeshError> {
     let sizes = size::vertex_sizes(mesh, options.size_field, edge_length);
+    if let Some(uv) = param::in_plane(mesh) {
+        let chart = chart::Chart {
+            mesh: mesh.clone(),
+            to_original: mesh.vertices().collect(),
+            opening: Opening::Uncut,
+        };
+        let mut out = triangulate_chart(mesh, &chart, &uv, "plane", options, &sizes, context)?;
+        out.edge_length = edge_length;
+        return Ok(out);
+    }
     let mut notes = Vec::new();
     for (i, solver) in parameterizers.iter().enumerate() {
         match remesh_with(mesh, *solver, options, &sizes, context) {
@@ -162,10 +174,32 @@ fn remesh_with(
     lap("chart", &mut timings);
     let uv = param::parameterize(&chart.mesh, solver, context)?;
     lap("parameterize", &mut timings);
+    let mut out = triangulate_chart(mesh, &chart, &uv, solver.name(), options, sizes, context)?;
+    timings.append(&mut out.timings);
+    out.timings = timings;
+    Ok(out)
+}
 
-    let planar = domain::planar_mesh(&chart.mesh, &uv)?;
+/// Triangulates the parameter domain of `chart` (positions `uv`), lifts it onto `mesh`
+/// and builds the result.
+fn triangulate_chart(
+    mesh: &Mesh,
+    chart: &chart::Chart,
+    uv: &[num_complex::Complex64],
+    parameterizer: &'static str,
+    options: &RemeshOptions,
+    sizes: &[f64],
+    context: &mut Context<'_>,
+) -> Result<Remeshing, RemeshError> {
+    let mut timings = Vec::new();
+    let mut clock = Instant::now();
+    let mut lap = |name: &'static str, timings: &mut Vec<(&'static str, f64)>| {
+        timings.push((name, clock.elapsed().as_secs_f64()));
+        clock = Instant::now();
+    };
+    let planar = domain::planar_mesh(&chart.mesh, uv)?;
     let domain = domain::Domain::new(&chart.mesh, &planar)?;
-    let samples = boundary::sample(&chart.mesh, &uv, &chart.to_original, |v| sizes[v.idx()]);
+    let samples = boundary::sample(&chart.mesh, uv, &chart.to_original, |v| sizes[v.idx()]);
     let size_at = |p: &SurfacePoint| {
         let (v, n) = chart.mesh.face_vertex_array(p.face);
         (0..n)
@@ -185,7 +219,7 @@ fn remesh_with(
         &size_at,
         options.min_angle,
         options.max_vertices,
-        solver.name(),
+        parameterizer,
         context,
     )?;
     lap("triangulate", &mut timings);
@@ -232,7 +266,7 @@ fn remesh_with(
             mesh: result,
             on_source,
         },
-        parameterizer: solver.name(),
+        parameterizer,
         opening: chart.opening,
         edge_length: 0.0,
         size_passes: tri.passes,

@@ -158,6 +158,44 @@ fn untangle(chart: &Mesh, uv: &mut [Complex64]) {
     }
 }
 
+/// The in-plane coordinates of a mesh that lies in a plane (every vertex within
+/// `1e-12` of the bounding-box diagonal from the plane through its first vertex normal
+/// to the total vector area `n`), in an orthonormal basis `(e1, e2)` with
+/// `e1 x e2 = n / |n|`, so that faces counter-clockwise about `n` stay so. A planar
+/// region is its own conformal parameterization, uncut whatever its number of boundary
+/// loops; `None` for a curved mesh, or one whose faces do not all turn the same way.
+pub fn in_plane(mesh: &Mesh) -> Option<Vec<Complex64>> {
+    let normal = mesh
+        .faces()
+        .map(|f| mesh.face_vector_area(f))
+        .fold(beltrami_mesh::Vector3::zeros(), |s, a| s + a)
+        .try_normalize(0.0)?;
+    let origin = mesh.positions().first()?.coords;
+    let tolerance = 1e-12 * mesh.bounding_box().diagonal();
+    if mesh
+        .positions()
+        .iter()
+        .any(|p| (p.coords - origin).dot(&normal).abs() > tolerance)
+    {
+        return None;
+    }
+    let helper = if normal.x.abs() < 0.9 {
+        beltrami_mesh::Vector3::x()
+    } else {
+        beltrami_mesh::Vector3::y()
+    };
+    let e1 = normal.cross(&helper).normalize();
+    let e2 = normal.cross(&e1);
+    let uv: Vec<Complex64> = mesh
+        .positions()
+        .iter()
+        .map(|p| Complex64::new((p.coords - origin).dot(&e1), (p.coords - origin).dot(&e2)))
+        .collect();
+    mesh.faces()
+        .all(|f| signed_area(mesh, &uv, f) > 0.0)
+        .then_some(uv)
+}
+
 /// Twice the signed area of the image of face `f`: `sum_i Im(conj(z_i) z_{i+1})` over
 /// its corners (the shoelace formula; positive when counter-clockwise).
 pub fn signed_area(mesh: &Mesh, uv: &[Complex64], f: FaceId) -> f64 {

@@ -31,9 +31,9 @@
 //! the outside to it crosses an odd number of constraint edges.
 //!
 //! `ALPHA` sets where edges stop being split. With frontal points the mean lifted edge
-//! follows it smoothly (measured on a square and a torus: mean `0.83 h` at `ALPHA =
-//! 1.3`, `0.93 h` at 1.5, `1.0`-`1.04 h` at 1.7); the value below puts the mean at
-//! about `h`.
+//! follows it smoothly (measured on a flat disk, a square, a torus and a sphere: mean
+//! `0.95`-`1.02 h` at `ALPHA = 1.6`, `1.02`-`1.05 h` at 1.72); the value below puts
+//! the mean at about `h`.
 
 use beltrami_core::Context;
 use beltrami_mesh::{Point3, SurfacePoint};
@@ -205,8 +205,8 @@ impl Triangulation {
     }
 }
 
-/// Where to split a face that is too large or skinny, and a radius for the closeness
-/// test: the point on the perpendicular bisector of the face's shortest lifted edge
+/// Where to split a face that is too large or skinny, and the radius of its closeness
+/// test in [`insert_all`]: the point on the perpendicular bisector of the face's shortest lifted edge
 /// `pq` that would make `pq` the base of an equilateral triangle of the asked size `h`
 /// (D. Rebay, "Efficient unstructured mesh generation by means of Delaunay
 /// triangulation and Bowyer-Watson algorithm", J. Comput. Phys. 106, 1993), but no
@@ -214,7 +214,10 @@ impl Triangulation {
 /// The size is carried into the plane by the edge's own length ratio. Inserting at the
 /// circumcenter only, sizes come out anywhere between `ALPHA h / 2` and `ALPHA h`
 /// depending on how the splits cascade; the frontal point builds on edges that are
-/// already of the right size.
+/// already of the right size. A frontal point is dropped when a vertex lies within
+/// `0.75 h` of it (in the plane): fronts that advance into a narrowing region, e.g.
+/// rings towards the centre of a disk, would otherwise keep their number of points and
+/// grow denser; a circumcenter is dropped within half the circumradius.
 fn frontal_point(z: &[Complex64; 3], p: &[Point3<f64>; 3], h: f64) -> (Complex64, f64) {
     let k = (0..3)
         .min_by(|&a, &b| {
@@ -227,7 +230,7 @@ fn frontal_point(z: &[Complex64; 3], p: &[Point3<f64>; 3], h: f64) -> (Complex64
     let base = (b - a).norm();
     let lifted = (p[(k + 1) % 3] - p[k]).norm();
     let circumcenter = circumcenter(a, b, c);
-    let radius = (circumcenter - a).norm();
+    let radius = 0.5 * (circumcenter - a).norm();
     if !(base > 0.0 && lifted > 0.0) {
         return (circumcenter, radius);
     }
@@ -240,8 +243,7 @@ fn frontal_point(z: &[Complex64; 3], p: &[Point3<f64>; 3], h: f64) -> (Complex64
     if to_circumcenter <= 0.0 || height >= to_circumcenter || h_plane <= 0.5 * base {
         return (circumcenter, radius);
     }
-    let q = m + normal * height;
-    (q, (q - a).norm())
+    (m + normal * height, 0.75 * h_plane)
 }
 
 /// The circumcenter of the triangle `a b c` of the plane.
@@ -252,8 +254,8 @@ fn circumcenter(a: Complex64, b: Complex64, c: Complex64) -> Complex64 {
     a + Complex64::new(c.im * nb - b.im * nc, b.re * nc - c.re * nb) / d
 }
 
-/// Inserts the points `(r, q)` in order, each unless a vertex lies within `r / 2` of it
-/// or it falls outside the domain, and lifts them; returns how many were inserted.
+/// Inserts the points `(r, q)` in order, each unless a vertex lies within `r` of it or
+/// it falls outside the domain, and lifts them; returns how many were inserted.
 fn insert_all(
     cdt: &mut Cdt,
     tri: &mut Triangulation,
@@ -264,7 +266,7 @@ fn insert_all(
 ) -> Result<usize, RemeshError> {
     let mut inserted = 0;
     for (r, q) in points {
-        if too_close(cdt, q, 0.5 * r) {
+        if too_close(cdt, q, r) {
             continue;
         }
         if let Some((point, position)) = domain.lift(q)?
@@ -280,7 +282,7 @@ fn insert_all(
 }
 
 /// Input vertices farther than `DEVIATION h` from the interpolated result at their
-/// parameter point (module docs), as (twice the radius of the closeness test of
+/// parameter point (module docs), as (the radius of the closeness test of
 /// [`insert_all`], point), farthest first.
 fn deviating(
     cdt: &Cdt,
