@@ -5,7 +5,8 @@
 //!    constrained Delaunay triangulation; a crossing constraint means the map overlaps.
 //! 2. Size passes: every inner face whose longest edge, *lifted onto the surface*, is
 //!    longer than `ALPHA h` (`h` the asked length there), or whose smallest lifted angle
-//!    is below the angle limit while its edges are not already short, gets a new vertex
+//!    is below the angle limit while its longest edge is still longer than `h` (so that
+//!    an anisotropic map cannot drive it on forever), gets a new vertex
 //!    at a frontal point towards its circumcenter ([`frontal_point`]; its centroid when
 //!    that point falls outside the domain), as in Delaunay refinement (J. Ruppert, "A Delaunay refinement algorithm for
 //!    quality 2-dimensional mesh generation", J. Algorithms 18, 1995; L. P. Chew,
@@ -130,7 +131,7 @@ pub fn triangulate(
                 .map(|k| (p[(k + 1) % 3] - p[k]).norm())
                 .fold(0.0, f64::max);
             let too_long = longest > ALPHA * h;
-            let skinny = longest > 0.5 * h && smallest_sine(&p) < sin_limit;
+            let skinny = longest > h && smallest_sine(&p) < sin_limit;
             if !(too_long || skinny) {
                 continue;
             }
