@@ -48,7 +48,7 @@ mod vertex_map;
 pub use build::{BuildOptions, BuildReport, Repair};
 pub use cut::{
     CutError, CutGraph, CutMesh, Generator, GeneratorKind, TorusSides, cut_along, cut_graph,
-    cut_to_disk,
+    cut_to_disk, shortest_path_tree,
 };
 pub use error::MeshError;
 pub use frame::FaceFrame;

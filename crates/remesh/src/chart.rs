@@ -2,10 +2,7 @@
 //! for a closed genus-0 surface, slit along one path), or the surface itself when it is
 //! already a disk or the parameterizer maps several boundary loops (a circle domain).
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
-
-use beltrami_mesh::{EdgeId, HalfedgeId, Mesh, VertexId, cut_along, cut_to_disk};
+use beltrami_mesh::{EdgeId, Mesh, VertexId, cut_along, cut_to_disk, shortest_path_tree};
 
 use crate::RemeshError;
 
@@ -104,9 +101,9 @@ pub fn open(mesh: &Mesh, keep_loops: bool) -> Result<Chart, RemeshError> {
 /// half a great circle keeps the conformal factor of the opened sphere bounded away from
 /// 0 and infinity except near the two ends, where the slit angle `2 pi` opens to `pi`.
 fn slit_path(mesh: &Mesh) -> Vec<EdgeId> {
-    let (far, _) = shortest_paths(mesh, VertexId(0));
+    let (far, _) = shortest_path_tree(mesh, VertexId(0));
     let a = farthest(&far);
-    let (dist, pred) = shortest_paths(mesh, a);
+    let (dist, pred) = shortest_path_tree(mesh, a);
     let mut v = farthest(&dist);
     let mut edges = Vec::new();
     while let Some(h) = pred[v.idx()] {
@@ -124,49 +121,4 @@ fn farthest(dist: &[f64]) -> VertexId {
         },
     );
     VertexId(i as u32)
-}
-
-/// A heap entry that pops the smallest distance first.
-struct Entry(f64, VertexId);
-
-impl PartialEq for Entry {
-    fn eq(&self, other: &Self) -> bool {
-        self.0 == other.0
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Entry {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.0.total_cmp(&self.0)
-    }
-}
-
-/// Dijkstra over edge lengths from `root`: distances and the halfedge each vertex was
-/// reached by.
-fn shortest_paths(mesh: &Mesh, root: VertexId) -> (Vec<f64>, Vec<Option<HalfedgeId>>) {
-    let mut dist = vec![f64::INFINITY; mesh.vertex_count()];
-    let mut pred = vec![None; mesh.vertex_count()];
-    let mut heap = BinaryHeap::new();
-    dist[root.idx()] = 0.0;
-    heap.push(Entry(0.0, root));
-    while let Some(Entry(d, v)) = heap.pop() {
-        if d > dist[v.idx()] {
-            continue;
-        }
-        for h in mesh.outgoing_halfedges(v) {
-            let w = mesh.target(h);
-            let nd = d + mesh.halfedge_vector(h).norm();
-            if nd < dist[w.idx()] {
-                dist[w.idx()] = nd;
-                pred[w.idx()] = Some(h);
-                heap.push(Entry(nd, w));
-            }
-        }
-    }
-    (dist, pred)
 }

@@ -156,6 +156,28 @@ fn remesh_at(
     })
 }
 
+/// Seconds per stage, each measured from the end of the previous one.
+struct Stopwatch {
+    laps: Vec<(&'static str, f64)>,
+    since: Instant,
+}
+
+impl Default for Stopwatch {
+    fn default() -> Self {
+        Self {
+            laps: Vec::new(),
+            since: Instant::now(),
+        }
+    }
+}
+
+impl Stopwatch {
+    fn lap(&mut self, name: &'static str) {
+        self.laps.push((name, self.since.elapsed().as_secs_f64()));
+        self.since = Instant::now();
+    }
+}
+
 fn remesh_with(
     mesh: &Mesh,
     solver: &dyn Solver,
@@ -163,20 +185,15 @@ fn remesh_with(
     sizes: &[f64],
     context: &mut Context<'_>,
 ) -> Result<Remeshing, RemeshError> {
-    let mut timings = Vec::new();
-    let mut clock = Instant::now();
-    let mut lap = |name: &'static str, timings: &mut Vec<(&'static str, f64)>| {
-        timings.push((name, clock.elapsed().as_secs_f64()));
-        clock = Instant::now();
-    };
+    let mut timings = Stopwatch::default();
     param::planar_target(solver)?;
     let chart = chart::open(mesh, param::keeps_loops(solver))?;
-    lap("chart", &mut timings);
+    timings.lap("chart");
     let uv = param::parameterize(&chart.mesh, solver, context)?;
-    lap("parameterize", &mut timings);
+    timings.lap("parameterize");
     let mut out = triangulate_chart(mesh, &chart, &uv, solver.name(), options, sizes, context)?;
-    timings.append(&mut out.timings);
-    out.timings = timings;
+    timings.laps.append(&mut out.timings);
+    out.timings = timings.laps;
     Ok(out)
 }
 
@@ -191,12 +208,7 @@ fn triangulate_chart(
     sizes: &[f64],
     context: &mut Context<'_>,
 ) -> Result<Remeshing, RemeshError> {
-    let mut timings = Vec::new();
-    let mut clock = Instant::now();
-    let mut lap = |name: &'static str, timings: &mut Vec<(&'static str, f64)>| {
-        timings.push((name, clock.elapsed().as_secs_f64()));
-        clock = Instant::now();
-    };
+    let mut timings = Stopwatch::default();
     let planar = domain::planar_mesh(&chart.mesh, uv)?;
     let domain = domain::Domain::new(&chart.mesh, &planar)?;
     let samples = boundary::sample(&chart.mesh, uv, &chart.to_original, |v| sizes[v.idx()]);
@@ -222,7 +234,7 @@ fn triangulate_chart(
         parameterizer,
         context,
     )?;
-    lap("triangulate", &mut timings);
+    timings.lap("triangulate");
 
     // Result vertices: the boundary samples by their seam identity, then the rest.
     let boundary = samples.points.len();
@@ -260,7 +272,7 @@ fn triangulate_chart(
     if expected != found {
         return Err(RemeshError::TopologyChanged { expected, found });
     }
-    lap("assemble", &mut timings);
+    timings.lap("assemble");
     Ok(Remeshing {
         remeshed: Remeshed {
             mesh: result,
@@ -270,7 +282,7 @@ fn triangulate_chart(
         opening: chart.opening,
         edge_length: 0.0,
         size_passes: tri.passes,
-        timings,
+        timings: timings.laps,
         notes: Vec::new(),
     })
 }
