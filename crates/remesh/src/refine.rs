@@ -28,6 +28,9 @@
 //!    triangle areas), each followed by a new constrained Delaunay triangulation of the
 //!    moved vertices. A move that would leave the domain is not made.
 //!
+//! 5. Edge flips: an inner edge is flipped when that raises the smallest lifted angle of
+//!    its two faces and keeps both faces positively oriented in the plane.
+//!
 //! Faces of the domain are found by crossing parity: a face is inside when a walk from
 //! the outside to it crosses an odd number of constraint edges.
 //!
@@ -193,7 +196,87 @@ pub fn triangulate(
         cdt = load(&tri.uv, &samples.edges, solver)?;
     }
     tri.faces = faces_of(&cdt);
+    for _ in 0..FLIP_SWEEPS {
+        if flip_for_angles(&mut tri, domain)? == 0 {
+            break;
+        }
+    }
     Ok(tri)
+}
+
+/// Sweeps of [`flip_for_angles`] at most.
+const FLIP_SWEEPS: usize = 8;
+
+/// One sweep of edge flips for the lifted angles: an inner edge shared by faces `abc`
+/// and `bad` becomes `cd` when that raises the smallest lifted angle of the two faces,
+/// both new faces keep a positive orientation in the plane (so the parameter
+/// triangulation stays a triangulation and no seam or boundary edge moves: those have
+/// one face in the domain), and the new edge's midpoint is no farther from the surface
+/// than the old one's or `FLIP_DEVIATION h` (a flip across a crease would cut it).
+/// Each flip raises the sorted angle vector of the mesh, so sweeps end; returns the
+/// flips made. Faces changed in this sweep wait for the next.
+fn flip_for_angles(tri: &mut Triangulation, domain: &Domain<'_>) -> Result<usize, RemeshError> {
+    use std::collections::HashMap;
+    let mut across: HashMap<(u32, u32), (usize, u32)> = HashMap::new();
+    for (f, face) in tri.faces.iter().enumerate() {
+        for k in 0..3 {
+            across.insert((face[k], face[(k + 1) % 3]), (f, face[(k + 2) % 3]));
+        }
+    }
+    let angle = |a: u32, b: u32, c: u32| {
+        smallest_sine(&[
+            tri.position[a as usize],
+            tri.position[b as usize],
+            tri.position[c as usize],
+        ])
+    };
+    let orientation = |a: u32, b: u32, c: u32| {
+        let z = [a, b, c].map(|i| tri.uv[i as usize]);
+        cross(z[1] - z[0], z[2] - z[0])
+    };
+    let mut changed = vec![false; tri.faces.len()];
+    let mut flips = Vec::new();
+    for (f, face) in tri.faces.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b, c) = (face[k], face[(k + 1) % 3], face[(k + 2) % 3]);
+            let Some(&(g, d)) = across.get(&(b, a)) else {
+                continue;
+            };
+            if g < f || changed[f] || changed[g] || across.contains_key(&(c, d)) {
+                continue;
+            }
+            let before = angle(a, b, c).min(angle(b, a, d));
+            let after = angle(a, d, c).min(angle(d, b, c));
+            if after > before * (1.0 + 1e-9)
+                && orientation(a, d, c) > 0.0
+                && orientation(d, b, c) > 0.0
+                && chord_gap(tri, domain, c, d)?
+                    <= chord_gap(tri, domain, a, b)?.max(FLIP_DEVIATION * tri.size[a as usize])
+            {
+                changed[f] = true;
+                changed[g] = true;
+                flips.push((f, g, [a, d, c], [d, b, c]));
+            }
+        }
+    }
+    for &(f, g, new_f, new_g) in &flips {
+        tri.faces[f] = new_f;
+        tri.faces[g] = new_g;
+    }
+    Ok(flips.len())
+}
+
+/// Largest distance from the surface of a flipped edge's midpoint, relative to the
+/// asked length, that is accepted whatever the old edge's.
+const FLIP_DEVIATION: f64 = 0.05;
+
+/// The distance between the midpoint of the chord `ab` and the surface point over the
+/// midpoint of `ab` in the plane.
+fn chord_gap(tri: &Triangulation, domain: &Domain<'_>, a: u32, b: u32) -> Result<f64, RemeshError> {
+    let (a, b) = (a as usize, b as usize);
+    let (_, on_surface) = domain.lift_closest((tri.uv[a] + tri.uv[b]) / 2.0)?;
+    let chord = (tri.position[a].coords + tri.position[b].coords) / 2.0;
+    Ok((on_surface.coords - chord).norm())
 }
 
 impl Triangulation {
