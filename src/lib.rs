@@ -25,6 +25,8 @@
 //!   then the flow on the target mesh.
 //! - [`qcmc`]: circle-domain maps of multiply-connected meshes (qcmc, Ho-Lui 2016): the
 //!   unit disk minus disks whose centres and radii are found with the map.
+//! - [`remesh`]: remeshing through a parameterization (spade's constrained Delaunay
+//!   refinement of the parameter domain with a size field measured on the surface).
 //! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
 //!   |mu| histograms as PNG.
 //!
@@ -64,6 +66,7 @@ pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
 pub use beltrami_qcmc as qcmc;
 pub use beltrami_register as register;
+pub use beltrami_remesh as remesh;
 pub use beltrami_render as render;
 pub use beltrami_spatial as spatial;
 

@@ -14,6 +14,7 @@ mod picture;
 mod pins;
 mod qc;
 mod register;
+mod remesh;
 mod render;
 mod solvers;
 
@@ -63,6 +64,9 @@ pub enum Command {
     /// Cut a surface of genus >= 1 (or with several boundary loops) into a disk along a
     /// greedy shortest system of loops and write it as OBJ.
     Cut(cut::CutArgs),
+    /// Remesh a surface with the asked edge length: parameterize it, triangulate the
+    /// parameter domain with constrained Delaunay refinement, lift back.
+    Remesh(remesh::RemeshArgs),
 }
 
 /// Runs the parsed command.
@@ -79,5 +83,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Cut(args) => cut::run(&args, cli.quiet),
         Command::Render(args) => render::run(&args, cli.quiet),
         Command::Histogram(args) => histogram::run(&args, cli.quiet),
+        Command::Remesh(args) => remesh::run(&args, cli.quiet),
     }
 }

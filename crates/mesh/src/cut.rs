@@ -296,6 +296,17 @@ impl Ord for Entry {
     }
 }
 
+/// Shortest paths by edge length from `root` over the whole mesh (Dijkstra; on a mesh
+/// with boundary, every boundary loop is settled as a whole when its first vertex is,
+/// as in the cut graph's tree): per vertex its distance (infinite off `root`'s
+/// component) and the halfedge it was reached by, pointing towards it (`None` at the
+/// root and off the component).
+pub fn shortest_path_tree(mesh: &Mesh, root: VertexId) -> (Vec<f64>, Vec<Option<HalfedgeId>>) {
+    let tree = VertexTree::shortest_paths(mesh, &[root], &mesh.edge_lengths());
+    let reached = tree.up.iter().map(|up| up.map(|h| mesh.twin(h))).collect();
+    (tree.dist, reached)
+}
+
 /// The spanning tree of the vertices: for each vertex the halfedge to its parent.
 struct VertexTree {
     /// Distance from the root, with every boundary loop contracted to a point.
@@ -765,18 +776,7 @@ pub fn cut_to_disk(mesh: &Mesh) -> Result<CutMesh, CutError> {
     let is_eight = eight.is_some();
     let cut = eight.unwrap_or(graph);
 
-    let mut in_cut = vec![false; mesh.edge_count()];
-    for &e in &cut.edges {
-        in_cut[e.idx()] = true;
-    }
-    let (soup, to_original) = split_along(mesh, &in_cut);
-    // The faces are the original's, already validated: accept every area, whatever
-    // tolerance the original was built with.
-    let options = BuildOptions {
-        degenerate_area_tolerance: -1.0,
-        repair: Repair::NONE,
-    };
-    let (cut_mesh, _) = Mesh::build(&soup, &options)?;
+    let (cut_mesh, to_original) = cut_along(mesh, &cut.edges)?;
     let boundary: Vec<HalfedgeId> = cut_mesh
         .boundary_loops()
         .next()
@@ -793,6 +793,30 @@ pub fn cut_to_disk(mesh: &Mesh) -> Result<CutMesh, CutError> {
         out.torus_sides = torus_sides(mesh, &mut out);
     }
     Ok(out)
+}
+
+/// Cuts `mesh` open along the given edges (any set, e.g. a path that slits a closed
+/// genus-0 surface into a disk): every vertex is split into one copy per wedge of faces
+/// between consecutive cut or boundary edges around it, as in [`cut_to_disk`]. Faces
+/// keep their ids, order and first vertex; the returned seam map gives the original
+/// vertex of every vertex of the cut mesh (vertex `v < n` is a copy of `v`).
+///
+/// # Errors
+/// [`CutError::Build`] if the cut mesh fails validation.
+pub fn cut_along(mesh: &Mesh, edges: &[EdgeId]) -> Result<(Mesh, Vec<VertexId>), CutError> {
+    let mut in_cut = vec![false; mesh.edge_count()];
+    for &e in edges {
+        in_cut[e.idx()] = true;
+    }
+    let (soup, to_original) = split_along(mesh, &in_cut);
+    // The faces are the original's, already validated: accept every area, whatever
+    // tolerance the original was built with.
+    let options = BuildOptions {
+        degenerate_area_tolerance: -1.0,
+        repair: Repair::NONE,
+    };
+    let (cut_mesh, _) = Mesh::build(&soup, &options)?;
+    Ok((cut_mesh, to_original))
 }
 
 /// The polygon soup of `mesh` with every vertex split into one copy per wedge of faces

@@ -47,7 +47,8 @@ mod vertex_map;
 
 pub use build::{BuildOptions, BuildReport, Repair};
 pub use cut::{
-    CutError, CutGraph, CutMesh, Generator, GeneratorKind, TorusSides, cut_graph, cut_to_disk,
+    CutError, CutGraph, CutMesh, Generator, GeneratorKind, TorusSides, cut_along, cut_graph,
+    cut_to_disk, shortest_path_tree,
 };
 pub use error::MeshError;
 pub use frame::FaceFrame;

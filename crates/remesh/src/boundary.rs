@@ -1,0 +1,174 @@
+//! Sampling the boundary of the parameter domain once per surface curve.
+//!
+//! The boundary of a chart consists of the surface's own boundary loops and, after a
+//! cut, of two copies of every cut curve. It splits at *nodes* (surface vertices where
+//! the number of cut and boundary edges around them is not 2: ends and branch points of
+//! the cut graph; a loop without one gets its smallest vertex id) into *runs*, each of
+//! which is a copy of one surface *chain* (a path of surface edges between two nodes),
+//! walked forwards or backwards. Every chain is divided into `n` pieces of equal length
+//! on the surface, and every copy places its samples at the same arc lengths, so that
+//! both copies of a seam point lift to the same surface point and become one vertex of
+//! the result: the seam is sampled once and the result closes up.
+
+use std::collections::HashMap;
+
+use beltrami_mesh::{HalfedgeId, Mesh, VertexId};
+use num_complex::Complex64;
+
+/// A sample's identity on the surface, shared by all its copies on the boundary.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum SeamPoint {
+    /// A node: a surface vertex.
+    Node(VertexId),
+    /// Sample `k` (`0 < k < n`) of chain `chain`, counted in the chain's own direction.
+    Chain { chain: usize, k: usize },
+}
+
+/// The boundary samples of the parameter domain and the constraint edges joining them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundarySamples {
+    /// The samples in the parameter domain, loop after loop, each loop in the order of
+    /// its boundary halfedges.
+    pub points: Vec<Complex64>,
+    /// Per sample, its vertex of the result: copies of one surface point share it.
+    pub vertex: Vec<u32>,
+    /// Number of distinct result vertices among the samples.
+    pub vertex_count: usize,
+    /// Constraint edges between consecutive samples of each loop (indices into
+    /// `points`).
+    pub edges: Vec<[usize; 2]>,
+}
+
+/// Samples the boundary of `chart` (parameter positions `uv`, surface vertex of each
+/// chart vertex `to_original`) with pieces of about `spacing(v)` on the surface near
+/// surface vertex `v` (a chain takes the mean over its vertices).
+pub fn sample(
+    chart: &Mesh,
+    uv: &[Complex64],
+    to_original: &[VertexId],
+    spacing: impl Fn(VertexId) -> f64,
+) -> BoundarySamples {
+    let original = |v: VertexId| to_original[v.idx()];
+    let edge_key = |h: HalfedgeId| {
+        let (a, b) = (original(chart.origin(h)).0, original(chart.target(h)).0);
+        (a.min(b), a.max(b))
+    };
+    // Cut and boundary edges of the surface around each surface vertex.
+    let mut keys: Vec<(u32, u32)> = chart
+        .boundary_loops()
+        .flat_map(|b| chart.loop_halfedges(b).map(edge_key))
+        .collect();
+    keys.sort_unstable();
+    keys.dedup();
+    let mut degree: HashMap<u32, usize> = HashMap::new();
+    for &(a, b) in &keys {
+        *degree.entry(a).or_default() += 1;
+        *degree.entry(b).or_default() += 1;
+    }
+    let is_node = |v: VertexId| degree.get(&original(v).0) != Some(&2);
+
+    let mut out = BoundarySamples {
+        points: Vec::new(),
+        vertex: Vec::new(),
+        vertex_count: 0,
+        edges: Vec::new(),
+    };
+    let mut ids: HashMap<SeamPoint, u32> = HashMap::new();
+    let mut chains: HashMap<Vec<u32>, (usize, usize)> = HashMap::new();
+    for b in chart.boundary_loops() {
+        let mut hs: Vec<HalfedgeId> = chart.loop_halfedges(b).collect();
+        let start = hs
+            .iter()
+            .position(|&h| is_node(chart.origin(h)))
+            .unwrap_or_else(|| {
+                (0..hs.len())
+                    .min_by_key(|&i| original(chart.origin(hs[i])).0)
+                    .unwrap_or(0)
+            });
+        hs.rotate_left(start);
+        let first = out.points.len();
+        let mut run: Vec<HalfedgeId> = Vec::new();
+        for (i, &h) in hs.iter().enumerate() {
+            run.push(h);
+            let last = i + 1 == hs.len();
+            if last || is_node(chart.target(h)) {
+                sample_run(
+                    chart,
+                    uv,
+                    &original,
+                    &run,
+                    &spacing,
+                    &mut chains,
+                    &mut ids,
+                    &mut out,
+                );
+                run.clear();
+            }
+        }
+        let count = out.points.len() - first;
+        out.edges
+            .extend((0..count).map(|i| [first + i, first + (i + 1) % count]));
+    }
+    out.vertex_count = ids.len();
+    out
+}
+
+/// Adds the samples of one run (all but its last point, which starts the next run).
+#[allow(clippy::too_many_arguments)]
+fn sample_run(
+    chart: &Mesh,
+    uv: &[Complex64],
+    original: &impl Fn(VertexId) -> VertexId,
+    run: &[HalfedgeId],
+    spacing: &impl Fn(VertexId) -> f64,
+    chains: &mut HashMap<Vec<u32>, (usize, usize)>,
+    ids: &mut HashMap<SeamPoint, u32>,
+    out: &mut BoundarySamples,
+) {
+    let mut sequence: Vec<u32> = run.iter().map(|&h| original(chart.origin(h)).0).collect();
+    sequence.push(original(chart.target(run[run.len() - 1])).0);
+    let reversed: Vec<u32> = sequence.iter().rev().copied().collect();
+    let forward = sequence <= reversed;
+    let closed = sequence[0] == sequence[sequence.len() - 1];
+    let lengths: Vec<f64> = run
+        .iter()
+        .map(|&h| chart.halfedge_vector(h).norm())
+        .collect();
+    let total: f64 = lengths.iter().sum();
+    let next_chain = chains.len();
+    let (chain, n) = *chains
+        .entry(if forward { sequence.clone() } else { reversed })
+        .or_insert_with(|| {
+            let mean_spacing =
+                sequence.iter().map(|&v| spacing(VertexId(v))).sum::<f64>() / sequence.len() as f64;
+            let n = (total / mean_spacing).round() as usize;
+            (next_chain, n.max(if closed { 3 } else { 1 }))
+        });
+    let mut edge = 0;
+    let mut before = 0.0;
+    for k in 0..n {
+        let s = total * k as f64 / n as f64;
+        while edge + 1 < run.len() && before + lengths[edge] < s {
+            before += lengths[edge];
+            edge += 1;
+        }
+        let h = run[edge];
+        let t = if lengths[edge] > 0.0 {
+            ((s - before) / lengths[edge]).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let (a, b) = (uv[chart.origin(h).idx()], uv[chart.target(h).idx()]);
+        let key = if k == 0 {
+            SeamPoint::Node(original(chart.origin(run[0])))
+        } else {
+            SeamPoint::Chain {
+                chain,
+                k: if forward { k } else { n - k },
+            }
+        };
+        let next = ids.len() as u32;
+        out.vertex.push(*ids.entry(key).or_insert(next));
+        out.points.push(a + (b - a) * t);
+    }
+}

@@ -1,0 +1,101 @@
+//! Why a remeshing could not be done.
+
+use beltrami_core::SolverError;
+use beltrami_mesh::{CutError, FaceId, MeshError};
+use beltrami_spatial::SpatialError;
+use thiserror::Error;
+
+/// Why a remeshing could not be done. Every variant names the option, face or solver at
+/// fault and what to do instead.
+#[derive(Debug, Error)]
+pub enum RemeshError {
+    /// An option is out of its range (a non-positive or non-finite edge length, a
+    /// vertex count below 3, a minimum angle that refinement cannot guarantee).
+    #[error("option `{option}`: {message}")]
+    InvalidOption {
+        /// The option's name as the command line spells it.
+        option: &'static str,
+        /// What is wrong and the accepted range.
+        message: String,
+    },
+    /// The mesh is not a single connected surface.
+    #[error("remeshing needs one connected surface; this mesh has {components} components")]
+    Components {
+        /// Number of connected components.
+        components: usize,
+    },
+    /// The parameterizer cannot be used for remeshing (it maps onto the sphere or a
+    /// mesh instead of the plane).
+    #[error("parameterizer `{solver}` cannot be used for remeshing: {message}")]
+    Parameterizer {
+        /// The solver's name.
+        solver: &'static str,
+        /// Why, and what to use instead.
+        message: String,
+    },
+    /// The parameterization failed.
+    #[error("parameterizing with `{solver}` failed: {error}")]
+    Solve {
+        /// The solver's name.
+        solver: &'static str,
+        /// Its error.
+        #[source]
+        error: SolverError,
+    },
+    /// The parameterization folds over: a face has a non-positive area in the plane, so
+    /// points of the parameter domain have no single preimage.
+    #[error(
+        "the map of `{solver}` is not one-to-one: {flipped} faces have non-positive area in the plane (first: face {first}); use a bijective parameterizer such as `tutte`"
+    )]
+    Flipped {
+        /// The solver's name.
+        solver: &'static str,
+        /// Number of faces with a non-positive signed area.
+        flipped: usize,
+        /// The first of them.
+        first: FaceId,
+    },
+    /// The boundary of the parameter domain crosses itself (the map overlaps globally).
+    #[error(
+        "the boundary of the parameter domain of `{solver}` crosses itself (the map overlaps); use a parameterizer with a convex boundary such as `tutte`"
+    )]
+    Overlap {
+        /// The solver's name.
+        solver: &'static str,
+    },
+    /// Cutting the surface into a disk failed.
+    #[error(transparent)]
+    Cut(#[from] CutError),
+    /// Building a mesh failed (the cut or parameter mesh, or the result).
+    #[error("building the {what} failed: {error}")]
+    Build {
+        /// Which mesh.
+        what: &'static str,
+        /// The validation error.
+        #[source]
+        error: MeshError,
+    },
+    /// Point location failed.
+    #[error(transparent)]
+    Spatial(#[from] SpatialError),
+    /// The result does not have the input's topology (a bug: please report it with the
+    /// mesh and the options).
+    #[error("the remeshed surface has {found}, the input {expected}")]
+    TopologyChanged {
+        /// The input's topology in words.
+        expected: String,
+        /// The result's.
+        found: String,
+    },
+    /// The size field asks for more vertices than the limit.
+    #[error(
+        "the asked edge length needs more than {limit} vertices (option `max-vertices`); ask for a longer edge length or raise the limit"
+    )]
+    TooManyVertices {
+        /// The limit.
+        limit: usize,
+    },
+    /// The remeshing was cancelled.
+    #[error("cancelled")]
+    Cancelled,
+}

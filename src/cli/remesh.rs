@@ -1,0 +1,239 @@
+//! `beltrami remesh`: a new triangle mesh of a surface with the asked edge length, made
+//! through a parameterization (see the `beltrami-remesh` crate and docs/remesh.md).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context as _, bail};
+use beltrami_core::{Context, Solver};
+use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_remesh::{Quality, RemeshOptions, Remeshing, Resolution, SizeField};
+use beltrami_render::{ColorBy, Scene, Style, View};
+use clap::{Args, ValueEnum};
+use serde_json::{Value, json};
+
+use super::load::load_mesh;
+use super::mapping::{check_output_format, png_path};
+
+/// Remeshing methods of `--method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Parameterize, triangulate the parameter domain (spade), lift back.
+    Param,
+}
+
+/// Size fields of `--size-field`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SizeFieldArg {
+    /// The asked edge length everywhere.
+    Uniform,
+    /// Shorter edges where the surface bends (down to a quarter of the asked length).
+    Curvature,
+}
+
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("resolution").required(true).args(["edge_length", "vertices"])))]
+pub struct RemeshArgs {
+    /// Mesh file (.obj, .gltf, .glb): one connected surface of any genus, with or
+    /// without boundary.
+    pub mesh: PathBuf,
+    /// The edge length on the surface, in the mesh's units.
+    #[arg(long = "edge-length", value_name = "L", allow_hyphen_values = true)]
+    pub edge_length: Option<f64>,
+    /// About this many vertices (the edge length of an equilateral mesh of the
+    /// surface's area with N vertices).
+    #[arg(long, value_name = "N")]
+    pub vertices: Option<usize>,
+    /// How to remesh.
+    #[arg(long, value_enum, default_value = "param")]
+    pub method: MethodArg,
+    /// The parameterizer, any registered solver that maps into the plane (`beltrami
+    /// solvers` lists them), or `auto`: lscm on a disk, on a closed genus-0 surface
+    /// slit open and on any other surface cut to a disk (qcmc for several boundary
+    /// loops when registered), with tutte when the map folds or overlaps.
+    #[arg(long, value_name = "NAME", default_value = "auto")]
+    pub param: String,
+    /// The smallest angle refinement enforces, in degrees (at most 33.8).
+    #[arg(
+        long = "min-angle",
+        value_name = "A",
+        default_value_t = 30.0,
+        allow_hyphen_values = true
+    )]
+    pub min_angle: f64,
+    /// How the edge length varies over the surface.
+    #[arg(long = "size-field", value_enum, default_value = "uniform")]
+    pub size_field: SizeFieldArg,
+    /// The most vertices the result may have.
+    #[arg(long = "max-vertices", value_name = "N", default_value_t = 5_000_000)]
+    pub max_vertices: usize,
+    /// Output mesh (.obj, .gltf, .glb).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Write the JSON report here.
+    #[arg(long, value_name = "R.json")]
+    pub report: Option<PathBuf>,
+    /// Print the JSON report on stdout instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Also draw the result in 3D with its edges as PNG.
+    #[arg(long, value_parser = png_path)]
+    pub png: Option<PathBuf>,
+    /// Repair what can be repaired safely in the input (see `beltrami info --repair`).
+    #[arg(long)]
+    pub repair: bool,
+}
+
+impl RemeshArgs {
+    fn options(&self) -> RemeshOptions {
+        RemeshOptions {
+            resolution: match (self.edge_length, self.vertices) {
+                (Some(l), _) => Resolution::EdgeLength(l),
+                (None, Some(n)) => Resolution::Vertices(n),
+                (None, None) => Resolution::EdgeLength(f64::NAN),
+            },
+            min_angle: self.min_angle,
+            size_field: match self.size_field {
+                SizeFieldArg::Uniform => SizeField::Uniform,
+                SizeFieldArg::Curvature => SizeField::Curvature,
+            },
+            max_vertices: self.max_vertices,
+        }
+    }
+}
+
+pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
+    check_output_format(&args.output)?;
+    let options = args.options();
+    options.validate()?;
+    let registry = beltrami::registry();
+    let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
+    let mesh = &loaded.mesh.mesh;
+    let solvers: Vec<&dyn Solver> = match args.method {
+        MethodArg::Param if args.param == "auto" => {
+            let (first, fallback) = beltrami_remesh::param::auto(&registry, mesh)?;
+            std::iter::once(first)
+                .chain(fallback.filter(|f| f.name() != first.name()))
+                .collect()
+        }
+        MethodArg::Param => vec![registry.get(&args.param)?],
+    };
+
+    let start = Instant::now();
+    let mut context = Context::new().with_cancel_flag(super::interrupt::cancel_flag());
+    let result = beltrami_remesh::remesh(mesh, &solvers, &options, &mut context)
+        .with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let out = &result.remeshed.mesh;
+    io::write(&args.output, out, &VertexAttributes::default())?;
+    let quality = beltrami_remesh::quality::measure(mesh, out)?;
+
+    if let Some(path) = &args.png {
+        let scene = Scene::new(out, None)?;
+        let style = Style {
+            view: View::Surface,
+            color: ColorBy::Plain,
+            wire: true,
+            ..Style::default()
+        };
+        beltrami_render::render(&scene, &style)?
+            .write_png(path)
+            .with_context(|| format!("cannot write the picture {}", path.display()))?;
+    }
+
+    let report = report_json(args, mesh, &result, &quality, seconds);
+    if let Some(path) = &args.report {
+        let text = serde_json::to_string_pretty(&report)?;
+        io::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
+            .with_context(|| format!("cannot write the report {}", path.display()))?;
+    }
+    if args.json {
+        println!("{report}");
+    } else if !quiet {
+        print_summary(args, &result, &quality, seconds);
+    }
+    if super::interrupt::interrupted() {
+        bail!("interrupted");
+    }
+    Ok(())
+}
+
+/// The JSON report: sizes, angles, edge lengths, distances (also relative to the
+/// input's bounding-box diagonal), the parameterizer and the timings.
+fn report_json(
+    args: &RemeshArgs,
+    input: &beltrami_mesh::Mesh,
+    result: &Remeshing,
+    q: &Quality,
+    seconds: f64,
+) -> Value {
+    let timings: serde_json::Map<String, Value> = result
+        .timings
+        .iter()
+        .map(|(name, s)| (name.to_string(), json!(s)))
+        .collect();
+    json!({
+        "mesh": args.mesh.display().to_string(),
+        "output": args.output.display().to_string(),
+        "method": "param",
+        "parameterizer": result.parameterizer,
+        "opening": result.opening.name(),
+        "topology": beltrami_core::topology::describe(input),
+        "input_vertices": input.vertex_count(),
+        "input_faces": input.face_count(),
+        "edge_length": result.edge_length,
+        "vertices": q.vertices,
+        "faces": q.faces,
+        "min_angle": q.min_angle,
+        "mean_angle": q.mean_angle,
+        "share_below_30": q.share_below_30,
+        "edge_min": q.edge_min,
+        "edge_mean": q.edge_mean,
+        "edge_max": q.edge_max,
+        "edge_spread": q.edge_spread,
+        "edge_mean_over_asked": q.edge_mean / result.edge_length,
+        "hausdorff": q.hausdorff,
+        "mean_distance": q.mean_distance,
+        "diagonal": q.diagonal,
+        "hausdorff_over_diagonal": q.hausdorff / q.diagonal,
+        "mean_distance_over_diagonal": q.mean_distance / q.diagonal,
+        "size_passes": result.size_passes,
+        "seconds": seconds,
+        "timings": timings,
+        "notes": result.notes,
+    })
+}
+
+fn print_summary(args: &RemeshArgs, result: &Remeshing, q: &Quality, seconds: f64) {
+    println!(
+        "{} -> {} ({}, {}, {seconds:.3} s)",
+        args.mesh.display(),
+        args.output.display(),
+        result.parameterizer,
+        result.opening.name()
+    );
+    println!("  vertices        {}", q.vertices);
+    println!("  faces           {}", q.faces);
+    println!(
+        "  angles          min {:.2}  mean {:.2}  under 30: {:.3}%",
+        q.min_angle,
+        q.mean_angle,
+        100.0 * q.share_below_30
+    );
+    println!(
+        "  edges           asked {:.4e}  mean {:.4e}  min {:.4e}  max {:.4e}  spread {:.3}",
+        result.edge_length, q.edge_mean, q.edge_min, q.edge_max, q.edge_spread
+    );
+    println!(
+        "  distance        Hausdorff {:.4e} ({:.3}% of the diagonal)  mean {:.4e}",
+        q.hausdorff,
+        100.0 * q.hausdorff / q.diagonal,
+        q.mean_distance
+    );
+    for (stage, s) in &result.timings {
+        println!("  {stage:<15} {s:.3} s");
+    }
+    for note in &result.notes {
+        println!("  note: {note}");
+    }
+}

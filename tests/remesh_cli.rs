@@ -1,0 +1,217 @@
+//! End-to-end runs of `beltrami remesh`: generated surfaces of every topology class
+//! keep their topology and get the asked edge length, the report and the picture are
+//! written, and bad options fail before any output is written. The shared meshes (one
+//! per class) run when `../shared` is there.
+
+use std::path::Path;
+
+use beltrami_core::topology::describe;
+use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_mesh::primitives::{Cells, annulus, disk, icosphere, torus};
+use beltrami_mesh::{BuildOptions, Mesh, PolygonSoup};
+
+mod common;
+use common::{beltrami, s, shared_meshes, text};
+
+fn write_soup(path: &Path, soup: &PolygonSoup) -> Mesh {
+    let mesh = Mesh::from_soup(soup).unwrap();
+    io::obj::write(path, &mesh, &VertexAttributes::default()).unwrap();
+    mesh
+}
+
+fn read(path: &Path) -> Mesh {
+    io::read(path, &BuildOptions::default()).unwrap().mesh
+}
+
+/// Runs `remesh INPUT --edge-length L -o OUT --report R`, checks the output's topology
+/// against the input's and the report's numbers against the output; returns the report.
+fn remesh_and_check(input: &Path, mesh: &Mesh, l: f64, extra: &[&str]) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("out.obj");
+    let report = dir.path().join("report.json");
+    let length = l.to_string();
+    let mut args = vec![
+        "remesh",
+        s(input),
+        "--edge-length",
+        &length,
+        "-o",
+        s(&output),
+        "--report",
+        s(&report),
+    ];
+    args.extend_from_slice(extra);
+    let out = beltrami(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let result = read(&output);
+    assert_eq!(
+        describe(&result),
+        describe(mesh),
+        "topology of {}",
+        input.display()
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["vertices"], result.vertex_count());
+    assert_eq!(r["faces"], result.face_count());
+    assert_eq!(r["topology"], describe(mesh));
+    for key in [
+        "min_angle",
+        "share_below_30",
+        "edge_spread",
+        "hausdorff",
+        "mean_distance",
+    ] {
+        assert!(
+            r[key].as_f64().is_some_and(f64::is_finite),
+            "{key}: {}",
+            r[key]
+        );
+    }
+    r
+}
+
+#[test]
+fn every_topology_class_keeps_its_topology_and_the_asked_edge_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, PolygonSoup, f64); 4] = [
+        ("disk", disk(5), 0.05),
+        ("sphere", icosphere(4), 0.1),
+        ("torus", torus(48, 20, 1.0, 0.4, Cells::Triangles), 0.08),
+        ("annulus", annulus(0.3, 12, 64), 0.05),
+    ];
+    for (name, soup, l) in cases {
+        let input = dir.path().join(format!("{name}.obj"));
+        let mesh = write_soup(&input, &soup);
+        let r = remesh_and_check(&input, &mesh, l, &[]);
+        let ratio = r["edge_mean_over_asked"].as_f64().unwrap();
+        assert!(
+            (ratio - 1.0).abs() < 0.1,
+            "{name}: mean edge {ratio} of the asked"
+        );
+        assert!(
+            r["min_angle"].as_f64().unwrap() > 20.0,
+            "{name}: {}",
+            r["min_angle"]
+        );
+    }
+}
+
+#[test]
+fn vertices_curvature_and_png_are_honoured() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("sphere.obj");
+    let output = dir.path().join("out.glb");
+    let png = dir.path().join("out.png");
+    write_soup(&input, &icosphere(4));
+    let out = beltrami(&[
+        "remesh",
+        s(&input),
+        "--vertices",
+        "1500",
+        "--size-field",
+        "curvature",
+        "--param",
+        "lscm",
+        "-o",
+        s(&output),
+        "--png",
+        s(&png),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let n = r["vertices"].as_f64().unwrap();
+    assert!((n / 1500.0 - 1.0).abs() < 0.15, "{n} vertices for 1500");
+    assert_eq!(r["parameterizer"], "lscm");
+    assert_eq!(r["opening"], "slit");
+    assert!(read(&output).vertex_count() == n as usize);
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+}
+
+#[test]
+fn bad_options_fail_with_the_option_named_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("disk.obj");
+    let sphere = dir.path().join("sphere.obj");
+    let output = dir.path().join("out.obj");
+    write_soup(&input, &disk(3));
+    write_soup(&sphere, &icosphere(2));
+    let cases: [(&[&str], &str); 9] = [
+        (&["--edge-length", "0"], "edge-length"),
+        (&["--edge-length", "-0.1"], "edge-length"),
+        (&["--edge-length", "NaN"], "edge-length"),
+        (&["--edge-length", "inf"], "edge-length"),
+        (&["--vertices", "2"], "vertices"),
+        (&["--edge-length", "0.1", "--min-angle", "35"], "min-angle"),
+        (
+            &["--edge-length", "0.1", "--param", "nosuch"],
+            "no solver named `nosuch`",
+        ),
+        (
+            &["--edge-length", "0.1", "--method", "qc-angles"],
+            "invalid value 'qc-angles'",
+        ),
+        (&[], "--edge-length <L>"),
+    ];
+    for (extra, expected) in cases {
+        let mut args = vec!["remesh", s(&input), "-o", s(&output)];
+        args.extend_from_slice(extra);
+        let out = beltrami(&args);
+        assert!(!out.status.success(), "{extra:?} succeeded");
+        let stderr = text(&out.stderr);
+        assert!(
+            stderr.contains(expected),
+            "{extra:?}: `{expected}` not in\n{stderr}"
+        );
+        assert!(!output.exists(), "{extra:?} wrote an output");
+    }
+    let out = beltrami(&[
+        "remesh",
+        s(&sphere),
+        "--edge-length",
+        "0.2",
+        "--param",
+        "sphere",
+        "-o",
+        s(&output),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("not into the plane"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!output.exists());
+}
+
+#[test]
+fn shared_meshes_of_every_class_keep_their_topology() {
+    let Some(dir) = shared_meshes("shared_meshes_of_every_class_keep_their_topology") else {
+        return;
+    };
+    for name in [
+        "disk_hemisphere",
+        "g0_spot",
+        "g1_bob",
+        "g2_eight",
+        "mc4_face_b",
+        "mc2_sophie",
+    ] {
+        let input = dir.join(format!("{name}.obj"));
+        let mesh = read(&input);
+        let l = 0.015 * mesh.bounding_box().diagonal();
+        let r = remesh_and_check(&input, &mesh, l, &[]);
+        let ratio = r["edge_mean_over_asked"].as_f64().unwrap();
+        assert!(
+            (ratio - 1.0).abs() < 0.1,
+            "{name}: mean edge {ratio} of the asked"
+        );
+        let hausdorff = r["hausdorff_over_diagonal"].as_f64().unwrap();
+        assert!(
+            hausdorff < 0.005,
+            "{name}: Hausdorff {hausdorff} of the diagonal"
+        );
+    }
+}
