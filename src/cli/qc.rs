@@ -182,7 +182,7 @@ fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<
 }
 
 pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
-    mapping::check_output_format(&args.output)?;
+    mapping::check_outputs(&args.output, &args.common, &[])?;
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;

@@ -54,7 +54,11 @@ pub struct RegisterArgs {
 }
 
 pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
-    mapping::check_output_format(&args.output)?;
+    mapping::check_outputs(
+        &args.output,
+        &args.common,
+        &[("--correspondence", args.correspondence.as_deref())],
+    )?;
     let registry = beltrami::registry();
     let solver = registry.get("register")?;
     let source_loaded = load_mesh(&args.source, args.common.repair, quiet || args.common.json)?;
