@@ -67,15 +67,21 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
 /// of an unsupported type, an index is out of its primitive's range, or the file has no
 /// triangle primitives.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
-    let invalid = |message: String| ReadError::Gltf {
-        path: path.to_path_buf(),
-        message,
-    };
     let bytes = super::source::read_bytes(path).map_err(|error| ReadError::Io {
         path: path.to_path_buf(),
         error,
     })?;
-    let gltf = parse(&bytes).map_err(invalid)?;
+    parse_bytes(path, &bytes)
+}
+
+/// Parses glTF or GLB content held in memory as [`read`] does; `path` names the file in
+/// errors, and its folder is where external buffer URIs are looked up.
+pub fn parse_bytes(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
+    let invalid = |message: String| ReadError::Gltf {
+        path: path.to_path_buf(),
+        message,
+    };
+    let gltf = parse(bytes).map_err(invalid)?;
     let buffers = load_buffers(&gltf, path)?;
     let instances = mesh_instances(&gltf.document).map_err(invalid)?;
 
