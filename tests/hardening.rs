@@ -230,6 +230,45 @@ fn numeric_options_out_of_range_and_ignored_options_are_refused() {
         ],
         &["sphere"],
     );
+    // Flags that the other flags make meaningless are refused, not ignored.
+    for (args, words) in [
+        (vec!["--free-radius"], ["--free-radius", "annulus"]),
+        (
+            vec!["--boundary-map", s(&mesh)],
+            ["--boundary-map", "given"],
+        ),
+        (
+            vec![
+                "--solver",
+                "beltrami-flow",
+                "--target",
+                "disk",
+                "--boundary",
+                "keep",
+            ],
+            ["--boundary", "disk"],
+        ),
+    ] {
+        let mut all = vec!["qc", s(&mesh), "--conformal", "-o", s(&out)];
+        all.extend(args);
+        fails_with(&all, &words);
+    }
+    let field = dir.path().join("zero.mu");
+    std::fs::write(&field, "# mu frame=face faces=32\n").unwrap();
+    fails_with(
+        &[
+            "register",
+            s(&ball),
+            s(&ball),
+            "--mu",
+            s(&field),
+            "--p",
+            "3",
+            "-o",
+            s(&out),
+        ],
+        &["--p", "--mu"],
+    );
     assert!(!out.exists());
 }
 

@@ -69,9 +69,9 @@ impl Repair {
 pub struct BuildOptions {
     /// A face is degenerate when its area is at most
     /// `degenerate_area_tolerance * d^2`, with `d` the bounding-box diagonal of all input
-    /// vertices. Default `1e-12`. A negative value accepts every face, even one of zero
-    /// area (for meshes whose faces were validated before); NaN and infinities are
-    /// refused ([`MeshError::InvalidTolerance`]).
+    /// vertices. Default `1e-12`. A negative value (down to minus infinity) accepts
+    /// every face, even one of zero area (for meshes whose faces were validated before);
+    /// NaN and plus infinity are refused ([`MeshError::InvalidTolerance`]).
     pub degenerate_area_tolerance: f64,
     /// What to repair instead of failing. Default: nothing.
     pub repair: Repair,
@@ -536,7 +536,7 @@ pub(crate) fn build(
     }
 
     let tolerance = options.degenerate_area_tolerance;
-    if !tolerance.is_finite() {
+    if tolerance.is_nan() || tolerance == f64::INFINITY {
         return Err(MeshError::InvalidTolerance { value: tolerance });
     }
     check_range(&soup.positions)?;

@@ -72,9 +72,9 @@ pub enum MeshError {
         min: f64,
     },
 
-    /// A degenerate-area tolerance that is NaN or infinite.
+    /// A degenerate-area tolerance that is NaN or plus infinity.
     #[error(
-        "the degenerate-area tolerance must be a finite number (negative accepts every face), got {value}"
+        "the degenerate-area tolerance must be a number below infinity (negative accepts every face), got {value}"
     )]
     InvalidTolerance {
         /// The tolerance given.
