@@ -168,10 +168,11 @@ pub fn read(
     source: &Mesh,
     target: &Mesh,
 ) -> Result<Vec<SurfacePoint>, CorrespondenceError> {
-    let text = std::fs::read_to_string(path).map_err(|error| CorrespondenceError::Read {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let text =
+        beltrami_mesh::io::source::read_text(path).map_err(|error| CorrespondenceError::Read {
+            path: path.to_path_buf(),
+            error,
+        })?;
     parse(path, &text, source, target)
 }
 

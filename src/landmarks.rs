@@ -241,10 +241,11 @@ fn parse_line(content: &str, source: &Mesh, target: &Mesh) -> Result<Parsed, Lin
 impl Landmarks {
     /// Reads and parses the file `path` against the source and target meshes.
     pub fn read(path: &Path, source: &Mesh, target: &Mesh) -> Result<Self, LandmarksError> {
-        let text = std::fs::read_to_string(path).map_err(|error| LandmarksError::Io {
-            path: path.to_path_buf(),
-            error,
-        })?;
+        let text =
+            beltrami_mesh::io::source::read_text(path).map_err(|error| LandmarksError::Io {
+                path: path.to_path_buf(),
+                error,
+            })?;
         Self::parse(path, &text, source, target)
     }
 

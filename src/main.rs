@@ -20,6 +20,14 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // A write beyond the file-size limit (`ulimit -f`) should fail with EFBIG, so that
+    // the atomic writer removes its temporary file and the error is reported, instead of
+    // SIGXFSZ killing the program with the temporary file left behind.
+    #[cfg(unix)]
+    // SAFETY: setting a signal to be ignored before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
     let args = cli::Cli::parse();
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,

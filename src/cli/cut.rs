@@ -37,6 +37,7 @@ pub fn run(args: &CutArgs, quiet: bool) -> anyhow::Result<()> {
             args.output.display()
         );
     }
+    super::outputs::check(&[("-o", Some(&args.output))])?;
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
     let mesh = &loaded.mesh.mesh;
     let cut = cut_to_disk(mesh).with_context(|| format!("cannot cut {}", args.mesh.display()))?;

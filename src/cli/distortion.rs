@@ -49,6 +49,7 @@ pub struct DistortionArgs {
 }
 
 pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
+    super::outputs::check(&[("--per-face", args.per_face.as_deref())])?;
     let quiet = quiet || args.json;
     let source = load_mesh(&args.source, args.repair, quiet)?.mesh;
     let mapped = read_mapped(&args.mapped, args.repair)?;

@@ -48,6 +48,7 @@ pub struct GenerateArgs {
 
 pub fn run(args: &GenerateArgs, quiet: bool) -> anyhow::Result<()> {
     super::mapping::check_output_format(&args.output)?;
+    super::outputs::check(&[("-o", Some(&args.output))])?;
     if args.level > 10 {
         bail!("--level {} is too fine (at most 10)", args.level);
     }

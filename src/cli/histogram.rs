@@ -39,6 +39,7 @@ pub struct HistogramArgs {
 
 pub fn run(args: &HistogramArgs, quiet: bool) -> anyhow::Result<()> {
     check_png_path(&args.output)?;
+    super::outputs::check(&[("-o", Some(&args.output))])?;
     let (loaded, image) = load_map(&args.mesh, args.mapped.as_deref(), args.repair, quiet)?;
     if image.is_none() {
         bail!(

@@ -115,6 +115,25 @@ pub fn check_output_format(output: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Fails, before any work, when `output` is not a mesh format beltrami writes or when
+/// any output of the command cannot be written ([`super::outputs::check`]): `output`
+/// (`-o`), `--png` and `--report` of `common`, and the command's `extra` outputs given as
+/// `(flag, path)`.
+pub fn check_outputs(
+    output: &Path,
+    common: &CommonArgs,
+    extra: &[(&str, Option<&Path>)],
+) -> anyhow::Result<()> {
+    check_output_format(output)?;
+    let mut paths = vec![
+        ("-o", Some(output)),
+        ("--png", common.png.as_deref()),
+        ("--report", common.report.as_deref()),
+    ];
+    paths.extend_from_slice(extra);
+    super::outputs::check(&paths)
+}
+
 /// The pins of `--pin` flags, without positions (the solver places them).
 pub fn resolve_pins(specs: &[PinSpec], mesh: &Mesh) -> anyhow::Result<Vec<Pin>> {
     specs

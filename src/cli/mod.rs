@@ -9,6 +9,7 @@ mod info;
 mod interrupt;
 mod load;
 mod mapping;
+mod outputs;
 mod param;
 mod picture;
 mod pins;

@@ -91,7 +91,7 @@ fn target_of(args: &ParamArgs, solver: &dyn Solver) -> Target<'static> {
 }
 
 pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
-    mapping::check_output_format(&args.output)?;
+    mapping::check_outputs(&args.output, &args.common, &[])?;
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;

@@ -28,6 +28,13 @@ impl FromStr for PinSpec {
                 .map_err(|_| format!("`{s}`: expected v<index>, e.g. v12"));
         }
         let coords: Result<Vec<f64>, _> = s.split(',').map(|t| t.trim().parse::<f64>()).collect();
+        if let Ok(values) = &coords
+            && values.iter().any(|x| !x.is_finite())
+        {
+            return Err(format!(
+                "`{s}`: the point's coordinates must be finite numbers"
+            ));
+        }
         match coords.as_deref() {
             Ok([x, y]) => Ok(PinSpec::Near(Point3::new(*x, *y, 0.0))),
             Ok([x, y, z]) => Ok(PinSpec::Near(Point3::new(*x, *y, *z))),

@@ -188,8 +188,32 @@ fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<
     })
 }
 
+/// Refuses, before any work, flags that the other flags make meaningless (they would be
+/// ignored silently): `--boundary` and `--boundary-map` off the plane target,
+/// `--boundary-map` without `--boundary given`, `--free-radius` off the annulus target.
+fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
+    let target = format!("{:?}", args.target).to_lowercase();
+    if args.boundary.is_some() && args.target != TargetArg::Plane {
+        bail!(
+            "--boundary is the boundary condition of --target plane; --target {target} has its own"
+        );
+    }
+    if args.boundary_map.is_some() && args.boundary != Some(QcBoundaryArg::Given) {
+        bail!(
+            "--boundary-map gives the boundary of --boundary given; add that or drop --boundary-map"
+        );
+    }
+    if args.free_radius && args.target != TargetArg::Annulus {
+        bail!(
+            "--free-radius lets the inner radius of --target annulus move; --target {target} has none"
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
-    mapping::check_output_format(&args.output)?;
+    mapping::check_outputs(&args.output, &args.common, &[])?;
+    check_flag_use(args)?;
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;

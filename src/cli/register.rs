@@ -21,9 +21,9 @@ pub struct RegisterArgs {
     pub source: PathBuf,
     /// The mesh to map onto, of the same topology.
     pub target: PathBuf,
-    /// Minimize the L^p norm of mu (p >= 2).
-    #[arg(long, default_value_t = 2.0)]
-    pub p: f64,
+    /// Minimize the L^p norm of mu (p >= 2) [default: 2].
+    #[arg(long)]
+    pub p: Option<f64>,
     /// A prescribed Beltrami coefficient per source face instead (the field format,
     /// face frame).
     #[arg(long)]
@@ -58,7 +58,11 @@ pub struct RegisterArgs {
 }
 
 pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
-    mapping::check_output_format(&args.output)?;
+    mapping::check_outputs(
+        &args.output,
+        &args.common,
+        &[("--correspondence", args.correspondence.as_deref())],
+    )?;
     let registry = beltrami::registry();
     let solver = registry.get("register")?;
     let source_loaded = load_mesh(&args.source, args.common.repair, quiet || args.common.json)?;
@@ -67,9 +71,14 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     let target = &target_loaded.mesh.mesh;
 
     let mut problem = Problem::new(source, Target::Mesh(target));
-    problem.goal = match &args.mu {
-        Some(path) => Goal::Prescribed(BeltramiField::read(path, source.face_count())?),
-        None => Goal::Conformal { p: args.p },
+    problem.goal = match (&args.mu, args.p) {
+        (Some(_), Some(_)) => {
+            bail!("--p is the exponent of the conformal goal; a prescribed --mu has no exponent")
+        }
+        (Some(path), None) => Goal::Prescribed(BeltramiField::read(path, source.face_count())?),
+        (None, p) => Goal::Conformal {
+            p: p.unwrap_or(2.0),
+        },
     };
     if let Some(path) = &args.landmarks {
         let marks = Landmarks::read(path, source, target)?;

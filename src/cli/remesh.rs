@@ -104,6 +104,11 @@ impl RemeshArgs {
 
 pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     check_output_format(&args.output)?;
+    super::outputs::check(&[
+        ("-o", Some(&args.output)),
+        ("--png", args.png.as_deref()),
+        ("--report", args.report.as_deref()),
+    ])?;
     let options = args.options();
     options.validate()?;
     let registry = beltrami::registry();

@@ -82,6 +82,7 @@ pub struct RenderArgs {
 
 pub fn run(args: &RenderArgs, quiet: bool) -> anyhow::Result<()> {
     check_png_path(&args.output)?;
+    super::outputs::check(&[("-o", Some(&args.output))])?;
     let start = Instant::now();
     let (loaded, image) = load_map(&args.mesh, args.map.as_deref(), args.repair, quiet)?;
     let has_map = image.is_some();

@@ -232,7 +232,7 @@ impl BeltramiField {
 
     /// Reads a field file (see the module docs) for a mesh of `face_count` faces.
     pub fn read(path: &Path, face_count: usize) -> Result<Self, FieldError> {
-        let text = std::fs::read_to_string(path).map_err(|error| FieldError::Io {
+        let text = beltrami_mesh::io::source::read_text(path).map_err(|error| FieldError::Io {
             path: path.to_path_buf(),
             error,
         })?;

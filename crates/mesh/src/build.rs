@@ -21,6 +21,22 @@ use crate::{ComponentId, EdgeId, HalfedgeId, MeshError, PolygonSoup, VertexId, V
 
 const NONE: u32 = u32::MAX;
 
+/// The largest coordinate magnitude the builder accepts.
+///
+/// Face areas are products of two coordinate differences, and the geometry downstream
+/// (vector areas, squared norms of cross products, Gram determinants of the element
+/// maps) takes products of four: with every |coordinate| <= 1e75 a difference is at most
+/// 2e75 and a product of four at most about 1e302, below `f64::MAX` (about 1.8e308).
+pub const MAX_COORDINATE: f64 = 1e75;
+
+/// The smallest bounding-box diagonal the builder accepts for vertices that do not all
+/// coincide.
+///
+/// The mirror of [`MAX_COORDINATE`]: a product of four lengths of at least 1e-75 is at
+/// least 1e-300, above the smallest normal `f64` (about 2.2e-308), so areas and their
+/// squares do not round to zero.
+pub const MIN_EXTENT: f64 = 1e-75;
+
 /// What the builder may repair instead of failing. Nothing is repaired unless asked, and
 /// everything repaired is listed in the [`BuildReport`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -53,7 +69,9 @@ impl Repair {
 pub struct BuildOptions {
     /// A face is degenerate when its area is at most
     /// `degenerate_area_tolerance * d^2`, with `d` the bounding-box diagonal of all input
-    /// vertices. Default `1e-12`.
+    /// vertices. Default `1e-12`. A negative value (down to minus infinity) accepts
+    /// every face, even one of zero area (for meshes whose faces were validated before);
+    /// NaN and plus infinity are refused ([`MeshError::InvalidTolerance`]).
     pub degenerate_area_tolerance: f64,
     /// What to repair instead of failing. Default: nothing.
     pub repair: Repair,
@@ -374,6 +392,43 @@ fn coincident_representatives(positions: &[Point3<f64>]) -> Vec<u32> {
         .collect()
 }
 
+/// Fails when a coordinate exceeds [`MAX_COORDINATE`] in magnitude (naming the first such
+/// vertex) or when the vertices, not all at one point, span less than [`MIN_EXTENT`].
+/// All vertices count, used or not, as in the degeneracy threshold.
+fn check_range(positions: &[Point3<f64>]) -> Result<(), MeshError> {
+    for (vertex, p) in positions.iter().enumerate() {
+        let value = [p.x, p.y, p.z]
+            .into_iter()
+            .fold(0.0_f64, |a, c| if c.abs() > a.abs() { c } else { a });
+        if value.abs() > MAX_COORDINATE {
+            return Err(MeshError::CoordinateOverflow {
+                vertex,
+                value,
+                max: MAX_COORDINATE,
+            });
+        }
+    }
+    // hypot, not the square root of a sum of squares: the squares of a tiny extent
+    // underflow to zero, which is the very thing to detect.
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let extent = |k: usize| (hi[k] - lo[k]).max(0.0);
+    let diagonal = extent(0).hypot(extent(1)).hypot(extent(2));
+    if diagonal > 0.0 && diagonal < MIN_EXTENT {
+        return Err(MeshError::ExtentUnderflow {
+            diagonal,
+            min: MIN_EXTENT,
+        });
+    }
+    Ok(())
+}
+
 fn squared_bbox_diagonal(positions: &[Point3<f64>]) -> f64 {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -479,6 +534,12 @@ pub(crate) fn build(
             z: p.z,
         });
     }
+
+    let tolerance = options.degenerate_area_tolerance;
+    if tolerance.is_nan() || tolerance == f64::INFINITY {
+        return Err(MeshError::InvalidTolerance { value: tolerance });
+    }
+    check_range(&soup.positions)?;
 
     let repair = options.repair;
     let threshold = options.degenerate_area_tolerance * squared_bbox_diagonal(&soup.positions);

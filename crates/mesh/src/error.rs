@@ -46,6 +46,41 @@ pub enum MeshError {
         z: f64,
     },
 
+    /// A coordinate so large in magnitude that areas overflow (see
+    /// [`crate::MAX_COORDINATE`]).
+    #[error(
+        "vertex {vertex} has the coordinate {value:e}, which overflows the geometry (face areas and their squares would exceed the largest f64): every coordinate must lie within +-{max:e}; scale the mesh down"
+    )]
+    CoordinateOverflow {
+        /// Input vertex index.
+        vertex: usize,
+        /// The coordinate of largest magnitude of that vertex.
+        value: f64,
+        /// The largest magnitude accepted.
+        max: f64,
+    },
+
+    /// Vertices so close together that face areas underflow to zero (see
+    /// [`crate::MIN_EXTENT`]).
+    #[error(
+        "the vertices span a bounding box of diagonal {diagonal:e}, so small that the geometry underflows (face areas and their squares round to zero): the diagonal must be at least {min:e}; scale the mesh up"
+    )]
+    ExtentUnderflow {
+        /// The bounding-box diagonal of the input vertices.
+        diagonal: f64,
+        /// The smallest diagonal accepted.
+        min: f64,
+    },
+
+    /// A degenerate-area tolerance that is NaN or plus infinity.
+    #[error(
+        "the degenerate-area tolerance must be a number below infinity (negative accepts every face), got {value}"
+    )]
+    InvalidTolerance {
+        /// The tolerance given.
+        value: f64,
+    },
+
     /// A face that lists the same vertex twice.
     #[error("face {face} uses vertex {vertex} more than once")]
     RepeatedVertex {

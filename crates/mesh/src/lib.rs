@@ -45,7 +45,7 @@ pub mod surface_point;
 mod topology;
 mod vertex_map;
 
-pub use build::{BuildOptions, BuildReport, Repair};
+pub use build::{BuildOptions, BuildReport, MAX_COORDINATE, MIN_EXTENT, Repair};
 pub use cut::{
     CutError, CutGraph, CutMesh, Generator, GeneratorKind, TorusSides, cut_along, cut_graph,
     cut_to_disk, shortest_path_tree,

@@ -316,20 +316,24 @@ fn a_bad_vertex_line_is_named_by_line() {
 fn an_out_of_range_index_names_face_index_and_line() {
     let err = read_err("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# comment\nf 1 3 9\n");
     match &err {
-        ReadError::Mesh { line, error, .. } => {
-            assert_eq!(*line, Some(6));
+        ReadError::ObjVertexIndex {
+            line,
+            face,
+            written,
+            vertex_count,
+            before,
+            ..
+        } => {
+            // The index is quoted as written in the file (1-based), not converted.
             assert_eq!(
-                *error,
-                MeshError::VertexIndexOutOfRange {
-                    face: 1,
-                    index: 8,
-                    vertex_count: 3
-                }
+                (*line, *face, written.as_str(), *vertex_count, *before),
+                (6, 1, "9", 3, 3)
             );
         }
         e => panic!("unexpected {e:?}"),
     }
     assert!(err.to_string().contains("bad.obj:6"), "{err}");
+    assert!(err.to_string().contains("`9`"), "{err}");
 }
 
 #[test]

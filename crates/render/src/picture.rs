@@ -69,9 +69,15 @@ impl Picture {
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_compression(png::Compression::High);
         let mut writer = encoder.write_header().map_err(std::io::Error::other)?;
-        writer
-            .write_image_data(&self.rgb())
-            .map_err(std::io::Error::other)?;
+        // Row by row, so that encoding adds one row of memory, not a copy of the picture.
+        let mut stream = writer.stream_writer().map_err(std::io::Error::other)?;
+        let mut row = Vec::with_capacity(3 * self.width() as usize);
+        for line in self.pixmap.data().chunks_exact(4 * self.width() as usize) {
+            row.clear();
+            row.extend(line.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]));
+            stream.write_all(&row)?;
+        }
+        stream.finish().map_err(std::io::Error::other)?;
         writer.finish().map_err(std::io::Error::other)
     }
 

@@ -26,11 +26,31 @@ pub struct Fragment {
     pub edge: [f32; 3],
 }
 
-/// A color and depth buffer.
+/// The most samples of one band: 2^23 samples of 7 bytes (color and depth), 56 MiB.
+/// A view larger than this is drawn band by band ([`bands`]), so that memory stays
+/// proportional to the picture's pixels (4 bytes each in the [`crate::Picture`]) and
+/// not to its samples.
+const BAND_SAMPLES: usize = 1 << 23;
+
+/// The bands `(top, rows)` of sample rows that cover a `width x height` view drawn at
+/// `samples` samples per pixel and axis: each at most [`BAND_SAMPLES`] samples (but at
+/// least one pixel row), `rows` a multiple of `samples` except perhaps the last.
+pub(crate) fn bands(width: usize, height: usize, samples: usize) -> Vec<(usize, usize)> {
+    let samples = samples.max(1);
+    let rows = (BAND_SAMPLES / width.max(1) / samples * samples).max(samples);
+    (0..height)
+        .step_by(rows)
+        .map(|top| (top, rows.min(height - top)))
+        .collect()
+}
+
+/// A color and depth buffer: sample rows `top..top + height` of a view `width` samples
+/// wide (all of it when `top` is 0 and `height` the view's height).
 #[derive(Debug, Clone)]
 pub struct Raster {
     width: usize,
     height: usize,
+    top: usize,
     color: Vec<Rgb>,
     depth: Vec<f32>,
 }
@@ -38,11 +58,19 @@ pub struct Raster {
 impl Raster {
     /// A `width x height` buffer filled with `background` at infinite depth.
     pub fn new(width: usize, height: usize, background: Rgb) -> Self {
+        Self::band(width, 0, height, background)
+    }
+
+    /// The band of sample rows `top..top + rows` of a view `width` samples wide, filled
+    /// with `background` at infinite depth. Triangles are given in the view's
+    /// coordinates and clipped to the band.
+    pub fn band(width: usize, top: usize, rows: usize, background: Rgb) -> Self {
         Self {
             width,
-            height,
-            color: vec![background; width * height],
-            depth: vec![f32::INFINITY; width * height],
+            height: rows,
+            top,
+            color: vec![background; width * rows],
+            depth: vec![f32::INFINITY; width * rows],
         }
     }
 
@@ -56,7 +84,7 @@ impl Raster {
         self.height
     }
 
-    /// The color of sample `(x, y)` (y down).
+    /// The color of sample `(x, y)` (y down, in the band's own rows: 0 is row `top`).
     pub fn color(&self, x: usize, y: usize) -> Rgb {
         self.color[y * self.width + x]
     }
@@ -91,7 +119,10 @@ impl Raster {
         let first = |c: i64| ((c as f64 / SUB - 0.5).ceil().max(0.0)) as i64;
         let last = |c: i64, n: usize| ((c as f64 / SUB - 0.5).floor() as i64).min(n as i64 - 1);
         let (x0, x1) = (first(lo(0)), last(hi(0), self.width));
-        let (y0, y1) = (first(lo(1)), last(hi(1), self.height));
+        let (y0, y1) = (
+            first(lo(1)).max(self.top as i64),
+            last(hi(1), self.top + self.height),
+        );
         if x0 > x1 || y0 > y1 {
             return;
         }
@@ -122,7 +153,7 @@ impl Raster {
             std::array::from_fn(|k| (1.0 / (SUB * SUB) / length[k].max(1e-12) as f64) as f32);
         for y in y0..=y1 {
             let mut e = row;
-            let line = y as usize * self.width;
+            let line = (y as usize - self.top) * self.width;
             for x in x0..=x1 {
                 if e[0] + bias[0] >= 0 && e[1] + bias[1] >= 0 && e[2] + bias[2] >= 0 {
                     let b = e.map(|ek| (ek as f64 * inv_area) as f32);
@@ -153,7 +184,7 @@ impl Raster {
     }
 
     /// Averages `factor x factor` blocks of samples into pixels, row by row: the
-    /// `(width / factor) x (height / factor)` picture, antialiased.
+    /// `(width / factor) x (height / factor)` picture (of the band), antialiased.
     pub fn downsample(&self, factor: usize) -> Vec<Rgb> {
         let (w, h) = (self.width / factor, self.height / factor);
         let n = (factor * factor) as u32;

@@ -7,7 +7,7 @@
 use beltrami_mesh::{Mesh, Point3, Vector3};
 
 use crate::colormap::BACKGROUND;
-use crate::raster3d::Raster;
+use crate::raster3d::{Raster, bands};
 use crate::shading::{Coloring, Lines, TriangleShader, fan};
 use crate::viewport::{Fit, Rect, bounds};
 use crate::{Camera, Picture};
@@ -68,28 +68,31 @@ pub(crate) fn draw(
         boundary: Some(4.0 * line),
         flipped: view.flipped.map(|flags| (3.0 * line, flags)),
     };
-    let mut raster = Raster::new(w, h, BACKGROUND);
-    for f in mesh.faces() {
-        for (corners, edges) in fan(mesh, f) {
-            let vertices = corners.map(|c| mesh.origin(c).idx());
-            let shader = TriangleShader::new(
-                mesh,
-                f,
-                corners,
-                edges,
-                &view.coloring,
-                &lines,
-                Some((vertices.map(|v| normals[v]), light)),
-            );
-            raster.triangle(vertices.map(|v| screen[v]), true, |fr| shader.shade(fr));
+    // Band by band, so that memory follows the pixels, not the samples.
+    for (top, rows) in bands(w, h, samples as usize) {
+        let mut raster = Raster::band(w, top, rows, BACKGROUND);
+        for f in mesh.faces() {
+            for (corners, edges) in fan(mesh, f) {
+                let vertices = corners.map(|c| mesh.origin(c).idx());
+                let shader = TriangleShader::new(
+                    mesh,
+                    f,
+                    corners,
+                    edges,
+                    &view.coloring,
+                    &lines,
+                    Some((vertices.map(|v| normals[v]), light)),
+                );
+                raster.triangle(vertices.map(|v| screen[v]), true, |fr| shader.shade(fr));
+            }
         }
+        picture.blit(
+            rect.x,
+            rect.y + (top / samples as usize) as u32,
+            rect.width as usize,
+            &raster.downsample(samples as usize),
+        );
     }
-    picture.blit(
-        rect.x,
-        rect.y,
-        rect.width as usize,
-        &raster.downsample(samples as usize),
-    );
 }
 
 /// Unit vertex normals: the sums of the incident fan triangles' vector areas.

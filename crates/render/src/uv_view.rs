@@ -7,7 +7,7 @@ use beltrami_mesh::{Mesh, Vector2};
 
 use crate::Picture;
 use crate::colormap::{BACKGROUND, INK, WARNING};
-use crate::raster3d::Raster;
+use crate::raster3d::{Raster, bands};
 use crate::shading::{Coloring, Lines, TriangleShader, fan};
 use crate::viewport::{Fit, Rect, bounds};
 
@@ -44,29 +44,32 @@ pub(crate) fn draw(picture: &mut Picture, rect: Rect, samples: u32, unit: f32, v
         let q = fit.apply(p.x, p.y);
         [q[0], q[1], 0.0]
     };
-    let mut raster = Raster::new(w, h, BACKGROUND);
     let lines = Lines {
         wire: view.wire.then_some(unit * samples as f32),
         boundary: None,
         flipped: None,
     };
     let is_flipped = |f: beltrami_mesh::FaceId| view.flipped.is_some_and(|fl| fl[f.idx()]);
-    // Flipped faces last, so that they cover what they fold over.
-    for pass in [false, true] {
-        for f in mesh.faces().filter(|&f| is_flipped(f) == pass) {
-            for (corners, edges) in fan(mesh, f) {
-                let shader =
-                    TriangleShader::new(mesh, f, corners, edges, &view.coloring, &lines, None);
-                raster.triangle(corners.map(at), false, |fr| shader.shade(fr));
+    // Band by band, so that memory follows the pixels, not the samples.
+    for (top, rows) in bands(w, h, samples as usize) {
+        let mut raster = Raster::band(w, top, rows, BACKGROUND);
+        // Flipped faces last, so that they cover what they fold over.
+        for pass in [false, true] {
+            for f in mesh.faces().filter(|&f| is_flipped(f) == pass) {
+                for (corners, edges) in fan(mesh, f) {
+                    let shader =
+                        TriangleShader::new(mesh, f, corners, edges, &view.coloring, &lines, None);
+                    raster.triangle(corners.map(at), false, |fr| shader.shade(fr));
+                }
             }
         }
+        picture.blit(
+            rect.x,
+            rect.y + (top / samples as usize) as u32,
+            rect.width as usize,
+            &raster.downsample(samples as usize),
+        );
     }
-    picture.blit(
-        rect.x,
-        rect.y,
-        rect.width as usize,
-        &raster.downsample(samples as usize),
-    );
 
     // Overlays, in pixels.
     let to_pixel = |h: beltrami_mesh::HalfedgeId| {

@@ -543,3 +543,40 @@ fn the_histogram_of_a_constant_mu_is_one_bar() {
         assert_eq!(count(other), 0);
     }
 }
+
+#[test]
+fn a_raster_drawn_in_bands_equals_the_raster_drawn_whole() {
+    // Big pictures are drawn band by band (bounded memory); the samples must not change.
+    let soup = primitives::jittered_grid(9, 7, Cells::Triangles, 0.3, 11);
+    let mesh = Mesh::from_soup(&soup).expect("a mesh");
+    let (w, h) = (83usize, 67usize);
+    let draw = |raster: &mut Raster| {
+        for f in mesh.faces() {
+            let (v, _) = mesh.face_vertex_array(f);
+            let p = |k: usize| {
+                let q = mesh.position(v[k]);
+                [q.x * w as f64, q.y * h as f64, q.x + q.y]
+            };
+            let c = [(f.idx() * 37 % 251) as u8, (f.idx() % 7) as u8, 9];
+            raster.triangle([p(0), p(1), p(2)], true, |fr| {
+                [c[0], c[1], (fr.bary[0] * 200.0) as u8]
+            });
+        }
+    };
+    let mut whole = Raster::new(w, h, [255; 3]);
+    draw(&mut whole);
+    for rows in [1usize, 4, 10, 66] {
+        let mut top = 0;
+        while top < h {
+            let n = rows.min(h - top);
+            let mut band = Raster::band(w, top, n, [255; 3]);
+            draw(&mut band);
+            for y in 0..n {
+                for x in 0..w {
+                    assert_eq!(band.color(x, y), whole.color(x, top + y), "{rows} rows");
+                }
+            }
+            top += n;
+        }
+    }
+}

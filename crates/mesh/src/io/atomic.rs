@@ -1,10 +1,22 @@
 //! Atomic file output: write under a temporary name, then rename.
+//!
+//! Temporary files are named `.beltrami-<pid>-<random>.tmp` in the destination's folder.
+//! They are removed on every failure the process sees (an error while filling, flushing,
+//! syncing or renaming; a full disk; a file-size limit, once the program ignores
+//! `SIGXFSZ` so that the write fails with `EFBIG` instead of killing it). A process that
+//! is killed outright cannot clean up: the next write into the same folder removes the
+//! temporary files of processes that no longer run ([`remove_stale`]).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use super::WriteError;
+
+/// The start of every temporary file name, followed by the writer's process id.
+const PREFIX: &str = ".beltrami-";
+/// The end of every temporary file name.
+const SUFFIX: &str = ".tmp";
 
 /// Writes a file through `fill` so that `path` either gets the complete content or is left
 /// as it was.
@@ -24,9 +36,11 @@ pub fn write_atomically(
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
+    remove_stale(dir);
+    let prefix = format!("{PREFIX}{}-", std::process::id());
     let tmp = tempfile::Builder::new()
-        .prefix(".beltrami-")
-        .suffix(".tmp")
+        .prefix(&prefix)
+        .suffix(SUFFIX)
         .tempfile_in(dir)
         .map_err(io)?;
     // Temporary files are private (0600); the output gets the usual 0644.
@@ -44,4 +58,33 @@ pub fn write_atomically(
     drop(writer);
     tmp.persist(path).map_err(|e| io(e.error))?;
     Ok(())
+}
+
+/// Removes the temporary files in `dir` left by beltrami processes that no longer run
+/// (names `.beltrami-<pid>-*.tmp` whose process is gone). Only on systems with `/proc`,
+/// where a process's liveness can be told without extra dependencies; failures are
+/// ignored (a stale file is harmless, and the write itself does not depend on this).
+pub fn remove_stale(dir: &Path) {
+    let proc = Path::new("/proc");
+    if !proc.join("self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(PREFIX))
+            .filter(|n| n.ends_with(SUFFIX))
+            .and_then(|n| n.split_once('-'))
+            .and_then(|(pid, _)| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !proc.join(pid.to_string()).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }

@@ -67,15 +67,21 @@ const BASE64: GeneralPurpose = GeneralPurpose::new(
 /// of an unsupported type, an index is out of its primitive's range, or the file has no
 /// triangle primitives.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
+    let bytes = super::source::read_bytes(path).map_err(|error| ReadError::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    parse_bytes(path, &bytes)
+}
+
+/// Parses glTF or GLB content held in memory as [`read`] does; `path` names the file in
+/// errors, and its folder is where external buffer URIs are looked up.
+pub fn parse_bytes(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
     let invalid = |message: String| ReadError::Gltf {
         path: path.to_path_buf(),
         message,
     };
-    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
-    let gltf = parse(&bytes).map_err(invalid)?;
+    let gltf = parse(bytes).map_err(invalid)?;
     let buffers = load_buffers(&gltf, path)?;
     let instances = mesh_instances(&gltf.document).map_err(invalid)?;
 
@@ -178,11 +184,21 @@ fn load_buffers<'a>(gltf: &'a Gltf, path: &Path) -> Result<Vec<Cow<'a, [u8]>>, R
                     decode_data_uri(rest).map_err(|m| invalid(format!("buffer {i}: {m}")))?,
                 ),
                 None => {
+                    // Check the declared length against the file before reading, and
+                    // read no more than it: the URI may name a device or a huge file.
                     let file = folder.join(uri);
-                    Cow::Owned(
-                        std::fs::read(&file)
-                            .map_err(|error| ReadError::Io { path: file, error })?,
-                    )
+                    let declared = buffer.length() as u64;
+                    let io = |error| ReadError::Io {
+                        path: file.clone(),
+                        error,
+                    };
+                    let len = super::source::regular_file_length(&file).map_err(io)?;
+                    if len < declared {
+                        return Err(invalid(format!(
+                            "buffer {i} has {len} bytes in {uri}, but its byteLength is {declared}"
+                        )));
+                    }
+                    Cow::Owned(super::source::read_prefix(&file, declared).map_err(io)?)
                 }
             },
         };
@@ -351,6 +367,16 @@ impl Merged {
                     return Err(format!(
                         "{name}: TEXCOORD_0 has {} values for {n} vertices",
                         uvs.len()
+                    ));
+                }
+                if let Some((k, t)) = uvs
+                    .iter()
+                    .enumerate()
+                    .find(|(_, t)| !(t[0].is_finite() && t[1].is_finite()))
+                {
+                    return Err(format!(
+                        "{name}: TEXCOORD_0 of vertex {k} is not finite ({}, {})",
+                        t[0], t[1]
                     ));
                 }
                 Some(uvs)

@@ -19,6 +19,7 @@ mod atomic;
 pub mod gltf;
 pub mod obj;
 mod slots;
+pub mod source;
 
 use std::path::{Path, PathBuf};
 
@@ -101,6 +102,43 @@ pub enum ReadError {
         line: Option<usize>,
         /// What is wrong.
         message: String,
+    },
+    /// An OBJ face corner whose vertex index names no vertex. The index is quoted as
+    /// written: OBJ indices are 1-based, and negative ones count back from the face's
+    /// line (-1 is the last `v` before it).
+    #[error(
+        "{path}:{line}: face {face} refers to vertex `{written}`, which names no vertex: the file has {vertex_count} vertices (indices 1..={vertex_count}), {before} of them before this line (relative indices -1..=-{before})"
+    )]
+    ObjVertexIndex {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number of the face.
+        line: usize,
+        /// 0-based face index.
+        face: usize,
+        /// The index as written in the file.
+        written: String,
+        /// Number of `v` lines in the file.
+        vertex_count: usize,
+        /// Number of `v` lines before the face.
+        before: usize,
+    },
+    /// A texture coordinate that is NaN or infinite.
+    #[error("{path}{}: {what} {index} is not finite ({u}, {v})", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    NonFiniteTexCoord {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number of the coordinate, when known (OBJ).
+        line: Option<usize>,
+        /// What `index` counts: "texture coordinate" (OBJ `vt`, 0-based) or
+        /// "TEXCOORD_0 of face corner" (glTF).
+        what: &'static str,
+        /// 0-based index.
+        index: usize,
+        /// First component.
+        u: f64,
+        /// Second component.
+        v: f64,
     },
     /// The file is not valid glTF, or has no triangles.
     #[error("{path}: {message}")]

@@ -22,11 +22,11 @@ use std::path::Path;
 use nalgebra::{Point3, Vector2};
 
 use super::{RawMesh, ReadError, VertexAttributes, WriteError};
-use crate::{Mesh, MeshError, PolygonSoup};
+use crate::{Mesh, PolygonSoup};
 
 /// Reads an OBJ file. See the module docs for what is kept.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
-    let bytes = std::fs::read(path).map_err(|error| ReadError::Io {
+    let bytes = super::source::read_bytes(path).map_err(|error| ReadError::Io {
         path: path.to_path_buf(),
         error,
     })?;
@@ -42,6 +42,18 @@ struct Prepared {
     face_lines: Vec<u32>,
     /// Whether every corner of every face names a texture coordinate.
     all_corners_have_uv: bool,
+    /// The first `vt` line with a NaN or infinite coordinate: its 1-based line, its
+    /// 0-based texture coordinate index and its two values.
+    non_finite_uv: Option<(usize, usize, f64, f64)>,
+}
+
+/// The first two numbers of a `vt` line, when both parse.
+fn texcoord(line: &[u8]) -> Option<(f64, f64)> {
+    let text = std::str::from_utf8(line).ok()?;
+    let mut tokens = text.split_whitespace().skip(1);
+    let u = tokens.next()?.parse().ok()?;
+    let v = tokens.next()?.parse().ok()?;
+    Some((u, v))
 }
 
 fn first_token(line: &[u8]) -> &[u8] {
@@ -77,9 +89,21 @@ fn prepare(bytes: &[u8]) -> Prepared {
     }
     let mut face_lines = Vec::new();
     let mut all_corners_have_uv = true;
+    let mut non_finite_uv = None;
+    let mut texcoords = 0usize;
     for (i, line) in bytes.split(|&c| c == b'\n').enumerate() {
         let keep = match first_token(line) {
-            b"v" | b"vt" => true,
+            b"v" => true,
+            b"vt" => {
+                if let Some((u, v)) = texcoord(line)
+                    && !(u.is_finite() && v.is_finite())
+                    && non_finite_uv.is_none()
+                {
+                    non_finite_uv = Some((i + 1, texcoords, u, v));
+                }
+                texcoords += 1;
+                true
+            }
             b"f" => {
                 face_lines.push((i + 1) as u32);
                 all_corners_have_uv &= line
@@ -102,12 +126,23 @@ fn prepare(bytes: &[u8]) -> Prepared {
         vertex_count,
         face_lines,
         all_corners_have_uv,
+        non_finite_uv,
     }
 }
 
 /// Parses OBJ text held in memory; `path` only names the file in errors.
 pub fn parse(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
     let prepared = prepare(bytes);
+    if let Some((line, index, u, v)) = prepared.non_finite_uv {
+        return Err(ReadError::NonFiniteTexCoord {
+            path: path.to_path_buf(),
+            line: Some(line),
+            what: "texture coordinate",
+            index,
+            u,
+            v,
+        });
+    }
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
@@ -235,21 +270,21 @@ fn locate_tobj_error(
                             }
                         }
                     };
+                    let written = token.split('/').next().unwrap_or("");
                     let (Ok(v), Ok(vt)) = (
                         resolve(fields.next(), positions),
                         resolve(fields.next(), texcoords),
                     ) else {
                         return bad(format!("cannot read face corner `{token}`"));
                     };
-                    if let Some(v) = v.filter(|&v| v < 0 || v as usize >= prepared.vertex_count) {
-                        return ReadError::Mesh {
+                    if v.is_some_and(|v| v < 0 || v as usize >= prepared.vertex_count) {
+                        return ReadError::ObjVertexIndex {
                             path,
-                            line: at,
-                            error: MeshError::VertexIndexOutOfRange {
-                                face,
-                                index: v.max(0) as usize,
-                                vertex_count: prepared.vertex_count,
-                            },
+                            line: i + 1,
+                            face,
+                            written: written.to_string(),
+                            vertex_count: prepared.vertex_count,
+                            before: positions,
                         };
                     }
                     if vt.is_some_and(|t| t < 0 || t as usize >= texcoords) {

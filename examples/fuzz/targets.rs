@@ -1,0 +1,228 @@
+//! The fuzz targets: one function per input parser or library entry point that takes
+//! bytes a user controls. Each returns `Ok` for accepted input and `Err` with the
+//! library's error message for refused input; a panic (or a stack overflow, which ends
+//! the process) is the bug to find. Shared by the driver (`examples/fuzz/main.rs`) and
+//! the regression test over `tests/corpus/` (`tests/hardening.rs`).
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use beltrami::correspondence;
+use beltrami::fem::{BeltramiField, Expr};
+use beltrami::landmarks::Landmarks;
+use beltrami::mesh::io::{self, RawMesh};
+use beltrami::mesh::primitives::{self, Cells};
+use beltrami::mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, cut_graph, cut_to_disk};
+use num_complex::Complex64;
+
+/// The targets, by the name the driver and the corpus folders use.
+pub const TARGETS: [&str; 8] = [
+    "obj",
+    "gltf",
+    "build",
+    "expr",
+    "field",
+    "landmarks",
+    "correspondence",
+    "cut",
+];
+
+/// Runs target `name` on `data`.
+pub fn run(name: &str, data: &[u8]) -> Result<(), String> {
+    match name {
+        "obj" => obj(data),
+        "gltf" => gltf(data),
+        "build" => build(data),
+        "expr" => expr(data),
+        "field" => field(data),
+        "landmarks" => landmarks(data),
+        "correspondence" => correspondence(data),
+        "cut" => cut(data),
+        _ => Err(format!("unknown target `{name}`")),
+    }
+}
+
+/// A mesh the builder accepted, cut: `cut_graph` always, `cut_to_disk` when it is
+/// connected (it refuses several components with an error, which is fine too).
+fn cut_accepted(mesh: &Mesh) -> Result<(), String> {
+    let graph = cut_graph(mesh);
+    if graph.components.len() != mesh.components().len() {
+        return Err("cut_graph lost a component".into());
+    }
+    cut_to_disk(mesh).map(|_| ()).map_err(|e| e.to_string())
+}
+
+fn text(data: &[u8]) -> Result<&str, String> {
+    std::str::from_utf8(data).map_err(|e| e.to_string())
+}
+
+/// Options of the builder chosen by one byte: the tolerance (the default, zero,
+/// negative, large) and each repair flag.
+fn options(byte: u8) -> BuildOptions {
+    BuildOptions {
+        degenerate_area_tolerance: [1e-12, 0.0, -1.0, 1e-3][usize::from(byte & 3)],
+        repair: Repair {
+            drop_degenerate_faces: byte & 4 != 0,
+            drop_duplicate_faces: byte & 8 != 0,
+            merge_coincident_vertices: byte & 16 != 0,
+        },
+    }
+}
+
+fn built(path: &Path, raw: RawMesh, options: &BuildOptions) -> Result<(), String> {
+    let loaded = io::build_raw(path, raw, options).map_err(|e| e.to_string())?;
+    let _ = loaded.vertex_uvs();
+    cut_accepted(&loaded.mesh)
+}
+
+/// The OBJ reader, then the builder with default options and the cuts.
+fn obj(data: &[u8]) -> Result<(), String> {
+    let path = Path::new("fuzz.obj");
+    let raw = io::obj::parse(path, data).map_err(|e| e.to_string())?;
+    built(path, raw, &BuildOptions::default())
+}
+
+/// The glTF/GLB reader (external buffers resolve beside a file that does not exist),
+/// then the builder and the cuts.
+fn gltf(data: &[u8]) -> Result<(), String> {
+    let path = Path::new("/nonexistent-beltrami-fuzz/fuzz.gltf");
+    let raw = io::gltf::parse_bytes(path, data).map_err(|e| e.to_string())?;
+    built(path, raw, &BuildOptions::default())
+}
+
+/// Coordinates the `build` target draws from: ordinary values and the edges of the
+/// accepted range.
+const VALUES: [f64; 16] = [
+    0.0,
+    1.0,
+    -1.0,
+    0.5,
+    2.0,
+    1e-12,
+    1e75,
+    -1e75,
+    1e76,
+    1e-75,
+    1e-76,
+    1e300,
+    1e-300,
+    3.0,
+    f64::NAN,
+    1e-320,
+];
+
+/// A polygon soup read from bytes: byte 0 chooses the options, byte 1 the vertex count
+/// (1..=16); then per vertex three bytes, each choosing a coordinate from [`VALUES`] or
+/// a small integer; the rest are faces, a length byte (3, 4 or other sizes) then that
+/// many vertex indices (modulo the count plus two, so some are out of range). The mesh
+/// the builder accepts is cut.
+fn build(data: &[u8]) -> Result<(), String> {
+    let mut bytes = data.iter().copied();
+    let options = options(bytes.next().unwrap_or(0));
+    let n = usize::from(bytes.next().unwrap_or(3) % 16) + 1;
+    let mut coordinate = || {
+        let b = bytes.next().unwrap_or(0);
+        if b & 0x80 != 0 {
+            VALUES[usize::from(b & 15)]
+        } else {
+            f64::from(b & 7)
+        }
+    };
+    let positions: Vec<Point3<f64>> = (0..n)
+        .map(|_| Point3::new(coordinate(), coordinate(), coordinate()))
+        .collect();
+    let mut soup = PolygonSoup::new(positions);
+    let mut face = Vec::new();
+    while let Some(len) = bytes.next() {
+        let len = match len % 8 {
+            0..=3 => 3,
+            4..=6 => 4,
+            _ => usize::from(len % 6),
+        };
+        face.clear();
+        face.extend((0..len).map_while(|_| bytes.next().map(|b| u32::from(b) % (n as u32 + 2))));
+        soup.push_face(&face);
+    }
+    let (mesh, _) = Mesh::build(&soup, &options).map_err(|e| e.to_string())?;
+    cut_accepted(&mesh)
+}
+
+/// The `--mu-expr` parser, then evaluation at a few points.
+fn expr(data: &[u8]) -> Result<(), String> {
+    let e = Expr::parse(text(data)?).map_err(|e| e.to_string())?;
+    for z in [
+        Complex64::new(0.0, 0.0),
+        Complex64::new(0.3, -0.2),
+        Complex64::new(1e300, 1e-300),
+    ] {
+        let _ = e.eval(z);
+    }
+    Ok(())
+}
+
+/// A disk (source and target of the file parsers): 16 faces.
+fn disk() -> &'static Mesh {
+    static DISK: OnceLock<Mesh> = OnceLock::new();
+    DISK.get_or_init(|| match Mesh::from_soup(&primitives::disk(1)) {
+        Ok(mesh) => mesh,
+        Err(e) => panic!("the generated disk is a valid mesh: {e}"),
+    })
+}
+
+/// A closed genus-1 mesh for the cut target's seeds.
+pub fn torus_obj() -> String {
+    let soup = primitives::torus(6, 4, 2.0, 0.7, Cells::Triangles);
+    let mut out = String::new();
+    for p in &soup.positions {
+        out.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    for f in soup.faces() {
+        out.push('f');
+        for v in f {
+            out.push_str(&format!(" {}", v + 1));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// A valid correspondence file for [`correspondence`]: every disk vertex onto a corner
+/// of face 0.
+pub fn correspondence_seed() -> String {
+    (0..disk().vertex_count())
+        .map(|k| format!("0 {} {} 0\n", k % 2, 1 - k % 2))
+        .collect()
+}
+
+/// The Beltrami field file parser, for the disk's face count.
+fn field(data: &[u8]) -> Result<(), String> {
+    BeltramiField::parse(Path::new("fuzz.mu"), text(data)?, disk().face_count())
+        .map(|_| ())
+        .map_err(|e| e.to_string())
+}
+
+/// The landmarks file parser, the disk onto itself, and the constraints it gives.
+fn landmarks(data: &[u8]) -> Result<(), String> {
+    let mesh = disk();
+    let marks = Landmarks::parse(Path::new("fuzz.landmarks"), text(data)?, mesh, mesh)
+        .map_err(|e| e.to_string())?;
+    let _ = marks.constraints(mesh);
+    Ok(())
+}
+
+/// The correspondence file parser, the disk onto itself.
+fn correspondence(data: &[u8]) -> Result<(), String> {
+    let mesh = disk();
+    correspondence::parse(Path::new("fuzz.corr"), text(data)?, mesh, mesh)
+        .map(|_| ())
+        .map_err(|e| e.to_string())
+}
+
+/// An OBJ built with the options of its first byte, then cut: every mesh the builder
+/// accepts, under any options, must cut without a panic.
+fn cut(data: &[u8]) -> Result<(), String> {
+    let (&first, rest) = data.split_first().ok_or("empty input")?;
+    let path = Path::new("fuzz.obj");
+    let raw = io::obj::parse(path, rest).map_err(|e| e.to_string())?;
+    built(path, raw, &options(first))
+}
