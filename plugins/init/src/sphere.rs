@@ -103,12 +103,14 @@ use beltrami_core::{
 };
 use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
-use beltrami_fem::{BoundaryMap, WeightError, WeightedMeanSystem};
+use beltrami_fem::{BoundaryMap, EdgeWeights, WeightError, WeightedMeanSystem};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
 use nalgebra::Matrix3;
 use num_complex::Complex64;
 
 use crate::{Weights, edge_weights, solve_options};
+
+mod conformal;
 
 /// The Tutte embedding of the mesh minus one face, inverse stereographic projection and
 /// Moebius centering (module docs): an initial map of a closed genus-0 mesh onto the
@@ -134,10 +136,36 @@ const NOT_A_SPHERE: &str = "use lscm/tutte for disks, or `beltrami cut` for high
 const CENTER_TOLERANCE: f64 = 1e-6;
 
 const OPTIONS: &[OptionSpec] = &[
+    OptionSpec {
+        name: "start",
+        kind: OptionKind::Choice {
+            default: "conformal",
+            choices: &["conformal", "tutte"],
+        },
+        help: "conformal: cotangent-harmonic map of the punctured mesh, then harmonic corrections in the two stereographic charts (nearly conformal, FLASH-like); tutte: Tutte embedding of the punctured mesh (a bijection before the projection, far from conformal)",
+    },
+    OptionSpec {
+        name: "corrections",
+        kind: OptionKind::Int {
+            default: 6,
+            min: 0,
+            max: 1000,
+        },
+        help: "start=conformal: harmonic chart corrections at most, alternating around the puncture and around its antipode (the first is FLASH's far-hemisphere correction)",
+    },
+    OptionSpec {
+        name: "overlap",
+        kind: OptionKind::Float {
+            default: 0.5,
+            min: 0.05,
+            max: 0.95,
+        },
+        help: "start=conformal: each chart correction frees the vertices with height above -overlap (around the puncture) or below +overlap (around the antipode)",
+    },
     crate::weights_option(
         "mean-value",
         &["mean-value", "uniform"],
-        "edge weights of the Tutte embedding: mean-value (Floater) or uniform; cotangent weights are negative on obtuse triangles and may fold the map",
+        "start=tutte: edge weights of the Tutte embedding: mean-value (Floater) or uniform; cotangent weights are negative on obtuse triangles and may fold the map",
     ),
     OptionSpec {
         name: "max-steps",
@@ -158,6 +186,9 @@ const ACCEPTS: Accepts = Accepts {
     goals: &[GoalKind::Conformal],
     constraints: &[],
 };
+
+/// The chart corrections stop once no vertex image moves farther than this.
+const CORRECTION_TOLERANCE: f64 = 1e-9;
 
 /// A normalization step halves its candidate this many times at most.
 const MAX_HALVINGS: u32 = 20;
@@ -195,42 +226,10 @@ impl Solver for Sphere {
         let mut metrics = Metrics::default();
 
         let removed = removed_face(mesh);
-        let punctured = context.stage("puncture", &mut report, || puncture(mesh, removed))?;
-        let share = mesh.face_area(removed) / mesh.total_area();
-        let radius = cap_radius(share);
-        report.notes.push(format!(
-            "removed face {} (input index, a {}) covering {:.3e} of the area; its vertices go to a circle of radius {radius:.4} before the projection",
-            mesh.face_to_input(removed),
-            if mesh.face_degree(removed) == 3 {
-                "triangle"
-            } else {
-                "quad"
-            },
-            share
-        ));
-
-        let (planar, negative) = context.stage("tutte", &mut report, || {
-            let weights = edge_weights(&punctured, kind).map_err(|e| match e {
-                WeightError::Fem(e) => SolverError::Fem(e),
-                error @ WeightError::NonFinite { .. } => SolverError::Weights {
-                    solver: NAME,
-                    error,
-                },
-            })?;
-            let boundary = hole_boundary(&punctured, radius);
-            let system = WeightedMeanSystem::new(&weights, &boundary)?;
-            let negative = weights.negative_count(system.interior().iter().copied());
-            Ok((system.solve(solve_options(settings))?, negative))
-        })?;
-        if negative > 0 {
-            report.notes.push(format!(
-                "{negative} mean-value weights of interior vertices are negative (reflex quad corners); the bijectivity theorem needs positive weights"
-            ));
-        }
-
-        let mut image: Vec<Point3<f64>> = context.stage("projection", &mut report, || {
-            Ok(planar.iter().map(|&z| inverse_stereographic(z)).collect())
-        })?;
+        let mut image = match start_of(settings) {
+            Start::Conformal => conformal_start(mesh, removed, settings, context, &mut report)?,
+            Start::Tutte => tutte_start(mesh, removed, kind, settings, context, &mut report)?,
+        };
 
         normalize(
             mesh,
@@ -276,6 +275,126 @@ impl Solver for Sphere {
             report,
         })
     }
+}
+
+/// The start of the solver's `start` option.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Start {
+    /// The linear conformal start ([`conformal`]).
+    Conformal,
+    /// The Tutte embedding of the punctured mesh (module docs, stages 1 to 3).
+    Tutte,
+}
+
+fn start_of(settings: &Settings) -> Start {
+    match settings.choice("start") {
+        "tutte" => Start::Tutte,
+        _ => Start::Conformal,
+    }
+}
+
+/// The linear conformal start ([`conformal`]): the punctured harmonic map (stage
+/// "harmonic"), its projection and Moebius centering (stage "projection"), and the
+/// chart corrections (stage "corrections").
+fn conformal_start(
+    mesh: &Mesh,
+    removed: FaceId,
+    settings: &Settings,
+    context: &mut Context<'_>,
+    report: &mut Report,
+) -> Result<Vec<Point3<f64>>, SolverError> {
+    let share = mesh.face_area(removed) / mesh.total_area();
+    report.notes.push(format!(
+        "punctured face {} (input index, covering {share:.3e} of the area): its vertices are held at a similar copy of it in the first harmonic map",
+        mesh.face_to_input(removed),
+    ));
+    let options = solve_options(settings);
+    let (weights, planar) = context.stage("harmonic", report, || {
+        let weights = EdgeWeights::cotangent(mesh).map_err(weight_error)?;
+        let planar = conformal::punctured_harmonic(mesh, &weights, removed, options)?;
+        Ok((weights, planar))
+    })?;
+    let mut image = context.stage("projection", report, || {
+        let mut image: Vec<Point3<f64>> =
+            planar.iter().map(|&z| inverse_stereographic(z)).collect();
+        centre(mesh, &mut image, settings.int("max-steps"), |_, _| Ok(()))?;
+        Ok(image)
+    })?;
+    let count = settings.int("corrections");
+    let corrections = context.stage("corrections", report, || {
+        let axis = radial_direction(mesh, &image, removed);
+        Ok(conformal::correct(
+            &weights,
+            &mut image,
+            axis,
+            settings.float("overlap"),
+            count,
+            CORRECTION_TOLERANCE,
+            options,
+        )?)
+    })?;
+    if count > 0 {
+        report.notes.push(format!(
+            "{} chart corrections (alternating harmonic solves around the puncture and around its antipode, overlap |h| < {}); the last moved a vertex image by {:.2e} at most",
+            corrections.done,
+            settings.float("overlap"),
+            corrections.last_move
+        ));
+    }
+    Ok(image)
+}
+
+/// The solver error of edge weights that cannot be computed.
+fn weight_error(error: WeightError) -> SolverError {
+    match error {
+        WeightError::Fem(e) => SolverError::Fem(e),
+        error @ WeightError::NonFinite { .. } => SolverError::Weights {
+            solver: NAME,
+            error,
+        },
+    }
+}
+
+/// The Tutte start (module docs, stages 1 to 3): puncture, Tutte embedding onto a
+/// regular polygon, inverse stereographic projection.
+fn tutte_start(
+    mesh: &Mesh,
+    removed: FaceId,
+    kind: Weights,
+    settings: &Settings,
+    context: &mut Context<'_>,
+    report: &mut Report,
+) -> Result<Vec<Point3<f64>>, SolverError> {
+    let punctured = context.stage("puncture", report, || puncture(mesh, removed))?;
+    let share = mesh.face_area(removed) / mesh.total_area();
+    let radius = cap_radius(share);
+    report.notes.push(format!(
+        "removed face {} (input index, a {}) covering {:.3e} of the area; its vertices go to a circle of radius {radius:.4} before the projection",
+        mesh.face_to_input(removed),
+        if mesh.face_degree(removed) == 3 {
+            "triangle"
+        } else {
+            "quad"
+        },
+        share
+    ));
+
+    let (planar, negative) = context.stage("tutte", report, || {
+        let weights = edge_weights(&punctured, kind).map_err(weight_error)?;
+        let boundary = hole_boundary(&punctured, radius);
+        let system = WeightedMeanSystem::new(&weights, &boundary)?;
+        let negative = weights.negative_count(system.interior().iter().copied());
+        Ok((system.solve(solve_options(settings))?, negative))
+    })?;
+    if negative > 0 {
+        report.notes.push(format!(
+            "{negative} mean-value weights of interior vertices are negative (reflex quad corners); the bijectivity theorem needs positive weights"
+        ));
+    }
+
+    context.stage("projection", report, || {
+        Ok(planar.iter().map(|&z| inverse_stereographic(z)).collect())
+    })
 }
 
 /// The capability check, returning the weights to use.
@@ -503,6 +622,55 @@ fn normalize(
 ) -> Result<(), SolverError> {
     context.check_cancelled()?;
     let start = std::time::Instant::now();
+    let centering = centre(mesh, image, max_steps, |steps, distance| {
+        context.check_cancelled()?;
+        metrics.energy_history.push(distance);
+        context.report(&Progress {
+            stage: "normalization",
+            done: steps,
+            total: Some(max_steps),
+            energy: Some(distance),
+        });
+        Ok(())
+    })?;
+    let Centering {
+        steps,
+        initial,
+        last,
+    } = centering;
+    metrics.iterations = steps;
+    report
+        .timings
+        .push(("normalization".to_string(), start.elapsed().as_secs_f64()));
+    if last <= CENTER_TOLERANCE {
+        report.notes.push(format!(
+            "Moebius centering moved the centre of mass of the area from {initial:.3e} to {last:.1e} from the origin in {steps} steps"
+        ));
+    } else {
+        report.notes.push(format!(
+            "Moebius centering stopped after {steps} steps with the centre of mass of the area {last:.3e} from the origin (started at {initial:.3e})"
+        ));
+    }
+    Ok(())
+}
+
+/// How a Moebius centering went: steps taken, and the distance of the centre of mass
+/// from the origin before and after.
+#[derive(Debug, Clone, Copy)]
+struct Centering {
+    steps: usize,
+    initial: f64,
+    last: f64,
+}
+
+/// The centering iteration of [`normalize`] (module docs), calling `on_step(steps,
+/// distance)` after each step; the image ends at unit length to the last bit.
+fn centre(
+    mesh: &Mesh,
+    image: &mut Vec<Point3<f64>>,
+    max_steps: usize,
+    mut on_step: impl FnMut(usize, f64) -> Result<(), SolverError>,
+) -> Result<Centering, SolverError> {
     let areas: Vec<f64> = mesh.faces().map(|f| mesh.face_area(f)).collect();
     let (mut c, mut m) = moments(mesh, &areas, image);
     let initial = c.norm();
@@ -511,7 +679,6 @@ fn normalize(
     // An average of unit vectors lies in the closed ball; on its boundary (all mass at
     // one point) no Moebius transformation can spread it.
     while c.norm() > CENTER_TOLERANCE && c.norm() < 1.0 && steps < max_steps {
-        context.check_cancelled()?;
         let newton = (2.0 * (Matrix3::identity() - m))
             .try_inverse()
             .map(|inverse| inverse * c)
@@ -532,34 +699,17 @@ fn normalize(
         std::mem::swap(image, &mut trial);
         (c, m) = (c_new, m_new);
         steps += 1;
-        metrics.energy_history.push(c.norm());
-        context.report(&Progress {
-            stage: "normalization",
-            done: steps,
-            total: Some(max_steps),
-            energy: Some(c.norm()),
-        });
+        on_step(steps, c.norm())?;
     }
     // Unit length to the last bit, also where no step was taken.
     for p in image.iter_mut() {
         *p = Point3::from(p.coords / p.coords.norm());
     }
-    metrics.iterations = steps;
-    report
-        .timings
-        .push(("normalization".to_string(), start.elapsed().as_secs_f64()));
-    if c.norm() <= CENTER_TOLERANCE {
-        report.notes.push(format!(
-            "Moebius centering moved the centre of mass of the area from {initial:.3e} to {:.1e} from the origin in {steps} steps",
-            c.norm()
-        ));
-    } else {
-        report.notes.push(format!(
-            "Moebius centering stopped after {steps} steps with the centre of mass of the area {:.3e} from the origin (started at {initial:.3e})",
-            c.norm()
-        ));
-    }
-    Ok(())
+    Ok(Centering {
+        steps,
+        initial,
+        last: c.norm(),
+    })
 }
 
 /// Per face: true if its image faces the centre (module docs: a triangle whose normal
