@@ -111,6 +111,9 @@ use num_complex::Complex64;
 use crate::{Weights, edge_weights, solve_options};
 
 mod conformal;
+mod untangle;
+
+use untangle::{Untangled, untangle};
 
 /// The Tutte embedding of the mesh minus one face, inverse stereographic projection and
 /// Moebius centering (module docs): an initial map of a closed genus-0 mesh onto the
@@ -147,7 +150,7 @@ const OPTIONS: &[OptionSpec] = &[
     OptionSpec {
         name: "corrections",
         kind: OptionKind::Int {
-            default: 6,
+            default: 8,
             min: 0,
             max: 1000,
         },
@@ -226,9 +229,16 @@ impl Solver for Sphere {
         let mut metrics = Metrics::default();
 
         let removed = removed_face(mesh);
-        let mut image = match start_of(settings) {
-            Start::Conformal => conformal_start(mesh, removed, settings, context, &mut report)?,
-            Start::Tutte => tutte_start(mesh, removed, kind, settings, context, &mut report)?,
+        let (mut image, cotangent) = match start_of(settings) {
+            Start::Conformal => {
+                let (image, weights) =
+                    conformal_start(mesh, removed, settings, context, &mut report)?;
+                (image, Some(weights))
+            }
+            Start::Tutte => (
+                tutte_start(mesh, removed, kind, settings, context, &mut report)?,
+                None,
+            ),
         };
 
         normalize(
@@ -239,6 +249,28 @@ impl Solver for Sphere {
             &mut report,
             &mut metrics,
         )?;
+
+        let untangled = context.stage("untangle", &mut report, || {
+            if !mesh.faces().any(|f| is_inward(mesh, &image, f)) {
+                return Ok(Untangled::default());
+            }
+            let weights = match cotangent {
+                Some(weights) => weights,
+                None => EdgeWeights::cotangent(mesh).map_err(weight_error)?,
+            };
+            Ok(untangle(
+                mesh,
+                &weights,
+                &mut image,
+                solve_options(settings),
+            )?)
+        })?;
+        if untangled.flipped > 0 {
+            report.notes.push(format!(
+                "{} faces were flipped after the linear solves; {} patches around them (up to {} rings of edges) were re-solved with positive weights, leaving {} flipped",
+                untangled.flipped, untangled.patches, untangled.rings, untangled.remaining
+            ));
+        }
 
         let (inward, distortion) = context.stage("distortion", &mut report, || {
             let inward = inward_faces(mesh, &image);
@@ -302,7 +334,7 @@ fn conformal_start(
     settings: &Settings,
     context: &mut Context<'_>,
     report: &mut Report,
-) -> Result<Vec<Point3<f64>>, SolverError> {
+) -> Result<(Vec<Point3<f64>>, EdgeWeights), SolverError> {
     let share = mesh.face_area(removed) / mesh.total_area();
     report.notes.push(format!(
         "punctured face {} (input index, covering {share:.3e} of the area): its vertices are held at a similar copy of it in the first harmonic map",
@@ -341,7 +373,7 @@ fn conformal_start(
             corrections.last_move
         ));
     }
-    Ok(image)
+    Ok((image, weights))
 }
 
 /// The solver error of edge weights that cannot be computed.
@@ -715,20 +747,21 @@ fn centre(
 /// Per face: true if its image faces the centre (module docs: a triangle whose normal
 /// points inward, a quad with such a triangle in either diagonal split).
 fn inward_faces(mesh: &Mesh, image: &[Point3<f64>]) -> Vec<bool> {
+    mesh.faces().map(|f| is_inward(mesh, image, f)).collect()
+}
+
+/// True if the image of `f` faces the centre (module docs).
+fn is_inward(mesh: &Mesh, image: &[Point3<f64>], f: FaceId) -> bool {
     const TRIANGLES: [[usize; 3]; 1] = [[0, 1, 2]];
     const QUAD_SPLITS: [[usize; 3]; 4] = [[0, 1, 2], [0, 2, 3], [0, 1, 3], [1, 2, 3]];
-    mesh.faces()
-        .map(|f| {
-            let (vertices, n) = mesh.face_vertex_array(f);
-            let p = |k: usize| image[vertices[k].idx()];
-            let m = image_mean(mesh, image, f);
-            let triangles: &[[usize; 3]] = if n == 3 { &TRIANGLES } else { &QUAD_SPLITS };
-            triangles.iter().any(|&[a, b, c]| {
-                let normal = (p(b) - p(a)).cross(&(p(c) - p(a)));
-                normal.dot(&m) <= 0.0
-            })
-        })
-        .collect()
+    let (vertices, n) = mesh.face_vertex_array(f);
+    let p = |k: usize| image[vertices[k].idx()];
+    let m = image_mean(mesh, image, f);
+    let triangles: &[[usize; 3]] = if n == 3 { &TRIANGLES } else { &QUAD_SPLITS };
+    triangles.iter().any(|&[a, b, c]| {
+        let normal = (p(b) - p(a)).cross(&(p(c) - p(a)));
+        normal.dot(&m) <= 0.0
+    })
 }
 
 /// The signed volume `sum_f (1/6) p0 . (p1 x p2)` enclosed by the source (quads split

@@ -91,8 +91,20 @@ pub(super) fn punctured_harmonic(
             (v, Complex64::new(d.dot(&e1), d.dot(&e2)))
         })
         .collect();
-    let mut z = ChartSystem::new(weights, |v| !fixed.iter().any(|&(f, _)| f == v), options)?
-        .solve(weights, |v| lookup(&fixed, v))?;
+    let mut system = ChartSystem::new(
+        weights,
+        f64::NEG_INFINITY,
+        |v| !fixed.iter().any(|&(f, _)| f == v),
+        options,
+    )?;
+    let solved = system.solve(weights, |v| lookup(&fixed, v))?;
+    let mut z = vec![Complex64::new(0.0, 0.0); mesh.vertex_count()];
+    for (&v, &zv) in system.free().iter().zip(&solved) {
+        z[v.idx()] = zv;
+    }
+    for &(v, zv) in &fixed {
+        z[v.idx()] = zv;
+    }
     let mean = z.iter().sum::<Complex64>() / z.len() as f64;
     let mut radii: Vec<f64> = z.iter().map(|&zi| (zi - mean).norm()).collect();
     let middle = radii.len() / 2;
@@ -118,7 +130,7 @@ fn lookup(fixed: &[(VertexId, Complex64)], v: VertexId) -> Complex64 {
 
 /// One of the two stereographic charts of the corrections (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Chart {
+pub(super) enum Chart {
     /// The north pole at 0: `w = (x + i y) / (1 + z)`.
     North,
     /// The south pole at 0: `w = (x + i y) / (1 - z)`.
@@ -127,7 +139,7 @@ enum Chart {
 
 impl Chart {
     /// The chart coordinate of a point of the unit sphere.
-    fn coordinate(self, p: &Point3<f64>) -> Complex64 {
+    pub(super) fn coordinate(self, p: &Point3<f64>) -> Complex64 {
         let d = match self {
             Chart::North => 1.0 + p.z,
             Chart::South => 1.0 - p.z,
@@ -136,7 +148,7 @@ impl Chart {
     }
 
     /// The point of the unit sphere at chart coordinate `w`.
-    fn point(self, w: Complex64) -> Point3<f64> {
+    pub(super) fn point(self, w: Complex64) -> Point3<f64> {
         match self {
             Chart::South => inverse_stereographic(w),
             Chart::North => {
@@ -151,7 +163,9 @@ impl Chart {
 /// once: `L_II w_I = sum_{j fixed} w_ij w_j` (the weighted-mean system of
 /// [`beltrami_fem::weighted_mean`] with an arbitrary fixed set, whose factorization is
 /// kept for the repeated corrections).
-struct ChartSystem {
+pub(super) struct ChartSystem {
+    /// Weights below this are raised to it (`-inf`: the weights as they are).
+    floor: f64,
     /// The sparse Cholesky factorization of `L_II` (rows and columns in the order of
     /// `free`).
     cholesky: SpdSolver<f64>,
@@ -162,9 +176,11 @@ struct ChartSystem {
 }
 
 impl ChartSystem {
-    /// The system of `weights` with the vertices where `is_free` holds as unknowns.
-    fn new(
+    /// The system of `weights` (each raised to at least `floor`) with the vertices where
+    /// `is_free` holds as unknowns.
+    pub(super) fn new(
         weights: &EdgeWeights,
+        floor: f64,
         is_free: impl Fn(VertexId) -> bool,
         options: SolveOptions,
     ) -> Result<Self, SolveError> {
@@ -181,6 +197,7 @@ impl ChartSystem {
         for (k, &v) in free.iter().enumerate() {
             let mut diagonal = 0.0;
             for (j, w) in weights.row(v) {
+                let w = w.max(floor);
                 diagonal += w;
                 let l = slot[j.idx()];
                 if l != usize::MAX && l > k {
@@ -194,24 +211,31 @@ impl ChartSystem {
         let mut cholesky = SpdSolver::new(matrix.symbolic(), options)?;
         cholesky.factorize(matrix.as_ref())?;
         Ok(Self {
+            floor,
             cholesky,
             free,
             slot,
         })
     }
 
-    /// Solves for the free vertices with the fixed ones at `fixed(v)`; returns the value
-    /// of every vertex (fixed ones included).
-    fn solve(
+    /// The free vertices, in the order of [`ChartSystem::solve`]'s values.
+    pub(super) fn free(&self) -> &[VertexId] {
+        &self.free
+    }
+
+    /// Solves for the free vertices with the fixed ones at `fixed(v)` (asked only for
+    /// fixed neighbours of free vertices); returns the values of the free vertices in
+    /// the order of [`ChartSystem::free`].
+    pub(super) fn solve(
         &mut self,
         weights: &EdgeWeights,
         fixed: impl Fn(VertexId) -> Complex64,
     ) -> Result<Vec<Complex64>, SolveError> {
-        let n = weights.vertex_count();
         let mut rhs = Mat::<f64>::zeros(self.free.len(), 2);
         for (k, &v) in self.free.iter().enumerate() {
             for (j, w) in weights.row(v) {
                 if self.slot[j.idx()] == usize::MAX {
+                    let w = w.max(self.floor);
                     let z = fixed(j);
                     rhs[(k, 0)] += w * z.re;
                     rhs[(k, 1)] += w * z.im;
@@ -219,21 +243,9 @@ impl ChartSystem {
             }
         }
         self.cholesky.solve_in_place(rhs.as_mut())?;
-        let x = rhs;
-        let mut map: Vec<Complex64> = (0..n)
-            .map(|i| {
-                let v = VertexId::from_usize(i);
-                if self.slot[i] == usize::MAX {
-                    fixed(v)
-                } else {
-                    Complex64::new(0.0, 0.0)
-                }
-            })
-            .collect();
-        for (k, v) in self.free.iter().enumerate() {
-            map[v.idx()] = Complex64::new(x[(k, 0)], x[(k, 1)]);
-        }
-        Ok(map)
+        Ok((0..self.free.len())
+            .map(|k| Complex64::new(rhs[(k, 0)], rhs[(k, 1)]))
+            .collect())
     }
 }
 
@@ -259,27 +271,18 @@ pub(super) fn correct(
     tolerance: f64,
     options: SolveOptions,
 ) -> Result<Corrections, SolveError> {
-    if let Some(rotation) = Rotation3::rotation_between(&axis, &Vector3::z()) {
-        for p in image.iter_mut() {
-            *p = rotation * *p;
-        }
-    } else if axis.z < 0.0 {
-        // `axis` is the south pole: turn the sphere over.
-        for p in image.iter_mut() {
-            *p = Point3::new(p.x, -p.y, -p.z);
-        }
-    }
+    turn_to_north(image, axis);
     let heights: Vec<f64> = image.iter().map(|p| p.z).collect();
     let north_free = free_set(&heights, |h| h > -tau);
     let south_free = free_set(&heights, |h| h < tau);
     let mut systems = [
         (
             Chart::North,
-            ChartSystem::new(weights, |v| north_free[v.idx()], options)?,
+            ChartSystem::new(weights, f64::NEG_INFINITY, |v| north_free[v.idx()], options)?,
         ),
         (
             Chart::South,
-            ChartSystem::new(weights, |v| south_free[v.idx()], options)?,
+            ChartSystem::new(weights, f64::NEG_INFINITY, |v| south_free[v.idx()], options)?,
         ),
     ];
     let mut result = Corrections {
@@ -291,8 +294,8 @@ pub(super) fn correct(
         let coordinates: Vec<Complex64> = image.iter().map(|p| chart.coordinate(p)).collect();
         let solved = system.solve(weights, |v| coordinates[v.idx()])?;
         let mut largest: f64 = 0.0;
-        for &v in &system.free {
-            let q = chart.point(solved[v.idx()]);
+        for (&v, &w) in system.free.iter().zip(&solved) {
+            let q = chart.point(w);
             largest = largest.max((q - image[v.idx()]).norm());
             image[v.idx()] = q;
         }
@@ -303,6 +306,20 @@ pub(super) fn correct(
         }
     }
     Ok(result)
+}
+
+/// Rotates the points so that the direction `axis` becomes the north pole `(0, 0, 1)`.
+pub(super) fn turn_to_north(points: &mut [Point3<f64>], axis: Vector3<f64>) {
+    if let Some(rotation) = Rotation3::rotation_between(&axis, &Vector3::z()) {
+        for p in points.iter_mut() {
+            *p = rotation * *p;
+        }
+    } else if axis.z < 0.0 {
+        // `axis` points south: turn the sphere over.
+        for p in points.iter_mut() {
+            *p = Point3::new(p.x, -p.y, -p.z);
+        }
+    }
 }
 
 /// Per vertex: free where `free(h)` holds, except that at least [`MIN_FIXED`] vertices
