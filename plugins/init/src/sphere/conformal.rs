@@ -97,7 +97,12 @@ pub(super) fn punctured_harmonic(
         |v| !fixed.iter().any(|&(f, _)| f == v),
         options,
     )?;
-    let solved = system.solve(weights, |v| lookup(&fixed, v))?;
+    let solved = system
+        .solve(weights, |v| lookup(&fixed, v))?
+        .ok_or(SolveError::NonFinite {
+            what: "the removed face's layout",
+            index: removed.idx(),
+        })?;
     let mut z = vec![Complex64::new(0.0, 0.0); mesh.vertex_count()];
     for (&v, &zv) in system.free().iter().zip(&solved) {
         z[v.idx()] = zv;
@@ -225,27 +230,33 @@ impl ChartSystem {
 
     /// Solves for the free vertices with the fixed ones at `fixed(v)` (asked only for
     /// fixed neighbours of free vertices); returns the values of the free vertices in
-    /// the order of [`ChartSystem::free`].
+    /// the order of [`ChartSystem::free`], or `None` when a fixed value asked for is not
+    /// finite (a fixed vertex at the pole the chart sends to infinity).
     pub(super) fn solve(
         &mut self,
         weights: &EdgeWeights,
         fixed: impl Fn(VertexId) -> Complex64,
-    ) -> Result<Vec<Complex64>, SolveError> {
+    ) -> Result<Option<Vec<Complex64>>, SolveError> {
         let mut rhs = Mat::<f64>::zeros(self.free.len(), 2);
         for (k, &v) in self.free.iter().enumerate() {
             for (j, w) in weights.row(v) {
                 if self.slot[j.idx()] == usize::MAX {
                     let w = w.max(self.floor);
                     let z = fixed(j);
+                    if !z.is_finite() {
+                        return Ok(None);
+                    }
                     rhs[(k, 0)] += w * z.re;
                     rhs[(k, 1)] += w * z.im;
                 }
             }
         }
         self.cholesky.solve_in_place(rhs.as_mut())?;
-        Ok((0..self.free.len())
-            .map(|k| Complex64::new(rhs[(k, 0)], rhs[(k, 1)]))
-            .collect())
+        Ok(Some(
+            (0..self.free.len())
+                .map(|k| Complex64::new(rhs[(k, 0)], rhs[(k, 1)]))
+                .collect(),
+        ))
     }
 }
 
@@ -292,7 +303,9 @@ pub(super) fn correct(
     for k in 0..count {
         let (chart, system) = &mut systems[k % 2];
         let coordinates: Vec<Complex64> = image.iter().map(|p| chart.coordinate(p)).collect();
-        let solved = system.solve(weights, |v| coordinates[v.idx()])?;
+        let Some(solved) = system.solve(weights, |v| coordinates[v.idx()])? else {
+            break;
+        };
         let mut largest: f64 = 0.0;
         for (&v, &w) in system.free.iter().zip(&solved) {
             let q = chart.point(w);

@@ -74,9 +74,12 @@ pub(super) fn untangle(
                     Rotation3::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
                 });
             let mut system = ChartSystem::new(weights, floor, |v| free[v.idx()], options)?;
-            let solved = system.solve(weights, |v| {
+            let Some(solved) = system.solve(weights, |v| {
                 Chart::South.coordinate(&(rotation * image[v.idx()]))
-            })?;
+            })?
+            else {
+                continue;
+            };
             for (&v, &w) in system.free().iter().zip(&solved) {
                 image[v.idx()] = rotation.inverse() * Chart::South.point(w);
             }
