@@ -1,10 +1,24 @@
-//! A closed genus-0 mesh onto the unit sphere: the initial bijection of spherical
-//! solvers (T. W. Wong and H. Zhao, "Computation of quasiconformal surface maps using
-//! discrete Beltrami flow", SIAM J. Imaging Sci. 7, 2014, section 4.1: "remove a
+//! A closed genus-0 mesh onto the unit sphere, nearly conformally: a linear conformal
+//! start (`conformal` (private module), the default), or Tutte's embedding of the mesh minus one face
+//! (`start=tutte`; T. W. Wong and H. Zhao, "Computation of quasiconformal surface maps
+//! using discrete Beltrami flow", SIAM J. Imaging Sci. 7, 2014, section 4.1: "remove a
 //! triangle ..., apply Tutte embedding ..., then map onto a sphere by stereographic
-//! projection, with the triangle put back to fill the hole").
+//! projection, with the triangle put back to fill the hole"), then Moebius
+//! normalization and the untangling of any flipped face (`untangle` (private module)).
 //!
 //! # Stages
+//!
+//! The conformal start (`start=conformal`, stages `harmonic`, `projection`,
+//! `corrections`; details in `conformal` (private module)): the cotangent-harmonic map of the mesh with
+//! the vertices of the face `r` chosen in stage 1 below held at a similar copy of `r`
+//! (FLASH's first solve: P. T. Choi, K. C. Lam, L. M. Lui, SIAM J. Imaging Sci. 8, 2015),
+//! its inverse stereographic projection (stage 3) and Moebius centering (stage 4), then
+//! harmonic corrections alternating between the stereographic charts centred at the
+//! puncture and at its antipode, each holding the other end of the sphere fixed (the
+//! first is FLASH's far-hemisphere correction, the next ones a Schwarz alternation that
+//! removes the seam it leaves). The linear solves reuse one factorization per chart.
+//!
+//! The Tutte start (`start=tutte`, stages `puncture`, `tutte`, `projection`):
 //!
 //! 1. **Puncture.** Remove one face `r`: the one with the largest `A_f q_f`, its area
 //!    times its shape quality `q_f = 4 tan(pi / n) A_f / sum_k l_k^2` (`n` = 3 or 4
@@ -36,6 +50,8 @@
 //!    removed face's share `a = A_r / A` of the surface area: the cap has area
 //!    `2 pi (1 - h)` with `h = (R^2 - 1) / (R^2 + 1)`, so `4 pi a = 4 pi / (R^2 + 1)` and
 //!    `R = sqrt(1/a - 1)`.
+//! Then, for both starts:
+//!
 //! 4. **Normalization.** Moebius centering (A. Baden, K. Crane, M. Kazhdan, "Moebius
 //!    registration", Computer Graphics Forum 37(5), SGP 2018): with source face areas
 //!    `A_f` and `x_f` the centroid of face `f`'s image projected onto the sphere, the
@@ -60,6 +76,9 @@
 //!    source is then spread around the sphere instead of crowding one side: the usual
 //!    normalization of the Moebius freedom of spherical maps.
 //!
+//! 5. **Untangling.** Faces whose image faces inward (below) are re-solved in small
+//!    patches with positive weights (`untangle` (private module)); the report counts them and any left.
+//!
 //! # Flips
 //!
 //! The image of a face is the flat polygon through its vertex images. It faces outward
@@ -75,8 +94,9 @@
 //! the flat image faces outward exactly when that cap is the smaller of the two the
 //! circle bounds. Tutte's map has no flips in the plane, but a very obtuse face has a
 //! circumdisk far larger than itself, which the projection and the centering may blow up
-//! beyond a hemisphere: such faces are the flips that remain (a handful in 10^5 on
-//! meshes with slivers).
+//! beyond a hemisphere. The cotangent weights of the conformal start are negative across
+//! edges opposite obtuse angles, so its harmonic solves may fold a face too (one in
+//! 10^5 on the shared meshes). Stage 5 removes both kinds.
 //!
 //! The image always has the combinatorial orientation of the source: when the source's
 //! faces face inward (negative signed volume), the image's faces still face outward, and
@@ -88,12 +108,13 @@
 //! ([`beltrami_fem::distortion::measure_surface`]) with [`ReferenceNormal::Radial`] (the
 //! direction of the image point at each quadrature point) as the reference normal; its
 //! flipped count is that of the inward faces above (together with any Gauss point the
-//! measure finds flipped). The map is an
-//! initialization, bijective up to the rare flips above but not conformal. The stretch is
-//! largest near the removed face's corners (a full turn around them is squeezed into the
-//! polygon's corner angle) and on long protrusions, which Tutte embeddings shrink
-//! geometrically.
-
+//! measure finds flipped). The conformal start's `|mu|` is a discretization error: on a
+//! round sphere moved by a rotation or a Moebius transformation mean `|mu|` falls by 4
+//! per halving of the edges, on an ellipsoid by 2 (tests `sphere_conformal`). The Tutte
+//! start is a bijective initialization but not conformal: its stretch is largest near
+//! the removed face's corners (a full turn around them is squeezed into the polygon's
+//! corner angle) and on long protrusions, which Tutte embeddings shrink geometrically.
+//!
 use std::f64::consts::{PI, TAU};
 
 use beltrami_core::{
@@ -115,17 +136,19 @@ mod untangle;
 
 use untangle::{Untangled, untangle};
 
-/// The Tutte embedding of the mesh minus one face, inverse stereographic projection and
-/// Moebius centering (module docs): an initial map of a closed genus-0 mesh onto the
-/// unit sphere, bijective up to rare flips of very obtuse faces.
+/// A closed genus-0 mesh onto the unit sphere (module docs): the linear conformal start
+/// (default) or the Tutte start, Moebius centering, untangling of flipped faces.
 ///
-/// Reads: `target` (`Sphere` only), `goal` (`Conformal { p: 2 }` only: the map is an
-/// initialization), `params.weights` (`MeanValue`, the default, or `Uniform`) and
-/// `params.threads` (uniform weights). Takes no pins and no curves. The report holds the
-/// timings of the stages (`puncture`, `tutte`, `projection`, `normalization`,
-/// `distortion`), the number of normalization steps as its iterations, the distance of
-/// the centre of mass from the origin after each step as its energy history, and notes
-/// naming the removed face (input index) and counting flipped faces.
+/// Reads: `target` (`Sphere` only), `goal` (`Conformal { p: 2 }` only) and the options
+/// `start` (`conformal`, the default, or `tutte`), `corrections` and `overlap` (the
+/// conformal start's chart corrections), `weights` (the Tutte start's: `mean-value`,
+/// the default, or `uniform`), `max-steps` (centering) and `threads`. Takes no pins and
+/// no curves. The report holds the timings of the stages (`harmonic`, `projection`,
+/// `corrections` or `puncture`, `tutte`, `projection`; then `normalization`,
+/// `untangle`, `distortion`), the number of normalization steps as its iterations, the
+/// distance of the centre of mass from the origin after each step as its energy
+/// history, and notes naming the removed face (input index), the corrections, and
+/// counting flipped faces before and after the untangling.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Sphere;
 
@@ -202,7 +225,7 @@ impl Solver for Sphere {
     }
 
     fn description(&self) -> &'static str {
-        "closed genus-0 mesh onto the unit sphere: Tutte embedding of the mesh minus one face, inverse stereographic projection, Moebius centering; a bijective initialization, not a conformal map"
+        "closed genus-0 mesh onto the unit sphere, nearly conformally: cotangent-harmonic map of the punctured mesh, harmonic corrections alternating between the two stereographic charts, Moebius centering, flipped faces untangled (start=tutte: the Tutte embedding of the old initialization)"
     }
 
     fn accepts(&self) -> Accepts {
@@ -312,7 +335,7 @@ impl Solver for Sphere {
 /// The start of the solver's `start` option.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Start {
-    /// The linear conformal start ([`conformal`]).
+    /// The linear conformal start (`conformal` (private module)).
     Conformal,
     /// The Tutte embedding of the punctured mesh (module docs, stages 1 to 3).
     Tutte,
@@ -325,7 +348,7 @@ fn start_of(settings: &Settings) -> Start {
     }
 }
 
-/// The linear conformal start ([`conformal`]): the punctured harmonic map (stage
+/// The linear conformal start (`conformal` (private module)): the punctured harmonic map (stage
 /// "harmonic"), its projection and Moebius centering (stage "projection"), and the
 /// chart corrections (stage "corrections").
 fn conformal_start(

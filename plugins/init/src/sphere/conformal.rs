@@ -43,20 +43,20 @@
 //! the sphere:
 //!
 //! ```text
-//! chart S (N at 0):         w = (x + i y) / (1 + z),   p = (2w, 1 - |w|^2) / (1 + |w|^2)
-//! chart N (S at 0):         w = (x + i y) / (1 - z),   p = (2w, |w|^2 - 1) / (1 + |w|^2)
+//! north chart (N at 0):  w = (x + i y) / (1 + z),   p = (2w, 1 - |w|^2) / (1 + |w|^2)
+//! south chart (S at 0):  w = (x + i y) / (1 - z),   p = (2w, |w|^2 - 1) / (1 + |w|^2)
 //! ```
 //!
-//! (the two are related by `w_S = 1 / conj(w_N)`). A correction in chart S frees the
+//! (the two are related by `w_north = 1 / conj(w_south)`). A correction in the north chart frees the
 //! vertices with `h_v > -tau` (around `r`) and holds the others at their current chart
-//! coordinates; a correction in chart N frees those with `h_v < tau` and holds the
-//! northern cap. Corrections alternate S, N, S, ... The first is FLASH's correction with
+//! coordinates; a correction in the south chart frees those with `h_v < tau` and holds the
+//! northern cap. Corrections alternate north, south, north, ... The first is FLASH's correction with
 //! a fixed region of heights below `-tau` instead of a tenth of the vertices; the next
 //! ones remove the seam the fixed region leaves, since the region held fixed by each
 //! solve was recomputed, as a conformal map, by the previous one. This is H. A.
 //! Schwarz's alternating method ("Ueber einen Grenzuebergang durch alternirendes
 //! Verfahren", 1870) for the conformal map of the sphere, with the overlap
-//! `|h| < tau`: in chart S the free disk has radius `R = sqrt((1 + tau) / (1 - tau))`
+//! `|h| < tau`: in the north chart the free disk has radius `R = sqrt((1 + tau) / (1 - tau))`
 //! and the other chart's free region begins at radius `1 / R`, so an error mode
 //! `w^k` shrinks by about `R^(-2k)` per pair of solves. The fixed sets are chosen once
 //! (from the heights after the punctured map), so each chart's matrix is factorized
@@ -270,7 +270,7 @@ pub(super) struct Corrections {
 }
 
 /// The chart corrections (module docs): `count` harmonic solves alternating between
-/// chart S and chart N, with the overlap `|h| < tau`, on the image rotated so that
+/// the north chart and the south chart, with the overlap `|h| < tau`, on the image rotated so that
 /// `axis` is the north pole. Stops early once no vertex image moves more than
 /// `tolerance`. `image` holds unit vectors; it is left in the rotated frame.
 pub(super) fn correct(
