@@ -1,15 +1,15 @@
 //! A closed genus-0 mesh onto the unit sphere, nearly conformally: a linear conformal
-//! start (`conformal` (private module), the default), or Tutte's embedding of the mesh minus one face
+//! start (`sphere/conformal.rs`, the default), or Tutte's embedding of the mesh minus one face
 //! (`start=tutte`; T. W. Wong and H. Zhao, "Computation of quasiconformal surface maps
 //! using discrete Beltrami flow", SIAM J. Imaging Sci. 7, 2014, section 4.1: "remove a
 //! triangle ..., apply Tutte embedding ..., then map onto a sphere by stereographic
 //! projection, with the triangle put back to fill the hole"), then Moebius
-//! normalization and the untangling of any flipped face (`untangle` (private module)).
+//! normalization and the untangling of any flipped face (`sphere/untangle.rs`).
 //!
 //! # Stages
 //!
 //! The conformal start (`start=conformal`, stages `harmonic`, `projection`,
-//! `corrections`; details in `conformal` (private module)): the cotangent-harmonic map of the mesh with
+//! `corrections`; details in `sphere/conformal.rs`): the cotangent-harmonic map of the mesh with
 //! the vertices of the face `r` chosen in stage 1 below held at a similar copy of `r`
 //! (FLASH's first solve: P. T. Choi, K. C. Lam, L. M. Lui, SIAM J. Imaging Sci. 8, 2015),
 //! its inverse stereographic projection (stage 3) and Moebius centering (stage 4), then
@@ -77,7 +77,7 @@
 //!    normalization of the Moebius freedom of spherical maps.
 //!
 //! 5. **Untangling.** Faces whose image faces inward (below) are re-solved in small
-//!    patches with positive weights (`untangle` (private module)); the report counts them and any left.
+//!    patches with positive weights (`sphere/untangle.rs`); the report counts them and any left.
 //!
 //! # Flips
 //!
@@ -335,7 +335,7 @@ impl Solver for Sphere {
 /// The start of the solver's `start` option.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Start {
-    /// The linear conformal start (`conformal` (private module)).
+    /// The linear conformal start (`sphere/conformal.rs`).
     Conformal,
     /// The Tutte embedding of the punctured mesh (module docs, stages 1 to 3).
     Tutte,
@@ -348,7 +348,7 @@ fn start_of(settings: &Settings) -> Start {
     }
 }
 
-/// The linear conformal start (`conformal` (private module)): the punctured harmonic map (stage
+/// The linear conformal start (`sphere/conformal.rs`): the punctured harmonic map (stage
 /// "harmonic"), its projection and Moebius centering (stage "projection"), and the
 /// chart corrections (stage "corrections").
 fn conformal_start(
