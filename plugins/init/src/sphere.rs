@@ -50,6 +50,7 @@
 //!    removed face's share `a = A_r / A` of the surface area: the cap has area
 //!    `2 pi (1 - h)` with `h = (R^2 - 1) / (R^2 + 1)`, so `4 pi a = 4 pi / (R^2 + 1)` and
 //!    `R = sqrt(1/a - 1)`.
+//!
 //! Then, for both starts:
 //!
 //! 4. **Normalization.** Moebius centering (A. Baden, K. Crane, M. Kazhdan, "Moebius
@@ -364,10 +365,11 @@ fn conformal_start(
         mesh.face_to_input(removed),
     ));
     let options = solve_options(settings);
-    let (weights, planar) = context.stage("harmonic", report, || {
+    let (weights, order, planar) = context.stage("harmonic", report, || {
         let weights = EdgeWeights::cotangent(mesh).map_err(weight_error)?;
-        let planar = conformal::punctured_harmonic(mesh, &weights, removed, options)?;
-        Ok((weights, planar))
+        let order = conformal::vertex_order(&weights)?;
+        let planar = conformal::punctured_harmonic(mesh, &weights, removed, &order, options)?;
+        Ok((weights, order, planar))
     })?;
     let mut image = context.stage("projection", report, || {
         let mut image: Vec<Point3<f64>> =
@@ -382,9 +384,12 @@ fn conformal_start(
             &weights,
             &mut image,
             axis,
-            settings.float("overlap"),
-            count,
-            CORRECTION_TOLERANCE,
+            conformal::CorrectionSettings {
+                overlap: settings.float("overlap"),
+                count,
+                tolerance: CORRECTION_TOLERANCE,
+            },
+            &order,
             options,
         )?)
     })?;

@@ -62,6 +62,7 @@
 //! (from the heights after the punctured map), so each chart's matrix is factorized
 //! once.
 
+use beltrami_fem::solve::amd_order;
 use beltrami_fem::{EdgeWeights, SolveError, SolveOptions, SpdSolver};
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector3, VertexId};
 use faer::Mat;
@@ -71,12 +72,31 @@ use num_complex::Complex64;
 
 use super::inverse_stereographic;
 
+/// The approximate minimum degree elimination order of the vertex graph of `weights`
+/// (the pattern of the cotangent Laplacian), shared by the three systems of the
+/// conformal start: eliminating a subset in the order of the whole keeps the fill low
+/// (the separators of the whole graph restricted to the subset).
+pub(super) fn vertex_order(weights: &EdgeWeights) -> Result<Vec<usize>, SolveError> {
+    let n = weights.vertex_count();
+    let mut triplets = Vec::new();
+    for i in 0..n {
+        triplets.push(Triplet::new(i, i, 1.0));
+        for (j, _) in weights.row(VertexId::from_usize(i)) {
+            triplets.push(Triplet::new(j.idx(), i, 1.0));
+        }
+    }
+    let pattern = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
+        .map_err(|_| SolveError::Faer(FaerError::IndexOverflow))?;
+    amd_order(pattern.symbolic())
+}
+
 /// The discrete harmonic map of `mesh` with the vertices of face `removed` fixed at a
 /// similar copy of it (module docs), centred and scaled to a median `|z|` of 1.
 pub(super) fn punctured_harmonic(
     mesh: &Mesh,
     weights: &EdgeWeights,
     removed: FaceId,
+    order: &[usize],
     options: SolveOptions,
 ) -> Result<Vec<Complex64>, SolveError> {
     let (corners, n) = mesh.face_vertex_array(removed);
@@ -95,6 +115,7 @@ pub(super) fn punctured_harmonic(
         weights,
         f64::NEG_INFINITY,
         |v| !fixed.iter().any(|&(f, _)| f == v),
+        Some(order),
         options,
     )?;
     let solved = system
@@ -183,10 +204,15 @@ pub(super) struct ChartSystem {
 impl ChartSystem {
     /// The system of `weights` (each raised to at least `floor`) with the vertices where
     /// `is_free` holds as unknowns.
+    ///
+    /// `order`, when given, is an elimination order of all the vertices
+    /// ([`vertex_order`]); the free vertices are eliminated in its order, which saves a
+    /// minimum-degree ordering per system. Without it the system is ordered by AMD.
     pub(super) fn new(
         weights: &EdgeWeights,
         floor: f64,
         is_free: impl Fn(VertexId) -> bool,
+        order: Option<&[usize]>,
         options: SolveOptions,
     ) -> Result<Self, SolveError> {
         let n = weights.vertex_count();
@@ -213,7 +239,17 @@ impl ChartSystem {
         }
         let matrix = SparseColMat::try_new_from_triplets(free.len(), free.len(), &triplets)
             .map_err(|_| SolveError::Faer(FaerError::IndexOverflow))?;
-        let mut cholesky = SpdSolver::new(matrix.symbolic(), options)?;
+        let mut cholesky = match order {
+            Some(order) => {
+                let restricted: Vec<usize> = order
+                    .iter()
+                    .map(|&i| slot[i])
+                    .filter(|&k| k != usize::MAX)
+                    .collect();
+                SpdSolver::with_order(matrix.symbolic(), &restricted, options)?
+            }
+            None => SpdSolver::new(matrix.symbolic(), options)?,
+        };
         cholesky.factorize(matrix.as_ref())?;
         Ok(Self {
             floor,
@@ -269,38 +305,62 @@ pub(super) struct Corrections {
     pub last_move: f64,
 }
 
-/// The chart corrections (module docs): `count` harmonic solves alternating between
-/// the north chart and the south chart, with the overlap `|h| < tau`, on the image rotated so that
-/// `axis` is the north pole. Stops early once no vertex image moves more than
-/// `tolerance`. `image` holds unit vectors; it is left in the rotated frame.
+/// What the chart corrections do (module docs).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CorrectionSettings {
+    /// `tau`: the north chart frees heights above `-tau`, the south chart below `tau`.
+    pub overlap: f64,
+    /// Corrections at most.
+    pub count: usize,
+    /// The corrections stop once no vertex image moves farther than this.
+    pub tolerance: f64,
+}
+
+/// The chart corrections (module docs): `settings.count` harmonic solves alternating
+/// between the north chart and the south chart, with the overlap
+/// `|h| < settings.overlap`, on the image rotated so that `axis` is the north pole.
+/// Stops early once no vertex image moves more than `settings.tolerance`. `image` holds
+/// unit vectors; it is left in the rotated frame.
 pub(super) fn correct(
     weights: &EdgeWeights,
     image: &mut [Point3<f64>],
     axis: Vector3<f64>,
-    tau: f64,
-    count: usize,
-    tolerance: f64,
+    settings: CorrectionSettings,
+    order: &[usize],
     options: SolveOptions,
 ) -> Result<Corrections, SolveError> {
     turn_to_north(image, axis);
     let heights: Vec<f64> = image.iter().map(|p| p.z).collect();
+    let tau = settings.overlap;
     let north_free = free_set(&heights, |h| h > -tau);
     let south_free = free_set(&heights, |h| h < tau);
     let mut systems = [
         (
             Chart::North,
-            ChartSystem::new(weights, f64::NEG_INFINITY, |v| north_free[v.idx()], options)?,
+            ChartSystem::new(
+                weights,
+                f64::NEG_INFINITY,
+                |v| north_free[v.idx()],
+                Some(order),
+                options,
+            )?,
         ),
         (
             Chart::South,
-            ChartSystem::new(weights, f64::NEG_INFINITY, |v| south_free[v.idx()], options)?,
+            ChartSystem::new(
+                weights,
+                f64::NEG_INFINITY,
+                |v| south_free[v.idx()],
+                Some(order),
+                options,
+            )?,
         ),
     ];
     let mut result = Corrections {
         done: 0,
         last_move: 0.0,
     };
-    for k in 0..count {
+    for k in 0..settings.count {
         let (chart, system) = &mut systems[k % 2];
         let coordinates: Vec<Complex64> = image.iter().map(|p| chart.coordinate(p)).collect();
         let Some(solved) = system.solve(weights, |v| coordinates[v.idx()])? else {
@@ -314,7 +374,7 @@ pub(super) fn correct(
         }
         result.done += 1;
         result.last_move = largest;
-        if largest <= tolerance {
+        if largest <= settings.tolerance {
             break;
         }
     }
@@ -336,8 +396,8 @@ pub(super) fn turn_to_north(points: &mut [Point3<f64>], axis: Vector3<f64>) {
 }
 
 /// Per vertex: free where `free(h)` holds, except that at least [`MIN_FIXED`] vertices
-/// (the ones the predicate frees last: lowest `h` for chart S's `h > -tau`, highest for
-/// chart N's) stay fixed so the system is nonsingular.
+/// (the ones the predicate frees last: lowest `h` for the north chart's `h > -tau`, highest for
+/// the south chart's) stay fixed so the system is nonsingular.
 fn free_set(heights: &[f64], free: impl Fn(f64) -> bool) -> Vec<bool> {
     let mut is_free: Vec<bool> = heights.iter().map(|&h| free(h)).collect();
     let fixed = is_free.iter().filter(|&&f| !f).count();

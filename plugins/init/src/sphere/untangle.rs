@@ -73,7 +73,7 @@ pub(super) fn untangle(
                 Rotation3::rotation_between(&axis, &-Vector3::z()).unwrap_or_else(|| {
                     Rotation3::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
                 });
-            let mut system = ChartSystem::new(weights, floor, |v| free[v.idx()], options)?;
+            let mut system = ChartSystem::new(weights, floor, |v| free[v.idx()], None, options)?;
             let Some(solved) = system.solve(weights, |v| {
                 Chart::South.coordinate(&(rotation * image[v.idx()]))
             })?
