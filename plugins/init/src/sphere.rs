@@ -380,7 +380,7 @@ fn conformal_start(
     let count = settings.int("corrections");
     let corrections = context.stage("corrections", report, || {
         let axis = radial_direction(mesh, &image, removed);
-        Ok(conformal::correct(
+        conformal::correct(
             &weights,
             &mut image,
             axis,
@@ -391,7 +391,8 @@ fn conformal_start(
             },
             &order,
             options,
-        )?)
+            |image| centre(mesh, image, settings.int("max-steps"), |_, _| Ok(())).map(|_| ()),
+        )
     })?;
     if count > 0 {
         report.notes.push(format!(

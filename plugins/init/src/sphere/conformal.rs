@@ -60,7 +60,9 @@
 //! and the other chart's free region begins at radius `1 / R`, so an error mode
 //! `w^k` shrinks by about `R^(-2k)` per pair of solves. The fixed sets are chosen once
 //! (from the heights after the punctured map), so each chart's matrix is factorized
-//! once.
+//! once. The area is Moebius-centred after each solve, which keeps the alternation from
+//! drifting along the Moebius group (each solve's discretization error is not invariant
+//! under it).
 
 use beltrami_fem::solve::amd_order;
 use beltrami_fem::{EdgeWeights, SolveError, SolveOptions, SpdSolver};
@@ -319,16 +321,24 @@ pub(super) struct CorrectionSettings {
 /// The chart corrections (module docs): `settings.count` harmonic solves alternating
 /// between the north chart and the south chart, with the overlap
 /// `|h| < settings.overlap`, on the image rotated so that `axis` is the north pole.
-/// Stops early once no vertex image moves more than `settings.tolerance`. `image` holds
-/// unit vectors; it is left in the rotated frame.
-pub(super) fn correct(
+/// After each solve `recentre` moves the centre of mass of the area back to the origin
+/// (a conformal change): the charts' discretization errors are not invariant under the
+/// Moebius group, and without it the alternation can drift along it (on a coarse,
+/// unevenly spread mesh, until the area crowds one side and the charts no longer
+/// resolve it). Stops early once no solve moves a vertex image more than
+/// `settings.tolerance`. `image` holds unit vectors; it is left in the rotated frame.
+pub(super) fn correct<E>(
     weights: &EdgeWeights,
-    image: &mut [Point3<f64>],
+    image: &mut Vec<Point3<f64>>,
     axis: Vector3<f64>,
     settings: CorrectionSettings,
     order: &[usize],
     options: SolveOptions,
-) -> Result<Corrections, SolveError> {
+    mut recentre: impl FnMut(&mut Vec<Point3<f64>>) -> Result<(), E>,
+) -> Result<Corrections, E>
+where
+    E: From<SolveError>,
+{
     turn_to_north(image, axis);
     let heights: Vec<f64> = image.iter().map(|p| p.z).collect();
     let tau = settings.overlap;
@@ -372,6 +382,7 @@ pub(super) fn correct(
             largest = largest.max((q - image[v.idx()]).norm());
             image[v.idx()] = q;
         }
+        recentre(image)?;
         result.done += 1;
         result.last_move = largest;
         if largest <= settings.tolerance {
