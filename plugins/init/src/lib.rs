@@ -26,12 +26,15 @@
 //!   `E_C(f) = sum_q w_q |f_zbar(q)|^2` over the quadrature points `q` of all faces (one
 //!   per triangle, four per quad) in the face frames, with two vertices pinned (by
 //!   default two boundary vertices far apart, at `(0, 0)` and `(1, 0)`).
-//! - [`Sphere`] (`sphere`): a closed genus-0 mesh onto the unit sphere, as an initial
-//!   bijection (T. W. Wong and H. Zhao, SIAM J. Imaging Sci. 7, 2014, section 4.1):
-//!   Tutte's embedding of the mesh minus one face onto a regular polygon, the inverse
-//!   stereographic projection `s(z) = (2x, 2y, |z|^2 - 1) / (|z|^2 + 1)`, and Moebius
+//! - [`Sphere`] (`sphere`): a closed genus-0 mesh onto the unit sphere, nearly
+//!   conformally: the cotangent-harmonic map of the mesh with one face's vertices held
+//!   (P. T. Choi, K. C. Lam, L. M. Lui, "FLASH", SIAM J. Imaging Sci. 8, 2015), the
+//!   inverse stereographic projection `s(z) = (2x, 2y, |z|^2 - 1) / (|z|^2 + 1)`,
+//!   harmonic corrections alternating between the two stereographic charts, Moebius
 //!   centering of the area (A. Baden, K. Crane, M. Kazhdan, "Moebius registration",
-//!   SGP 2018).
+//!   SGP 2018) and local re-solves of flipped faces; or, with `start=tutte`, the Tutte
+//!   embedding of the mesh minus one face (T. W. Wong and H. Zhao, SIAM J. Imaging
+//!   Sci. 7, 2014, section 4.1).
 //!
 //! The first three need a single topological disk, [`Sphere`] a closed genus-0 surface;
 //! a mesh of another topology gets [`beltrami_core::SolverError::Unsupported`] saying

@@ -1,10 +1,24 @@
-//! A closed genus-0 mesh onto the unit sphere: the initial bijection of spherical
-//! solvers (T. W. Wong and H. Zhao, "Computation of quasiconformal surface maps using
-//! discrete Beltrami flow", SIAM J. Imaging Sci. 7, 2014, section 4.1: "remove a
+//! A closed genus-0 mesh onto the unit sphere, nearly conformally: a linear conformal
+//! start (`sphere/conformal.rs`, the default), or Tutte's embedding of the mesh minus one face
+//! (`start=tutte`; T. W. Wong and H. Zhao, "Computation of quasiconformal surface maps
+//! using discrete Beltrami flow", SIAM J. Imaging Sci. 7, 2014, section 4.1: "remove a
 //! triangle ..., apply Tutte embedding ..., then map onto a sphere by stereographic
-//! projection, with the triangle put back to fill the hole").
+//! projection, with the triangle put back to fill the hole"), then Moebius
+//! normalization and the untangling of any flipped face (`sphere/untangle.rs`).
 //!
 //! # Stages
+//!
+//! The conformal start (`start=conformal`, stages `harmonic`, `projection`,
+//! `corrections`; details in `sphere/conformal.rs`): the cotangent-harmonic map of the mesh with
+//! the vertices of the face `r` chosen in stage 1 below held at a similar copy of `r`
+//! (FLASH's first solve: P. T. Choi, K. C. Lam, L. M. Lui, SIAM J. Imaging Sci. 8, 2015),
+//! its inverse stereographic projection (stage 3) and Moebius centering (stage 4), then
+//! harmonic corrections alternating between the stereographic charts centred at the
+//! puncture and at its antipode, each holding the other end of the sphere fixed (the
+//! first is FLASH's far-hemisphere correction, the next ones a Schwarz alternation that
+//! removes the seam it leaves). The linear solves reuse one factorization per chart.
+//!
+//! The Tutte start (`start=tutte`, stages `puncture`, `tutte`, `projection`):
 //!
 //! 1. **Puncture.** Remove one face `r`: the one with the largest `A_f q_f`, its area
 //!    times its shape quality `q_f = 4 tan(pi / n) A_f / sum_k l_k^2` (`n` = 3 or 4
@@ -36,6 +50,9 @@
 //!    removed face's share `a = A_r / A` of the surface area: the cap has area
 //!    `2 pi (1 - h)` with `h = (R^2 - 1) / (R^2 + 1)`, so `4 pi a = 4 pi / (R^2 + 1)` and
 //!    `R = sqrt(1/a - 1)`.
+//!
+//! Then, for both starts:
+//!
 //! 4. **Normalization.** Moebius centering (A. Baden, K. Crane, M. Kazhdan, "Moebius
 //!    registration", Computer Graphics Forum 37(5), SGP 2018): with source face areas
 //!    `A_f` and `x_f` the centroid of face `f`'s image projected onto the sphere, the
@@ -60,6 +77,9 @@
 //!    source is then spread around the sphere instead of crowding one side: the usual
 //!    normalization of the Moebius freedom of spherical maps.
 //!
+//! 5. **Untangling.** Faces whose image faces inward (below) are re-solved in small
+//!    patches with positive weights (`sphere/untangle.rs`); the report counts them and any left.
+//!
 //! # Flips
 //!
 //! The image of a face is the flat polygon through its vertex images. It faces outward
@@ -75,8 +95,9 @@
 //! the flat image faces outward exactly when that cap is the smaller of the two the
 //! circle bounds. Tutte's map has no flips in the plane, but a very obtuse face has a
 //! circumdisk far larger than itself, which the projection and the centering may blow up
-//! beyond a hemisphere: such faces are the flips that remain (a handful in 10^5 on
-//! meshes with slivers).
+//! beyond a hemisphere. The cotangent weights of the conformal start are negative across
+//! edges opposite obtuse angles, so its harmonic solves may fold a face too (one in
+//! 10^5 on the shared meshes). Stage 5 removes both kinds.
 //!
 //! The image always has the combinatorial orientation of the source: when the source's
 //! faces face inward (negative signed volume), the image's faces still face outward, and
@@ -88,12 +109,13 @@
 //! ([`beltrami_fem::distortion::measure_surface`]) with [`ReferenceNormal::Radial`] (the
 //! direction of the image point at each quadrature point) as the reference normal; its
 //! flipped count is that of the inward faces above (together with any Gauss point the
-//! measure finds flipped). The map is an
-//! initialization, bijective up to the rare flips above but not conformal. The stretch is
-//! largest near the removed face's corners (a full turn around them is squeezed into the
-//! polygon's corner angle) and on long protrusions, which Tutte embeddings shrink
-//! geometrically.
-
+//! measure finds flipped). The conformal start's `|mu|` is a discretization error: on a
+//! round sphere moved by a rotation or a Moebius transformation mean `|mu|` falls by 4
+//! per halving of the edges, on an ellipsoid by 2 (tests `sphere_conformal`). The Tutte
+//! start is a bijective initialization but not conformal: its stretch is largest near
+//! the removed face's corners (a full turn around them is squeezed into the polygon's
+//! corner angle) and on long protrusions, which Tutte embeddings shrink geometrically.
+//!
 use std::f64::consts::{PI, TAU};
 
 use beltrami_core::{
@@ -103,24 +125,31 @@ use beltrami_core::{
 };
 use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
-use beltrami_fem::{BoundaryMap, WeightError, WeightedMeanSystem};
+use beltrami_fem::{BoundaryMap, EdgeWeights, WeightError, WeightedMeanSystem};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
 use nalgebra::Matrix3;
 use num_complex::Complex64;
 
 use crate::{Weights, edge_weights, solve_options};
 
-/// The Tutte embedding of the mesh minus one face, inverse stereographic projection and
-/// Moebius centering (module docs): an initial map of a closed genus-0 mesh onto the
-/// unit sphere, bijective up to rare flips of very obtuse faces.
+mod conformal;
+mod untangle;
+
+use untangle::{Untangled, untangle};
+
+/// A closed genus-0 mesh onto the unit sphere (module docs): the linear conformal start
+/// (default) or the Tutte start, Moebius centering, untangling of flipped faces.
 ///
-/// Reads: `target` (`Sphere` only), `goal` (`Conformal { p: 2 }` only: the map is an
-/// initialization), `params.weights` (`MeanValue`, the default, or `Uniform`) and
-/// `params.threads` (uniform weights). Takes no pins and no curves. The report holds the
-/// timings of the stages (`puncture`, `tutte`, `projection`, `normalization`,
-/// `distortion`), the number of normalization steps as its iterations, the distance of
-/// the centre of mass from the origin after each step as its energy history, and notes
-/// naming the removed face (input index) and counting flipped faces.
+/// Reads: `target` (`Sphere` only), `goal` (`Conformal { p: 2 }` only) and the options
+/// `start` (`conformal`, the default, or `tutte`), `corrections` and `overlap` (the
+/// conformal start's chart corrections), `weights` (the Tutte start's: `mean-value`,
+/// the default, or `uniform`), `max-steps` (centering) and `threads`. Takes no pins and
+/// no curves. The report holds the timings of the stages (`harmonic`, `projection`,
+/// `corrections` or `puncture`, `tutte`, `projection`; then `normalization`,
+/// `untangle`, `distortion`), the number of normalization steps as its iterations, the
+/// distance of the centre of mass from the origin after each step as its energy
+/// history, and notes naming the removed face (input index), the corrections, and
+/// counting flipped faces before and after the untangling.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Sphere;
 
@@ -134,10 +163,36 @@ const NOT_A_SPHERE: &str = "use lscm/tutte for disks, or `beltrami cut` for high
 const CENTER_TOLERANCE: f64 = 1e-6;
 
 const OPTIONS: &[OptionSpec] = &[
+    OptionSpec {
+        name: "start",
+        kind: OptionKind::Choice {
+            default: "conformal",
+            choices: &["conformal", "tutte"],
+        },
+        help: "conformal: cotangent-harmonic map of the punctured mesh, then harmonic corrections in the two stereographic charts (nearly conformal, FLASH-like); tutte: Tutte embedding of the punctured mesh (a bijection before the projection, far from conformal)",
+    },
+    OptionSpec {
+        name: "corrections",
+        kind: OptionKind::Int {
+            default: 8,
+            min: 0,
+            max: 1000,
+        },
+        help: "start=conformal: harmonic chart corrections at most, alternating around the puncture and around its antipode (the first is FLASH's far-hemisphere correction)",
+    },
+    OptionSpec {
+        name: "overlap",
+        kind: OptionKind::Float {
+            default: 0.5,
+            min: 0.05,
+            max: 0.95,
+        },
+        help: "start=conformal: each chart correction frees the vertices with height above -overlap (around the puncture) or below +overlap (around the antipode)",
+    },
     crate::weights_option(
         "mean-value",
         &["mean-value", "uniform"],
-        "edge weights of the Tutte embedding: mean-value (Floater) or uniform; cotangent weights are negative on obtuse triangles and may fold the map",
+        "start=tutte: edge weights of the Tutte embedding: mean-value (Floater) or uniform; cotangent weights are negative on obtuse triangles and may fold the map",
     ),
     OptionSpec {
         name: "max-steps",
@@ -159,6 +214,9 @@ const ACCEPTS: Accepts = Accepts {
     constraints: &[],
 };
 
+/// The chart corrections stop once no vertex image moves farther than this.
+const CORRECTION_TOLERANCE: f64 = 1e-9;
+
 /// A normalization step halves its candidate this many times at most.
 const MAX_HALVINGS: u32 = 20;
 
@@ -168,7 +226,7 @@ impl Solver for Sphere {
     }
 
     fn description(&self) -> &'static str {
-        "closed genus-0 mesh onto the unit sphere: Tutte embedding of the mesh minus one face, inverse stereographic projection, Moebius centering; a bijective initialization, not a conformal map"
+        "closed genus-0 mesh onto the unit sphere, nearly conformally: cotangent-harmonic map of the punctured mesh, harmonic corrections alternating between the two stereographic charts, Moebius centering, flipped faces untangled (start=tutte: the Tutte embedding of the old initialization)"
     }
 
     fn accepts(&self) -> Accepts {
@@ -195,42 +253,17 @@ impl Solver for Sphere {
         let mut metrics = Metrics::default();
 
         let removed = removed_face(mesh);
-        let punctured = context.stage("puncture", &mut report, || puncture(mesh, removed))?;
-        let share = mesh.face_area(removed) / mesh.total_area();
-        let radius = cap_radius(share);
-        report.notes.push(format!(
-            "removed face {} (input index, a {}) covering {:.3e} of the area; its vertices go to a circle of radius {radius:.4} before the projection",
-            mesh.face_to_input(removed),
-            if mesh.face_degree(removed) == 3 {
-                "triangle"
-            } else {
-                "quad"
-            },
-            share
-        ));
-
-        let (planar, negative) = context.stage("tutte", &mut report, || {
-            let weights = edge_weights(&punctured, kind).map_err(|e| match e {
-                WeightError::Fem(e) => SolverError::Fem(e),
-                error @ WeightError::NonFinite { .. } => SolverError::Weights {
-                    solver: NAME,
-                    error,
-                },
-            })?;
-            let boundary = hole_boundary(&punctured, radius);
-            let system = WeightedMeanSystem::new(&weights, &boundary)?;
-            let negative = weights.negative_count(system.interior().iter().copied());
-            Ok((system.solve(solve_options(settings))?, negative))
-        })?;
-        if negative > 0 {
-            report.notes.push(format!(
-                "{negative} mean-value weights of interior vertices are negative (reflex quad corners); the bijectivity theorem needs positive weights"
-            ));
-        }
-
-        let mut image: Vec<Point3<f64>> = context.stage("projection", &mut report, || {
-            Ok(planar.iter().map(|&z| inverse_stereographic(z)).collect())
-        })?;
+        let (mut image, cotangent) = match start_of(settings) {
+            Start::Conformal => {
+                let (image, weights) =
+                    conformal_start(mesh, removed, settings, context, &mut report)?;
+                (image, Some(weights))
+            }
+            Start::Tutte => (
+                tutte_start(mesh, removed, kind, settings, context, &mut report)?,
+                None,
+            ),
+        };
 
         normalize(
             mesh,
@@ -240,6 +273,28 @@ impl Solver for Sphere {
             &mut report,
             &mut metrics,
         )?;
+
+        let untangled = context.stage("untangle", &mut report, || {
+            if !mesh.faces().any(|f| is_inward(mesh, &image, f)) {
+                return Ok(Untangled::default());
+            }
+            let weights = match cotangent {
+                Some(weights) => weights,
+                None => EdgeWeights::cotangent(mesh).map_err(weight_error)?,
+            };
+            Ok(untangle(
+                mesh,
+                &weights,
+                &mut image,
+                solve_options(settings),
+            )?)
+        })?;
+        if untangled.flipped > 0 {
+            report.notes.push(format!(
+                "{} faces were flipped after the linear solves; {} patches around them (up to {} rings of edges) were re-solved with positive weights, leaving {} flipped",
+                untangled.flipped, untangled.patches, untangled.rings, untangled.remaining
+            ));
+        }
 
         let (inward, distortion) = context.stage("distortion", &mut report, || {
             let inward = inward_faces(mesh, &image);
@@ -276,6 +331,131 @@ impl Solver for Sphere {
             report,
         })
     }
+}
+
+/// The start of the solver's `start` option.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Start {
+    /// The linear conformal start (`sphere/conformal.rs`).
+    Conformal,
+    /// The Tutte embedding of the punctured mesh (module docs, stages 1 to 3).
+    Tutte,
+}
+
+fn start_of(settings: &Settings) -> Start {
+    match settings.choice("start") {
+        "tutte" => Start::Tutte,
+        _ => Start::Conformal,
+    }
+}
+
+/// The linear conformal start (`sphere/conformal.rs`): the punctured harmonic map (stage
+/// "harmonic"), its projection and Moebius centering (stage "projection"), and the
+/// chart corrections (stage "corrections").
+fn conformal_start(
+    mesh: &Mesh,
+    removed: FaceId,
+    settings: &Settings,
+    context: &mut Context<'_>,
+    report: &mut Report,
+) -> Result<(Vec<Point3<f64>>, EdgeWeights), SolverError> {
+    let share = mesh.face_area(removed) / mesh.total_area();
+    report.notes.push(format!(
+        "punctured face {} (input index, covering {share:.3e} of the area): its vertices are held at a similar copy of it in the first harmonic map",
+        mesh.face_to_input(removed),
+    ));
+    let options = solve_options(settings);
+    let (weights, order, planar) = context.stage("harmonic", report, || {
+        let weights = EdgeWeights::cotangent(mesh).map_err(weight_error)?;
+        let order = conformal::vertex_order(&weights)?;
+        let planar = conformal::punctured_harmonic(mesh, &weights, removed, &order, options)?;
+        Ok((weights, order, planar))
+    })?;
+    let mut image = context.stage("projection", report, || {
+        let mut image: Vec<Point3<f64>> =
+            planar.iter().map(|&z| inverse_stereographic(z)).collect();
+        centre(mesh, &mut image, settings.int("max-steps"), |_, _| Ok(()))?;
+        Ok(image)
+    })?;
+    let count = settings.int("corrections");
+    let corrections = context.stage("corrections", report, || {
+        let axis = radial_direction(mesh, &image, removed);
+        conformal::correct(
+            &weights,
+            &mut image,
+            axis,
+            conformal::CorrectionSettings {
+                overlap: settings.float("overlap"),
+                count,
+                tolerance: CORRECTION_TOLERANCE,
+            },
+            &order,
+            options,
+            |image| centre(mesh, image, settings.int("max-steps"), |_, _| Ok(())).map(|_| ()),
+        )
+    })?;
+    if count > 0 {
+        report.notes.push(format!(
+            "{} chart corrections (alternating harmonic solves around the puncture and around its antipode, overlap |h| < {}); the last moved a vertex image by {:.2e} at most",
+            corrections.done,
+            settings.float("overlap"),
+            corrections.last_move
+        ));
+    }
+    Ok((image, weights))
+}
+
+/// The solver error of edge weights that cannot be computed.
+fn weight_error(error: WeightError) -> SolverError {
+    match error {
+        WeightError::Fem(e) => SolverError::Fem(e),
+        error @ WeightError::NonFinite { .. } => SolverError::Weights {
+            solver: NAME,
+            error,
+        },
+    }
+}
+
+/// The Tutte start (module docs, stages 1 to 3): puncture, Tutte embedding onto a
+/// regular polygon, inverse stereographic projection.
+fn tutte_start(
+    mesh: &Mesh,
+    removed: FaceId,
+    kind: Weights,
+    settings: &Settings,
+    context: &mut Context<'_>,
+    report: &mut Report,
+) -> Result<Vec<Point3<f64>>, SolverError> {
+    let punctured = context.stage("puncture", report, || puncture(mesh, removed))?;
+    let share = mesh.face_area(removed) / mesh.total_area();
+    let radius = cap_radius(share);
+    report.notes.push(format!(
+        "removed face {} (input index, a {}) covering {:.3e} of the area; its vertices go to a circle of radius {radius:.4} before the projection",
+        mesh.face_to_input(removed),
+        if mesh.face_degree(removed) == 3 {
+            "triangle"
+        } else {
+            "quad"
+        },
+        share
+    ));
+
+    let (planar, negative) = context.stage("tutte", report, || {
+        let weights = edge_weights(&punctured, kind).map_err(weight_error)?;
+        let boundary = hole_boundary(&punctured, radius);
+        let system = WeightedMeanSystem::new(&weights, &boundary)?;
+        let negative = weights.negative_count(system.interior().iter().copied());
+        Ok((system.solve(solve_options(settings))?, negative))
+    })?;
+    if negative > 0 {
+        report.notes.push(format!(
+            "{negative} mean-value weights of interior vertices are negative (reflex quad corners); the bijectivity theorem needs positive weights"
+        ));
+    }
+
+    context.stage("projection", report, || {
+        Ok(planar.iter().map(|&z| inverse_stereographic(z)).collect())
+    })
 }
 
 /// The capability check, returning the weights to use.
@@ -503,6 +683,55 @@ fn normalize(
 ) -> Result<(), SolverError> {
     context.check_cancelled()?;
     let start = std::time::Instant::now();
+    let centering = centre(mesh, image, max_steps, |steps, distance| {
+        context.check_cancelled()?;
+        metrics.energy_history.push(distance);
+        context.report(&Progress {
+            stage: "normalization",
+            done: steps,
+            total: Some(max_steps),
+            energy: Some(distance),
+        });
+        Ok(())
+    })?;
+    let Centering {
+        steps,
+        initial,
+        last,
+    } = centering;
+    metrics.iterations = steps;
+    report
+        .timings
+        .push(("normalization".to_string(), start.elapsed().as_secs_f64()));
+    if last <= CENTER_TOLERANCE {
+        report.notes.push(format!(
+            "Moebius centering moved the centre of mass of the area from {initial:.3e} to {last:.1e} from the origin in {steps} steps"
+        ));
+    } else {
+        report.notes.push(format!(
+            "Moebius centering stopped after {steps} steps with the centre of mass of the area {last:.3e} from the origin (started at {initial:.3e})"
+        ));
+    }
+    Ok(())
+}
+
+/// How a Moebius centering went: steps taken, and the distance of the centre of mass
+/// from the origin before and after.
+#[derive(Debug, Clone, Copy)]
+struct Centering {
+    steps: usize,
+    initial: f64,
+    last: f64,
+}
+
+/// The centering iteration of [`normalize`] (module docs), calling `on_step(steps,
+/// distance)` after each step; the image ends at unit length to the last bit.
+fn centre(
+    mesh: &Mesh,
+    image: &mut Vec<Point3<f64>>,
+    max_steps: usize,
+    mut on_step: impl FnMut(usize, f64) -> Result<(), SolverError>,
+) -> Result<Centering, SolverError> {
     let areas: Vec<f64> = mesh.faces().map(|f| mesh.face_area(f)).collect();
     let (mut c, mut m) = moments(mesh, &areas, image);
     let initial = c.norm();
@@ -511,7 +740,6 @@ fn normalize(
     // An average of unit vectors lies in the closed ball; on its boundary (all mass at
     // one point) no Moebius transformation can spread it.
     while c.norm() > CENTER_TOLERANCE && c.norm() < 1.0 && steps < max_steps {
-        context.check_cancelled()?;
         let newton = (2.0 * (Matrix3::identity() - m))
             .try_inverse()
             .map(|inverse| inverse * c)
@@ -532,53 +760,37 @@ fn normalize(
         std::mem::swap(image, &mut trial);
         (c, m) = (c_new, m_new);
         steps += 1;
-        metrics.energy_history.push(c.norm());
-        context.report(&Progress {
-            stage: "normalization",
-            done: steps,
-            total: Some(max_steps),
-            energy: Some(c.norm()),
-        });
+        on_step(steps, c.norm())?;
     }
     // Unit length to the last bit, also where no step was taken.
     for p in image.iter_mut() {
         *p = Point3::from(p.coords / p.coords.norm());
     }
-    metrics.iterations = steps;
-    report
-        .timings
-        .push(("normalization".to_string(), start.elapsed().as_secs_f64()));
-    if c.norm() <= CENTER_TOLERANCE {
-        report.notes.push(format!(
-            "Moebius centering moved the centre of mass of the area from {initial:.3e} to {:.1e} from the origin in {steps} steps",
-            c.norm()
-        ));
-    } else {
-        report.notes.push(format!(
-            "Moebius centering stopped after {steps} steps with the centre of mass of the area {:.3e} from the origin (started at {initial:.3e})",
-            c.norm()
-        ));
-    }
-    Ok(())
+    Ok(Centering {
+        steps,
+        initial,
+        last: c.norm(),
+    })
 }
 
 /// Per face: true if its image faces the centre (module docs: a triangle whose normal
 /// points inward, a quad with such a triangle in either diagonal split).
 fn inward_faces(mesh: &Mesh, image: &[Point3<f64>]) -> Vec<bool> {
+    mesh.faces().map(|f| is_inward(mesh, image, f)).collect()
+}
+
+/// True if the image of `f` faces the centre (module docs).
+fn is_inward(mesh: &Mesh, image: &[Point3<f64>], f: FaceId) -> bool {
     const TRIANGLES: [[usize; 3]; 1] = [[0, 1, 2]];
     const QUAD_SPLITS: [[usize; 3]; 4] = [[0, 1, 2], [0, 2, 3], [0, 1, 3], [1, 2, 3]];
-    mesh.faces()
-        .map(|f| {
-            let (vertices, n) = mesh.face_vertex_array(f);
-            let p = |k: usize| image[vertices[k].idx()];
-            let m = image_mean(mesh, image, f);
-            let triangles: &[[usize; 3]] = if n == 3 { &TRIANGLES } else { &QUAD_SPLITS };
-            triangles.iter().any(|&[a, b, c]| {
-                let normal = (p(b) - p(a)).cross(&(p(c) - p(a)));
-                normal.dot(&m) <= 0.0
-            })
-        })
-        .collect()
+    let (vertices, n) = mesh.face_vertex_array(f);
+    let p = |k: usize| image[vertices[k].idx()];
+    let m = image_mean(mesh, image, f);
+    let triangles: &[[usize; 3]] = if n == 3 { &TRIANGLES } else { &QUAD_SPLITS };
+    triangles.iter().any(|&[a, b, c]| {
+        let normal = (p(b) - p(a)).cross(&(p(c) - p(a)));
+        normal.dot(&m) <= 0.0
+    })
 }
 
 /// The signed volume `sum_f (1/6) p0 . (p1 x p2)` enclosed by the source (quads split

@@ -1,5 +1,6 @@
-//! The sphere solver: closed genus-0 meshes onto the unit sphere (Tutte embedding of the
-//! mesh minus one face, inverse stereographic projection, Moebius centering). Checked
+//! The sphere solver: closed genus-0 meshes onto the unit sphere (the conformal start by
+//! default, the Tutte embedding of the mesh minus one face on request; inverse
+//! stereographic projection, Moebius centering, untangling). Checked
 //! here without the solver's own helpers: unit length, the centre of mass of the area,
 //! the covering degree (signed solid angles add up to 4 pi), faces facing outward, and
 //! near-conformality on a round sphere.
@@ -159,21 +160,20 @@ fn check(name: &str, mesh: &Mesh, solution: &Solution, max_flipped: usize) -> us
         "{name}: {flipped} flipped faces, at most {max_flipped} expected"
     );
     let stages: Vec<&str> = report.timings.iter().map(|(s, _)| s.as_str()).collect();
-    assert_eq!(
-        stages,
-        [
-            "puncture",
-            "tutte",
-            "projection",
-            "normalization",
-            "distortion"
-        ],
-        "{name}"
-    );
-    let removed = report
-        .notes
-        .iter()
-        .any(|n| n.starts_with("removed face") && n.contains("input index"));
+    let tutte = ["puncture", "tutte", "projection"];
+    let conformal = ["harmonic", "projection", "corrections"];
+    let start = if stages.starts_with(&tutte) {
+        &tutte
+    } else {
+        &conformal
+    };
+    let last = ["normalization", "untangle", "distortion"];
+    assert_eq!(stages[..3], start[..], "{name}: {stages:?}");
+    assert_eq!(stages[3..], last[..], "{name}: {stages:?}");
+    let removed = report.notes.iter().any(|n| {
+        (n.starts_with("removed face") || n.starts_with("punctured face"))
+            && n.contains("input index")
+    });
     assert!(removed, "{name}: no note names the removed face");
     let mu = metrics.mu.as_ref().expect("mu measured");
     assert_eq!(mu.len(), mesh.face_count(), "{name}");
@@ -187,19 +187,18 @@ fn icosphere_goes_onto_the_sphere_nearly_conformally() {
     Sphere.check(&problem).unwrap();
     let solution = solve_with(&problem);
     assert_eq!(check("icosphere(3)", &mesh, &solution, 0), 0);
-    // The identity has mu = 0; this map differs from a rotation by the stretch around
-    // the removed face's corners and the mean-value weights. Measured: mean 0.072,
-    // l2 0.090, max 0.33.
+    // The identity has mu = 0; this map differs from a rotation by the discretization
+    // error of the linear solves. Measured: mean 0.0008, l2 0.0011, max 0.0046.
     let d = solution.metrics.distortion.unwrap();
-    assert!(d.mu_mean < 0.1, "mu mean {}", d.mu_mean);
-    assert!(d.mu_l2 < 0.13, "mu l2 {}", d.mu_l2);
-    assert!(d.mu_max < 0.5, "mu max {}", d.mu_max);
+    assert!(d.mu_mean < 0.002, "mu mean {}", d.mu_mean);
+    assert!(d.mu_l2 < 0.003, "mu l2 {}", d.mu_l2);
+    assert!(d.mu_max < 0.01, "mu max {}", d.mu_max);
 }
 
 #[test]
 fn the_distortion_of_the_icosphere_shrinks_under_refinement() {
-    // The stretch stays in a few rings around the removed face, a shrinking share of
-    // the faces. Measured mu mean: 0.093, 0.072, 0.024 for 2, 3, 4 subdivisions.
+    // Second order in the edge length. Measured mu mean: 0.0030, 0.0008, 0.0002 for 2, 3,
+    // 4 subdivisions.
     let means: Vec<f64> = (2..=4)
         .map(|s| {
             let mesh = Mesh::from_soup(&icosphere(s)).unwrap();
@@ -209,17 +208,22 @@ fn the_distortion_of_the_icosphere_shrinks_under_refinement() {
         })
         .collect();
     println!("mu mean by subdivision 2, 3, 4: {means:.4?}");
-    assert!(means[2] < 0.6 * means[0], "{means:?}");
-    assert!(means[2] < means[1], "{means:?}");
+    assert!(means[1] < 0.35 * means[0], "{means:?}");
+    assert!(means[2] < 0.35 * means[1], "{means:?}");
 }
 
 #[test]
-fn uniform_weights_work_too() {
+fn the_tutte_start_works_with_both_weights() {
     let mesh = Mesh::from_soup(&icosphere(2)).unwrap();
-    let mut problem = Problem::new(&mesh, Target::Sphere);
-    problem.options.set_text("weights", "uniform");
-    let solution = solve_with(&problem);
-    assert_eq!(check("icosphere(2), uniform", &mesh, &solution, 0), 0);
+    for weights in ["mean-value", "uniform"] {
+        let mut problem = Problem::new(&mesh, Target::Sphere);
+        problem.options.set_text("start", "tutte");
+        problem.options.set_text("weights", weights);
+        let solution = solve_with(&problem);
+        let name = format!("icosphere(2), tutte, {weights}");
+        assert_eq!(check(&name, &mesh, &solution, 0), 0);
+        assert_eq!(solution.report.timings[1].0, "tutte", "{name}");
+    }
 }
 
 #[test]
@@ -328,23 +332,23 @@ fn spot_maps_without_flips() {
 }
 
 #[test]
-fn bunny_maps_with_few_flips() {
+fn bunny_maps_without_flips() {
     let Some(mesh) = shared("g0_bunny_closed.obj") else {
         return;
     };
     let solution = solve(&mesh);
-    check("g0_bunny_closed", &mesh, &solution, 10);
+    check("g0_bunny_closed", &mesh, &solution, 0);
 }
 
 #[test]
-fn quad_meshes_map_with_few_flips() {
+fn quad_meshes_map_without_flips() {
     for name in ["quad_horse.obj", "quad_fandisk.obj"] {
         let Some(mesh) = shared(name) else {
             continue;
         };
         assert!(mesh.quad_count() > 0, "{name} has quads");
         let solution = solve(&mesh);
-        check(name, &mesh, &solution, 10);
+        check(name, &mesh, &solution, 0);
     }
 }
 

@@ -141,7 +141,11 @@ fn sphere(
     side: Side,
     notes: &mut Vec<String>,
 ) -> Result<Vec<Vector3<f64>>, RegisterError> {
-    let problem = Problem::new(mesh, Target::Sphere);
+    let mut problem = Problem::new(mesh, Target::Sphere);
+    // The Tutte start, which the registration was tuned from: the sphere solver's default
+    // conformal start gives a near-conformal initial map, from which the flow's
+    // objective no longer halves mean |mu| (issue 12; switching is a separate change).
+    problem.options.set_text("start", "tutte");
     let solution = Sphere
         .solve(&problem, &mut Context::new())
         .map_err(|error| RegisterError::Sphere { side, error })?;

@@ -154,3 +154,26 @@ pub fn summary(solution: &Solution) -> String {
         report.seconds()
     )
 }
+
+/// The shared mesh `name` (in `../shared/meshes`), or `None` (after printing SKIPPED for
+/// `test`) when it is absent.
+pub fn shared_mesh(test: &str, name: &str) -> Option<Mesh> {
+    let path = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/meshes"
+    ))
+    .join(name);
+    if !path.exists() {
+        let _ = writeln!(
+            std::io::stderr(),
+            "SKIPPED {test}: {} is absent",
+            path.display()
+        );
+        return None;
+    }
+    Some(
+        read(&path, &BuildOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .mesh,
+    )
+}
