@@ -71,5 +71,6 @@ pub fn registry() -> beltrami_core::Registry {
     beltrami_lsqc::register(&mut registry);
     beltrami_flow::register(&mut registry);
     beltrami_register::register(&mut registry);
+    beltrami_extremal::register(&mut registry);
     registry
 }
