@@ -78,5 +78,6 @@ pub fn registry() -> beltrami_core::Registry {
     beltrami_flow::register(&mut registry);
     beltrami_register::register(&mut registry);
     beltrami_qcmc::register(&mut registry);
+    beltrami_extremal::register(&mut registry);
     registry
 }

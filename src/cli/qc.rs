@@ -2,7 +2,8 @@
 //! (`--mu FILE`, the `distortion` field format) or as an expression of `z`
 //! (`--mu-expr "0.6*z"`) — or the most conformal one (`--conformal [--p P]`), by lsqc
 //! (one linear solve into the plane) or beltrami-flow (onto the input's own planar
-//! region, the unit disk, an annulus or the unit sphere).
+//! region, the unit disk, an annulus or the unit sphere); or, with `--solver extremal`
+//! and no goal flag, the extremal map of the boundary condition (`--init`, `--qd`).
 //!
 //! `z` in `--mu-expr` is `x + i y` of the face centroids for planar targets (a mesh in
 //! the plane z = 0), and the stereographic coordinate from the north pole,
@@ -13,7 +14,8 @@ use std::path::PathBuf;
 use anyhow::{Context as _, bail};
 use beltrami::map_file;
 use beltrami_core::{
-    Constraint, Goal, Map, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind,
+    Constraint, Goal, GoalKind, Map, OptionValue, PlanarBoundary, Problem, Solver, Target,
+    TargetKind,
 };
 use beltrami_fem::{BeltramiField, Expr};
 use beltrami_mesh::Mesh;
@@ -53,7 +55,7 @@ pub enum QcBoundaryArg {
 }
 
 #[derive(Debug, Args)]
-#[command(group(ArgGroup::new("goal").required(true).args(["mu", "mu_expr", "conformal"])))]
+#[command(group(ArgGroup::new("goal").args(["mu", "mu_expr", "conformal"])))]
 pub struct QcArgs {
     /// Mesh file (.obj, .gltf, .glb).
     pub mesh: PathBuf,
@@ -96,6 +98,14 @@ pub struct QcArgs {
     /// nearest vertex; repeatable.
     #[arg(long = "pin")]
     pub pins: Vec<PinSpec>,
+    /// extremal: the start map, `harmonic` or `tutte` with the prescribed boundary, or a
+    /// mesh file whose texture coordinates (or x, y) give it (it may be folded).
+    #[arg(long)]
+    pub init: Option<String>,
+    /// extremal: write the quadratic differential phi per face here (`# qd
+    /// frame=global faces=N`, then `re im` per face in the input's face order).
+    #[arg(long)]
+    pub qd: Option<PathBuf>,
     /// Iterative solvers: stop when the largest vertex update is below this (relative
     /// to the target's size) [default: 1e-6].
     #[arg(long)]
@@ -114,8 +124,15 @@ pub struct QcArgs {
     pub common: mapping::CommonArgs,
 }
 
-/// The goal of `--mu`, `--mu-expr` or `--conformal`.
-fn goal_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<Goal> {
+/// The goal of `--mu`, `--mu-expr` or `--conformal`; without one, the extremal map for
+/// a solver that computes extremal maps.
+fn goal_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<Goal> {
+    if args.mu.is_none() && args.mu_expr.is_none() && !args.conformal {
+        if solver.accepts().goals.contains(&GoalKind::Extremal) {
+            return Ok(Goal::Extremal);
+        }
+        bail!("give the goal with --mu FILE, --mu-expr EXPR or --conformal");
+    }
     if args.conformal {
         return Ok(Goal::Conformal {
             p: args.p.unwrap_or(2.0),
@@ -190,7 +207,8 @@ fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<
 
 /// Refuses, before any work, flags that the other flags make meaningless (they would be
 /// ignored silently): `--boundary` and `--boundary-map` off the plane target,
-/// `--boundary-map` without `--boundary given`, `--free-radius` off the annulus target.
+/// `--boundary-map` without `--boundary given`, `--qd` off the extremal solver,
+/// `--free-radius` off the annulus target.
 fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
     let target = format!("{:?}", args.target).to_lowercase();
     if args.boundary.is_some() && args.target != TargetArg::Plane {
@@ -203,6 +221,12 @@ fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
             "--boundary-map gives the boundary of --boundary given; add that or drop --boundary-map"
         );
     }
+    if args.qd.is_some() && args.solver != "extremal" {
+        bail!(
+            "--qd writes the quadratic differential of --solver extremal; {} computes none",
+            args.solver
+        );
+    }
     if args.free_radius && args.target != TargetArg::Annulus {
         bail!(
             "--free-radius lets the inner radius of --target annulus move; --target {target} has none"
@@ -212,16 +236,24 @@ fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
 }
 
 pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
-    mapping::check_outputs(&args.output, &args.common, &[])?;
+    mapping::check_outputs(&args.output, &args.common, &[("--qd", args.qd.as_deref())])?;
     check_flag_use(args)?;
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
-    let goal = goal_of(args, mesh)?;
+    let goal = goal_of(args, mesh, solver)?;
 
     let mut problem = Problem::new(mesh, target_of(args, mesh, solver)?);
     problem.goal = goal;
+    let init = match args.init.as_deref() {
+        None => None,
+        Some(name @ ("harmonic" | "tutte")) => Some(name),
+        Some(path) => {
+            problem.initial = Some(Map::Planar(boundary_map(std::path::Path::new(path), mesh)?));
+            None
+        }
+    };
     problem.constraints.extend(
         mapping::resolve_pins(&args.pins, mesh)?
             .into_iter()
@@ -242,6 +274,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             ),
             ("threads", args.threads.map(OptionValue::Int), None),
             ("outer", args.outer.map(|l| OptionValue::Int(l + 1)), None),
+            ("init", init.map(|s| OptionValue::Choice(s.into())), None),
         ],
         &args.common,
     );
@@ -252,6 +285,9 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         bail!("{} gave points in space for a planar target", solver.name());
     }
     map_file::write(&args.output, mesh, &solution, None)?;
+    if let Some(path) = &args.qd {
+        write_quadratic_differential(path, mesh, &solution)?;
+    }
     mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
 
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
@@ -261,14 +297,20 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     );
     report.insert(
         "goal".into(),
-        json!(if args.conformal {
-            format!("conformal L^{}", args.p.unwrap_or(2.0))
-        } else {
-            "prescribed mu".into()
+        json!(match &problem.goal {
+            Goal::Conformal { p } => format!("conformal L^{p}"),
+            Goal::Prescribed(_) => "prescribed mu".into(),
+            Goal::Extremal => "extremal".into(),
         }),
     );
     report.extend(beltrami::report::mu_error_keys(error.as_ref()));
     let mut extra = circles(mesh, &solution, &mut report);
+    extra.extend(
+        solution
+            .metrics
+            .k
+            .map(|k| format!("k               {k:.6}")),
+    );
     extra.extend(error.iter().map(|e| {
         format!(
             "|mu - target|   L2 (RMS) {:.4e}  sup {:.4e} (face {})",
@@ -335,4 +377,37 @@ pub(super) fn circles(
     }
     report.insert("circles".into(), json!(values));
     lines
+}
+
+/// Writes `--qd`: the solution's quadratic differential, one face per line in the
+/// input's face order, atomically.
+fn write_quadratic_differential(
+    path: &std::path::Path,
+    mesh: &Mesh,
+    solution: &beltrami_core::Solution,
+) -> anyhow::Result<()> {
+    let Some(qd) = &solution.extras.quadratic_differential else {
+        bail!(
+            "--qd: {} computes no quadratic differential",
+            solution.report.solver
+        );
+    };
+    let faces = mesh
+        .faces()
+        .map(|f| mesh.face_to_input(f) + 1)
+        .max()
+        .unwrap_or(0);
+    let mut by_input = vec![Complex64::new(0.0, 0.0); faces];
+    for (f, &phi) in mesh.faces().zip(&qd.values) {
+        by_input[mesh.face_to_input(f)] = phi;
+    }
+    beltrami_mesh::io::write_atomically(path, |w| {
+        use std::io::Write as _;
+        writeln!(w, "# qd frame={} faces={}", qd.frame.name(), by_input.len())?;
+        for phi in &by_input {
+            writeln!(w, "{} {}", phi.re, phi.im)?;
+        }
+        Ok(())
+    })
+    .with_context(|| format!("cannot write --qd {}", path.display()))
 }

@@ -41,7 +41,7 @@ mod cholesky;
 mod normal;
 mod saddle;
 
-pub use saddle::{SaddlePointSolution, solve_saddle_point};
+pub use saddle::{SaddlePointSolution, SaddlePointSolver, solve_saddle_point};
 
 use crate::dof::{DofMap, Scalar};
 use beltrami_mesh::VertexId;

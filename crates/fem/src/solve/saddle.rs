@@ -2,12 +2,16 @@
 //! for constraints a [`DofMap`](crate::dof::DofMap) cannot express (general linear
 //! relations `C x = d`, e.g. a zero mean or a fixed area-weighted centroid).
 
-use super::{SolveError, SolveOptions, check_finite, check_finite_matrix, check_len};
+use super::{
+    SolveError, SolveOptions, check_finite, check_finite_matrix, check_finite_solution, check_len,
+};
 use crate::dof::Scalar;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::LuError;
-use faer::sparse::linalg::lu::{LuRef, NumericLu, factorize_symbolic_lu};
-use faer::sparse::{FaerError, SparseColMat, SparseColMatRef, Triplet};
+use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::{
+    Argsort, FaerError, Pair, SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet,
+};
 use faer::{Conj, Mat, MatMut, Par};
 
 /// The solution of a saddle-point system: the minimizer and the Lagrange multipliers.
@@ -232,4 +236,172 @@ fn inverse_norm_1_estimate<T: Scalar>(
         return f64::INFINITY;
     }
     estimate.max(2.0 * norm_1(&alt) / (3.0 * size as f64))
+}
+
+/// A saddle-point system `[H C^H; C 0] [x; lambda] = [g; d]` whose pattern stays fixed
+/// while its values change, as in an iteration that solves one constrained quadratic
+/// problem per step: the pattern of the KKT matrix, the scatter of the entries into it
+/// and the symbolic LU factorization (fill-reducing column order, elimination tree) are
+/// computed once in [`SaddlePointSolver::new`]; each [`SaddlePointSolver::solve`] refills
+/// the values and repeats only the numeric LU with partial pivoting.
+///
+/// The minimization it solves is the one of [`solve_saddle_point`]. Unlike that
+/// one-shot function, it neither equilibrates nor estimates the condition number (each
+/// estimate costs a dozen extra solves per step); a singular system shows as a
+/// [`SolveError::Singular`] from the numeric factorization or as
+/// [`SolveError::NonFiniteSolution`].
+pub struct SaddlePointSolver<T: Scalar> {
+    /// Unknowns `n` (rows of `H`) and constraints `p` (rows of `C`).
+    n: usize,
+    p: usize,
+    h_entries: usize,
+    c_entries: usize,
+    symbolic: SymbolicSparseColMat<usize>,
+    argsort: Argsort<usize>,
+    lu: SymbolicLu<usize>,
+    numeric: NumericLu<usize, T>,
+    buffer: MemBuffer,
+    /// KKT values in entry order: `H`, then `C`, then `C^H`.
+    values: Vec<T>,
+}
+
+impl<T: Scalar> std::fmt::Debug for SaddlePointSolver<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SaddlePointSolver")
+            .field("n", &self.n)
+            .field("p", &self.p)
+            .field("nnz", &self.symbolic.row_idx().len())
+            .finish_non_exhaustive()
+    }
+}
+
+impl<T: Scalar> SaddlePointSolver<T> {
+    /// Symbolic phase for `H` (`n x n`, both triangles) with entries at `h_positions`
+    /// and `C` (`p x n`) with entries at `c_positions` (`(row, col)`; duplicates are
+    /// summed on every solve).
+    ///
+    /// Errors: [`SolveError::Length`] for a position outside its matrix,
+    /// [`SolveError::Faer`] if faer cannot build the pattern or its factorization.
+    pub fn new(
+        n: usize,
+        h_positions: &[(usize, usize)],
+        p: usize,
+        c_positions: &[(usize, usize)],
+    ) -> Result<Self, SolveError> {
+        let outside = |what, limit: usize, got: usize| SolveError::Length {
+            what,
+            expected: limit,
+            got,
+        };
+        let mut pairs = Vec::with_capacity(h_positions.len() + 2 * c_positions.len());
+        for &(row, col) in h_positions {
+            if row >= n || col >= n {
+                return Err(outside("an index of H", n, row.max(col)));
+            }
+            pairs.push(Pair { row, col });
+        }
+        for &(row, col) in c_positions {
+            if row >= p {
+                return Err(outside("a row index of C", p, row));
+            }
+            if col >= n {
+                return Err(outside("a column index of C", n, col));
+            }
+            pairs.push(Pair { row: n + row, col });
+        }
+        for &(row, col) in c_positions {
+            pairs.push(Pair {
+                row: col,
+                col: n + row,
+            });
+        }
+        let size = n + p;
+        let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(size, size, &pairs)
+            .map_err(|e| match e {
+                faer::sparse::CreationError::Generic(e) => SolveError::Faer(e),
+                faer::sparse::CreationError::OutOfBounds { row, col } => SolveError::Length {
+                    what: "a KKT index",
+                    expected: size,
+                    got: row.max(col),
+                },
+            })?;
+        let lu = factorize_symbolic_lu(symbolic.as_ref(), Default::default())?;
+        let scratch = lu
+            .factorize_numeric_lu_scratch::<T>(Par::Seq, Default::default())
+            .or(lu.solve_in_place_scratch::<T>(1, Par::Seq));
+        let buffer = MemBuffer::try_new(scratch).map_err(FaerError::from)?;
+        Ok(Self {
+            n,
+            p,
+            h_entries: h_positions.len(),
+            c_entries: c_positions.len(),
+            symbolic,
+            argsort,
+            lu,
+            numeric: NumericLu::new(),
+            buffer,
+            values: vec![T::from_f64(0.0); pairs.len()],
+        })
+    }
+
+    /// Numeric phase: `x` and `lambda` for the values `h_values` and `c_values` (in the
+    /// order of the positions given to [`new`](Self::new)) and right-hand sides `g`
+    /// (`n`), `d` (`p`).
+    pub fn solve(
+        &mut self,
+        h_values: &[T],
+        c_values: &[T],
+        g: &[T],
+        d: &[T],
+    ) -> Result<SaddlePointSolution<T>, SolveError> {
+        let (n, p) = (self.n, self.p);
+        check_len("the number of H values", self.h_entries, h_values.len())?;
+        check_len("the number of C values", self.c_entries, c_values.len())?;
+        check_len("the length of g", n, g.len())?;
+        check_len("the length of d", p, d.len())?;
+        check_finite("H", h_values)?;
+        check_finite("C", c_values)?;
+        check_finite("g", g)?;
+        check_finite("d", d)?;
+        let (h_part, rest) = self.values.split_at_mut(self.h_entries);
+        let (c_part, ch_part) = rest.split_at_mut(self.c_entries);
+        h_part.copy_from_slice(h_values);
+        c_part.copy_from_slice(c_values);
+        for (dst, v) in ch_part.iter_mut().zip(c_values) {
+            *dst = v.conjugate();
+        }
+        let kkt =
+            SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, &self.values)?;
+        let size = n + p;
+        let lu = self
+            .lu
+            .factorize_numeric_lu(
+                &mut self.numeric,
+                kkt.as_ref(),
+                Par::Seq,
+                MemStack::new(&mut self.buffer),
+                Default::default(),
+            )
+            .map_err(|e| match e {
+                LuError::SymbolicSingular { index } => SolveError::Singular {
+                    index: self.lu.col_perm().arrays().0[index.min(size - 1)],
+                    node: None,
+                    ratio: 0.0,
+                },
+                LuError::Generic(e) => SolveError::Faer(e),
+            })?;
+        let mut z = Mat::<T>::from_fn(size, 1, |i, _| if i < n { g[i] } else { d[i - n] });
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            z.as_mut(),
+            Par::Seq,
+            MemStack::new(&mut self.buffer),
+        );
+        let z: Vec<T> = (0..size).map(|i| z[(i, 0)]).collect();
+        check_finite_solution(&z)?;
+        Ok(SaddlePointSolution {
+            x: z[..n].to_vec(),
+            multipliers: z[n..].to_vec(),
+        })
+    }
 }

@@ -1,0 +1,618 @@
+//! [`Extremal`]: the solver behind `--solver extremal` (crate docs): the boundary
+//! values, the start map, then Algorithm 1 of Weber, Myles and Zorin (2012).
+
+use beltrami_core::{
+    Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
+    Output, PlanarBoundary, Problem, Progress, QuadraticDifferential, Report, Settings, Solution,
+    Solver, SolverError, Stop, THREADS, Target, TargetKind, Topology,
+};
+use beltrami_fem::assembly::Pattern;
+use beltrami_fem::beltrami::planar_map;
+use beltrami_fem::element::check_planar;
+use beltrami_fem::{
+    BoundaryMap, Distortion, DofConstraints, DofMap, EdgeWeights, Elements, FemError, Frame,
+    LeastSquaresSolver, SolveOptions, WeightedMeanSystem,
+};
+use beltrami_mesh::{Mesh, VertexId};
+use num_complex::Complex64;
+
+use crate::forms::{FormStep, HarmonicForms};
+
+const NAME: &str = "extremal";
+
+/// The extremal quasiconformal map of a planar mesh with a prescribed boundary (crate
+/// docs).
+///
+/// Reads: `target` (`Plane(Keep | Given)`: every boundary vertex of every loop fixed),
+/// `goal` (`Extremal`), `initial` (a planar start map, folded or not; its boundary
+/// values are replaced by the prescribed ones) and the options `init`, `tolerance`,
+/// `max-iters`, `inner-iters`, `threads`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Extremal;
+
+const OPTIONS: &[OptionSpec] = &[
+    OptionSpec {
+        name: "init",
+        kind: OptionKind::Choice {
+            default: "harmonic",
+            choices: &["harmonic", "tutte"],
+        },
+        help: "the start map when none is given: harmonic (cotangent weights) or tutte (uniform weights), with the prescribed boundary",
+    },
+    OptionSpec {
+        name: "tolerance",
+        kind: OptionKind::Float {
+            default: 1e-6,
+            min: 0.0,
+            max: 1.0,
+        },
+        help: "stop when an outer iteration lowers the least-squares Beltrami energy by less than this fraction",
+    },
+    OptionSpec {
+        name: "max-iters",
+        kind: OptionKind::Int {
+            default: 200,
+            min: 1,
+            max: 100_000,
+        },
+        help: "most outer iterations (each: the h-steps, then one f-step)",
+    },
+    OptionSpec {
+        name: "inner-iters",
+        kind: OptionKind::Int {
+            default: 20,
+            min: 1,
+            max: 1000,
+        },
+        help: "most h-steps (quadratic differential and k) per outer iteration",
+    },
+    THREADS,
+];
+
+const ACCEPTS: Accepts = Accepts {
+    elements: &[Element::Triangle],
+    topologies: &[
+        Topology::Disk,
+        Topology::Annulus,
+        Topology::MultiplyConnected,
+    ],
+    targets: &[TargetKind::PlaneKeep, TargetKind::PlaneGiven],
+    goals: &[GoalKind::Extremal],
+    constraints: &[],
+};
+
+fn unsupported(message: impl Into<String>) -> SolverError {
+    SolverError::Unsupported {
+        solver: NAME,
+        message: message.into(),
+    }
+}
+
+fn invalid(message: impl Into<String>) -> SolverError {
+    SolverError::InvalidInput {
+        solver: NAME,
+        message: message.into(),
+    }
+}
+
+impl Solver for Extremal {
+    fn name(&self) -> &'static str {
+        NAME
+    }
+
+    fn description(&self) -> &'static str {
+        "extremal (Teichmueller) map with a prescribed boundary: constant |mu| = k, holomorphic quadratic differential (Weber-Myles-Zorin 2012)"
+    }
+
+    fn accepts(&self) -> Accepts {
+        ACCEPTS
+    }
+
+    fn options(&self) -> &'static [OptionSpec] {
+        OPTIONS
+    }
+
+    fn check_problem(&self, problem: &Problem<'_>, _: &Settings) -> Result<(), SolverError> {
+        setup(problem).map(|_| ())
+    }
+
+    fn run(
+        &self,
+        problem: &Problem<'_>,
+        settings: &Settings,
+        context: &mut Context<'_>,
+    ) -> Result<Solution, SolverError> {
+        let mesh = problem.source;
+        let mut report = Report::new(NAME);
+        let fixed = setup(problem)?;
+        let options = SolveOptions {
+            threads: settings.int("threads"),
+            ..SolveOptions::default()
+        };
+        let initial = context.stage("initial map", &mut report, || {
+            start_map(problem, &fixed, settings.choice("init"), options)
+        })?;
+        let parameters = Parameters {
+            tolerance: settings.float("tolerance"),
+            max_iters: settings.int("max-iters"),
+            inner_iters: settings.int("inner-iters"),
+            options,
+        };
+        let mut run = context.stage("setup", &mut report, || {
+            Algorithm::new(mesh, &fixed, initial, parameters)
+        })?;
+        let initial_distortion = run.distortion()?.stats;
+        let outcome = report.time("iterations", || run.iterate(context))?;
+        let distortion = run.distortion()?;
+        if distortion.stats.flipped > 0 {
+            report.notes.push(format!(
+                "{} of {} faces are flipped (the discrete map is extremal only in the limit of refinement; flips stay near sharp concave boundary corners)",
+                distortion.stats.flipped,
+                mesh.face_count()
+            ));
+        }
+        let metrics = Metrics {
+            mu: Some(distortion.field),
+            distortion: Some(distortion.stats),
+            initial_distortion: Some(initial_distortion),
+            k: Some(run.k),
+            iterations: outcome.iterations,
+            energy_history: outcome.energy_history,
+            step_sizes: outcome.step_sizes,
+            stop: Some(outcome.stop),
+            factorizations: Some(outcome.factorizations),
+            ..Metrics::default()
+        };
+        let extras = Extras {
+            quadratic_differential: Some(run.quadratic_differential()),
+            ..Extras::default()
+        };
+        Ok(Solution {
+            output: Output::Map(Map::Planar(run.map)),
+            metrics,
+            extras,
+            report,
+        })
+    }
+}
+
+/// The capability check: a planar triangle mesh, the extremal goal, fixed values for
+/// every boundary vertex. Returns the fixed vertices with their images.
+fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError> {
+    let mesh = problem.source;
+    if problem.goal != Goal::Extremal {
+        return Err(unsupported(
+            "extremal computes the extremal map of a boundary condition; for a prescribed mu use lsqc or beltrami-flow",
+        ));
+    }
+    if let Err(FemError::NotPlanar { vertex, z }) = check_planar(mesh) {
+        return Err(unsupported(format!(
+            "extremal maps planar meshes (z = 0), but vertex {vertex} has z = {z:e}; flatten the surface conformally first (e.g. `beltrami param --solver lscm`): distortion is conformally invariant"
+        )));
+    }
+    let boundary: Vec<VertexId> = mesh
+        .boundary_loop_list()
+        .into_iter()
+        .flat_map(|l| l.vertices)
+        .collect();
+    let fixed = match &problem.target {
+        Target::Plane(PlanarBoundary::Keep) => boundary
+            .iter()
+            .map(|&v| {
+                let p = mesh.position(v);
+                (v, Complex64::new(p.x, p.y))
+            })
+            .collect(),
+        Target::Plane(PlanarBoundary::Given(values)) => {
+            if values.len() != mesh.vertex_count() {
+                return Err(invalid(format!(
+                    "the boundary map has {} values, but the mesh has {} vertices",
+                    values.len(),
+                    mesh.vertex_count()
+                )));
+            }
+            boundary
+                .iter()
+                .map(|&v| {
+                    let z = values[v.idx()];
+                    if z.is_finite() {
+                        Ok((v, z))
+                    } else {
+                        Err(invalid(format!(
+                            "the boundary map is not finite at boundary vertex {v}"
+                        )))
+                    }
+                })
+                .collect::<Result<_, _>>()?
+        }
+        _ => {
+            return Err(unsupported(
+                "extremal needs the boundary values: keep the source's boundary or give a boundary map (`--boundary given --boundary-map MAP`)",
+            ));
+        }
+    };
+    if let Some(Map::Planar(z)) = &problem.initial {
+        if z.len() != mesh.vertex_count() {
+            return Err(invalid(format!(
+                "the initial map has {} values, but the mesh has {} vertices",
+                z.len(),
+                mesh.vertex_count()
+            )));
+        }
+        if let Some(v) = z.iter().position(|z| !z.is_finite()) {
+            return Err(invalid(format!(
+                "the initial map is not finite at vertex {v}"
+            )));
+        }
+    } else if problem.initial.is_some() {
+        return Err(unsupported("extremal starts from a planar map"));
+    }
+    Ok(fixed)
+}
+
+/// The start map: the given one with the prescribed boundary values, or the harmonic
+/// (cotangent) or Tutte (uniform) map with those values.
+fn start_map(
+    problem: &Problem<'_>,
+    fixed: &[(VertexId, Complex64)],
+    init: &str,
+    options: SolveOptions,
+) -> Result<Vec<Complex64>, SolverError> {
+    let mesh = problem.source;
+    if let Some(Map::Planar(z)) = &problem.initial {
+        let mut z = z.clone();
+        for &(v, w) in fixed {
+            z[v.idx()] = w;
+        }
+        return Ok(z);
+    }
+    let weights = if init == "tutte" {
+        EdgeWeights::uniform(mesh)
+    } else {
+        EdgeWeights::cotangent(mesh).map_err(|error| SolverError::Weights {
+            solver: NAME,
+            error,
+        })?
+    };
+    let boundary = BoundaryMap {
+        vertices: fixed.iter().map(|&(v, _)| v).collect(),
+        positions: fixed.iter().map(|&(_, z)| z).collect(),
+    };
+    Ok(WeightedMeanSystem::new(&weights, &boundary)?.solve(options)?)
+}
+
+/// The stopping rule and the linear-solver options of Algorithm 1.
+#[derive(Debug, Clone, Copy)]
+struct Parameters {
+    tolerance: f64,
+    max_iters: usize,
+    inner_iters: usize,
+    options: SolveOptions,
+}
+
+/// What the iteration did.
+struct Outcome {
+    iterations: usize,
+    energy_history: Vec<f64>,
+    step_sizes: Vec<f64>,
+    stop: Stop,
+    factorizations: usize,
+}
+
+/// The state of Algorithm 1: the map `f`, the harmonic form `x` with its per-face
+/// values `psi = conj(phi)`, the dilatation `k`, and the two reusable systems.
+struct Algorithm<'a> {
+    mesh: &'a Mesh,
+    elements: Elements,
+    areas: Vec<f64>,
+    forms: HarmonicForms,
+    form_step: FormStep,
+    pattern: Pattern,
+    /// Per entry of the f-step operator: `(d/dz, d/dzbar)` of the shape function.
+    derivative_entries: Vec<(Complex64, Complex64)>,
+    map_step: LeastSquaresSolver<Complex64>,
+    parameters: Parameters,
+    map: Vec<Complex64>,
+    fz: Vec<Complex64>,
+    fzbar: Vec<Complex64>,
+    x: Vec<f64>,
+    psi: Vec<Complex64>,
+    k: f64,
+    factorizations: usize,
+}
+
+/// `psi / |psi|`, and 0 where `psi` vanishes (a zero of the quadratic differential,
+/// where the direction of stretch is undefined).
+fn direction(psi: Complex64, floor: f64) -> Complex64 {
+    let r = psi.norm();
+    if r > floor {
+        psi / r
+    } else {
+        Complex64::new(0.0, 0.0)
+    }
+}
+
+/// `1e-14 max |psi|`: below it `psi` counts as zero.
+fn floor_of(psi: &[Complex64]) -> f64 {
+    1e-14 * psi.iter().fold(0.0_f64, |m, p| m.max(p.norm()))
+}
+
+impl<'a> Algorithm<'a> {
+    fn new(
+        mesh: &'a Mesh,
+        fixed: &[(VertexId, Complex64)],
+        map: Vec<Complex64>,
+        parameters: Parameters,
+    ) -> Result<Self, SolverError> {
+        let elements = Elements::new(mesh, Frame::Global)?;
+        let areas: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
+        let weights = EdgeWeights::cotangent(mesh).map_err(|error| SolverError::Weights {
+            solver: NAME,
+            error,
+        })?;
+        let forms = HarmonicForms::new(mesh, &elements, &weights);
+        let form_step = FormStep::new(&forms)?;
+        let mut positions = Vec::with_capacity(3 * elements.point_count());
+        let mut derivative_entries = Vec::with_capacity(3 * elements.point_count());
+        for (row, q) in elements.points().iter().enumerate() {
+            for (k, v) in elements.nodes(q.face).iter().enumerate() {
+                let g = q.grad[k];
+                positions.push((row, v.idx()));
+                derivative_entries.push((
+                    Complex64::new(0.5 * g.x, -0.5 * g.y),
+                    Complex64::new(0.5 * g.x, 0.5 * g.y),
+                ));
+            }
+        }
+        let pattern = Pattern::new(elements.point_count(), mesh.vertex_count(), &positions)?;
+        let mut constraints = DofConstraints::new();
+        for &(v, z) in fixed {
+            constraints.fix(v, z);
+        }
+        let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
+        let map_step =
+            LeastSquaresSolver::new(pattern.symbolic().as_ref(), &dofs, parameters.options)?;
+        let mut algorithm = Self {
+            mesh,
+            elements,
+            areas,
+            forms,
+            form_step,
+            pattern,
+            derivative_entries,
+            map_step,
+            parameters,
+            map,
+            fz: Vec::new(),
+            fzbar: Vec::new(),
+            x: Vec::new(),
+            psi: Vec::new(),
+            k: 0.0,
+            factorizations: 0,
+        };
+        algorithm.update_derivatives()?;
+        // Algorithm 1's start: h minimizing the energy with s = 1 and k = 1.
+        let b = algorithm.fz.clone();
+        algorithm.x = algorithm.solve_form(&b)?;
+        algorithm.psi = algorithm.forms.psi(&algorithm.x);
+        algorithm.update_k();
+        Ok(algorithm)
+    }
+
+    fn update_derivatives(&mut self) -> Result<(), SolverError> {
+        let d = planar_map(&self.elements, self.mesh.vertex_count(), &self.map)?;
+        self.fz = d.iter().map(|d| d.fz).collect();
+        self.fzbar = d.iter().map(|d| d.fzbar).collect();
+        Ok(())
+    }
+
+    fn solve_form(&mut self, b: &[Complex64]) -> Result<Vec<f64>, SolverError> {
+        self.factorizations += 1;
+        Ok(self
+            .form_step
+            .solve(&self.forms, &self.fzbar, b, &self.areas)?)
+    }
+
+    /// `E = sum_m A_m |f_zbar - k psi_m/|psi_m| f_z|^2` (eq. 9) for the per-face values
+    /// `psi` and `k`.
+    fn energy_of(&self, psi: &[Complex64], k: f64) -> f64 {
+        let floor = floor_of(psi);
+        psi.iter()
+            .zip(&self.fz)
+            .zip(&self.fzbar)
+            .zip(&self.areas)
+            .map(|(((&p, &fz), &fzbar), &a)| a * (fzbar - k * direction(p, floor) * fz).norm_sqr())
+            .sum()
+    }
+
+    fn energy(&self) -> f64 {
+        self.energy_of(&self.psi, self.k)
+    }
+
+    /// The optimal `k` for the current map and directions (eq. 12, Proposition 3):
+    /// `k = sum A Re(conj(mu_hat f_z) f_zbar) / sum A |f_z|^2`. A negative `k` is the
+    /// same map with the opposite form: the form's sign is flipped to keep `k >= 0`.
+    fn update_k(&mut self) {
+        let floor = floor_of(&self.psi);
+        let (mut num, mut den) = (0.0, 0.0);
+        for (((&p, &fz), &fzbar), &a) in self
+            .psi
+            .iter()
+            .zip(&self.fz)
+            .zip(&self.fzbar)
+            .zip(&self.areas)
+        {
+            num += a * ((direction(p, floor) * fz).conj() * fzbar).re;
+            den += a * fz.norm_sqr();
+        }
+        let k = if den > 0.0 { num / den } else { 0.0 };
+        if k < 0.0 {
+            self.x.iter_mut().for_each(|x| *x = -*x);
+            self.psi.iter_mut().for_each(|p| *p = -*p);
+        }
+        self.k = k.abs();
+    }
+
+    /// One h-step: the new form for the current `s = 1/|psi|`, `k` and map, the line
+    /// search between the old and the new form with `s` projected back to `1/|psi(t)|`,
+    /// then `k` (eq. 12). Returns the step `t`.
+    fn form_step(&mut self) -> Result<f64, SolverError> {
+        let floor = floor_of(&self.psi);
+        let b: Vec<Complex64> = self
+            .psi
+            .iter()
+            .zip(&self.fz)
+            .map(|(&p, &fz)| self.k * fz / p.norm().max(floor.max(f64::MIN_POSITIVE)))
+            .collect();
+        let x_new = self.solve_form(&b)?;
+        let psi_new = self.forms.psi(&x_new);
+        let blend = |t: f64| -> Vec<Complex64> {
+            self.psi
+                .iter()
+                .zip(&psi_new)
+                .map(|(&a, &b)| a * (1.0 - t) + b * t)
+                .collect()
+        };
+        let energy = |t: f64| self.energy_of(&blend(t), self.k);
+        let t = golden_section(energy, 40);
+        let t = [t, 1.0]
+            .into_iter()
+            .fold((0.0, energy(0.0)), |best, t| {
+                let e = energy(t);
+                if e < best.1 { (t, e) } else { best }
+            })
+            .0;
+        self.psi = blend(t);
+        self.x = self
+            .x
+            .iter()
+            .zip(&x_new)
+            .map(|(&a, &b)| a * (1.0 - t) + b * t)
+            .collect();
+        self.update_k();
+        Ok(t)
+    }
+
+    /// The f-step: the least-squares map for `mu = k psi / |psi|` with the boundary
+    /// fixed (the LSQC system, refilled into its fixed pattern).
+    fn map_step(&mut self) -> Result<(), SolverError> {
+        let floor = floor_of(&self.psi);
+        let mut values = Vec::with_capacity(self.derivative_entries.len());
+        for (q, p) in self.elements.points().iter().zip(&self.psi) {
+            let mu = self.k * direction(*p, floor);
+            let start = values.len();
+            let n = self.elements.nodes(q.face).len();
+            for &(dz, dzbar) in &self.derivative_entries[start..start + n] {
+                values.push(dzbar - mu * dz);
+            }
+        }
+        let operator = self.pattern.assemble(&values)?;
+        let zero = vec![Complex64::new(0.0, 0.0); operator.nrows()];
+        self.map_step
+            .solve_into(operator.as_ref(), Some(&self.areas), &zero, &mut self.map)?;
+        self.factorizations += 1;
+        self.update_derivatives()?;
+        self.update_k();
+        Ok(())
+    }
+
+    /// The outer loop of Algorithm 1, until the relative energy decrease of an outer
+    /// iteration falls below the tolerance, the iteration limit, or cancellation.
+    fn iterate(&mut self, context: &mut Context<'_>) -> Result<Outcome, SolverError> {
+        let Parameters {
+            tolerance,
+            max_iters,
+            inner_iters,
+            ..
+        } = self.parameters;
+        let mut energy = self.energy();
+        let mut energy_history = vec![energy];
+        let mut step_sizes = Vec::new();
+        let mut stop = Stop::IterationLimit;
+        let mut iterations = 0;
+        while iterations < max_iters {
+            if context.is_cancelled() {
+                stop = Stop::Cancelled;
+                break;
+            }
+            let before = energy;
+            for _ in 0..inner_iters {
+                let inner_before = energy;
+                step_sizes.push(self.form_step()?);
+                energy = self.energy();
+                if inner_before - energy <= tolerance * inner_before {
+                    break;
+                }
+            }
+            self.map_step()?;
+            energy = self.energy();
+            iterations += 1;
+            energy_history.push(energy);
+            context.report(&Progress {
+                stage: "extremal",
+                done: iterations,
+                total: Some(max_iters),
+                energy: Some(energy),
+            });
+            if before - energy <= tolerance * before {
+                stop = Stop::Converged { tolerance };
+                break;
+            }
+        }
+        Ok(Outcome {
+            iterations,
+            energy_history,
+            step_sizes,
+            stop,
+            factorizations: self.factorizations,
+        })
+    }
+
+    fn distortion(&self) -> Result<Distortion, SolverError> {
+        let d = planar_map(&self.elements, self.mesh.vertex_count(), &self.map)?;
+        Ok(Distortion::from_derivatives(&self.elements, &d)?)
+    }
+
+    /// `phi = conj(psi)` per face, scaled to an area-weighted mean `|phi|` of 1 (a
+    /// quadratic differential of a Teichmueller map is fixed up to a positive factor).
+    fn quadratic_differential(&self) -> QuadraticDifferential {
+        let total: f64 = self.areas.iter().sum();
+        let mean: f64 = self
+            .psi
+            .iter()
+            .zip(&self.areas)
+            .map(|(p, a)| a * p.norm())
+            .sum::<f64>()
+            / total;
+        let scale = if mean > 0.0 { 1.0 / mean } else { 1.0 };
+        QuadraticDifferential {
+            frame: Frame::Global,
+            values: self.psi.iter().map(|p| p.conj() * scale).collect(),
+        }
+    }
+}
+
+/// The minimizer of `f` on `[0, 1]` by golden-section search (`steps` reductions).
+fn golden_section(f: impl Fn(f64) -> f64, steps: usize) -> f64 {
+    let ratio = (5.0_f64.sqrt() - 1.0) / 2.0;
+    let (mut a, mut b) = (0.0, 1.0);
+    let mut c = b - ratio * (b - a);
+    let mut d = a + ratio * (b - a);
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..steps {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - ratio * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + ratio * (b - a);
+            fd = f(d);
+        }
+    }
+    0.5 * (a + b)
+}
