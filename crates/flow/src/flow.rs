@@ -153,8 +153,9 @@ fn weights_and_targets(
             1.0
         } else {
             mu.norm().max(MU_FLOOR).powf(objective.p - 2.0)
-        } + objective.barrier_weight(mu.norm());
-        weights.push(objective.areas[f] * shrink * shrink * reweight);
+        };
+        let barrier = objective.barrier_area(f) * objective.barrier_weight(mu.norm());
+        weights.push((objective.areas[f] * reweight + barrier) * shrink * shrink);
         // 1 / theta = f_z / conj(f_z).
         rho.push(-error * fz / (shrink * fz.conj()));
     }

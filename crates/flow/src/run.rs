@@ -13,7 +13,7 @@ use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
 use crate::flow::{self, FlowOptions, FlowRun, Stop};
-use crate::measure::{ImageFace, Objective};
+use crate::measure::{Barrier, ImageFace, Objective};
 use crate::mesh_target::MeshTarget;
 use crate::setup::{Domain, curve_roles, diagonal, domain, goals, mesh_roles, pins, region_roles};
 use crate::system::FlowSystem;
@@ -125,11 +125,11 @@ pub fn solve(
         )));
     }
     let threads = settings.int("threads");
-    let objective = Objective {
-        areas: elements.face_areas(),
-        sigma: goal.sigma.clone(),
-        p: goal.p,
+    let barrier = match problem.target {
+        Target::Sphere | Target::Mesh(_) => Barrier::AREA_WEIGHTED,
+        _ => Barrier::PLANAR,
     };
+    let objective = Objective::new(elements.face_areas(), goal.sigma.clone(), goal.p, barrier);
     let options = SolveOptions {
         threads,
         ..SolveOptions::default()
