@@ -310,31 +310,38 @@ fn slivers_do_not_end_near_a_fold() {
         return;
     };
     // The human face has 54 sliver triangles (angles of 1.5-24 degrees). Weighted by
-    // area alone the flow drove them to |mu| 0.999; the near-fold barrier keeps every
-    // face well away from the fold, and the mean stays where it was (0.0224 before).
-    let dir = tempfile::tempdir().unwrap();
-    let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
-    let run = beltrami(&[
-        "qc",
-        s(&shared.join("disk_human_face.obj")),
-        "--solver",
-        "beltrami-flow",
-        "--target",
-        "disk",
-        "--conformal",
-        "-o",
-        s(&out),
-        "--report",
-        s(&report),
-    ]);
-    assert!(run.status.success(), "{}", text(&run.stderr));
-    let r = read_json(&report);
-    let (mean, max) = (
-        r["mu_mean"].as_f64().unwrap(),
-        r["mu_max"].as_f64().unwrap(),
-    );
-    println!("human face onto the disk: mean |mu| {mean}, max {max}");
-    assert_eq!(r["flipped"], 0);
-    assert!(max < 0.6, "max |mu| {max}");
-    assert!(mean < 0.0215, "mean |mu| {mean}");
+    // area alone the flow drove them to |mu| 0.999; the near-fold barrier, which weighs
+    // every face at least by the mean area, keeps every face away from the fold. The
+    // bounds are the Choi-Lui disk map's mean and max |mu| on the same meshes
+    // (`../shared/peers`: 0.0214 / 0.283 and 0.0195 / 0.835).
+    for (mesh, mean_bound, max_bound) in [
+        ("disk_human_face.obj", 0.0214, 0.283),
+        ("disk_hand.obj", 0.0195, 0.835),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
+        let run = beltrami(&[
+            "qc",
+            s(&shared.join(mesh)),
+            "--solver",
+            "beltrami-flow",
+            "--target",
+            "disk",
+            "--conformal",
+            "-o",
+            s(&out),
+            "--report",
+            s(&report),
+        ]);
+        assert!(run.status.success(), "{}", text(&run.stderr));
+        let r = read_json(&report);
+        let (mean, max) = (
+            r["mu_mean"].as_f64().unwrap(),
+            r["mu_max"].as_f64().unwrap(),
+        );
+        println!("{mesh} onto the disk: mean |mu| {mean}, max {max}");
+        assert_eq!(r["flipped"], 0);
+        assert!(max < max_bound, "{mesh}: max |mu| {max}");
+        assert!(mean < mean_bound, "{mesh}: mean |mu| {mean}");
+    }
 }
