@@ -49,6 +49,7 @@ mod options;
 pub mod param;
 pub mod quality;
 pub mod refine;
+mod seam_flips;
 pub mod size;
 
 use std::time::Instant;
@@ -249,6 +250,7 @@ fn triangulate_chart(
     let mut compact = vec![u32::MAX; slots];
     let mut positions = Vec::new();
     let mut on_source: Vec<SurfacePoint> = Vec::new();
+    let mut sizes_out = Vec::new();
     let mut faces = Vec::with_capacity(tri.faces.len());
     for face in &tri.faces {
         let mut out = [0u32; 3];
@@ -258,11 +260,14 @@ fn triangulate_chart(
                 compact[j] = positions.len() as u32;
                 positions.push(tri.position[i as usize]);
                 on_source.push(tri.on_chart[i as usize]);
+                sizes_out.push(tri.size[i as usize]);
             }
             *slot = compact[j];
         }
         faces.push(out);
     }
+    let surface = beltrami_spatial::SurfaceIndex::new(mesh)?;
+    seam_flips::flip_for_angles(&mut faces, &positions, &sizes_out, &surface)?;
     let soup = PolygonSoup::from_triangles(positions, &faces);
     let result = Mesh::from_soup(&soup).map_err(|error| RemeshError::Build {
         what: "remeshed surface",

@@ -268,7 +268,7 @@ fn flip_for_angles(tri: &mut Triangulation, domain: &Domain<'_>) -> Result<usize
 
 /// Largest distance from the surface of a flipped edge's midpoint, relative to the
 /// asked length, that is accepted whatever the old edge's.
-const FLIP_DEVIATION: f64 = 0.05;
+pub(crate) const FLIP_DEVIATION: f64 = 0.05;
 
 /// The distance between the midpoint of the chord `ab` and the surface point over the
 /// midpoint of `ab` in the plane.
@@ -497,7 +497,7 @@ fn smooth(
 
 /// The smallest sine of the three angles of a triangle in R^3:
 /// `sin A = 2 area / (|b| |c|)` at each corner.
-fn smallest_sine(p: &[Point3<f64>; 3]) -> f64 {
+pub(crate) fn smallest_sine(p: &[Point3<f64>; 3]) -> f64 {
     let twice_area = (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
     let l = [
         (p[1] - p[2]).norm(),
