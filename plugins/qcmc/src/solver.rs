@@ -139,6 +139,7 @@ impl Solver for Qcmc {
         }
         metrics.initial_distortion = Some(measure(mesh, &elements, &state.map)?.stats);
         let mut flips = flipped(&triangles, &state.map);
+        let mut near = near_folds(&elements, &state.map)?;
         let iterate = std::time::Instant::now();
         let mut factorizations = 0;
         let stop = loop {
@@ -154,7 +155,10 @@ impl Solver for Qcmc {
             let mut accepted = None;
             for _ in 0..=HALVINGS {
                 let trial = step.apply(&state, t, system.loop_of());
-                if admissible(&trial) && flipped(&triangles, &trial.map) <= flips {
+                if admissible(&trial)
+                    && flipped(&triangles, &trial.map) <= flips
+                    && near_folds(&elements, &trial.map)? <= near
+                {
                     let e = StepSystem::energy(&elements, mu, &trial.map);
                     if e < energy {
                         accepted = Some((trial, e));
@@ -168,6 +172,7 @@ impl Solver for Qcmc {
             };
             let moved = largest_move(&state, &trial);
             flips = flipped(&triangles, &trial.map);
+            near = near_folds(&elements, &trial.map)?;
             state = trial;
             energy = e;
             metrics.iterations += 1;
@@ -316,6 +321,26 @@ fn flipped(triangles: &[([usize; 3], f64)], map: &[num_complex::Complex64]) -> u
             sign * ((map[*b] - map[*a]).conj() * (map[*c] - map[*a])).im <= 0.0
         })
         .count()
+}
+
+/// `|mu|` from which a face counts as a near-fold: its image is within a factor 200 of
+/// collapsing onto a segment (`|mu| = (s1 - s2) / (s1 + s2)` with `s1 >= s2` the
+/// singular values of the face's map).
+const NEAR_FOLD: f64 = 0.99;
+
+/// Number of faces whose image is a near-fold (`NEAR_FOLD <= |mu| < 1`): the least-squares
+/// energy, weighted by the faces' areas, lets a step slide two boundary vertices of a
+/// small circle together (measured on `mc8_peaks`: two vertices of loop 5 ended 7e-8
+/// apart, a face at `|mu|` 0.99999), so a step may not add to them, as it may not add
+/// to the flips.
+fn near_folds(elements: &Elements, map: &[num_complex::Complex64]) -> Result<usize, SolverError> {
+    Ok(planar_map(elements, map.len(), map)?
+        .iter()
+        .filter(|d| {
+            let m = d.mu().norm();
+            (NEAR_FOLD..1.0).contains(&m)
+        })
+        .count())
 }
 
 /// The largest move of a vertex, centre or radius between two states.
