@@ -215,3 +215,23 @@ fn shared_meshes_of_every_class_keep_their_topology() {
         );
     }
 }
+
+#[test]
+fn eight_small_holes_are_remeshed_through_their_circle_domain() {
+    let Some(dir) = shared_meshes("eight_small_holes_are_remeshed_through_their_circle_domain")
+    else {
+        return;
+    };
+    // `auto` maps mc8_peaks uncut onto its circle domain (qcmc). Two vertices of a
+    // 20-vertex hole once slid together there (a face at |mu| 0.99999), and refinement
+    // around that near-fold passed 100,000 vertices in 1.6 s where about 8,000 are asked.
+    let input = dir.join("mc8_peaks.obj");
+    let mesh = read(&input);
+    let l = 0.01 * mesh.bounding_box().diagonal();
+    let r = remesh_and_check(&input, &mesh, l, &["--max-vertices", "100000"]);
+    assert_eq!(r["parameterizer"], "qcmc");
+    println!(
+        "mc8_peaks: {} vertices, min angle {}, Hausdorff {} of the diagonal",
+        r["vertices"], r["min_angle"], r["hausdorff_over_diagonal"]
+    );
+}
