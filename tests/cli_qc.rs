@@ -163,3 +163,29 @@ fn given_boundary_comes_from_a_map_file() {
         assert!((2.0 * p.x - x).abs() < 1e-12 && (2.0 * p.y - y).abs() < 1e-12);
     }
 }
+
+#[test]
+fn the_default_solver_follows_the_target() {
+    let dir = tempfile::tempdir().unwrap();
+    let (grid, _) = planar_grid(dir.path(), Cells::Triangles);
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("report.json");
+    for (target, goal, solver) in [
+        ("plane", "--mu-expr=0.2", "lsqc"),
+        ("disk", "--conformal", "beltrami-flow"),
+    ] {
+        let run = beltrami(&[
+            "qc",
+            s(&grid),
+            "--target",
+            target,
+            goal,
+            "-o",
+            s(&out),
+            "--report",
+            s(&report),
+        ]);
+        assert!(run.status.success(), "{target}: {}", text(&run.stderr));
+        assert_eq!(read_json(&report)["solver"], solver, "--target {target}");
+    }
+}

@@ -59,9 +59,11 @@ pub enum QcBoundaryArg {
 pub struct QcArgs {
     /// Mesh file (.obj, .gltf, .glb).
     pub mesh: PathBuf,
-    /// Solver name: lsqc, beltrami-flow or qcmc (onto a circle domain).
-    #[arg(long, default_value = "lsqc")]
-    pub solver: String,
+    /// Solver name: lsqc, beltrami-flow, extremal or qcmc (onto a circle domain).
+    /// Default: lsqc onto the plane, beltrami-flow onto the disk, an annulus or the
+    /// sphere.
+    #[arg(long)]
+    pub solver: Option<String>,
     /// The Beltrami coefficient per face, in the field format (`# mu frame=... faces=N`).
     #[arg(long)]
     pub mu: Option<PathBuf>,
@@ -205,6 +207,17 @@ fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<
     })
 }
 
+/// The solver of `--solver`, or the one that maps onto `--target`: lsqc onto the plane
+/// (one linear solve), beltrami-flow onto the disk, an annulus or the sphere (lsqc maps
+/// into the plane only).
+fn solver_name(args: &QcArgs) -> &str {
+    match (&args.solver, args.target) {
+        (Some(name), _) => name,
+        (None, TargetArg::Plane) => "lsqc",
+        (None, TargetArg::Disk | TargetArg::Annulus | TargetArg::Sphere) => "beltrami-flow",
+    }
+}
+
 /// Refuses, before any work, flags that the other flags make meaningless (they would be
 /// ignored silently): `--boundary` and `--boundary-map` off the plane target,
 /// `--boundary-map` without `--boundary given`, `--qd` off the extremal solver,
@@ -221,10 +234,10 @@ fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
             "--boundary-map gives the boundary of --boundary given; add that or drop --boundary-map"
         );
     }
-    if args.qd.is_some() && args.solver != "extremal" {
+    if args.qd.is_some() && solver_name(args) != "extremal" {
         bail!(
             "--qd writes the quadratic differential of --solver extremal; {} computes none",
-            args.solver
+            solver_name(args)
         );
     }
     if args.free_radius && args.target != TargetArg::Annulus {
@@ -239,7 +252,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     mapping::check_outputs(&args.output, &args.common, &[("--qd", args.qd.as_deref())])?;
     check_flag_use(args)?;
     let registry = beltrami::registry();
-    let solver = registry.get(&args.solver)?;
+    let solver = registry.get(solver_name(args))?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
     let goal = goal_of(args, mesh, solver)?;
