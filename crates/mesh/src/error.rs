@@ -33,6 +33,16 @@ pub enum MeshError {
         vertex_count: usize,
     },
 
+    /// New positions for a mesh ([`crate::Mesh::with_positions`]) that are not one per
+    /// vertex.
+    #[error("{got} positions for a mesh of {expected} vertices")]
+    PositionCount {
+        /// Number of mesh vertices.
+        expected: usize,
+        /// Number of positions given.
+        got: usize,
+    },
+
     /// A coordinate that is NaN or infinite.
     #[error("vertex {vertex} has a non-finite coordinate ({x}, {y}, {z})")]
     NonFiniteCoordinate {

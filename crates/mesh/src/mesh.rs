@@ -184,6 +184,39 @@ impl Mesh {
     pub fn positions(&self) -> &[Point3<f64>] {
         &self.positions
     }
+
+    /// The same mesh (connectivity, ids, input maps) with the vertices at `positions`
+    /// (indexed by [`VertexId`]), e.g. a surface laid out in the plane. Connectivity
+    /// and orientation are combinatorial and stay valid; the geometry is not checked
+    /// beyond finiteness, so faces may be degenerate or turned over in the new layout.
+    ///
+    /// Errors: [`MeshError::PositionCount`] unless there is one position per vertex,
+    /// [`MeshError::NonFiniteCoordinate`] (naming the input index) for a NaN or
+    /// infinite coordinate.
+    pub fn with_positions(&self, positions: Vec<Point3<f64>>) -> Result<Mesh, MeshError> {
+        if positions.len() != self.positions.len() {
+            return Err(MeshError::PositionCount {
+                expected: self.positions.len(),
+                got: positions.len(),
+            });
+        }
+        if let Some(v) = positions
+            .iter()
+            .position(|p| !p.coords.iter().all(|x| x.is_finite()))
+        {
+            let p = positions[v];
+            return Err(MeshError::NonFiniteCoordinate {
+                vertex: self.vertex_map.to_input(VertexId(v as u32)),
+                x: p.x,
+                y: p.y,
+                z: p.z,
+            });
+        }
+        Ok(Mesh {
+            positions,
+            ..self.clone()
+        })
+    }
     /// The map between input vertex indices and mesh vertices.
     pub fn vertex_map(&self) -> &VertexMap {
         &self.vertex_map

@@ -776,3 +776,38 @@ fn nearest_vertex_is_the_closest_one() {
         .unwrap();
     assert_eq!(mesh.nearest_vertex(&far), Some(expected));
 }
+
+#[test]
+fn with_positions_keeps_the_connectivity_and_checks_the_count() {
+    let mesh = Mesh::from_soup(&beltrami_mesh::primitives::grid(
+        3,
+        2,
+        beltrami_mesh::primitives::Cells::Triangles,
+    ))
+    .unwrap();
+    let lifted: Vec<_> = mesh
+        .positions()
+        .iter()
+        .map(|p| beltrami_mesh::Point3::new(p.x, p.y, p.x * p.y))
+        .collect();
+    let moved = mesh.with_positions(lifted.clone()).unwrap();
+    assert_eq!(moved.positions(), &lifted[..]);
+    for f in mesh.faces() {
+        assert!(mesh.face_vertices(f).eq(moved.face_vertices(f)));
+    }
+    assert_eq!(moved.boundary_loop_list().len(), 1);
+    let short = lifted[..3].to_vec();
+    assert!(matches!(
+        mesh.with_positions(short),
+        Err(beltrami_mesh::MeshError::PositionCount {
+            expected: 12,
+            got: 3
+        })
+    ));
+    let mut bad = lifted;
+    bad[5].z = f64::NAN;
+    assert!(matches!(
+        mesh.with_positions(bad),
+        Err(beltrami_mesh::MeshError::NonFiniteCoordinate { vertex: 5, .. })
+    ));
+}

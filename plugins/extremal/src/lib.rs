@@ -41,14 +41,17 @@
 //! Planar meshes (z = 0) of genus 0 with one or several boundary loops, every boundary
 //! vertex fixed (`PlanarBoundary::Keep` or `Given`). On a multiply connected domain the
 //! harmonic forms include one non-exact generator per inner loop ([`forms`]). A curved
-//! surface is refused with the way out: flatten it conformally first (distortion is
-//! conformally invariant, section 4.2 "Extension to surfaces").
+//! disk is laid out in the plane by LSCM first and `mu` is measured on the surface in
+//! its face frames (distortion is conformally invariant, section 4.2 "Extension to
+//! surfaces"); a curved surface with several boundary loops is refused with the way out
+//! (flatten it first).
 //!
 //! The solution carries `metrics.k` (eq. 12 at the end), the energy history, the step
 //! sizes of the line searches, the measured `mu` with its statistics and flips, the
 //! start map's statistics, and `extras.quadratic_differential` (`phi` per face in the
 //! global frame, scaled to an area-weighted mean `|phi|` of 1).
 
+mod flatten;
 pub mod forms;
 mod solver;
 

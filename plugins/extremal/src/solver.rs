@@ -8,7 +8,7 @@ use beltrami_core::{
 };
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
-use beltrami_fem::element::check_planar;
+use beltrami_fem::element::{check_planar, is_planar};
 use beltrami_fem::{
     BoundaryMap, Distortion, DofConstraints, DofMap, EdgeWeights, Elements, FemError, Frame,
     LeastSquaresSolver, SolveOptions, WeightedMeanSystem,
@@ -16,9 +16,10 @@ use beltrami_fem::{
 use beltrami_mesh::{Mesh, VertexId};
 use num_complex::Complex64;
 
+use crate::flatten::{Flattening, flatten};
 use crate::forms::{FormStep, HarmonicForms};
 
-const NAME: &str = "extremal";
+pub(crate) const NAME: &str = "extremal";
 
 /// The extremal quasiconformal map of a planar mesh with a prescribed boundary (crate
 /// docs).
@@ -129,8 +130,19 @@ impl Solver for Extremal {
             threads: settings.int("threads"),
             ..SolveOptions::default()
         };
+        let flat = if is_planar(mesh) {
+            None
+        } else {
+            let flat = context.stage("flattening", &mut report, || flatten(mesh))?;
+            report.notes.push(format!(
+                "the surface was laid out in the plane by LSCM (|mu| of that layout: mean {:.2e}, max {:.2e}); mu is measured on the surface, in its face frames",
+                flat.mu_mean, flat.mu_max
+            ));
+            Some(flat)
+        };
+        let domain = flat.as_ref().map_or(mesh, |f| &f.mesh);
         let initial = context.stage("initial map", &mut report, || {
-            start_map(problem, &fixed, settings.choice("init"), options)
+            start_map(domain, problem, &fixed, settings.choice("init"), options)
         })?;
         let parameters = Parameters {
             tolerance: settings.float("tolerance"),
@@ -139,11 +151,11 @@ impl Solver for Extremal {
             options,
         };
         let mut run = context.stage("setup", &mut report, || {
-            Algorithm::new(mesh, &fixed, initial, parameters)
+            Algorithm::new(domain, &fixed, initial, parameters)
         })?;
-        let initial_distortion = run.distortion()?.stats;
+        let initial_distortion = measure(mesh, flat.as_ref(), &run)?.stats;
         let outcome = report.time("iterations", || run.iterate(context))?;
-        let distortion = run.distortion()?;
+        let distortion = measure(mesh, flat.as_ref(), &run)?;
         if distortion.stats.flipped > 0 {
             report.notes.push(format!(
                 "{} of {} faces are flipped (the discrete map is extremal only in the limit of refinement; flips stay near sharp concave boundary corners)",
@@ -163,8 +175,16 @@ impl Solver for Extremal {
             factorizations: Some(outcome.factorizations),
             ..Metrics::default()
         };
+        let mut qd = run.quadratic_differential();
+        if let Some(flat) = &flat {
+            // phi dz^2 carried into each face's frame by the flattening's derivative.
+            for (phi, c) in qd.values.iter_mut().zip(&flat.derivative) {
+                *phi *= c * c;
+            }
+            qd.frame = Frame::Face;
+        }
         let extras = Extras {
-            quadratic_differential: Some(run.quadratic_differential()),
+            quadratic_differential: Some(qd),
             ..Extras::default()
         };
         Ok(Solution {
@@ -185,9 +205,12 @@ fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverErro
             "extremal computes the extremal map of a boundary condition; for a prescribed mu use lsqc or beltrami-flow",
         ));
     }
-    if let Err(FemError::NotPlanar { vertex, z }) = check_planar(mesh) {
+    if let Err(FemError::NotPlanar { vertex, z }) = check_planar(mesh)
+        && Topology::of(mesh) != Topology::Disk
+    {
         return Err(unsupported(format!(
-            "extremal maps planar meshes (z = 0), but vertex {vertex} has z = {z:e}; flatten the surface conformally first (e.g. `beltrami param --solver lscm`): distortion is conformally invariant"
+            "extremal maps planar meshes (z = 0) and curved disks (laid out conformally first), but this curved mesh (vertex {vertex} has z = {z:e}) has {}: flatten it conformally first (distortion is conformally invariant) and map the flat copy",
+            beltrami_core::topology::describe(mesh)
         )));
     }
     let boundary: Vec<VertexId> = mesh
@@ -250,15 +273,16 @@ fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverErro
     Ok(fixed)
 }
 
-/// The start map: the given one with the prescribed boundary values, or the harmonic
-/// (cotangent) or Tutte (uniform) map with those values.
+/// The start map on `mesh` (the source or its flat copy): the given one with the
+/// prescribed boundary values, or the harmonic (cotangent) or Tutte (uniform) map with
+/// those values.
 fn start_map(
+    mesh: &Mesh,
     problem: &Problem<'_>,
     fixed: &[(VertexId, Complex64)],
     init: &str,
     options: SolveOptions,
 ) -> Result<Vec<Complex64>, SolverError> {
-    let mesh = problem.source;
     if let Some(Map::Planar(z)) = &problem.initial {
         let mut z = z.clone();
         for &(v, w) in fixed {
@@ -279,6 +303,21 @@ fn start_map(
         positions: fixed.iter().map(|&(_, z)| z).collect(),
     };
     Ok(WeightedMeanSystem::new(&weights, &boundary)?.solve(options)?)
+}
+
+/// `mu` of the iteration's map: in the global frame of a planar source, or measured on
+/// the curved source in its face frames when the map was computed on its flattening.
+fn measure(
+    mesh: &Mesh,
+    flat: Option<&Flattening>,
+    run: &Algorithm<'_>,
+) -> Result<Distortion, SolverError> {
+    if flat.is_none() {
+        return run.distortion();
+    }
+    let elements = Elements::new(mesh, Frame::Face)?;
+    let d = planar_map(&elements, mesh.vertex_count(), &run.map)?;
+    Ok(Distortion::from_derivatives(&elements, &d)?)
 }
 
 /// The stopping rule and the linear-solver options of Algorithm 1.
