@@ -1,5 +1,6 @@
 //! Command-line interface: argument parsing and one module per command.
 
+mod batch;
 mod bench;
 mod cut;
 mod distortion;
@@ -68,6 +69,9 @@ pub enum Command {
     /// Remesh a surface with the asked edge length: parameterize it, triangulate the
     /// parameter domain with constrained Delaunay refinement, lift back.
     Remesh(remesh::RemeshArgs),
+    /// Run many param, qc, register and remesh jobs (one JSON object per line) in
+    /// parallel, one JSON report line per job; `--resume` skips finished outputs.
+    Batch(batch::BatchArgs),
 }
 
 /// Runs the parsed command.
@@ -85,5 +89,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(args) => render::run(&args, cli.quiet),
         Command::Histogram(args) => histogram::run(&args, cli.quiet),
         Command::Remesh(args) => remesh::run(&args, cli.quiet),
+        Command::Batch(args) => batch::run(&args, cli.quiet),
     }
 }

@@ -1,0 +1,105 @@
+//! End-to-end runs of `beltrami batch`: good jobs beside a broken one, the report lines,
+//! the exit code, and `--resume` after outputs were removed (as after a kill).
+
+use std::path::Path;
+
+mod common;
+use common::{beltrami, s, text};
+
+fn report_lines(path: &Path) -> Vec<serde_json::Value> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+#[test]
+fn a_broken_job_is_reported_and_the_others_finish_then_resume_skips_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = |name: &str| d.join(name).to_str().unwrap().to_string();
+    let jobs = d.join("jobs.jsonl");
+    let lines = [
+        format!(
+            r#"{{"command": "param", "input": "meshes/spot.obj", "output": "{}", "options": {{"solver": "sphere"}}}}"#,
+            out("spot_sphere.obj")
+        ),
+        "# a comment line".to_string(),
+        format!(
+            r#"{{"command": "param", "input": "meshes/disk_hemisphere.obj", "output": "{}", "options": {{"solver": "tutte", "boundary": "square"}}}}"#,
+            out("hemi_tutte.obj")
+        ),
+        format!(
+            r#"{{"command": "param", "input": "{}", "output": "{}", "options": {{"solver": "lscm"}}}}"#,
+            out("missing.obj"),
+            out("never.obj")
+        ),
+        format!(
+            r#"{{"command": "register", "input": ["meshes/spot.obj", "meshes/blob.obj"], "output": "{}"}}"#,
+            out("spot_on_blob.obj")
+        ),
+    ];
+    std::fs::write(&jobs, lines.join("\n") + "\n").unwrap();
+    let report = d.join("report.jsonl");
+    let run = beltrami(&["batch", s(&jobs), "--jobs", "2", "--report", s(&report)]);
+    assert!(!run.status.success(), "one job fails, so the batch does");
+    assert!(
+        text(&run.stderr).contains("1 of 4 jobs failed"),
+        "{}",
+        text(&run.stderr)
+    );
+    let lines = report_lines(&report);
+    assert_eq!(lines.len(), 4);
+    let status: Vec<&str> = lines
+        .iter()
+        .map(|l| l["status"].as_str().unwrap())
+        .collect();
+    assert_eq!(status, ["ok", "ok", "error", "ok"]);
+    assert_eq!(lines[2]["line"], 4);
+    assert!(
+        lines[2]["message"]
+            .as_str()
+            .unwrap()
+            .contains("missing.obj"),
+        "{}",
+        lines[2]
+    );
+    assert_eq!(lines[0]["report"]["solver"], "sphere");
+    assert_eq!(lines[3]["report"]["flipped"], 0);
+    for name in ["spot_sphere.obj", "hemi_tutte.obj", "spot_on_blob.obj"] {
+        assert!(d.join(name).exists(), "{name}");
+    }
+    assert!(!d.join("never.obj").exists());
+
+    // As after a kill: one output gone; --resume redoes only that job.
+    std::fs::remove_file(d.join("hemi_tutte.obj")).unwrap();
+    let run = beltrami(&["batch", s(&jobs), "--resume", "--report", s(&report)]);
+    assert!(!run.status.success());
+    let status: Vec<String> = report_lines(&report)
+        .iter()
+        .map(|l| l["status"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(status, ["skipped", "ok", "error", "skipped"]);
+    assert!(d.join("hemi_tutte.obj").exists());
+}
+
+#[test]
+fn a_malformed_jobs_file_is_refused_before_any_job_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.jsonl");
+    let output = dir.path().join("a.obj");
+    std::fs::write(
+        &jobs,
+        format!(
+            "{{\"command\": \"param\", \"input\": \"meshes/spot.obj\", \"output\": \"{}\", \"options\": {{\"solver\": \"sphere\"}}}}\n{{\"command\": \"paint\"}}\n",
+            s(&output)
+        ),
+    )
+    .unwrap();
+    let run = beltrami(&["batch", s(&jobs)]);
+    assert!(!run.status.success());
+    let stderr = text(&run.stderr);
+    assert!(stderr.contains("line 2"), "{stderr}");
+    assert!(!output.exists(), "no job ran");
+}
