@@ -4,7 +4,7 @@
 //! given as a file, and refusals that write nothing.
 
 use std::f64::consts::TAU;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_mesh::primitives::annulus;
@@ -29,7 +29,7 @@ fn ring_map(z: Complex64) -> Complex64 {
 
 /// The annulus mesh (`rings` by `6 rings` sectors), written to `dir`, with a slight
 /// twist of every ring so that the mesh is not symmetric under reflections.
-fn ring_of(dir: &Path, rings: usize) -> (std::path::PathBuf, Mesh) {
+fn ring_of(dir: &Path, rings: usize) -> (PathBuf, Mesh) {
     let mut soup = annulus(R0, rings, 6 * rings);
     for p in soup.positions.iter_mut() {
         let z = Complex64::new(p.x, p.y);
@@ -43,8 +43,18 @@ fn ring_of(dir: &Path, rings: usize) -> (std::path::PathBuf, Mesh) {
     (path, mesh)
 }
 
-fn ring(dir: &Path) -> (std::path::PathBuf, Mesh) {
-    ring_of(dir, 8)
+/// The `rings`-ring annulus, the ring map at its vertices, and that map written as the
+/// boundary-map file `map.obj`.
+fn ring_with_map(dir: &Path, rings: usize) -> (PathBuf, Mesh, Vec<Complex64>, PathBuf) {
+    let (input, mesh) = ring_of(dir, rings);
+    let exact: Vec<Complex64> = mesh
+        .positions()
+        .iter()
+        .map(|p| ring_map(Complex64::new(p.x, p.y)))
+        .collect();
+    let map = dir.join("map.obj");
+    write_map(&map, &mesh, &exact);
+    (input, mesh, exact, map)
 }
 
 /// `mesh` with its vertices moved to `image` (a map file: positions x, y).
@@ -72,14 +82,7 @@ fn read_json(path: &Path) -> serde_json::Value {
 /// Runs the ring-map problem on the `rings`-ring mesh; returns k, the largest vertex
 /// error and the area-weighted RMS of the error in the direction of phi.
 fn ring_problem(dir: &Path, rings: usize) -> (f64, f64, f64) {
-    let (input, mesh) = ring_of(dir, rings);
-    let exact: Vec<Complex64> = mesh
-        .positions()
-        .iter()
-        .map(|p| ring_map(Complex64::new(p.x, p.y)))
-        .collect();
-    let map = dir.join("map.obj");
-    write_map(&map, &mesh, &exact);
+    let (input, mesh, exact, map) = ring_with_map(dir, rings);
     let (out, qd, report) = (dir.join("out.obj"), dir.join("qd.txt"), dir.join("r.json"));
     let run = beltrami(&[
         "qc",
@@ -157,14 +160,7 @@ fn the_ring_map_comes_back_with_its_k_and_quadratic_differential() {
 #[test]
 fn a_folded_start_from_a_file_ends_without_flips() {
     let dir = tempfile::tempdir().unwrap();
-    let (input, mesh) = ring(dir.path());
-    let exact: Vec<Complex64> = mesh
-        .positions()
-        .iter()
-        .map(|p| ring_map(Complex64::new(p.x, p.y)))
-        .collect();
-    let map = dir.path().join("map.obj");
-    write_map(&map, &mesh, &exact);
+    let (input, mesh, exact, map) = ring_with_map(dir.path(), 8);
     // The exact map with the images of the vertices within 0.2 of z0 = 0.7 mirrored
     // across the horizontal line through the image of z0: every face there turns over.
     // The fold stays inside a disk, so the start is homotopic to the exact map with the
@@ -219,14 +215,7 @@ fn a_folded_start_from_a_file_ends_without_flips() {
 #[test]
 fn refusals_name_the_problem_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let (input, mesh) = ring(dir.path());
-    let exact: Vec<Complex64> = mesh
-        .positions()
-        .iter()
-        .map(|p| ring_map(Complex64::new(p.x, p.y)))
-        .collect();
-    let map = dir.path().join("map.obj");
-    write_map(&map, &mesh, &exact);
+    let (input, mesh, _, map) = ring_with_map(dir.path(), 8);
     let out = dir.path().join("out.obj");
     // --qd with a solver that computes no quadratic differential.
     let run = beltrami(&[
