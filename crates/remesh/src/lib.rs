@@ -51,6 +51,7 @@ pub mod quality;
 pub mod refine;
 mod seam_flips;
 pub mod size;
+mod star_relaxation;
 
 use std::time::Instant;
 
@@ -267,6 +268,8 @@ fn triangulate_chart(
         faces.push(out);
     }
     let surface = beltrami_spatial::SurfaceIndex::new(mesh)?;
+    seam_flips::flip_for_angles(&mut faces, &positions, &sizes_out, &surface)?;
+    star_relaxation::relax_worst_stars(&faces, &mut positions, &mut on_source, &surface)?;
     seam_flips::flip_for_angles(&mut faces, &positions, &sizes_out, &surface)?;
     let soup = PolygonSoup::from_triangles(positions, &faces);
     let result = Mesh::from_soup(&soup).map_err(|error| RemeshError::Build {
