@@ -29,6 +29,7 @@ pub mod expr;
 pub mod field;
 pub mod operators;
 pub mod quaternion;
+pub mod quaternionic_lsqc;
 pub mod solve;
 pub mod weighted_mean;
 pub mod weights;

@@ -62,6 +62,7 @@
 //! ```
 
 mod lsqc;
+pub mod space;
 
 pub use lsqc::{Lsqc, beltrami_operator};
 

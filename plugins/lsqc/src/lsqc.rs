@@ -22,7 +22,8 @@ use num_complex::Complex64;
 /// The least-squares quasiconformal map (crate docs).
 ///
 /// Reads: `goal` (`Prescribed(field)`, or `Conformal { p: 2 }` for `mu = 0`), `target`
-/// (`Plane(Keep | Given | Free)`), the pins of `constraints` and the option `threads`. With a fixed
+/// (`Plane(Keep | Given | Free)`, or `Surface`: the quaternionic map into R^3 of
+/// [`crate::space`], vertices held by pins with positions in space), the pins of `constraints` and the option `threads`. With a fixed
 /// boundary (`Keep`, `Given`) pins add further fixed vertices; with a free boundary it
 /// needs two or more pins, or none (two boundary vertices far apart are pinned at
 /// `(0, 0)` and `(1, 0)`, as in lscm). A pin without a position stays where it is on a
@@ -32,17 +33,28 @@ use num_complex::Complex64;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Lsqc;
 
-const NAME: &str = "lsqc";
+pub(crate) const NAME: &str = "lsqc";
 
 const OPTIONS: &[OptionSpec] = &[THREADS];
 
 const ACCEPTS: Accepts = Accepts {
     elements: &[Element::Triangle, Element::Quad],
-    topologies: &[Topology::Disk],
+    // Into the plane: disks (checked by `setup`, with the way out); into space: any
+    // surface with held vertices.
+    topologies: &[
+        Topology::Disk,
+        Topology::Annulus,
+        Topology::MultiplyConnected,
+        Topology::Sphere,
+        Topology::Torus,
+        Topology::HigherGenus,
+        Topology::BoundedHigherGenus,
+    ],
     targets: &[
         TargetKind::PlaneKeep,
         TargetKind::PlaneGiven,
         TargetKind::PlaneFree,
+        TargetKind::Surface,
     ],
     goals: &[GoalKind::Conformal, GoalKind::Prescribed],
     constraints: &[ConstraintKind::Hold, ConstraintKind::Pin],
@@ -73,6 +85,9 @@ impl Solver for Lsqc {
         problem: &Problem<'_>,
         _settings: &Settings,
     ) -> Result<(), SolverError> {
+        if matches!(problem.target, Target::Surface) {
+            return crate::space::setup(problem).map(|_| ());
+        }
         setup(problem).map(|_| ())
     }
 
@@ -82,6 +97,9 @@ impl Solver for Lsqc {
         settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
+        if matches!(problem.target, Target::Surface) {
+            return crate::space::run(problem, settings, context);
+        }
         let mesh = problem.source;
         let mut report = Report::new(NAME);
         let mut metrics = Metrics::default();
@@ -186,14 +204,14 @@ struct Setup {
     default_pins: Option<(VertexId, VertexId)>,
 }
 
-fn unsupported(message: String) -> SolverError {
+pub(crate) fn unsupported(message: String) -> SolverError {
     SolverError::Unsupported {
         solver: NAME,
         message,
     }
 }
 
-fn invalid(message: String) -> SolverError {
+pub(crate) fn invalid(message: String) -> SolverError {
     SolverError::InvalidInput {
         solver: NAME,
         message,

@@ -1,0 +1,175 @@
+//! lsqc into R^3 (`Target::Surface`): the quaternionic least-squares quasiconformal
+//! map of a surface (Gruber-Aulisa 2022, Definition 3.3, Lemma 3.4 and Algorithm 1).
+//!
+//! The unknowns are the three coordinates of every vertex image; the energy is
+//! `sum_q w_q |df^- - mu df^+|^2` ([`beltrami_fem::quaternionic_lsqc`]), `mu = mu1 + mu2 N`
+//! from a Beltrami field in the face frames (`mu = 0` for `--conformal`). Pins with
+//! positions in space hold vertices (the boundary of a boundary map, or any vertices);
+//! one sparse solve (the normal equations' Cholesky, AMD order). The energy is
+//! homogeneous in the images (the zero map has none), so a map needs held vertices:
+//! without them the problem is refused.
+
+use beltrami_core::{
+    Context, Extras, Goal, Map, Metrics, Output, Position, Problem, Report, Settings, Solution,
+    SolverError,
+};
+use beltrami_fem::beltrami::face_mu;
+use beltrami_fem::distortion::measure_surface;
+use beltrami_fem::dof::DofBuilder;
+use beltrami_fem::quaternion::quaternionic_mu;
+use beltrami_fem::quaternionic_lsqc::{quaternionic_operator, row_weights};
+use beltrami_fem::{
+    BeltramiField, Elements, Frame, LeastSquaresSolver, MuError, ReferenceNormal, SolveOptions,
+};
+use beltrami_mesh::{Point3, VertexId};
+
+use crate::lsqc::{NAME, invalid, unsupported};
+
+/// What the check finds: the field in the face frames and the held vertices.
+pub(crate) struct SpaceSetup {
+    field: BeltramiField,
+    held: Vec<(VertexId, Point3<f64>)>,
+}
+
+/// The capability check of the space target.
+pub(crate) fn setup(problem: &Problem<'_>) -> Result<SpaceSetup, SolverError> {
+    let mesh = problem.source;
+    let field = match &problem.goal {
+        Goal::Prescribed(field) => {
+            field.check(mesh.face_count())?;
+            if field.frame != Frame::Face {
+                return Err(unsupported(
+                    "a map into space takes its Beltrami field in the face frames (`# mu frame=face`), where mu1 + i mu2 is the quaternionic mu1 + mu2 N".to_string(),
+                ));
+            }
+            field.clone()
+        }
+        Goal::Conformal { p } if *p == 2.0 => BeltramiField::zero(Frame::Face, mesh.face_count()),
+        Goal::Conformal { p } => {
+            return Err(unsupported(format!(
+                "lsqc minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu"
+            )));
+        }
+        Goal::Extremal => {
+            return Err(unsupported(
+                "lsqc follows a prescribed Beltrami coefficient; for extremal maps use extremal"
+                    .to_string(),
+            ));
+        }
+    };
+    if problem.constraints.curves().next().is_some() {
+        return Err(unsupported(
+            "lsqc does not make vertices follow curves yet".to_string(),
+        ));
+    }
+    let mut held = Vec::new();
+    for pin in problem.constraints.pins() {
+        let v = pin.vertex;
+        if v.idx() >= mesh.vertex_count() {
+            return Err(invalid(format!(
+                "a pin is on vertex {v}, but the mesh has {} vertices",
+                mesh.vertex_count()
+            )));
+        }
+        match pin.position {
+            Some(Position::Spatial(p)) if p.coords.iter().all(|x| x.is_finite()) => {
+                held.push((v, p));
+            }
+            Some(Position::Spatial(_)) => {
+                return Err(invalid(format!(
+                    "the position of the pin on vertex {v} is not finite"
+                )));
+            }
+            Some(Position::Planar(_)) | None => {
+                return Err(unsupported(format!(
+                    "a map into space holds vertices at points of R^3, but the pin on vertex {v} has {}",
+                    if pin.position.is_none() {
+                        "no position"
+                    } else {
+                        "a position in the plane"
+                    }
+                )));
+            }
+        }
+    }
+    if held.len() < 3 {
+        return Err(unsupported(format!(
+            "a map into space needs vertices held at points of R^3 (the boundary of a boundary map, `--boundary given --boundary-map MAP`, or pins): the energy is zero for the zero map, and {} held vertices do not fix the image{}",
+            held.len(),
+            if mesh.boundary_loop_list().is_empty() {
+                "; this surface has no boundary, so pin vertices with positions"
+            } else {
+                ""
+            }
+        )));
+    }
+    Ok(SpaceSetup { field, held })
+}
+
+/// Runs the space target (module docs).
+pub(crate) fn run(
+    problem: &Problem<'_>,
+    settings: &Settings,
+    context: &mut Context<'_>,
+) -> Result<Solution, SolverError> {
+    let mesh = problem.source;
+    let mut report = Report::new(NAME);
+    let mut metrics = Metrics::default();
+    let SpaceSetup { field, held } = setup(problem)?;
+    let n = mesh.vertex_count();
+    let (elements, operator, mut solver) = context.stage("assembly", &mut report, || {
+        let elements = Elements::new(mesh, Frame::Face)?;
+        let operator = quaternionic_operator(&elements, n, &field.mu)?;
+        let mut builder = DofBuilder::<f64>::new(n, 3)?;
+        let mut is_held = vec![false; n];
+        for &(v, p) in &held {
+            builder.origin(v, &[p.x, p.y, p.z])?;
+            is_held[v.idx()] = true;
+        }
+        for v in mesh.vertices().filter(|v| !is_held[v.idx()]) {
+            builder.free(&[v])?;
+        }
+        let dofs = builder.build()?;
+        let options = SolveOptions {
+            threads: settings.int("threads"),
+            ..SolveOptions::default()
+        };
+        let solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, options)?;
+        Ok((elements, operator, solver))
+    })?;
+    let weights = row_weights(&elements);
+    let x = context.stage("solve", &mut report, || {
+        Ok(solver.solve(
+            operator.as_ref(),
+            Some(&weights),
+            &vec![0.0; operator.nrows()],
+        )?)
+    })?;
+    let image: Vec<Point3<f64>> = x
+        .chunks_exact(3)
+        .map(|c| Point3::new(c[0], c[1], c[2]))
+        .collect();
+    let distortion = context.stage("distortion", &mut report, || {
+        Ok(measure_surface(mesh, &image, ReferenceNormal::Source)?)
+    })?;
+    let quaternionic = face_mu(&elements, &quaternionic_mu(&elements, n, &image)?);
+    metrics.mu_error = Some(MuError::new(&elements, &quaternionic, &field.mu)?);
+    if distortion.stats.flipped > 0 {
+        report.notes.push(format!(
+            "{} of {} faces turn against the source's normals: the least-squares map is not guaranteed to be a bijection",
+            distortion.stats.flipped,
+            mesh.face_count()
+        ));
+    }
+    report.notes.push(
+        "|mu| is the map's own distortion (in the image's tangent planes); |mu - target| compares the quaternionic mu1 + mu2 N with the field".to_string(),
+    );
+    metrics.mu = Some(distortion.field);
+    metrics.distortion = Some(distortion.stats);
+    Ok(Solution {
+        output: Output::Map(Map::Spatial(image)),
+        metrics,
+        extras: Extras::default(),
+        report,
+    })
+}

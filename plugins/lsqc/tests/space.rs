@@ -1,0 +1,145 @@
+//! lsqc into R^3 (`Target::Surface`, the quaternionic least-squares map of
+//! Gruber-Aulisa 2022) against exact answers: the identity of a curved surface is
+//! conformal (`df^- = 0`) and comes back from its own boundary; an affine planar map
+//! comes back from its own measured mu (the complex special case), triangles and quads;
+//! the solve commutes with rotations of R^3 (frames and normals handled consistently);
+//! a problem that fixes nothing is refused.
+
+use beltrami_core::{Constraint, Context, Goal, Map, Pin, Position, Problem, Solver, Target};
+use beltrami_fem::beltrami::face_mu;
+use beltrami_fem::quaternion::quaternionic_mu;
+use beltrami_fem::{BeltramiField, Elements, Frame};
+use beltrami_lsqc::Lsqc;
+use beltrami_mesh::primitives::{Cells, jittered_grid};
+use beltrami_mesh::{Mesh, Point3, Vector3};
+use nalgebra::{Rotation3, Unit};
+
+/// A jittered grid bent onto a paraboloid cap `z = 0.4 (x^2 + y^2)` (curved, not
+/// developable).
+fn cap(n: usize, cells: Cells) -> Mesh {
+    let mut soup = jittered_grid(n, n, cells, 0.3, 5);
+    for p in &mut soup.positions {
+        p.z = 0.4 * (p.x * p.x + p.y * p.y);
+    }
+    Mesh::from_soup(&soup).unwrap()
+}
+
+/// The problem of mapping `mesh` into space with `field` (`None`: conformal) and the
+/// boundary held at `held`'s positions.
+fn problem<'a>(mesh: &'a Mesh, field: Option<BeltramiField>, held: &[Point3<f64>]) -> Problem<'a> {
+    let mut problem = Problem::new(mesh, Target::Surface);
+    problem.goal = match field {
+        Some(f) => Goal::Prescribed(f),
+        None => Goal::Conformal { p: 2.0 },
+    };
+    for l in mesh.boundary_loop_list() {
+        for v in l.vertices {
+            problem.constraints.push(Constraint::Pin(Pin {
+                vertex: v,
+                position: Some(Position::Spatial(held[v.idx()])),
+            }));
+        }
+    }
+    problem
+}
+
+fn image(problem: &Problem<'_>) -> Vec<Point3<f64>> {
+    let solution = Lsqc.solve(problem, &mut Context::new()).unwrap();
+    match solution.map() {
+        Some(Map::Spatial(points)) => points.clone(),
+        other => panic!("expected a map into space, got {other:?}"),
+    }
+}
+
+fn largest_distance(a: &[Point3<f64>], b: &[Point3<f64>]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (p - q).norm())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn the_identity_of_a_curved_surface_is_conformal_and_comes_back() {
+    for cells in [Cells::Triangles, Cells::Quads] {
+        let mesh = cap(8, cells);
+        let own = mesh.positions().to_vec();
+        let got = image(&problem(&mesh, None, &own));
+        let error = largest_distance(&got, &own);
+        assert!(error < 1e-10, "{cells:?}: identity off by {error}");
+    }
+}
+
+#[test]
+fn a_planar_map_with_its_own_measured_mu_comes_back() {
+    // N = (0, 0, 1): the quaternionic problem is the complex one of Lui et al. 2014. An
+    // affine map of a jittered planar grid into the plane z = 0, its mu measured per face
+    // (Lemma 5.2) and prescribed, its boundary held: its residual vanishes, so the
+    // least-squares map is the affine map itself, triangles and quads.
+    for cells in [Cells::Triangles, Cells::Quads] {
+        let mesh = Mesh::from_soup(&jittered_grid(9, 9, cells, 0.3, 3)).unwrap();
+        let exact: Vec<Point3<f64>> = mesh
+            .positions()
+            .iter()
+            .map(|p| Point3::new(1.3 * p.x + 0.4 * p.y, 0.2 * p.x + 0.8 * p.y, 0.0))
+            .collect();
+        let elements = Elements::new(&mesh, Frame::Face).unwrap();
+        let mu = face_mu(
+            &elements,
+            &quaternionic_mu(&elements, mesh.vertex_count(), &exact).unwrap(),
+        );
+        assert!(mu.iter().all(|m| m.norm() > 0.1), "a non-conformal map");
+        let got = image(&problem(
+            &mesh,
+            Some(BeltramiField::new(Frame::Face, mu)),
+            &exact,
+        ));
+        let error = largest_distance(&got, &exact);
+        assert!(error < 1e-10, "{cells:?}: affine map off by {error}");
+    }
+}
+
+#[test]
+fn the_solve_commutes_with_rotations() {
+    let mesh = cap(8, Cells::Triangles);
+    let bent: Vec<Point3<f64>> = mesh
+        .positions()
+        .iter()
+        .map(|p| Point3::new(p.x + 0.3 * p.y * p.y, p.y, p.z + 0.2 * p.x))
+        .collect();
+    let field = BeltramiField::new(
+        Frame::Face,
+        vec![num_complex::Complex64::new(0.2, -0.1); mesh.face_count()],
+    );
+    let before = image(&problem(&mesh, Some(field.clone()), &bent));
+    let rotation =
+        Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(1.0, 2.0, 0.5)), 0.7);
+    // The same surface, the same held points, rotated; the face frames rotate with it.
+    let rotated_source: Vec<Point3<f64>> = mesh.positions().iter().map(|p| rotation * p).collect();
+    let rotated_mesh = mesh.with_positions(rotated_source).unwrap();
+    let rotated_held: Vec<Point3<f64>> = bent.iter().map(|p| rotation * p).collect();
+    let after = image(&problem(&rotated_mesh, Some(field), &rotated_held));
+    let expected: Vec<Point3<f64>> = before.iter().map(|p| rotation * p).collect();
+    let error = largest_distance(&after, &expected);
+    assert!(error < 1e-9, "rotation changed the map by {error}");
+}
+
+#[test]
+fn a_problem_that_fixes_nothing_is_refused() {
+    let closed = Mesh::from_soup(&beltrami_mesh::primitives::icosphere(2)).unwrap();
+    let problem = Problem::new(&closed, Target::Surface);
+    let error = Lsqc.check(&problem).unwrap_err().to_string();
+    assert!(error.contains("no boundary"), "{error}");
+    // A field in the global frame has no meaning on a curved surface's faces in space.
+    let mesh = cap(4, Cells::Triangles);
+    let own = mesh.positions().to_vec();
+    let field = BeltramiField::zero(Frame::Global, mesh.face_count());
+    let error = Lsqc
+        .check(&problem_with(&mesh, field, &own))
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("face frame"), "{error}");
+}
+
+fn problem_with<'a>(mesh: &'a Mesh, field: BeltramiField, held: &[Point3<f64>]) -> Problem<'a> {
+    problem(mesh, Some(field), held)
+}
