@@ -89,6 +89,18 @@ pub fn read_planar(
     })
 }
 
+/// The map into R^3 in a mesh file with `source`'s faces: its positions, matched face
+/// by face ([`correspondence`]).
+pub fn read_spatial(
+    path: &Path,
+    source: &Mesh,
+    repair: bool,
+) -> Result<Vec<Point3<f64>>, ReadMapError> {
+    let mapped = read_mapped(path, repair)?;
+    let to_mapped = correspondence(source, &mapped.mesh)?;
+    Ok(spatial_images(&mapped.mesh, &to_mapped))
+}
+
 /// Reads a map's mesh file. Its positions are the map's image (or do not matter, for a
 /// map given by texture coordinates), so they must not change its connectivity: a face
 /// collapsed by the map is a measurement (`|mu| = 1`, flipped), not a defect. So no face

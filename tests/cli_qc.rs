@@ -189,3 +189,59 @@ fn the_default_solver_follows_the_target() {
         assert_eq!(read_json(&report)["solver"], solver, "--target {target}");
     }
 }
+
+#[test]
+fn the_space_target_maps_a_curved_surface_into_r3() {
+    // The identity of a curved surface is conformal in the quaternionic sense
+    // (df^- = 0): with its own boundary held, the least-squares map is the surface.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("r.json");
+    let hemisphere = "meshes/disk_hemisphere.obj";
+    let run = beltrami(&[
+        "qc",
+        hemisphere,
+        "--target",
+        "space",
+        "--boundary",
+        "given",
+        "--boundary-map",
+        hemisphere,
+        "--conformal",
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert_eq!(read_json(&report)["solver"], "lsqc");
+    let input = io::read(Path::new(hemisphere), &Default::default())
+        .unwrap()
+        .mesh;
+    let output = io::read(&out, &Default::default()).unwrap().mesh;
+    let error = input
+        .positions()
+        .iter()
+        .zip(output.positions())
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(error < 1e-10, "the identity came back off by {error}");
+    // Without held vertices nothing fixes the image: refused before any work.
+    let none = dir.path().join("none.obj");
+    let run = beltrami(&[
+        "qc",
+        hemisphere,
+        "--target",
+        "space",
+        "--conformal",
+        "-o",
+        s(&none),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("--boundary given"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!none.exists());
+}

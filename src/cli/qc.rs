@@ -14,8 +14,8 @@ use std::path::PathBuf;
 use anyhow::{Context as _, bail};
 use beltrami::map_file;
 use beltrami_core::{
-    Constraint, Goal, GoalKind, Map, OptionValue, PlanarBoundary, Problem, Solver, Target,
-    TargetKind,
+    Constraint, Goal, GoalKind, Map, OptionValue, Pin, PlanarBoundary, Position, Problem, Solver,
+    Target, TargetKind,
 };
 use beltrami_fem::{BeltramiField, Expr};
 use beltrami_mesh::Mesh;
@@ -41,6 +41,9 @@ pub enum TargetArg {
     Annulus,
     /// The unit sphere (closed genus-0 meshes).
     Sphere,
+    /// Points of R^3 (lsqc): the quaternionic least-squares map of the surface, its
+    /// boundary held at the positions (`v`) of `--boundary-map` (`--boundary given`).
+    Space,
 }
 
 /// Boundary conditions of `--boundary` (plane target).
@@ -204,6 +207,7 @@ fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<
             },
         },
         TargetArg::Sphere => Target::Sphere,
+        TargetArg::Space => Target::Surface,
     })
 }
 
@@ -215,6 +219,7 @@ fn solver_name(args: &QcArgs) -> &str {
         (Some(name), _) => name,
         (None, TargetArg::Plane) => "lsqc",
         (None, TargetArg::Disk | TargetArg::Annulus | TargetArg::Sphere) => "beltrami-flow",
+        (None, TargetArg::Space) => "lsqc",
     }
 }
 
@@ -224,9 +229,14 @@ fn solver_name(args: &QcArgs) -> &str {
 /// `--free-radius` off the annulus target.
 fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
     let target = format!("{:?}", args.target).to_lowercase();
-    if args.boundary.is_some() && args.target != TargetArg::Plane {
+    if args.boundary.is_some() && !matches!(args.target, TargetArg::Plane | TargetArg::Space) {
         bail!(
-            "--boundary is the boundary condition of --target plane; --target {target} has its own"
+            "--boundary is the boundary condition of --target plane and space; --target {target} has its own"
+        );
+    }
+    if args.target == TargetArg::Space && args.boundary != Some(QcBoundaryArg::Given) {
+        bail!(
+            "--target space holds the boundary at the positions of a map: add --boundary given --boundary-map MAP"
         );
     }
     if args.boundary_map.is_some() && args.boundary != Some(QcBoundaryArg::Given) {
@@ -272,6 +282,21 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             .into_iter()
             .map(Constraint::Pin),
     );
+    if let (TargetArg::Space, Some(path)) = (args.target, &args.boundary_map) {
+        let held = beltrami::mapped::read_spatial(path, mesh, false)
+            .with_context(|| format!("--boundary-map {}", path.display()))?;
+        problem.constraints.extend(
+            mesh.boundary_loop_list()
+                .into_iter()
+                .flat_map(|l| l.vertices)
+                .map(|v| {
+                    Constraint::Pin(Pin {
+                        vertex: v,
+                        position: Some(Position::Spatial(held[v.idx()])),
+                    })
+                }),
+        );
+    }
     problem.options = mapping::solver_options(
         solver,
         &[
@@ -294,7 +319,10 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
     let error = solution.metrics.mu_error;
-    if let (Some(Map::Spatial(_)), false) = (solution.map(), args.target == TargetArg::Sphere) {
+    if let (Some(Map::Spatial(_)), false) = (
+        solution.map(),
+        matches!(args.target, TargetArg::Sphere | TargetArg::Space),
+    ) {
         bail!("{} gave points in space for a planar target", solver.name());
     }
     map_file::write(&args.output, mesh, &solution, None)?;
