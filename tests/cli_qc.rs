@@ -226,6 +226,49 @@ fn the_space_target_maps_a_curved_surface_into_r3() {
         .map(|(a, b)| (a - b).norm())
         .fold(0.0, f64::max);
     assert!(error < 1e-10, "the identity came back off by {error}");
+    // The normal constraint is accepted with the space target, refused elsewhere or
+    // with a weight that is not positive.
+    let run = beltrami(&[
+        "qc",
+        hemisphere,
+        "--target",
+        "space",
+        "--boundary",
+        "given",
+        "--boundary-map",
+        hemisphere,
+        "--conformal",
+        "--normal-constraint",
+        "1e4",
+        "-o",
+        s(&out),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    for (flags, message) in [
+        (&["--normal-constraint", "0"][..], "positive"),
+        (
+            &["--normal-constraint", "1", "--target", "plane"][..],
+            "--target space",
+        ),
+    ] {
+        let bad = dir.path().join("bad.obj");
+        let mut args = vec!["qc", hemisphere, "--conformal", "-o", s(&bad)];
+        args.extend_from_slice(flags);
+        if !flags.contains(&"plane") {
+            args.extend([
+                "--target",
+                "space",
+                "--boundary",
+                "given",
+                "--boundary-map",
+                hemisphere,
+            ]);
+        }
+        let run = beltrami(&args);
+        assert!(!run.status.success(), "{flags:?}");
+        assert!(text(&run.stderr).contains(message), "{}", text(&run.stderr));
+        assert!(!bad.exists());
+    }
     // Without held vertices nothing fixes the image: refused before any work.
     let none = dir.path().join("none.obj");
     let run = beltrami(&[

@@ -107,6 +107,10 @@ pub struct QcArgs {
     /// mesh file whose texture coordinates (or x, y) give it (it may be folded).
     #[arg(long)]
     pub init: Option<String>,
+    /// space: keep the displacement of every vertex tangent to the surface (Gruber-Aulisa
+    /// 2022, section 4.1, linearized), a penalty of weight W > 0 (e.g. 1e4).
+    #[arg(long = "normal-constraint", value_name = "W")]
+    pub normal_constraint: Option<f64>,
     /// extremal: write the quadratic differential phi per face here (`# qd
     /// frame=global faces=N`, then `re im` per face in the input's face order).
     #[arg(long)]
@@ -234,6 +238,16 @@ fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
             "--boundary is the boundary condition of --target plane and space; --target {target} has its own"
         );
     }
+    if let Some(w) = args.normal_constraint {
+        if args.target != TargetArg::Space {
+            bail!(
+                "--normal-constraint keeps a map into space near the surface: it needs --target space"
+            );
+        }
+        if !(w.is_finite() && w > 0.0) {
+            bail!("--normal-constraint {w}: the weight must be a positive number");
+        }
+    }
     if args.target == TargetArg::Space && args.boundary != Some(QcBoundaryArg::Given) {
         bail!(
             "--target space holds the boundary at the positions of a map: add --boundary given --boundary-map MAP"
@@ -282,6 +296,9 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             .into_iter()
             .map(Constraint::Pin),
     );
+    if let Some(weight) = args.normal_constraint {
+        problem.constraints.push(Constraint::Normal { weight });
+    }
     if let (TargetArg::Space, Some(path)) = (args.target, &args.boundary_map) {
         let held = beltrami::mapped::read_spatial(path, mesh, false)
             .with_context(|| format!("--boundary-map {}", path.display()))?;

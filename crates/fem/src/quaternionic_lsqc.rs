@@ -15,6 +15,7 @@
 //! frame (`Frame::Face`): for a map that stays in the source's tangent planes it is the
 //! intrinsic Beltrami coefficient.
 
+use beltrami_mesh::Mesh;
 use faer::sparse::SparseColMat;
 use nalgebra::{Quaternion, Vector3};
 use num_complex::Complex64;
@@ -28,11 +29,13 @@ pub const ROWS_PER_POINT: usize = 4;
 
 /// The operator `x -> df^- - mu df^+` (module docs) of `elements` (built with
 /// `Frame::Face`) for the coefficients `mu` per face (`mu1 + i mu2`), on `vertex_count`
-/// vertices: `4 Q` rows, `3 vertex_count` columns.
+/// vertices: `4 Q` rows, `3 vertex_count` columns, followed by the rows of `extra`
+/// (e.g. [`NormalConstraint`]).
 pub fn quaternionic_operator(
     elements: &Elements,
     vertex_count: usize,
     mu: &[Complex64],
+    extra: Option<&NormalConstraint>,
 ) -> Result<SparseColMat<usize, f64>, FemError> {
     if mu.len() != elements.face_count() {
         return Err(FemError::Length {
@@ -63,12 +66,60 @@ pub fn quaternionic_operator(
             }
         }
     }
-    Pattern::new(
-        ROWS_PER_POINT * elements.point_count(),
-        3 * vertex_count,
-        &positions,
-    )?
-    .assemble(&values)
+    let first = ROWS_PER_POINT * elements.point_count();
+    let mut rows = first;
+    if let Some(extra) = extra {
+        for (r, normal) in extra.normals.iter().enumerate() {
+            for axis in 0..3 {
+                positions.push((first + r, 3 * r + axis));
+                values.push(normal[axis]);
+            }
+        }
+        rows += extra.normals.len();
+    }
+    Pattern::new(rows, 3 * vertex_count, &positions)?.assemble(&values)
+}
+
+/// The linearized normal constraint of section 4.1: the displacement of every vertex
+/// stays tangent to the source, `<f(x_v) - x_v, N_v> = 0`, as the penalty
+/// `(1 / eps) sum_v A_v <f(x_v) - x_v, N_v>^2` (the paper's Lagrange multiplier with its
+/// `eps` term eliminated: `rho = -<v, N> / eps`), with `A_v` a third of the areas of the
+/// triangles around `v` (a quarter of the quads') and `N_v` the angle-weighted vertex
+/// normal. One row per vertex after the `4 Q` rows of the operator.
+#[derive(Debug, Clone)]
+pub struct NormalConstraint {
+    /// `N_v` per vertex.
+    pub normals: Vec<Vector3<f64>>,
+    /// `<x_v, N_v>` per vertex: the right-hand side.
+    pub rhs: Vec<f64>,
+    /// `A_v / eps` per vertex: the row weights.
+    pub weights: Vec<f64>,
+}
+
+impl NormalConstraint {
+    /// The constraint of `mesh` with the weight `1 / eps = weight`.
+    pub fn new(mesh: &Mesh, weight: f64) -> Self {
+        let normals = mesh.vertex_normals();
+        let mut areas = vec![0.0; mesh.vertex_count()];
+        for f in mesh.faces() {
+            let (v, n) = mesh.face_vertex_array(f);
+            let share = mesh.face_area(f) / n as f64;
+            for v in &v[..n] {
+                areas[v.idx()] += share;
+            }
+        }
+        let rhs = mesh
+            .positions()
+            .iter()
+            .zip(&normals)
+            .map(|(p, n)| p.coords.dot(n))
+            .collect();
+        Self {
+            normals,
+            rhs,
+            weights: areas.iter().map(|a| a * weight).collect(),
+        }
+    }
 }
 
 /// The weight of every row of [`quaternionic_operator`]: the quadrature weight of its

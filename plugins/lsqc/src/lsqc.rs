@@ -2,9 +2,9 @@
 //! Beltrami coefficient (module docs of the crate).
 
 use beltrami_core::{
-    Accepts, ConstraintKind, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionSpec,
-    Output, PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver, SolverError,
-    THREADS, Target, TargetKind, Topology, topology,
+    Accepts, Constraint, ConstraintKind, Context, Element, Extras, Goal, GoalKind, Map, Metrics,
+    OptionSpec, Output, PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver,
+    SolverError, THREADS, Target, TargetKind, Topology, topology,
 };
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
@@ -57,7 +57,11 @@ const ACCEPTS: Accepts = Accepts {
         TargetKind::Surface,
     ],
     goals: &[GoalKind::Conformal, GoalKind::Prescribed],
-    constraints: &[ConstraintKind::Hold, ConstraintKind::Pin],
+    constraints: &[
+        ConstraintKind::Hold,
+        ConstraintKind::Pin,
+        ConstraintKind::Normal,
+    ],
 };
 
 /// What to do with a mesh that is not a disk.
@@ -252,6 +256,15 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
     if problem.constraints.curves().next().is_some() {
         return Err(unsupported(
             "lsqc does not make vertices follow curves yet; use beltrami-flow".to_string(),
+        ));
+    }
+    if problem
+        .constraints
+        .iter()
+        .any(|c| matches!(c, Constraint::Normal { .. }))
+    {
+        return Err(unsupported(
+            "the normal constraint keeps a map into space near the surface's normals; it has no meaning in the plane: use --target space".to_string(),
         ));
     }
     let pins = pins(problem, planar.is_ok())?;

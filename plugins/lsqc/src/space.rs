@@ -10,14 +10,14 @@
 //! without them the problem is refused.
 
 use beltrami_core::{
-    Context, Extras, Goal, Map, Metrics, Output, Position, Problem, Report, Settings, Solution,
-    SolverError,
+    Constraint, Context, Extras, Goal, Map, Metrics, Output, Position, Problem, Report, Settings,
+    Solution, SolverError,
 };
 use beltrami_fem::beltrami::face_mu;
 use beltrami_fem::distortion::measure_surface;
 use beltrami_fem::dof::DofBuilder;
 use beltrami_fem::quaternion::quaternionic_mu;
-use beltrami_fem::quaternionic_lsqc::{quaternionic_operator, row_weights};
+use beltrami_fem::quaternionic_lsqc::{NormalConstraint, quaternionic_operator, row_weights};
 use beltrami_fem::{
     BeltramiField, Elements, Frame, LeastSquaresSolver, MuError, ReferenceNormal, SolveOptions,
 };
@@ -117,9 +117,13 @@ pub(crate) fn run(
     let mut metrics = Metrics::default();
     let SpaceSetup { field, held } = setup(problem)?;
     let n = mesh.vertex_count();
+    let normal = problem.constraints.iter().find_map(|c| match c {
+        Constraint::Normal { weight } => Some(NormalConstraint::new(mesh, *weight)),
+        _ => None,
+    });
     let (elements, operator, mut solver) = context.stage("assembly", &mut report, || {
         let elements = Elements::new(mesh, Frame::Face)?;
-        let operator = quaternionic_operator(&elements, n, &field.mu)?;
+        let operator = quaternionic_operator(&elements, n, &field.mu, normal.as_ref())?;
         let mut builder = DofBuilder::<f64>::new(n, 3)?;
         let mut is_held = vec![false; n];
         for &(v, p) in &held {
@@ -137,13 +141,14 @@ pub(crate) fn run(
         let solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, options)?;
         Ok((elements, operator, solver))
     })?;
-    let weights = row_weights(&elements);
+    let mut weights = row_weights(&elements);
+    let mut rhs = vec![0.0; weights.len()];
+    if let Some(normal) = &normal {
+        weights.extend(&normal.weights);
+        rhs.extend(&normal.rhs);
+    }
     let x = context.stage("solve", &mut report, || {
-        Ok(solver.solve(
-            operator.as_ref(),
-            Some(&weights),
-            &vec![0.0; operator.nrows()],
-        )?)
+        Ok(solver.solve(operator.as_ref(), Some(&weights), &rhs)?)
     })?;
     let image: Vec<Point3<f64>> = x
         .chunks_exact(3)

@@ -143,3 +143,59 @@ fn a_problem_that_fixes_nothing_is_refused() {
 fn problem_with<'a>(mesh: &'a Mesh, field: BeltramiField, held: &[Point3<f64>]) -> Problem<'a> {
     problem(mesh, Some(field), held)
 }
+
+/// The largest distance from the unit sphere of the conformal map of a spherical cap
+/// (the disk of level 4 lifted by inverse stereographic projection, radius 0.7 in the
+/// plane) whose boundary slides along the sphere by the azimuth
+/// `phi -> phi + amplitude sin phi`, with the normal constraint of weight `weight`
+/// (`None`: without it).
+fn cap_on_sphere(amplitude: f64, weight: Option<f64>) -> f64 {
+    let mut soup = beltrami_mesh::primitives::disk(4);
+    for p in &mut soup.positions {
+        let (x, y) = (0.7 * p.x, 0.7 * p.y);
+        let r2 = x * x + y * y;
+        *p = Point3::new(2.0 * x, 2.0 * y, r2 - 1.0) / (r2 + 1.0);
+    }
+    let mesh = Mesh::from_soup(&soup).unwrap();
+    let held: Vec<Point3<f64>> = mesh
+        .positions()
+        .iter()
+        .map(|p| {
+            let phi = p.y.atan2(p.x);
+            let rho = (p.x * p.x + p.y * p.y).sqrt();
+            let moved = phi + amplitude * phi.sin();
+            Point3::new(rho * moved.cos(), rho * moved.sin(), p.z)
+        })
+        .collect();
+    let mut problem = problem(&mesh, None, &held);
+    if let Some(weight) = weight {
+        problem.constraints.push(Constraint::Normal { weight });
+    }
+    image(&problem)
+        .iter()
+        .map(|p| (p.coords.norm() - 1.0).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn the_normal_constraint_keeps_a_sphere_on_the_sphere_to_second_order() {
+    // The constraint keeps every displacement tangent to the source (section 4.1,
+    // linearized with N_old): the image leaves the sphere by the square of the
+    // displacement, where the unconstrained map leaves it by the displacement itself.
+    let amplitudes = [0.2, 0.1, 0.05];
+    let free: Vec<f64> = amplitudes.iter().map(|&a| cap_on_sphere(a, None)).collect();
+    let held: Vec<f64> = amplitudes
+        .iter()
+        .map(|&a| cap_on_sphere(a, Some(1e4)))
+        .collect();
+    println!("distance from the sphere: without {free:?}, with the normal constraint {held:?}");
+    for (h, f) in held.iter().zip(&free) {
+        assert!(h < f, "with {h}, without {f}");
+    }
+    for w in held.windows(2) {
+        assert!(
+            w[1] < 0.3 * w[0],
+            "not second order in the displacement: {held:?}"
+        );
+    }
+}
