@@ -79,5 +79,6 @@ pub fn registry() -> beltrami_core::Registry {
     beltrami_register::register(&mut registry);
     beltrami_qcmc::register(&mut registry);
     beltrami_extremal::register(&mut registry);
+    beltrami_qc_iteration::register(&mut registry);
     registry
 }

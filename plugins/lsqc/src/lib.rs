@@ -64,7 +64,8 @@
 mod lsqc;
 pub mod space;
 
-pub use lsqc::{Lsqc, beltrami_operator};
+pub use beltrami_fem::operators::beltrami_operator;
+pub use lsqc::Lsqc;
 
 /// Adds [`Lsqc`] to `registry`.
 pub fn register(registry: &mut beltrami_core::Registry) {

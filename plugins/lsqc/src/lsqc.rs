@@ -6,17 +6,15 @@ use beltrami_core::{
     OptionSpec, Output, PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver,
     SolverError, THREADS, Target, TargetKind, Topology, topology,
 };
-use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::boundary::{self, BoundaryError};
 use beltrami_fem::element::check_planar;
-use beltrami_fem::operators::apply;
+use beltrami_fem::operators::{apply, beltrami_operator};
 use beltrami_fem::{
     BeltramiField, Distortion, DofConstraints, DofMap, Elements, FemError, Frame,
     LeastSquaresSolver, MuError, SolveOptions,
 };
-use beltrami_mesh::{Mesh, VertexId};
-use faer::sparse::SparseColMat;
+use beltrami_mesh::VertexId;
 use num_complex::Complex64;
 
 /// The least-squares quasiconformal map (crate docs).
@@ -168,36 +166,6 @@ impl Solver for Lsqc {
             report,
         })
     }
-}
-
-/// The operator `A = D_zbar - diag(mu_q) D_z` (quadrature points x vertices) of the
-/// elements, `mu_q = mu[f]` at every quadrature point of face `f`: `(A x)_q` is
-/// `f_zbar(q) - mu_f f_z(q)` of the map with vertex values `x`, in the elements' frame.
-pub fn beltrami_operator(
-    mesh: &Mesh,
-    elements: &Elements,
-    mu: &[Complex64],
-) -> Result<SparseColMat<usize, Complex64>, FemError> {
-    if mu.len() != elements.face_count() {
-        return Err(FemError::Length {
-            what: "Beltrami coefficient",
-            expected: elements.face_count(),
-            got: mu.len(),
-        });
-    }
-    let mut positions = Vec::with_capacity(elements.point_count() * 4);
-    let mut values = Vec::with_capacity(elements.point_count() * 4);
-    for (row, q) in elements.points().iter().enumerate() {
-        let m = mu[q.face.idx()];
-        for (k, v) in elements.nodes(q.face).iter().enumerate() {
-            let g = q.grad[k];
-            let dz = Complex64::new(0.5 * g.x, -0.5 * g.y);
-            let dzbar = Complex64::new(0.5 * g.x, 0.5 * g.y);
-            positions.push((row, v.idx()));
-            values.push(dzbar - m * dz);
-        }
-    }
-    Pattern::new(elements.point_count(), mesh.vertex_count(), &positions)?.assemble(&values)
 }
 
 /// What the capability check finds: the field in the frame the elements use, the fixed

@@ -1,0 +1,158 @@
+//! `beltrami qc --solver qc-iteration` against exact answers: the ring map between two
+//! annuli is the Teichmueller map of its boundary values, `k = (K - 1) / (K + 1)`; the
+//! QC iteration converges to it under refinement and agrees with the `extremal` solver
+//! on the same Dirichlet problems (two methods, one answer).
+
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+
+use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_mesh::primitives::annulus;
+use beltrami_mesh::{BuildOptions, Mesh, Point3};
+use num_complex::Complex64;
+
+mod common;
+use common::{beltrami, s, text};
+
+const R0: f64 = 0.4;
+const S0: f64 = 0.25;
+const S1: f64 = 1.2;
+
+fn stretch() -> f64 {
+    (S1 / S0).ln() / (1.0 / R0).ln()
+}
+
+/// The `rings`-ring annulus `R0 < r < 1`, each ring slightly twisted, and the ring map
+/// at its vertices written as a boundary-map file.
+fn ring_problem(dir: &Path, rings: usize) -> (PathBuf, PathBuf, Vec<Complex64>) {
+    let mut soup = annulus(R0, rings, 6 * rings);
+    for p in soup.positions.iter_mut() {
+        let z = Complex64::new(p.x, p.y) * Complex64::from_polar(1.0, 0.02 * (TAU * p.x).sin());
+        *p = Point3::new(z.re, z.im, 0.0);
+    }
+    let mesh = Mesh::from_soup(&soup).unwrap();
+    let input = dir.join(format!("ring{rings}.obj"));
+    io::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let exact: Vec<Complex64> = mesh
+        .positions()
+        .iter()
+        .map(|p| {
+            let z = Complex64::new(p.x, p.y);
+            Complex64::from_polar(S0 * (z.norm() / R0).powf(stretch()), z.arg())
+        })
+        .collect();
+    let positions: Vec<Point3<f64>> = exact.iter().map(|w| Point3::new(w.re, w.im, 0.0)).collect();
+    let map = dir.join(format!("map{rings}.obj"));
+    let attributes = VertexAttributes {
+        positions: Some(&positions),
+        ..VertexAttributes::default()
+    };
+    io::write(&map, &mesh, &attributes).unwrap();
+    (input, map, exact)
+}
+
+/// Runs `solver` on the problem; its `k`, largest vertex error and flips.
+fn run(solver: &str, input: &Path, map: &Path, exact: &[Complex64]) -> (f64, f64, u64) {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
+    let run = beltrami(&[
+        "qc",
+        s(input),
+        "--solver",
+        solver,
+        "--boundary",
+        "given",
+        "--boundary-map",
+        s(map),
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{solver}: {}", text(&run.stderr));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let uv = io::read(&out, &BuildOptions::default())
+        .unwrap()
+        .vertex_uvs()
+        .unwrap();
+    let error = uv
+        .iter()
+        .zip(exact)
+        .map(|(t, w)| (Complex64::new(t.x, t.y) - w).norm())
+        .fold(0.0, f64::max);
+    (
+        r["k"].as_f64().unwrap(),
+        error,
+        r["flipped"].as_u64().unwrap(),
+    )
+}
+
+#[test]
+fn the_qc_iteration_reaches_the_ring_maps_k_and_agrees_with_extremal() {
+    let dir = tempfile::tempdir().unwrap();
+    let k_exact = (stretch() - 1.0) / (stretch() + 1.0);
+    let mut last: Option<f64> = None;
+    for rings in [6, 12, 24] {
+        let (input, map, exact) = ring_problem(dir.path(), rings);
+        let (k, error, flips) = run("qc-iteration", &input, &map, &exact);
+        let (k_extremal, _, _) = run("extremal", &input, &map, &exact);
+        println!(
+            "{rings} rings: qc-iteration k {k:.6}, extremal k {k_extremal:.6}, exact {k_exact:.6}, vertex error {error:.3e}"
+        );
+        assert_eq!(flips, 0);
+        assert!(
+            (k - k_exact).abs() < 0.01 * k_exact,
+            "k {k}, exact {k_exact}"
+        );
+        assert!(
+            (k - k_extremal).abs() < 0.01 * k_exact,
+            "qc-iteration {k}, extremal {k_extremal}"
+        );
+        if let Some(e) = last {
+            assert!(error < 0.6 * e, "vertex error {error} after {e}");
+        }
+        last = Some(error);
+    }
+}
+
+#[test]
+fn a_prescribed_goal_or_a_curved_mesh_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, map, _) = ring_problem(dir.path(), 4);
+    let out = dir.path().join("out.obj");
+    let run = beltrami(&[
+        "qc",
+        s(&input),
+        "--solver",
+        "qc-iteration",
+        "--boundary",
+        "given",
+        "--boundary-map",
+        s(&map),
+        "--mu-expr",
+        "0.2",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(text(&run.stderr).contains("lsqc"), "{}", text(&run.stderr));
+    assert!(!out.exists());
+    let run = beltrami(&[
+        "qc",
+        "meshes/disk_hemisphere.obj",
+        "--solver",
+        "qc-iteration",
+        "--boundary",
+        "keep",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("planar"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!out.exists());
+}
