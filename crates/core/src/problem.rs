@@ -120,4 +120,50 @@ impl<'a> Problem<'a> {
             options: Options::default(),
         }
     }
+
+    /// The held boundary of a planar Dirichlet target: every vertex of every boundary
+    /// loop with its image, `x + i y` of its own position for `Plane(Keep)`, `values[v]`
+    /// for `Plane(Given(values))`; `None` for any other target. The error says what is
+    /// wrong with the given values (their count, a non-finite value at a named vertex),
+    /// for the solver to wrap in its own error.
+    pub fn planar_boundary_values(&self) -> Option<Result<Vec<(VertexId, Complex64)>, String>> {
+        let mesh = self.source;
+        let boundary = || {
+            mesh.boundary_loop_list()
+                .into_iter()
+                .flat_map(|l| l.vertices)
+        };
+        match &self.target {
+            Target::Plane(PlanarBoundary::Keep) => Some(Ok(boundary()
+                .map(|v| {
+                    let p = mesh.position(v);
+                    (v, Complex64::new(p.x, p.y))
+                })
+                .collect())),
+            Target::Plane(PlanarBoundary::Given(values)) => {
+                if values.len() != mesh.vertex_count() {
+                    return Some(Err(format!(
+                        "the boundary map has {} values, but the mesh has {} vertices",
+                        values.len(),
+                        mesh.vertex_count()
+                    )));
+                }
+                Some(
+                    boundary()
+                        .map(|v| {
+                            let z = values[v.idx()];
+                            if z.is_finite() {
+                                Ok((v, z))
+                            } else {
+                                Err(format!(
+                                    "the boundary map is not finite at boundary vertex {v}"
+                                ))
+                            }
+                        })
+                        .collect(),
+                )
+            }
+            _ => None,
+        }
+    }
 }

@@ -3,8 +3,8 @@
 
 use beltrami_core::{
     Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
-    Output, PlanarBoundary, Problem, Progress, QuadraticDifferential, Report, Settings, Solution,
-    Solver, SolverError, Stop, THREADS, Target, TargetKind, Topology,
+    Output, Problem, Progress, QuadraticDifferential, Report, Settings, Solution, Solver,
+    SolverError, Stop, THREADS, TargetKind, Topology,
 };
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
@@ -213,42 +213,9 @@ fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverErro
             beltrami_core::topology::describe(mesh)
         )));
     }
-    let boundary: Vec<VertexId> = mesh
-        .boundary_loop_list()
-        .into_iter()
-        .flat_map(|l| l.vertices)
-        .collect();
-    let fixed = match &problem.target {
-        Target::Plane(PlanarBoundary::Keep) => boundary
-            .iter()
-            .map(|&v| {
-                let p = mesh.position(v);
-                (v, Complex64::new(p.x, p.y))
-            })
-            .collect(),
-        Target::Plane(PlanarBoundary::Given(values)) => {
-            if values.len() != mesh.vertex_count() {
-                return Err(invalid(format!(
-                    "the boundary map has {} values, but the mesh has {} vertices",
-                    values.len(),
-                    mesh.vertex_count()
-                )));
-            }
-            boundary
-                .iter()
-                .map(|&v| {
-                    let z = values[v.idx()];
-                    if z.is_finite() {
-                        Ok((v, z))
-                    } else {
-                        Err(invalid(format!(
-                            "the boundary map is not finite at boundary vertex {v}"
-                        )))
-                    }
-                })
-                .collect::<Result<_, _>>()?
-        }
-        _ => {
+    let fixed = match problem.planar_boundary_values() {
+        Some(values) => values.map_err(invalid)?,
+        None => {
             return Err(unsupported(
                 "extremal needs the boundary values: keep the source's boundary or give a boundary map (`--boundary given --boundary-map MAP`)",
             ));

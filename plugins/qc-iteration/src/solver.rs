@@ -2,8 +2,8 @@
 
 use beltrami_core::{
     Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
-    Output, PlanarBoundary, Problem, Progress, Report, Settings, Solution, Solver, SolverError,
-    Stop, THREADS, Target, TargetKind, Topology,
+    Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, Stop, THREADS,
+    TargetKind, Topology,
 };
 use beltrami_fem::beltrami::{face_mu, planar_map};
 use beltrami_fem::element::check_planar;
@@ -202,48 +202,12 @@ fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverErro
             "the QC iteration maps planar meshes (z = 0), but vertex {vertex} has z = {z:e}; flatten the surface first or use extremal, which flattens curved disks"
         )));
     }
-    let boundary: Vec<VertexId> = mesh
-        .boundary_loop_list()
-        .into_iter()
-        .flat_map(|l| l.vertices)
-        .collect();
-    match &problem.target {
-        Target::Plane(PlanarBoundary::Keep) => Ok(boundary
-            .iter()
-            .map(|&v| {
-                let p = mesh.position(v);
-                (v, Complex64::new(p.x, p.y))
-            })
-            .collect()),
-        Target::Plane(PlanarBoundary::Given(values)) => {
-            if values.len() != mesh.vertex_count() {
-                return Err(SolverError::InvalidInput {
-                    solver: NAME,
-                    message: format!(
-                        "the boundary map has {} values, but the mesh has {} vertices",
-                        values.len(),
-                        mesh.vertex_count()
-                    ),
-                });
-            }
-            boundary
-                .iter()
-                .map(|&v| {
-                    let z = values[v.idx()];
-                    if z.is_finite() {
-                        Ok((v, z))
-                    } else {
-                        Err(SolverError::InvalidInput {
-                            solver: NAME,
-                            message: format!(
-                                "the boundary map is not finite at boundary vertex {v}"
-                            ),
-                        })
-                    }
-                })
-                .collect()
-        }
-        _ => Err(unsupported(
+    match problem.planar_boundary_values() {
+        Some(values) => values.map_err(|message| SolverError::InvalidInput {
+            solver: NAME,
+            message,
+        }),
+        None => Err(unsupported(
             "the QC iteration needs the boundary values: keep the source's boundary or give a boundary map (`--boundary given --boundary-map MAP`)",
         )),
     }
