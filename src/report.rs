@@ -23,10 +23,14 @@
 //! | `timings` | `[{stage, seconds}]` in the order they happened |
 //! | `notes` | remarks for people (prose) |
 //!
-//! [`mu_error_keys`] gives the flat `mu_error_*` keys of `beltrami qc`'s report.
+//! [`mu_error_keys`] gives the flat `mu_error_*` keys of `beltrami qc`'s report, and
+//! [`circles`] the `circles` of a circle-domain map. [`error_message`] is the one-line
+//! text of an error and its causes, as the command-line program and the Python package
+//! print it.
 
-use beltrami_core::Solution;
+use beltrami_core::{Circle, Solution};
 use beltrami_fem::MuError;
+use beltrami_mesh::Mesh;
 use serde_json::{Map as JsonMap, Value, json};
 
 /// The stages whose time makes up an iteration of the Beltrami flow (its linear solves
@@ -101,6 +105,120 @@ pub fn mu_error_keys(error: Option<&MuError>) -> JsonMap<String, Value> {
         json!(error.map(|e| e.sup_face.idx())),
     );
     keys
+}
+
+/// The report of a remeshing of `input` (`beltrami remesh --report` without the file
+/// names): the method and parameterizer, sizes, angles, edge lengths, distances (also
+/// relative to the input's bounding-box diagonal), the seconds and the timings.
+pub fn remesh(
+    input: &Mesh,
+    result: &beltrami_remesh::Remeshing,
+    q: &beltrami_remesh::Quality,
+    seconds: f64,
+) -> JsonMap<String, Value> {
+    let timings: JsonMap<String, Value> = result
+        .timings
+        .iter()
+        .map(|(name, s)| (name.to_string(), json!(s)))
+        .collect();
+    let value = json!({
+        "method": "param",
+        "parameterizer": result.parameterizer,
+        "opening": result.opening.name(),
+        "topology": beltrami_core::topology::describe(input),
+        "input_vertices": input.vertex_count(),
+        "input_faces": input.face_count(),
+        "edge_length": result.edge_length,
+        "vertices": q.vertices,
+        "faces": q.faces,
+        "min_angle": q.min_angle,
+        "mean_angle": q.mean_angle,
+        "share_below_30": q.share_below_30,
+        "edge_min": q.edge_min,
+        "edge_mean": q.edge_mean,
+        "edge_max": q.edge_max,
+        "edge_spread": q.edge_spread,
+        "edge_mean_over_asked": q.edge_mean / result.edge_length,
+        "hausdorff": q.hausdorff,
+        "mean_distance": q.mean_distance,
+        "diagonal": q.diagonal,
+        "hausdorff_over_diagonal": q.hausdorff / q.diagonal,
+        "mean_distance_over_diagonal": q.mean_distance / q.diagonal,
+        "size_passes": result.size_passes,
+        "seconds": seconds,
+        "timings": timings,
+        "notes": result.notes,
+    });
+    match value {
+        Value::Object(map) => map,
+        _ => JsonMap::new(),
+    }
+}
+
+/// A circle of a circle-domain map with how far its boundary loop's images are from it:
+/// `deviation` is the largest `| |g - c| - r | / r` over the loop's images `g` (NaN when
+/// the loop index is not one of `mesh`'s loops).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CircleFit {
+    /// The circle the solver reports.
+    pub circle: Circle,
+    /// The largest relative distance of the loop's images from the circle.
+    pub deviation: f64,
+}
+
+/// The circles of a circle-domain map (`extras.circles` of `solution`, a map of `mesh`)
+/// with their deviations; empty for other solutions.
+pub fn circle_fits(mesh: &Mesh, solution: &Solution) -> Vec<CircleFit> {
+    let (Some(circles), Some(map)) = (&solution.extras.circles, solution.planar()) else {
+        return Vec::new();
+    };
+    let loops = mesh.boundary_loop_list();
+    circles
+        .iter()
+        .map(|c| CircleFit {
+            circle: *c,
+            deviation: loops.get(c.boundary_loop).map_or(f64::NAN, |l| {
+                l.vertices
+                    .iter()
+                    .map(|v| ((map[v.idx()] - c.center).norm() - c.radius).abs() / c.radius)
+                    .fold(0.0, f64::max)
+            }),
+        })
+        .collect()
+}
+
+/// The report's `circles`: per circle of [`circle_fits`], `{loop, center: [x, y],
+/// radius, deviation}`.
+pub fn circles(fits: &[CircleFit]) -> Value {
+    fits.iter()
+        .map(|f| {
+            json!({
+                "loop": f.circle.boundary_loop,
+                "center": [f.circle.center.re, f.circle.center.im],
+                "radius": f.circle.radius,
+                "deviation": f.deviation,
+            })
+        })
+        .collect()
+}
+
+/// The error and its causes joined by `: `, each cause left out when the text before it
+/// already quotes it (library errors that wrap another show it in their own message and
+/// keep it as their source for callers that downcast).
+pub fn error_message(error: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = String::new();
+    let mut cause = Some(error);
+    while let Some(e) = cause {
+        let line = e.to_string();
+        if !text.contains(&line) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&line);
+        }
+        cause = e.source();
+    }
+    text
 }
 
 #[cfg(test)]

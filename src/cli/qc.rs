@@ -403,38 +403,27 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     )
 }
 
-/// The circles of a circle-domain map (`extras.circles`): the report's `circles` (per
-/// loop its index, centre, radius and `deviation`, the largest `| |g - c| - r | / r`
-/// over the loop's images `g`) and a summary line per circle.
+/// The circles of a circle-domain map (`extras.circles`): the report's `circles`
+/// ([`beltrami::report::circles`]) and a summary line per circle.
 pub(super) fn circles(
     mesh: &Mesh,
     solution: &beltrami_core::Solution,
     report: &mut serde_json::Map<String, serde_json::Value>,
 ) -> Vec<String> {
-    let (Some(circles), Some(map)) = (&solution.extras.circles, solution.planar()) else {
+    let fits = beltrami::report::circle_fits(mesh, solution);
+    if fits.is_empty() {
         return Vec::new();
-    };
-    let loops = mesh.boundary_loop_list();
-    let mut lines = Vec::new();
-    let mut values = Vec::new();
-    for c in circles {
-        let deviation = loops.get(c.boundary_loop).map_or(f64::NAN, |l| {
-            l.vertices
-                .iter()
-                .map(|v| ((map[v.idx()] - c.center).norm() - c.radius).abs() / c.radius)
-                .fold(0.0, f64::max)
-        });
-        lines.push(format!(
-            "loop {:<3} circle centre ({:+.6}, {:+.6})  radius {:.6}  deviation {:.1e}",
-            c.boundary_loop, c.center.re, c.center.im, c.radius, deviation
-        ));
-        values.push(json!({
-            "loop": c.boundary_loop, "center": [c.center.re, c.center.im],
-            "radius": c.radius, "deviation": deviation,
-        }));
     }
-    report.insert("circles".into(), json!(values));
-    lines
+    report.insert("circles".into(), beltrami::report::circles(&fits));
+    fits.iter()
+        .map(|f| {
+            let c = &f.circle;
+            format!(
+                "loop {:<3} circle centre ({:+.6}, {:+.6})  radius {:.6}  deviation {:.1e}",
+                c.boundary_loop, c.center.re, c.center.im, c.radius, f.deviation
+            )
+        })
+        .collect()
 }
 
 /// Writes `--qd`: the solution's quadratic differential, one face per line in the

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context as _, bail};
-use beltrami_core::{Context, Solver};
+use beltrami_core::Context;
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_remesh::{Quality, RemeshOptions, Remeshing, Resolution, SizeField};
 use beltrami_render::{ColorBy, Scene, Style, View};
@@ -114,14 +114,8 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     let registry = beltrami::registry();
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
     let mesh = &loaded.mesh.mesh;
-    let solvers: Vec<&dyn Solver> = match args.method {
-        MethodArg::Param if args.param == "auto" => {
-            let (first, fallback) = beltrami_remesh::param::auto(&registry, mesh)?;
-            std::iter::once(first)
-                .chain(fallback.filter(|f| f.name() != first.name()))
-                .collect()
-        }
-        MethodArg::Param => vec![registry.get(&args.param)?],
+    let solvers = match args.method {
+        MethodArg::Param => beltrami_remesh::param::chosen(&registry, mesh, &args.param)?,
     };
 
     let start = Instant::now();
@@ -163,8 +157,7 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The JSON report: sizes, angles, edge lengths, distances (also relative to the
-/// input's bounding-box diagonal), the parameterizer and the timings.
+/// The JSON report: the input and output files and [`beltrami::report::remesh`].
 fn report_json(
     args: &RemeshArgs,
     input: &beltrami_mesh::Mesh,
@@ -172,41 +165,11 @@ fn report_json(
     q: &Quality,
     seconds: f64,
 ) -> Value {
-    let timings: serde_json::Map<String, Value> = result
-        .timings
-        .iter()
-        .map(|(name, s)| (name.to_string(), json!(s)))
-        .collect();
-    json!({
-        "mesh": args.mesh.display().to_string(),
-        "output": args.output.display().to_string(),
-        "method": "param",
-        "parameterizer": result.parameterizer,
-        "opening": result.opening.name(),
-        "topology": beltrami_core::topology::describe(input),
-        "input_vertices": input.vertex_count(),
-        "input_faces": input.face_count(),
-        "edge_length": result.edge_length,
-        "vertices": q.vertices,
-        "faces": q.faces,
-        "min_angle": q.min_angle,
-        "mean_angle": q.mean_angle,
-        "share_below_30": q.share_below_30,
-        "edge_min": q.edge_min,
-        "edge_mean": q.edge_mean,
-        "edge_max": q.edge_max,
-        "edge_spread": q.edge_spread,
-        "edge_mean_over_asked": q.edge_mean / result.edge_length,
-        "hausdorff": q.hausdorff,
-        "mean_distance": q.mean_distance,
-        "diagonal": q.diagonal,
-        "hausdorff_over_diagonal": q.hausdorff / q.diagonal,
-        "mean_distance_over_diagonal": q.mean_distance / q.diagonal,
-        "size_passes": result.size_passes,
-        "seconds": seconds,
-        "timings": timings,
-        "notes": result.notes,
-    })
+    let mut report = serde_json::Map::new();
+    report.insert("mesh".into(), json!(args.mesh.display().to_string()));
+    report.insert("output".into(), json!(args.output.display().to_string()));
+    report.extend(beltrami::report::remesh(input, result, q, seconds));
+    Value::Object(report)
 }
 
 fn print_summary(args: &RemeshArgs, result: &Remeshing, q: &Quality, seconds: f64) {

@@ -79,6 +79,27 @@ pub fn auto<'r>(
     Ok((lscm, fallback))
 }
 
+/// The parameterizers to try, in order, for the name `name`: `auto` gives [`auto`]'s
+/// choice and then its fallback (when it differs), any other name the registered solver
+/// of that name alone.
+pub fn chosen<'r>(
+    registry: &'r Registry,
+    mesh: &Mesh,
+    name: &str,
+) -> Result<Vec<&'r dyn Solver>, RemeshError> {
+    if name != "auto" {
+        let solver = registry.get(name).map_err(|error| RemeshError::Solve {
+            solver: "remesh",
+            error,
+        })?;
+        return Ok(vec![solver]);
+    }
+    let (first, fallback) = auto(registry, mesh)?;
+    Ok(std::iter::once(first)
+        .chain(fallback.filter(|f| f.name() != first.name()))
+        .collect())
+}
+
 /// Maps `chart` into the plane with `solver` and checks that no face folds over
 /// (non-positive signed area of its image, summed over the triangle fan of a quad).
 pub fn parameterize(

@@ -1,0 +1,625 @@
+"""beltrami: quasiconformal maps of triangle and quad meshes, numpy arrays in and out.
+
+Meshes are given as ``V`` (float64, ``(n, 3)``; ``(n, 2)`` for a planar mesh in z = 0)
+and ``F`` (integer, ``(m, 3)`` triangles or ``(m, 4)`` quads, 0-based). Maps come back
+as arrays whose rows are the rows of ``V``: ``(n, 2)`` for a map into the plane (texture
+coordinates), ``(n, 3)`` for a map into R^3 (the sphere, a target surface). Beltrami
+coefficients ``mu = f_zbar / f_z`` are complex, one per row of ``F``.
+
+Every solver call takes the options of the matching ``beltrami`` command as keyword
+arguments (``--max-iters`` is ``max_iters``), with the command's defaults, so that a call
+and the command give the same map; ``options={"name": value}`` sets any solver option
+(``--option NAME=VALUE``; :func:`solvers` lists them). With ``info=True`` a call also
+returns the command's JSON report as a dict (``mu_mean``, ``mu_max``, ``flipped``,
+``iterations``, ``k``, timings, ...).
+
+Solves run with the GIL released; Ctrl-C stops an iterative solve at its next step
+(``KeyboardInterrupt``). Errors are :class:`BeltramiError` subclasses (see
+``beltrami._errors``) with the command line's messages.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Callable, Dict, Iterable, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _native
+from ._errors import (
+    BeltramiError,
+    ConstraintError,
+    FieldError,
+    MeshError,
+    MeshFileError,
+    OptionError,
+    SolverError,
+    UnsupportedError,
+)
+
+__version__ = _native.__version__
+
+ArrayLike = Any
+Progress = Callable[[str, int, Optional[int], Optional[float]], None]
+
+__all__ = [
+    "BeltramiError",
+    "ConstraintError",
+    "FieldError",
+    "MeshError",
+    "MeshFileError",
+    "OptionError",
+    "SolverError",
+    "UnsupportedError",
+    "beltrami_coefficient",
+    "beltrami_flow",
+    "circle_domain",
+    "cut_to_disk",
+    "distortion",
+    "extremal",
+    "harmonic",
+    "lscm",
+    "lsqc",
+    "mesh_info",
+    "qc_iteration",
+    "read_mesh",
+    "register",
+    "remesh",
+    "solvers",
+    "sphere_map",
+    "tutte",
+    "write_mesh",
+]
+
+
+# ---- arrays -------------------------------------------------------------------------
+
+
+def _matrix(name: str, a: ArrayLike, dtype: Any, error: type) -> np.ndarray:
+    """``a`` as a 2-D array of ``dtype`` (no copy when it already is one)."""
+    try:
+        out = np.asarray(a, dtype=dtype)
+    except (TypeError, ValueError) as e:
+        raise error(f"{name}: {e}") from None
+    if out.ndim != 2:
+        raise error(f"{name} has {out.ndim} dimensions; expected a 2-D array")
+    return out
+
+
+def _mesh(V: ArrayLike, F: ArrayLike) -> Tuple[np.ndarray, np.ndarray]:
+    V = _matrix("V", V, np.float64, MeshError)
+    F = np.asarray(F)
+    if F.dtype.kind not in "iu":
+        raise MeshError(f"F has dtype {F.dtype}; give integer vertex indices")
+    return V, _matrix("F", F, np.int64, MeshError)
+
+
+def _mu(mu: ArrayLike) -> np.ndarray:
+    out = np.asarray(mu, dtype=np.complex128)
+    if out.ndim != 1:
+        raise FieldError(f"mu has {out.ndim} dimensions; expected one complex value per face")
+    return out
+
+
+# ---- the call description ---------------------------------------------------------
+
+
+def _text(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return str(value)
+
+
+def _options(options: Optional[Dict[str, Any]], **flags: Any) -> Dict[str, str]:
+    """Solver options as text: the dedicated keyword arguments given (not None), then
+    ``options``."""
+    out = {name.replace("_", "-"): _text(v) for name, v in flags.items() if v is not None}
+    for name, value in (options or {}).items():
+        out[str(name)] = _text(value)
+    return out
+
+
+def _goal(
+    mu: Optional[ArrayLike], mu_expr: Optional[str], mu_frame: Optional[str], p: Optional[float]
+) -> Dict[str, Any]:
+    if mu is not None and mu_expr is not None:
+        raise OptionError("give mu or mu_expr, not both")
+    if (mu is not None or mu_expr is not None) and p is not None:
+        raise OptionError("p is the exponent of the conformal goal; a prescribed mu has no exponent")
+    if mu is not None:
+        if mu_frame not in (None, "global", "face"):
+            raise OptionError(f"mu_frame={mu_frame!r}: expected 'global' or 'face'")
+        return {"kind": "mu", "frame": mu_frame or "global"}
+    if mu_expr is not None:
+        return {"kind": "mu_expr", "expr": str(mu_expr)}
+    return {"kind": "conformal", "p": 2.0 if p is None else float(p)}
+
+
+def _pins(pins: Iterable[int]) -> list:
+    return [int(i) for i in pins]
+
+
+def _solve(
+    solver: str,
+    V: ArrayLike,
+    F: ArrayLike,
+    spec: Dict[str, Any],
+    *,
+    boundary_map: Optional[ArrayLike] = None,
+    initial: Optional[ArrayLike] = None,
+    mu: Optional[ArrayLike] = None,
+    target: Optional[Tuple[ArrayLike, ArrayLike]] = None,
+    progress: Optional[Progress] = None,
+) -> Dict[str, Any]:
+    V, F = _mesh(V, F)
+    TV, TF = _mesh(*target) if target is not None else (None, None)
+    out = _native.solve(
+        solver,
+        V,
+        F,
+        json.dumps(spec),
+        None if boundary_map is None else _matrix("boundary_map", boundary_map, np.float64, ConstraintError),
+        None if initial is None else _matrix("init", initial, np.float64, ConstraintError),
+        None if mu is None else _mu(mu),
+        TV,
+        TF,
+        progress,
+    )
+    out["report"] = json.loads(out["report"])
+    return out
+
+
+def _result(out: Dict[str, Any], info: bool) -> Any:
+    return (out["image"], out["report"]) if info else out["image"]
+
+
+# ---- initial maps (`beltrami param`) -------------------------------------------------
+
+
+def tutte(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    boundary: str = "circle",
+    weights: Optional[str] = None,
+    pins: Sequence[int] = (),
+    options: Optional[Dict[str, Any]] = None,
+    info: bool = False,
+) -> Any:
+    """Tutte's embedding of a disk: every interior vertex at the weighted mean of its
+    neighbours (``weights`` ``uniform`` or ``mean-value``), the boundary on the unit
+    circle by arc length (``boundary='circle'``) or on the unit square. Bijective for a
+    convex boundary (Tutte 1963, Floater 2003). Returns ``UV`` ``(n, 2)``.
+    ``beltrami param --solver tutte``."""
+    spec = {"target": "plane", "boundary": boundary, "pins": _pins(pins),
+            "options": _options(options, weights=weights)}
+    return _result(_solve("tutte", V, F, spec), info)
+
+
+def harmonic(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    boundary: str = "circle",
+    weights: Optional[str] = None,
+    pins: Sequence[int] = (),
+    options: Optional[Dict[str, Any]] = None,
+    info: bool = False,
+) -> Any:
+    """The discrete harmonic map of a disk (cotangent weights, Pinkall-Polthier 1993)
+    with the boundary on the unit circle by arc length or on the unit square. Returns
+    ``UV`` ``(n, 2)``. ``beltrami param --solver harmonic``."""
+    spec = {"target": "plane", "boundary": boundary, "pins": _pins(pins),
+            "options": _options(options, weights=weights)}
+    return _result(_solve("harmonic", V, F, spec), info)
+
+
+def lscm(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    pins: Sequence[int] = (),
+    options: Optional[Dict[str, Any]] = None,
+    info: bool = False,
+) -> Any:
+    """Least-squares conformal map (Levy et al. 2002): the minimum of
+    ``sum_f A_f |f_zbar|^2`` with a free boundary and two pinned vertices (``pins``; by
+    default two boundary vertices far apart) sent to 0 and 1. Returns ``UV`` ``(n, 2)``.
+    ``beltrami param --solver lscm``."""
+    spec = {"target": "plane", "boundary": "free", "pins": _pins(pins),
+            "options": _options(options)}
+    return _result(_solve("lscm", V, F, spec), info)
+
+
+def sphere_map(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    options: Optional[Dict[str, Any]] = None,
+    info: bool = False,
+) -> Any:
+    """A conformal map of a closed genus-0 mesh onto the unit sphere, without flipped
+    faces: the harmonic map of the punctured mesh, Moebius centring and chart
+    corrections (docs/sphere.md). Returns ``W`` ``(n, 3)`` on the unit sphere.
+    ``beltrami param --solver sphere``."""
+    spec = {"target": "sphere", "options": _options(options)}
+    return _result(_solve("sphere", V, F, spec), info)
+
+
+# ---- quasiconformal maps (`beltrami qc`) ---------------------------------------------
+
+
+_QC_DEFAULTS = {"tolerance": "1e-06", "max-iters": "200"}
+
+
+def lsqc(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = None,
+    mu_expr: Optional[str] = None,
+    mu_frame: Optional[str] = None,
+    target: str = "plane",
+    boundary: Optional[str] = None,
+    boundary_map: Optional[ArrayLike] = None,
+    pins: Sequence[int] = (),
+    normal_constraint: Optional[float] = None,
+    threads: Optional[int] = None,
+    options: Optional[Dict[str, Any]] = None,
+    info: bool = False,
+) -> Any:
+    """The least-squares quasiconformal map with Beltrami coefficient ``mu`` (one complex
+    value per face, in the plane's frame for a planar mesh, ``mu_frame='face'`` for the
+    face frames) or ``mu_expr`` (an expression of ``z = x + i y`` at the face
+    centroids), or the conformal one when neither is given: the minimum of
+    ``sum_f A_f |f_zbar - mu f_z|^2`` (Mastin-Thompson; Gruber-Aulisa 2022, eq. 3.3).
+
+    ``target='plane'`` (default) maps into the plane with ``boundary`` ``'free'``
+    (default, with ``pins``), ``'keep'`` (the input's own boundary) or ``'given'``
+    (``boundary_map`` ``(n, 2)``); ``target='space'`` maps a surface into R^3 with its
+    boundary held at ``boundary_map`` ``(n, 3)`` (the quaternionic map of Gruber-Aulisa
+    2022), optionally with the normal constraint of weight ``normal_constraint``.
+    Returns ``UV`` ``(n, 2)`` or ``X`` ``(n, 3)``. ``beltrami qc --solver lsqc``."""
+    if target not in ("plane", "space"):
+        raise OptionError(f"lsqc maps into the plane or space, not target={target!r}")
+    spec = {
+        "target": target,
+        "boundary": boundary or ("given" if target == "space" else "free"),
+        "goal": _goal(mu, mu_expr, mu_frame, None),
+        "pins": _pins(pins),
+        "normal_constraint": normal_constraint,
+        "options": _options(options, threads=threads),
+        "defaults": _QC_DEFAULTS,
+    }
+    out = _solve("lsqc", V, F, spec, boundary_map=boundary_map, mu=mu)
+    return _result(out, info)
+
+
+def beltrami_flow(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = None,
+    mu_expr: Optional[str] = None,
+    mu_frame: Optional[str] = None,
+    p: Optional[float] = None,
+    target: str = "disk",
+    boundary: Optional[str] = None,
+    boundary_map: Optional[ArrayLike] = None,
+    free_radius: bool = False,
+    pins: Sequence[int] = (),
+    tolerance: Optional[float] = None,
+    max_iters: Optional[int] = None,
+    threads: Optional[int] = None,
+    options: Optional[Dict[str, Any]] = None,
+    progress: Optional[Progress] = None,
+    info: bool = False,
+) -> Any:
+    """The discrete Beltrami flow (Wong-Zhao 2014): the bijective map onto ``target``
+    (``'disk'``, ``'annulus'``, ``'sphere'`` or ``'plane'``, the input's own planar
+    region) with Beltrami coefficient ``mu``/``mu_expr``, or the most conformal one
+    (smallest ``L^p`` norm of mu, ``p >= 2``) when neither is given. On the sphere
+    ``mu_expr`` is in the stereographic coordinate. ``progress(stage, done, total,
+    energy)`` is called at every step. Returns ``UV`` ``(n, 2)`` or ``W`` ``(n, 3)`` on
+    the sphere. ``beltrami qc --solver beltrami-flow``."""
+    if target not in ("disk", "annulus", "sphere", "plane"):
+        raise OptionError(
+            f"beltrami_flow maps onto 'disk', 'annulus', 'sphere' or 'plane', not target={target!r}"
+        )
+    spec = {
+        "target": target,
+        "boundary": boundary or "keep",
+        "free_radius": bool(free_radius),
+        "goal": _goal(mu, mu_expr, mu_frame, p),
+        "pins": _pins(pins),
+        "options": _options(options, tolerance=tolerance, max_iters=max_iters, threads=threads),
+        "defaults": _QC_DEFAULTS,
+    }
+    out = _solve("beltrami-flow", V, F, spec, boundary_map=boundary_map, mu=mu, progress=progress)
+    return _result(out, info)
+
+
+def _extremal_like(
+    solver: str,
+    V: ArrayLike,
+    F: ArrayLike,
+    boundary_map: ArrayLike,
+    init: Union[str, ArrayLike, None],
+    flags: Dict[str, Any],
+    options: Optional[Dict[str, Any]],
+    progress: Optional[Progress],
+    info: bool,
+) -> Any:
+    initial = None
+    if init is not None and not isinstance(init, str):
+        initial, init = init, None
+    spec = {
+        "target": "plane",
+        "boundary": "given",
+        "goal": {"kind": "extremal"},
+        "options": _options(options, init=init, **flags),
+        "defaults": _QC_DEFAULTS,
+    }
+    out = _solve(solver, V, F, spec, boundary_map=boundary_map, initial=initial, progress=progress)
+    if not info:
+        return out["image"]
+    report = out["report"]
+    if "qd" in out:
+        report["quadratic_differential"] = out["qd"]
+    return out["image"], report
+
+
+def extremal(
+    V: ArrayLike,
+    F: ArrayLike,
+    boundary_map: ArrayLike,
+    *,
+    init: Union[str, ArrayLike, None] = None,
+    tolerance: Optional[float] = None,
+    max_iters: Optional[int] = None,
+    threads: Optional[int] = None,
+    options: Optional[Dict[str, Any]] = None,
+    progress: Optional[Progress] = None,
+    info: bool = False,
+) -> Any:
+    """The extremal (Teichmueller) map of a disk with the boundary values of
+    ``boundary_map`` ``(n, 2)``: the map of smallest largest distortion, with constant
+    ``|mu| = k`` and ``mu = k conj(phi)/|phi|`` for a holomorphic quadratic differential
+    ``phi`` (Weber-Myles-Zorin 2012, Algorithm 1). ``init``: ``'harmonic'``, ``'tutte'``
+    or an ``(n, 2)`` start map (it may fold). Returns ``UV`` ``(n, 2)``; with
+    ``info=True`` the report has ``k`` and ``quadratic_differential`` (one complex value
+    per face). ``beltrami qc --solver extremal --boundary given``."""
+    return _extremal_like(
+        "extremal", V, F, boundary_map, init,
+        {"tolerance": tolerance, "max_iters": max_iters, "threads": threads},
+        options, progress, info,
+    )
+
+
+def qc_iteration(
+    V: ArrayLike,
+    F: ArrayLike,
+    boundary_map: ArrayLike,
+    *,
+    init: Union[str, ArrayLike, None] = None,
+    tolerance: Optional[float] = None,
+    max_iters: Optional[int] = None,
+    threads: Optional[int] = None,
+    options: Optional[Dict[str, Any]] = None,
+    progress: Optional[Progress] = None,
+    info: bool = False,
+) -> Any:
+    """The QC iteration towards the Teichmueller map with the boundary values of
+    ``boundary_map`` (Lui et al. 2014): alternate the LSQC map of the current mu with
+    averaging of mu and projection onto constant modulus. Returns ``UV`` ``(n, 2)``.
+    ``beltrami qc --solver qc-iteration --boundary given``."""
+    return _extremal_like(
+        "qc-iteration", V, F, boundary_map, init,
+        {"tolerance": tolerance, "max_iters": max_iters, "threads": threads},
+        options, progress, info,
+    )
+
+
+def circle_domain(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = None,
+    mu_expr: Optional[str] = None,
+    mu_frame: Optional[str] = None,
+    outer: Optional[int] = None,
+    tolerance: Optional[float] = None,
+    max_iters: Optional[int] = None,
+    options: Optional[Dict[str, Any]] = None,
+    progress: Optional[Progress] = None,
+    info: bool = False,
+) -> Any:
+    """The map of a genus-0 surface with several boundary loops onto a circle domain
+    (the unit disk minus disks), conformal or with Beltrami coefficient ``mu``
+    (Ho-Lui 2016, Algorithm 2). ``outer`` is the boundary loop sent to the unit circle
+    (default: the longest). Returns ``UV`` ``(n, 2)``; with ``info=True`` the report has
+    the ``circles`` (loop, centre, radius, deviation). ``beltrami param --solver qcmc``,
+    or ``beltrami qc --solver qcmc`` with a mu."""
+    prescribed = mu is not None or mu_expr is not None
+    spec = {
+        "target": "circle-domain",
+        "goal": _goal(mu, mu_expr, mu_frame, None),
+        "options": _options(
+            options,
+            tolerance=tolerance,
+            max_iters=max_iters,
+            outer=None if outer is None else int(outer) + 1,
+        ),
+        "defaults": _QC_DEFAULTS if prescribed else {},
+    }
+    return _result(_solve("qcmc", V, F, spec, mu=mu, progress=progress), info)
+
+
+# ---- registration (`beltrami register`) ----------------------------------------------
+
+
+def _landmarks(landmarks: Any) -> Optional[str]:
+    """The text of a landmarks file from a path, or from pairs: ``(src, tgt)`` moves a
+    source vertex onto a target vertex (``v``), ``(src, (x, y, z))`` onto a point
+    (``p``)."""
+    if landmarks is None:
+        return None
+    if isinstance(landmarks, (str, os.PathLike)):
+        try:
+            with open(landmarks, encoding="utf-8") as f:
+                return f.read()
+        except OSError as e:
+            raise MeshFileError(f"landmarks {os.fspath(landmarks)}: {e.strerror}") from None
+    lines = []
+    for k, pair in enumerate(landmarks):
+        try:
+            src, goal = pair
+        except (TypeError, ValueError):
+            raise ConstraintError(f"landmark {k}: expected (source vertex, target vertex or point)") from None
+        if np.ndim(goal) == 0:
+            lines.append(f"v {int(src)} {int(goal)}")
+        else:
+            x, y, z = (float(c) for c in goal)
+            lines.append(f"p {int(src)} {x!r} {y!r} {z!r}")
+    return "\n".join(lines) + "\n"
+
+
+def register(
+    V: ArrayLike,
+    F: ArrayLike,
+    TV: ArrayLike,
+    TF: ArrayLike,
+    *,
+    landmarks: Any = None,
+    mu: Optional[ArrayLike] = None,
+    p: Optional[float] = None,
+    tolerance: Optional[float] = None,
+    max_iters: Optional[int] = None,
+    threads: Optional[int] = None,
+    allow_flips: bool = False,
+    options: Optional[Dict[str, Any]] = None,
+    progress: Optional[Progress] = None,
+    info: bool = False,
+) -> Any:
+    """A bijective map of the mesh ``V, F`` onto the mesh ``TV, TF`` of the same topology
+    (disk, closed genus 0 or 1), as conformal as the ``landmarks`` allow (smallest
+    ``L^p`` norm of mu) or with the Beltrami coefficient ``mu`` (face frames): an initial
+    bijection through a common parameter domain, then the Beltrami flow on the target
+    (Wong-Zhao 2014). ``landmarks`` is a landmarks file (``v``, ``p`` and ``c`` lines) or
+    pairs ``(src, tgt)`` / ``(src, (x, y, z))``.
+
+    Returns ``(P, face, bary)``: the image of every vertex ``(n, 3)``, the row of ``TF``
+    it lies in and its barycentric coordinates there (``(n, 3)``, ``(n, 4)`` on quads).
+    ``beltrami register`` (with ``--correspondence``)."""
+    spec = {
+        "target": "mesh",
+        "goal": {"kind": "mu", "frame": "face"} if mu is not None else _goal(None, None, None, p),
+        "landmarks": _landmarks(landmarks),
+        "options": _options(
+            options,
+            tolerance=tolerance,
+            max_iters=max_iters,
+            threads=threads,
+            allow_flips=True if allow_flips else None,
+        ),
+        "defaults": {"tolerance": "1e-05", "max-iters": "100"},
+    }
+    if mu is not None and p is not None:
+        raise OptionError("p is the exponent of the conformal goal; a prescribed mu has no exponent")
+    out = _solve("register", V, F, spec, mu=mu, target=(TV, TF), progress=progress)
+    result = (out["image"], out["face"], out["bary"])
+    return (*result, out["report"]) if info else result
+
+
+# ---- measuring -----------------------------------------------------------------------
+
+
+def beltrami_coefficient(V: ArrayLike, F: ArrayLike, X: ArrayLike) -> np.ndarray:
+    """The Beltrami coefficient ``mu = f_zbar / f_z`` of the map with images ``X`` per
+    face (rows of ``F``; complex). ``X`` ``(n, 2)`` is a map into the plane, measured in
+    the plane's frame when ``V`` lies in z = 0 and in each face's frame otherwise;
+    ``X`` ``(n, 3)`` a map into R^3, measured in the face frames. As ``beltrami
+    distortion --per-face``."""
+    V, F = _mesh(V, F)
+    mu, _frame = _native.beltrami_coefficient(V, F, _matrix("X", X, np.float64, ConstraintError))
+    return mu
+
+
+def distortion(V: ArrayLike, F: ArrayLike, X: ArrayLike) -> Dict[str, Any]:
+    """Statistics of ``|mu|`` of the map with images ``X`` (see
+    :func:`beltrami_coefficient`): ``faces``, ``flipped``, ``mu_mean``, ``mu_max``,
+    ``mu_std``, ``mu_l2`` (area-weighted), ``frame`` and ``flipped_faces`` (rows of
+    ``F``). As ``beltrami distortion --json``."""
+    V, F = _mesh(V, F)
+    return _native.distortion(V, F, _matrix("X", X, np.float64, ConstraintError))
+
+
+def mesh_info(V: ArrayLike, F: ArrayLike) -> Dict[str, Any]:
+    """Validates the mesh and returns its sizes and topology: ``vertices``, ``faces``,
+    ``edges``, ``boundary_loops``, ``components``, ``euler_characteristic``, ``genus``,
+    ``topology``. An invalid mesh raises :class:`MeshError` naming the element."""
+    return _native.mesh_info(*_mesh(V, F))
+
+
+# ---- new meshes ----------------------------------------------------------------------
+
+
+def remesh(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    edge_length: Optional[float] = None,
+    vertices: Optional[int] = None,
+    param: str = "auto",
+    min_angle: float = 30.0,
+    size_field: str = "uniform",
+    max_vertices: int = 5_000_000,
+    info: bool = False,
+) -> Any:
+    """A new triangle mesh of the surface with the asked ``edge_length`` (or about
+    ``vertices`` vertices): parameterize (``param``: ``auto`` or a solver), triangulate
+    the parameter domain by constrained Delaunay refinement with angles of at least
+    ``min_angle`` degrees, lift back (docs/remesh.md). Returns ``(V2, F2)``.
+    ``beltrami remesh``."""
+    V, F = _mesh(V, F)
+    V2, F2, report = _native.remesh(
+        V, F, edge_length, vertices, param, float(min_angle), size_field, int(max_vertices)
+    )
+    return (V2, F2, json.loads(report)) if info else (V2, F2)
+
+
+def cut_to_disk(V: ArrayLike, F: ArrayLike, *, info: bool = False) -> Any:
+    """The surface (genus >= 1, or several boundary loops) cut into a topological disk
+    along a greedy shortest system of loops. Returns ``(V2, F2, original)``: face ``i``
+    of ``F2`` is face ``i`` of ``F``, and ``original[j]`` is the row of ``V`` that
+    cut-mesh vertex ``j`` copies. ``beltrami cut``."""
+    V2, F2, original, report = _native.cut_to_disk(*_mesh(V, F))
+    return (V2, F2, original, json.loads(report)) if info else (V2, F2, original)
+
+
+# ---- files and the catalog -----------------------------------------------------------
+
+
+def read_mesh(path: Union[str, "os.PathLike[str]"], *, uv: bool = False) -> Any:
+    """Reads an OBJ, glTF or GLB mesh: ``(V, F)``, or ``(V, F, UV)`` with ``uv=True``
+    (``UV`` ``(n, 2)`` when the file has one texture coordinate per vertex, else None).
+    The mesh is validated as the command line validates its input."""
+    V, F, UV = _native.read_mesh(os.fspath(path))
+    return (V, F, UV) if uv else (V, F)
+
+
+def write_mesh(
+    path: Union[str, "os.PathLike[str]"], V: ArrayLike, F: ArrayLike, uv: Optional[ArrayLike] = None
+) -> None:
+    """Writes the mesh (OBJ, glTF or GLB by extension), with texture coordinates ``uv``
+    ``(n, 2)`` when given; atomically (a complete file or none)."""
+    V, F = _mesh(V, F)
+    UV = None if uv is None else _matrix("uv", uv, np.float64, ConstraintError)
+    _native.write_mesh(os.fspath(path), V, F, UV)
+
+
+def solvers() -> list:
+    """Every registered solver with what it accepts and its options (types, defaults,
+    ranges), as ``beltrami solvers --json``."""
+    return json.loads(_native.solvers())

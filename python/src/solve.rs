@@ -1,0 +1,430 @@
+//! `solve`: one call of a registered solver, described by the Python package.
+//!
+//! The package turns a call's keyword arguments into a description (JSON text, keys
+//! below) and the arrays beside it; this module builds the [`Problem`] the command line
+//! builds from the same flags, checks it (options, constraints, topology: before any
+//! work), solves it with the GIL released and returns the map in the input's vertex
+//! order with the JSON report of `--report`.
+//!
+//! | key | value |
+//! |---|---|
+//! | `target` | `plane`, `disk`, `annulus`, `sphere`, `space`, `circle-domain`, `mesh` |
+//! | `boundary` | `plane`: `circle`, `square`, `free`, `keep` or `given` (`boundary_map`) |
+//! | `free_radius` | `annulus`: let the inner radius move (else the input's is kept) |
+//! | `goal` | `{"kind": "conformal", "p": P}`, `{"kind": "mu", "frame": F}` (`mu`), `{"kind": "mu_expr", "expr": E}`, `{"kind": "extremal"}` |
+//! | `pins` | input vertex indices held where the solver puts them |
+//! | `normal_constraint` | `space`: the weight of the normal constraint |
+//! | `landmarks` | `mesh`: the text of a landmarks file |
+//! | `options` | solver options as text, `{name: value}` (`--option NAME=VALUE`) |
+//! | `defaults` | the command's defaults, set when the solver declares the option |
+//!
+//! Ctrl-C: the solver's progress reports check Python's signals; a pending
+//! `KeyboardInterrupt` cancels the solve (at its next report) and is raised.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use beltrami::landmarks::Landmarks;
+use beltrami::map_file::{self, Image};
+use beltrami_core::{
+    Constraint, Context, Goal, Map, Pin, PlanarBoundary, Position, Problem, Progress, Solution,
+    Target,
+};
+use beltrami_fem::{BeltramiField, Expr, Frame};
+use beltrami_mesh::Mesh;
+use num_complex::Complex64;
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use serde_json::{Map as JsonMap, Value, json};
+
+use crate::arrays;
+use crate::errors::{self, Kind};
+
+/// The arrays of a call beside its description.
+pub struct Inputs<'py> {
+    boundary_map: Option<PyReadonlyArray2<'py, f64>>,
+    initial: Option<PyReadonlyArray2<'py, f64>>,
+    mu: Option<PyReadonlyArray1<'py, Complex64>>,
+}
+
+fn option_error(message: String) -> PyErr {
+    errors::raise(Kind::Option, message)
+}
+
+fn text<'a>(spec: &'a JsonMap<String, Value>, key: &str) -> Option<&'a str> {
+    spec.get(key).and_then(Value::as_str)
+}
+
+/// The target of the description (`target_mesh` for `mesh`).
+fn target<'a>(
+    spec: &JsonMap<String, Value>,
+    mesh: &Mesh,
+    target_mesh: Option<&'a Mesh>,
+    inputs: &Inputs<'_>,
+) -> PyResult<Target<'a>> {
+    let name = text(spec, "target").unwrap_or("plane");
+    Ok(match name {
+        "plane" => Target::Plane(match text(spec, "boundary").unwrap_or("keep") {
+            "circle" => PlanarBoundary::Circle,
+            "square" => PlanarBoundary::Square { corners: None },
+            "free" => PlanarBoundary::Free,
+            "keep" => PlanarBoundary::Keep,
+            "given" => {
+                let Some(map) = &inputs.boundary_map else {
+                    return Err(option_error(
+                        "boundary='given' needs boundary_map, an (n, 2) array".into(),
+                    ));
+                };
+                PlanarBoundary::Given(arrays::planar(mesh, map.as_array(), "boundary_map")?)
+            }
+            other => {
+                return Err(option_error(format!(
+                    "boundary={other:?}: expected 'circle', 'square', 'free', 'keep' or 'given'"
+                )));
+            }
+        }),
+        "disk" => Target::Disk,
+        "annulus" => Target::Annulus {
+            inner_radius: if spec.get("free_radius").and_then(Value::as_bool) == Some(true) {
+                None
+            } else {
+                beltrami::flow_engine::annulus_inner_radius(mesh)
+            },
+        },
+        "sphere" => Target::Sphere,
+        "space" => Target::Surface,
+        "circle-domain" => Target::CircleDomain,
+        "mesh" => Target::Mesh(
+            target_mesh
+                .ok_or_else(|| option_error("the target mesh (TV, TF) is missing".into()))?,
+        ),
+        other => {
+            return Err(option_error(format!(
+                "target={other:?}: expected 'plane', 'disk', 'annulus', 'sphere' or 'space'"
+            )));
+        }
+    })
+}
+
+/// The goal of the description (the problem's default, the conformal map, without one).
+fn goal(spec: &JsonMap<String, Value>, mesh: &Mesh, inputs: &Inputs<'_>) -> PyResult<Option<Goal>> {
+    let Some(goal) = spec.get("goal").and_then(Value::as_object) else {
+        return Ok(None);
+    };
+    let field_error = |e: &(dyn std::error::Error + 'static)| errors::from_error(Kind::Field, e);
+    Ok(Some(match goal.get("kind").and_then(Value::as_str) {
+        Some("conformal") => Goal::Conformal {
+            p: goal.get("p").and_then(Value::as_f64).unwrap_or(2.0),
+        },
+        Some("extremal") => Goal::Extremal,
+        Some("mu") => {
+            let Some(mu) = &inputs.mu else {
+                return Err(option_error("mu is missing".into()));
+            };
+            let frame = match goal.get("frame").and_then(Value::as_str) {
+                Some("face") => Frame::Face,
+                _ => Frame::Global,
+            };
+            let values = arrays::faces_from_rows(mesh, mu.as_array(), "mu")?;
+            Goal::Prescribed(BeltramiField::new(frame, values))
+        }
+        Some("mu_expr") => {
+            let source = goal.get("expr").and_then(Value::as_str).unwrap_or("");
+            let expr = Expr::parse(source).map_err(|e| {
+                errors::raise(
+                    Kind::Field,
+                    format!(
+                        "mu_expr {source:?}: {}",
+                        beltrami::report::error_message(&e)
+                    ),
+                )
+            })?;
+            let field = if text(spec, "target") == Some("sphere") {
+                beltrami::flow::stereographic::field(mesh, |z| expr.eval(z))
+                    .map_err(|e| field_error(&e))?
+            } else {
+                expr.field(mesh).map_err(|e| {
+                    errors::raise(
+                        Kind::Field,
+                        format!(
+                            "mu_expr evaluates mu at z = x + i y and needs a mesh in the plane z = 0 ({}); give a per-face mu instead",
+                            beltrami::report::error_message(&e)
+                        ),
+                    )
+                })?
+            };
+            Goal::Prescribed(field)
+        }
+        other => return Err(option_error(format!("goal {other:?} is not a goal"))),
+    }))
+}
+
+/// The constraints of the description: pins, the normal constraint, the held boundary
+/// of `space`, landmarks.
+fn constraints(
+    spec: &JsonMap<String, Value>,
+    problem: &mut Problem<'_>,
+    target_mesh: Option<&Mesh>,
+    inputs: &Inputs<'_>,
+) -> PyResult<()> {
+    let mesh = problem.source;
+    for pin in spec
+        .get("pins")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
+        let index = pin.as_i64().ok_or_else(|| {
+            errors::raise(Kind::Constraint, format!("pin {pin}: not a vertex index"))
+        })?;
+        problem.constraints.push(Constraint::Pin(Pin {
+            vertex: arrays::vertex(mesh, index, "pins")?,
+            position: None,
+        }));
+    }
+    if let Some(weight) = spec.get("normal_constraint").and_then(Value::as_f64) {
+        problem.constraints.push(Constraint::Normal { weight });
+    }
+    if text(spec, "target") == Some("space") {
+        let Some(map) = &inputs.boundary_map else {
+            return Err(option_error(
+                "target='space' holds the boundary at the positions of boundary_map, an (n, 3) array"
+                    .into(),
+            ));
+        };
+        let held = arrays::spatial(mesh, map.as_array(), "boundary_map")?;
+        problem.constraints.extend(
+            mesh.boundary_loop_list()
+                .into_iter()
+                .flat_map(|l| l.vertices)
+                .map(|v| {
+                    Constraint::Pin(Pin {
+                        vertex: v,
+                        position: Some(Position::Spatial(held[v.idx()])),
+                    })
+                }),
+        );
+    }
+    if let (Some(source), Some(target)) = (text(spec, "landmarks"), target_mesh) {
+        let marks = Landmarks::parse(Path::new("landmarks"), source, mesh, target)
+            .map_err(|e| errors::from_error(Kind::Constraint, &e))?;
+        problem
+            .constraints
+            .extend(marks.constraints(target).iter().cloned());
+    }
+    Ok(())
+}
+
+/// Sets the description's `options` (always) and `defaults` (when `solver` declares
+/// them), as the command line's `solver_options` does.
+fn options(
+    spec: &JsonMap<String, Value>,
+    problem: &mut Problem<'_>,
+    solver: &dyn beltrami_core::Solver,
+) {
+    let declared = |name: &str| solver.options().iter().any(|s| s.name == name);
+    let entries = |key: &str| {
+        spec.get(key)
+            .and_then(Value::as_object)
+            .into_iter()
+            .flatten()
+            .map(|(k, v)| {
+                (
+                    k.clone(),
+                    v.as_str().map_or_else(|| v.to_string(), str::to_string),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    for (name, value) in entries("defaults") {
+        if declared(&name) {
+            problem.options.set_text(&name, &value);
+        }
+    }
+    for (name, value) in entries("options") {
+        problem.options.set_text(&name, &value);
+    }
+}
+
+/// Checks and runs `solver` on `problem` with the GIL released; Python's signals are
+/// checked at every progress report (and `progress`, a Python callable, called with
+/// `(stage, done, total, energy)`), a `KeyboardInterrupt` or an exception of the
+/// callable cancelling the solve.
+fn run(
+    py: Python<'_>,
+    solver: &dyn beltrami_core::Solver,
+    problem: &Problem<'_>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Solution, f64)> {
+    let settings = solver.check(problem).map_err(|e| errors::from_solver(&e))?;
+    let cancel = Arc::new(AtomicBool::new(false));
+    let mut pending: Option<PyErr> = None;
+    let start = Instant::now();
+    let result = py.detach(|| {
+        let flag = Arc::clone(&cancel);
+        let mut context = Context::new()
+            .with_cancel_flag(Arc::clone(&cancel))
+            .with_progress(|p: &Progress| {
+                if pending.is_some() {
+                    return;
+                }
+                let outcome = Python::attach(|py| {
+                    py.check_signals()?;
+                    if let Some(callback) = &progress {
+                        callback.call1(py, (p.stage, p.done, p.total, p.energy))?;
+                    }
+                    Ok::<(), PyErr>(())
+                });
+                if let Err(e) = outcome {
+                    pending = Some(e);
+                    flag.store(true, Ordering::Relaxed);
+                }
+            });
+        solver.run(problem, &settings, &mut context)
+    });
+    let seconds = start.elapsed().as_secs_f64();
+    if let Some(e) = pending {
+        return Err(e);
+    }
+    let solution = result.map_err(|e| errors::from_solver(&e))?;
+    Ok((solution, seconds))
+}
+
+/// The report of `--report` for `solution` (without the file names).
+fn report(mesh: &Mesh, solution: &Solution, seconds: f64) -> String {
+    let mut report = beltrami::report::solution_json(solution);
+    report.insert("seconds".into(), json!(seconds));
+    report.extend(beltrami::report::mu_error_keys(
+        solution.metrics.mu_error.as_ref(),
+    ));
+    let fits = beltrami::report::circle_fits(mesh, solution);
+    if !fits.is_empty() {
+        report.insert("circles".into(), beltrami::report::circles(&fits));
+    }
+    Value::Object(report).to_string()
+}
+
+/// Solves one call (module docs) and returns a dict: `image` (`(n, 2)` planar images or
+/// `(n, 3)` points, rows in the input's vertex order), `kind` (`uv` or `xyz`), `report`
+/// (JSON text), and when the solver gives them `face` and `bary` (a map onto a target
+/// mesh: the target face row and barycentric coordinates per vertex), `qd` (the
+/// quadratic differential per face row of an extremal map).
+#[pyfunction]
+#[pyo3(signature = (solver, v, f, spec, boundary_map=None, initial=None, mu=None, target_v=None, target_f=None, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn solve<'py>(
+    py: Python<'py>,
+    solver: &str,
+    v: PyReadonlyArray2<'_, f64>,
+    f: PyReadonlyArray2<'_, i64>,
+    spec: &str,
+    boundary_map: Option<PyReadonlyArray2<'py, f64>>,
+    initial: Option<PyReadonlyArray2<'py, f64>>,
+    mu: Option<PyReadonlyArray1<'py, Complex64>>,
+    target_v: Option<PyReadonlyArray2<'_, f64>>,
+    target_f: Option<PyReadonlyArray2<'_, i64>>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let spec: Value = serde_json::from_str(spec)
+        .map_err(|e| option_error(format!("the call's description is not JSON: {e}")))?;
+    let spec = spec.as_object().cloned().unwrap_or_default();
+    let inputs = Inputs {
+        boundary_map,
+        initial,
+        mu,
+    };
+    let registry = beltrami::registry();
+    let solver = registry.get(solver).map_err(|e| errors::from_solver(&e))?;
+    let mesh = arrays::mesh(v.as_array(), f.as_array())?;
+    let target_mesh = match (target_v, target_f) {
+        (Some(tv), Some(tf)) => Some(arrays::mesh(tv.as_array(), tf.as_array())?),
+        _ => None,
+    };
+
+    let mut problem = Problem::new(&mesh, target(&spec, &mesh, target_mesh.as_ref(), &inputs)?);
+    if let Some(goal) = goal(&spec, &mesh, &inputs)? {
+        problem.goal = goal;
+    }
+    if let Some(initial) = &inputs.initial {
+        problem.initial = Some(Map::Planar(arrays::planar(
+            &mesh,
+            initial.as_array(),
+            "init",
+        )?));
+    }
+    constraints(&spec, &mut problem, target_mesh.as_ref(), &inputs)?;
+    options(&spec, &mut problem, solver);
+
+    let (solution, seconds) = run(py, solver, &problem, progress)?;
+    let out = PyDict::new(py);
+    let Some(map) = solution.map() else {
+        return Err(errors::raise(
+            Kind::Solver,
+            format!("{} gave no map", solver.name()),
+        ));
+    };
+    let image = map_file::image(&mesh, map, target_mesh.as_ref())
+        .map_err(|e| errors::from_error(Kind::Solver, &e))?;
+    match image {
+        Image::Uv(uv) => {
+            out.set_item("kind", "uv")?;
+            out.set_item(
+                "image",
+                arrays::vertex_rows(&mesh, &uv, 2, |t| vec![t.x, t.y]).into_pyarray(py),
+            )?;
+        }
+        Image::Positions(p) => {
+            out.set_item("kind", "xyz")?;
+            out.set_item(
+                "image",
+                arrays::vertex_rows(&mesh, &p, 3, |p| vec![p.x, p.y, p.z]).into_pyarray(py),
+            )?;
+        }
+    }
+    if let (Map::OnMesh(points), Some(target)) = (map, target_mesh.as_ref()) {
+        let face: Vec<f64> = points
+            .iter()
+            .map(|p| target.face_to_input(p.face) as f64)
+            .collect();
+        let degree = points
+            .iter()
+            .map(|p| target.face_degree(p.face))
+            .max()
+            .unwrap_or(3);
+        let rows = arrays::vertex_rows(&mesh, &face, 1, |&f| vec![f]);
+        let face: Array1<i64> = rows
+            .column(0)
+            .mapv(|x| if x.is_nan() { -1 } else { x as i64 });
+        let bary: Array2<f64> = arrays::vertex_rows(&mesh, points, degree, |p| {
+            p.coords[..target.face_degree(p.face)].to_vec()
+        });
+        out.set_item("face", face.into_pyarray(py))?;
+        out.set_item("bary", bary.into_pyarray(py))?;
+    }
+    if let Some(qd) = &solution.extras.quadratic_differential {
+        let nan = Complex64::new(f64::NAN, f64::NAN);
+        out.set_item(
+            "qd",
+            arrays::face_rows(&mesh, &qd.values, nan).into_pyarray(py),
+        )?;
+    }
+    out.set_item("report", report(&mesh, &solution, seconds))?;
+    Ok(out)
+}
+
+/// Every registered solver as the JSON text of `beltrami solvers --json`.
+#[pyfunction]
+pub fn solvers() -> String {
+    let registry = beltrami::registry();
+    Value::Array(
+        registry
+            .iter()
+            .map(beltrami::catalog::solver_json)
+            .collect(),
+    )
+    .to_string()
+}

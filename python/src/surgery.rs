@@ -1,0 +1,143 @@
+//! New meshes from a mesh: `remesh` and `cut_to_disk`.
+
+use std::time::Instant;
+
+use beltrami_core::Context;
+use beltrami_mesh::Mesh;
+use beltrami_remesh::{RemeshOptions, Resolution, SizeField};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::prelude::*;
+use serde_json::json;
+
+use crate::arrays;
+use crate::errors::{self, Kind};
+
+/// The positions `(n, 3)` and faces `(m, k)` of a mesh built here (its vertices and
+/// faces in its own order).
+fn mesh_arrays(mesh: &Mesh) -> PyResult<(Array2<f64>, Array2<i64>)> {
+    let mut v = Array2::zeros((mesh.vertex_count(), 3));
+    for (i, p) in mesh.positions().iter().enumerate() {
+        for c in 0..3 {
+            v[[i, c]] = p[c];
+        }
+    }
+    let f = arrays::faces(mesh)
+        .ok_or_else(|| errors::raise(Kind::Solver, "the new mesh mixes triangles and quads"))?;
+    Ok((v, f))
+}
+
+/// A new triangle mesh of the surface `V`, `F` with the asked edge length (or about
+/// `vertices` vertices), made through a parameterization (`beltrami remesh`): returns
+/// the positions, the triangles and the JSON report of `--report`.
+#[pyfunction]
+#[pyo3(signature = (v, f, edge_length=None, vertices=None, param="auto", min_angle=30.0, size_field="uniform", max_vertices=5_000_000))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn remesh<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'_, f64>,
+    f: PyReadonlyArray2<'_, i64>,
+    edge_length: Option<f64>,
+    vertices: Option<usize>,
+    param: &str,
+    min_angle: f64,
+    size_field: &str,
+    max_vertices: usize,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, String)> {
+    let resolution = match (edge_length, vertices) {
+        (Some(l), None) => Resolution::EdgeLength(l),
+        (None, Some(n)) => Resolution::Vertices(n),
+        _ => {
+            return Err(errors::raise(
+                Kind::Option,
+                "give one of edge_length and vertices",
+            ));
+        }
+    };
+    let size_field = match size_field {
+        "uniform" => SizeField::Uniform,
+        "curvature" => SizeField::Curvature,
+        other => {
+            return Err(errors::raise(
+                Kind::Option,
+                format!("size_field={other:?}: expected 'uniform' or 'curvature'"),
+            ));
+        }
+    };
+    let options = RemeshOptions {
+        resolution,
+        min_angle,
+        size_field,
+        max_vertices,
+    };
+    let remesh_error = |e: &beltrami_remesh::RemeshError| errors::from_error(Kind::Solver, e);
+    options
+        .validate()
+        .map_err(|e| errors::from_error(Kind::Option, &e))?;
+    let mesh = arrays::mesh(v.as_array(), f.as_array())?;
+    let registry = beltrami::registry();
+    let solvers =
+        beltrami_remesh::param::chosen(&registry, &mesh, param).map_err(|e| remesh_error(&e))?;
+    let start = Instant::now();
+    let result = py.detach(|| {
+        let mut context = Context::new();
+        let result = beltrami_remesh::remesh(&mesh, &solvers, &options, &mut context)?;
+        let quality = beltrami_remesh::quality::measure(&mesh, &result.remeshed.mesh)?;
+        Ok((result, quality))
+    });
+    let (result, quality) = result.map_err(|e| remesh_error(&e))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let report = beltrami::report::remesh(&mesh, &result, &quality, seconds);
+    let (v, f) = mesh_arrays(&result.remeshed.mesh)?;
+    Ok((
+        v.into_pyarray(py),
+        f.into_pyarray(py),
+        serde_json::Value::Object(report).to_string(),
+    ))
+}
+
+/// The surface `V`, `F` (genus >= 1 or several boundary loops) cut into a topological
+/// disk along a greedy shortest system of loops (`beltrami cut`): returns the cut
+/// mesh's positions and faces (face `i` is face `i` of `F`), the input vertex of every
+/// cut-mesh vertex, and a report (`genus`, `boundary_loops`, `cut_edges`, `cut_length`,
+/// `boundary_edges`, `boundary_length`).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+pub fn cut_to_disk<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'_, f64>,
+    f: PyReadonlyArray2<'_, i64>,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<i64>>,
+    Bound<'py, PyArray1<i64>>,
+    String,
+)> {
+    let mesh = arrays::mesh(v.as_array(), f.as_array())?;
+    let cut = py
+        .detach(|| beltrami_mesh::cut_to_disk(&mesh))
+        .map_err(|e| errors::from_error(Kind::Unsupported, &e))?;
+    let (cv, cf) = mesh_arrays(&cut.mesh)?;
+    let original: Array1<i64> = cut
+        .to_original
+        .iter()
+        .map(|&o| mesh.vertex_map().to_input(o) as i64)
+        .collect();
+    let component = cut.cut.components[0];
+    let report = json!({
+        "genus": component.genus,
+        "boundary_loops": component.boundary_loops,
+        "cut_edges": cut.cut.edges.len(),
+        "cut_length": cut.cut.length(&mesh),
+        "vertices": cut.mesh.vertex_count(),
+        "faces": cut.mesh.face_count(),
+        "boundary_edges": cut.boundary.len(),
+        "boundary_length": cut.boundary_length(),
+    });
+    Ok((
+        cv.into_pyarray(py),
+        cf.into_pyarray(py),
+        original.into_pyarray(py),
+        report.to_string(),
+    ))
+}
