@@ -1,0 +1,231 @@
+"""Every call against the ``beltrami`` command on the same mesh: the same map to 1e-9."""
+
+import json
+
+import numpy as np
+import pytest
+
+import beltrami
+from conftest import MESHES, close
+
+
+def uv_of(path):
+    _, _, uv = beltrami.read_mesh(path, uv=True)
+    assert uv is not None, f"{path} has no texture coordinates"
+    return uv
+
+
+def positions_of(path):
+    return beltrami.read_mesh(path)[0]
+
+
+def report_of(path):
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
+
+
+@pytest.mark.parametrize(
+    "solver,flags,kwargs",
+    [
+        ("tutte", [], {}),
+        ("tutte", ["--boundary", "square", "--weights", "mean-value"], {"boundary": "square", "weights": "mean-value"}),
+        ("harmonic", [], {}),
+        ("lscm", [], {}),
+        ("lscm", ["--pin", "v0", "--pin", "v700"], {"pins": [0, 700]}),
+    ],
+)
+def test_initial_maps_match_param(cli, hemisphere, tmp_path, solver, flags, kwargs):
+    out = tmp_path / "out.obj"
+    cli("param", hemisphere, "--solver", solver, *flags, "-o", out)
+    V, F = beltrami.read_mesh(hemisphere)
+    uv = getattr(beltrami, solver)(V, F, **kwargs)
+    assert uv.shape == (len(V), 2)
+    close(uv, uv_of(out))
+
+
+def test_sphere_map_matches_param(cli, tmp_path):
+    out = tmp_path / "out.obj"
+    cli("param", MESHES / "spot.obj", "--solver", "sphere", "-o", out)
+    V, F = beltrami.read_mesh(MESHES / "spot.obj")
+    W, report = beltrami.sphere_map(V, F, info=True)
+    close(W, positions_of(out))
+    close(np.linalg.norm(W, axis=1), np.ones(len(W)), 1e-12)
+    assert report["flipped"] == 0
+
+
+def test_lsqc_matches_qc_with_an_expression_and_a_field(cli, generated, tmp_path):
+    disk = generated("disk", 3)
+    V, F = beltrami.read_mesh(disk)
+    out = tmp_path / "expr.obj"
+    cli("qc", disk, "--mu-expr", "0.3*z", "-o", out)
+    close(beltrami.lsqc(V, F, mu_expr="0.3*z"), uv_of(out))
+
+    mu = 0.25 * np.exp(1j * np.arange(len(F)) / 7.0)
+    field = tmp_path / "mu.txt"
+    field.write_text(
+        f"# mu frame=global faces={len(F)}\n" + "".join(f"{float(z.real)!r} {float(z.imag)!r}\n" for z in mu)
+    )
+    out = tmp_path / "field.obj"
+    cli("qc", disk, "--mu", field, "--boundary", "keep", "-o", out, "--report", tmp_path / "r.json")
+    uv, report = beltrami.lsqc(V, F, mu=mu, boundary="keep", info=True)
+    close(uv, uv_of(out))
+    assert report["mu_error"]["rms"] == pytest.approx(report_of(tmp_path / "r.json")["mu_error"]["rms"], abs=1e-12)
+
+
+def test_lsqc_into_space_matches_qc(cli, hemisphere, tmp_path):
+    out = tmp_path / "out.obj"
+    cli("qc", hemisphere, "--target", "space", "--boundary", "given", "--boundary-map", hemisphere,
+        "--conformal", "-o", out)
+    V, F = beltrami.read_mesh(hemisphere)
+    X = beltrami.lsqc(V, F, target="space", boundary_map=V)
+    close(X, positions_of(out))
+
+
+@pytest.mark.parametrize(
+    "flags,kwargs",
+    [
+        (["--target", "disk", "--conformal"], {"target": "disk"}),
+        (["--target", "disk", "--conformal", "--p", "4", "--max-iters", "5"], {"target": "disk", "p": 4, "max_iters": 5}),
+    ],
+)
+def test_beltrami_flow_matches_qc(cli, hemisphere, tmp_path, flags, kwargs):
+    out = tmp_path / "out.obj"
+    cli("qc", hemisphere, "--solver", "beltrami-flow", *flags, "-o", out)
+    V, F = beltrami.read_mesh(hemisphere)
+    close(beltrami.beltrami_flow(V, F, **kwargs), uv_of(out))
+
+
+def test_beltrami_flow_onto_the_sphere_with_a_prescribed_mu_matches_qc(cli, generated, tmp_path):
+    sphere = generated("sphere", 2)
+    out = tmp_path / "out.obj"
+    cli("qc", sphere, "--target", "sphere", "--mu-expr", "0.2", "-o", out)
+    V, F = beltrami.read_mesh(sphere)
+    close(beltrami.beltrami_flow(V, F, target="sphere", mu_expr="0.2"), positions_of(out))
+
+
+def affine_boundary_problem(generated, tmp_path):
+    """A disk and the boundary values of the affine map z + 0.2 conj(z): the extremal
+    map is that affine map, k = 0.2."""
+    disk = generated("disk", 3)
+    V, F = beltrami.read_mesh(disk)
+    z = V[:, 0] + 1j * V[:, 1]
+    w = z + 0.2 * np.conj(z)
+    target = np.stack([w.real, w.imag], axis=1)
+    boundary = tmp_path / "boundary.obj"
+    beltrami.write_mesh(boundary, V, F, uv=target)
+    return disk, V, F, target, boundary
+
+
+@pytest.mark.parametrize("call,solver", [("extremal", "extremal"), ("qc_iteration", "qc-iteration")])
+def test_extremal_maps_match_qc_and_find_the_affine_map(cli, generated, tmp_path, call, solver):
+    disk, V, F, target, boundary = affine_boundary_problem(generated, tmp_path)
+    out = tmp_path / "out.obj"
+    cli("qc", disk, "--solver", solver, "--boundary", "given", "--boundary-map", boundary, "-o", out)
+    uv, report = getattr(beltrami, call)(V, F, target, info=True)
+    close(uv, uv_of(out))
+    assert report["k"] == pytest.approx(0.2, abs=1e-6)
+    close(uv, target, 1e-6)
+
+
+def test_extremal_start_map_and_quadratic_differential_match_qc(cli, generated, tmp_path):
+    disk, V, F, target, boundary = affine_boundary_problem(generated, tmp_path)
+    start = tmp_path / "start.obj"
+    beltrami.write_mesh(start, V, F, uv=beltrami.tutte(V, F))
+    out, qd = tmp_path / "out.obj", tmp_path / "qd.txt"
+    cli("qc", disk, "--solver", "extremal", "--boundary", "given", "--boundary-map", boundary,
+        "--init", start, "--qd", qd, "-o", out)
+    uv, report = beltrami.extremal(V, F, target, init=beltrami.tutte(V, F), info=True)
+    close(uv, uv_of(out))
+    lines = qd.read_text().splitlines()[1:]
+    phi = np.array([complex(float(a), float(b)) for a, b in (l.split() for l in lines)])
+    close(report["quadratic_differential"], phi)
+
+
+def test_circle_domain_matches_param_qcmc(cli, generated, tmp_path):
+    annulus = generated("annulus", 2)
+    out, r = tmp_path / "out.obj", tmp_path / "r.json"
+    cli("param", annulus, "--solver", "qcmc", "-o", out, "--report", r)
+    V, F = beltrami.read_mesh(annulus)
+    uv, report = beltrami.circle_domain(V, F, info=True)
+    close(uv, uv_of(out))
+    assert [c["loop"] for c in report["circles"]] == [c["loop"] for c in report_of(r)["circles"]]
+
+
+def test_register_matches_the_command_with_its_correspondence(cli, tmp_path):
+    source, target = MESHES / "spot.obj", MESHES / "blob.obj"
+    out, corr = tmp_path / "out.obj", tmp_path / "corr.txt"
+    landmarks = tmp_path / "marks.txt"
+    landmarks.write_text("v 0 0\n")
+    cli("register", source, target, "--landmarks", landmarks, "--max-iters", "3",
+        "--correspondence", corr, "-o", out)
+    V, F = beltrami.read_mesh(source)
+    TV, TF = beltrami.read_mesh(target)
+    P, face, bary = beltrami.register(V, F, TV, TF, landmarks=[(0, 0)], max_iters=3)
+    close(P, positions_of(out))
+    rows = [l.split() for l in corr.read_text().splitlines()]
+    np.testing.assert_array_equal(face, [int(r[0]) for r in rows])
+    close(bary, np.array([[float(x) for x in r[1:]] for r in rows]))
+    # The barycentric coordinates reproduce the positions on the target.
+    close(np.einsum("ij,ijk->ik", bary, TV[TF[face]]), P, 1e-12)
+
+
+def test_beltrami_coefficient_and_distortion_match_the_command(cli, hemisphere, tmp_path):
+    V, F = beltrami.read_mesh(hemisphere)
+    uv = beltrami.tutte(V, F)
+    mapped, per_face = tmp_path / "mapped.obj", tmp_path / "mu.txt"
+    beltrami.write_mesh(mapped, V, F, uv=uv)
+    run = cli("distortion", hemisphere, mapped, "--json", "--per-face", per_face)
+    expected = json.loads(run.stdout)
+    stats = beltrami.distortion(V, F, uv)
+    for key in ("faces", "flipped", "mu_mean", "mu_max", "mu_std", "mu_l2", "frame"):
+        assert stats[key] == pytest.approx(expected[key], abs=1e-12), key
+    lines = per_face.read_text().splitlines()
+    assert "frame=face" in lines[0]
+    mu = np.array([complex(float(a), float(b)) for a, b in (l.split() for l in lines[1:])])
+    close(beltrami.beltrami_coefficient(V, F, uv), mu)
+
+
+def test_remesh_matches_the_command(cli, hemisphere, tmp_path):
+    out, r = tmp_path / "out.obj", tmp_path / "r.json"
+    cli("remesh", hemisphere, "--edge-length", "0.08", "-o", out, "--report", r)
+    V, F = beltrami.read_mesh(hemisphere)
+    V2, F2, report = beltrami.remesh(V, F, edge_length=0.08, info=True)
+    W, G = beltrami.read_mesh(out)
+    close(V2, W)
+    np.testing.assert_array_equal(F2, G)
+    assert report["min_angle"] == pytest.approx(report_of(r)["min_angle"], abs=1e-12)
+    assert report["min_angle"] >= 20.0
+
+
+def test_cut_to_disk_matches_the_command(cli, generated, tmp_path):
+    torus = generated("torus1", 0)
+    out = tmp_path / "out.obj"
+    cli("cut", torus, "-o", out)
+    V, F = beltrami.read_mesh(torus)
+    V2, F2, original, report = beltrami.cut_to_disk(V, F, info=True)
+    W, G = beltrami.read_mesh(out)
+    close(V2, W, 0.0)
+    np.testing.assert_array_equal(F2, G)
+    close(V2, V[original], 0.0)
+    assert report["genus"] == 1
+    assert beltrami.mesh_info(V2, F2)["topology"] == "genus 0 and one boundary loop"
+
+
+def test_read_and_write_round_trip(hemisphere, tmp_path):
+    V, F = beltrami.read_mesh(hemisphere)
+    uv = beltrami.lscm(V, F)
+    for name in ("m.obj", "m.glb"):
+        beltrami.write_mesh(tmp_path / name, V, F, uv=uv)
+        W, G, back = beltrami.read_mesh(tmp_path / name, uv=True)
+        close(W, V, 1e-6 if name.endswith("glb") else 0.0)
+        np.testing.assert_array_equal(G, F)
+        close(back, uv, 1e-6 if name.endswith("glb") else 0.0)
+
+
+def test_the_catalog_lists_every_solver(cli):
+    ours = beltrami.solvers()
+    theirs = json.loads(cli("solvers", "--json").stdout)
+    assert ours == theirs
+    names = {s["name"] for s in ours}
+    assert {"tutte", "harmonic", "lscm", "sphere", "lsqc", "beltrami-flow", "register", "qcmc",
+            "extremal", "qc-iteration"} <= names
