@@ -13,6 +13,11 @@ build:
 test:
     cargo test --workspace --release
 
+# Install the Python package into the active environment and run its tests.
+python:
+    pip install "./python[test]"
+    python -m pytest -q python/tests
+
 # What CI runs: fmt, clippy, tests.
 ci:
     bash .ci/run
