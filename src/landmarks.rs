@@ -11,6 +11,13 @@
 //! c SRC_V1,SRC_V2,... TGT_W1,TGT_W2,...   # a source chain onto a target chain, ends fixed
 //! ```
 //!
+//! Maps into the plane (`beltrami qc --landmarks`, the four-point problem of the
+//! extremal solver) take points of the plane instead, read by [`read_planar`]:
+//!
+//! ```text
+//! p SRC_VERTEX x y                        # source vertex onto the point x + i y
+//! ```
+//!
 //! Vertex indices are 0-based in each mesh file's own order (the input order,
 //! [`beltrami_mesh::VertexMap`]); coordinates are finite numbers. A chain has at least
 //! two vertices; a source vertex has at most one `v` or `p` line. Errors
@@ -32,6 +39,7 @@ use std::path::{Path, PathBuf};
 
 use beltrami_core::{Constraint, Constraints, Curve, Landmark, Position};
 use beltrami_mesh::{Mesh, Point3, VertexId};
+use num_complex::Complex64;
 use thiserror::Error;
 
 /// Which mesh a vertex index of the file refers to.
@@ -93,6 +101,12 @@ pub enum LineError {
     #[error("expected `v SRC TGT`, `p SRC x y z` or `c SRC,SRC,.. TGT,TGT,..`, found `{found}`")]
     Syntax {
         /// The line without its comment.
+        found: String,
+    },
+    /// A line of a planar landmarks file that is not `p SRC x y`.
+    #[error("expected `p SRC x y` (a source vertex and a point of the plane), found `{found}`")]
+    PlanarSyntax {
+        /// The line's content (comment removed).
         found: String,
     },
     /// A source vertex already has a `v` or `p` line.
@@ -236,6 +250,50 @@ fn parse_line(content: &str, source: &Mesh, target: &Mesh) -> Result<Parsed, Lin
             });
         }
     })
+}
+
+/// Reads the landmarks of a map of `source` into the plane (module docs: `p SRC x y`
+/// lines) as [`Landmark`] constraints with planar positions, in file order; errors name
+/// the file and line.
+pub fn read_planar(path: &Path, source: &Mesh) -> Result<Vec<Landmark>, LandmarksError> {
+    let text = beltrami_mesh::io::source::read_text(path).map_err(|error| LandmarksError::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let mut out: Vec<Landmark> = Vec::new();
+    let mut first_line: HashMap<VertexId, usize> = HashMap::new();
+    for (k, raw) in text.lines().enumerate() {
+        let line = k + 1;
+        let content = raw.split('#').next().unwrap_or("").trim();
+        if content.is_empty() {
+            continue;
+        }
+        let at = |error| LandmarksError::Line {
+            path: path.to_path_buf(),
+            line,
+            error,
+        };
+        let fields: Vec<&str> = content.split_whitespace().collect();
+        let ["p", s, x, y] = fields.as_slice() else {
+            return Err(at(LineError::PlanarSyntax {
+                found: content.to_string(),
+            }));
+        };
+        let vertex = vertex(s, source, Side::Source).map_err(at)?;
+        let point = Complex64::new(coordinate(x).map_err(at)?, coordinate(y).map_err(at)?);
+        if let Some(&first_line) = first_line.get(&vertex) {
+            return Err(at(LineError::TwoLandmarks {
+                index: source.vertex_map().to_input(vertex),
+                first_line,
+            }));
+        }
+        first_line.insert(vertex, line);
+        out.push(Landmark {
+            vertex,
+            position: Position::Planar(point),
+        });
+    }
+    Ok(out)
 }
 
 impl Landmarks {

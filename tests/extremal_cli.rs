@@ -278,3 +278,123 @@ fn refusals_name_the_problem_and_write_nothing() {
     assert!(!out.exists());
     println!("{}", text(&run.stderr));
 }
+
+/// `--target disk --landmarks`: the four-point problem through the command line. The
+/// exact k for these points is 0.1225 (plugins/extremal/tests/four_point.rs derives it
+/// from elliptic integrals); the landmarks land exactly, the boundary stays on the
+/// circle, and landmark files that cannot be met are refused before any output.
+#[test]
+fn the_four_point_problem_slides_the_boundary_on_the_circle() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = Mesh::from_soup(&beltrami_mesh::primitives::disk(5)).unwrap();
+    let input = dir.path().join("disk.obj");
+    io::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let boundary = &mesh.boundary_loop_list()[0].vertices;
+    let nearest = |w: Complex64| {
+        *boundary
+            .iter()
+            .min_by(|&&a, &&b| {
+                let d = |v: beltrami_mesh::VertexId| {
+                    let p = mesh.position(v);
+                    (Complex64::new(p.x, p.y) - w).norm()
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    };
+    let phi = std::f64::consts::PI / 6.0;
+    let marks: Vec<(usize, Complex64)> = (0..4)
+        .map(|j| {
+            let from = Complex64::from_polar(1.0, TAU / 8.0 + j as f64 * TAU / 4.0);
+            let to = [phi, TAU / 2.0 - phi, TAU / 2.0 + phi, TAU - phi][j];
+            (nearest(from).idx(), Complex64::from_polar(1.0, to))
+        })
+        .collect();
+    let write_marks = |name: &str, marks: &[(usize, Complex64)]| {
+        let path = dir.path().join(name);
+        let text: String = marks
+            .iter()
+            .map(|(v, w)| format!("p {v} {} {}\n", w.re, w.im))
+            .collect();
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let good = write_marks("marks.txt", &marks);
+    let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
+    let run = beltrami(&[
+        "qc",
+        s(&input),
+        "--solver",
+        "extremal",
+        "--target",
+        "disk",
+        "--landmarks",
+        s(&good),
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let r = read_json(&report);
+    let k = r["k"].as_f64().unwrap();
+    assert!((k - 0.1225).abs() < 0.02 * 0.1225, "k {k}");
+    assert_eq!(r["flipped"], 0);
+    let uv = read_uv(&out);
+    for (v, w) in &marks {
+        assert!((uv[*v] - w).norm() < 1e-9, "vertex {v}");
+    }
+    for v in boundary {
+        assert!((uv[v.idx()].norm() - 1.0).abs() < 1e-9);
+    }
+
+    let refused = |marks_file: &Path, extra: &[&str], expected: &str| {
+        let out = dir.path().join("refused.obj");
+        let mut args = vec![
+            "qc",
+            s(&input),
+            "--solver",
+            "extremal",
+            "--landmarks",
+            s(marks_file),
+        ];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", s(&out)]);
+        let run = beltrami(&args);
+        assert!(!run.status.success(), "accepted; expected: {expected}");
+        assert!(
+            text(&run.stderr).contains(expected),
+            "{}",
+            text(&run.stderr)
+        );
+        assert!(!out.exists());
+    };
+    let three = write_marks("three.txt", &marks[..3]);
+    refused(
+        &three,
+        &["--target", "disk"],
+        "exactly four boundary landmarks",
+    );
+    let mut swapped = marks.clone();
+    (swapped[1].1, swapped[3].1) = (marks[3].1, marks[1].1);
+    let swapped = write_marks("swapped.txt", &swapped);
+    refused(
+        &swapped,
+        &["--target", "disk"],
+        "not in the order of their vertices",
+    );
+    let off = write_marks("off.txt", &[(marks[0].0, Complex64::new(0.5, 0.0))]);
+    refused(&off, &["--target", "disk"], "not on the unit circle");
+    refused(
+        &good,
+        &[],
+        "--landmarks moves boundary points of --target disk",
+    );
+    let syntax = dir.path().join("syntax.txt");
+    std::fs::write(&syntax, "p 6 1 0 0\n").unwrap();
+    refused(
+        &syntax,
+        &["--target", "disk"],
+        "syntax.txt:1: expected `p SRC x y`",
+    );
+}

@@ -229,3 +229,12 @@ def test_the_catalog_lists_every_solver(cli):
     names = {s["name"] for s in ours}
     assert {"tutte", "harmonic", "lscm", "sphere", "lsqc", "beltrami-flow", "register", "qcmc",
             "extremal", "qc-iteration"} <= names
+
+
+@pytest.mark.parametrize("name", ["disk_hemisphere.obj", "spot.obj"])
+def test_mesh_info_matches_info(cli, name):
+    expected = json.loads(cli("info", MESHES / name, "--json").stdout)
+    info = beltrami.mesh_info(*beltrami.read_mesh(MESHES / name))
+    for key in ("vertices", "faces", "edges", "components", "euler_characteristic", "genus"):
+        assert info[key] == expected[key], key
+    assert info["boundary_loops"] == len(expected["boundary_loops"])

@@ -103,6 +103,11 @@ pub struct QcArgs {
     /// nearest vertex; repeatable.
     #[arg(long = "pin")]
     pub pins: Vec<PinSpec>,
+    /// extremal with `--target disk`: the four-point problem's landmarks, lines `p INDEX x
+    /// y` (a boundary vertex, 0-based, and its point on the unit circle); the rest of the
+    /// boundary slides on the circle.
+    #[arg(long)]
+    pub landmarks: Option<PathBuf>,
     /// extremal: the start map, `harmonic` or `tutte` with the prescribed boundary, or a
     /// mesh file whose texture coordinates (or x, y) give it (it may be folded).
     #[arg(long)]
@@ -264,6 +269,11 @@ fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
             solver_name(args)
         );
     }
+    if args.landmarks.is_some() && args.target != TargetArg::Disk {
+        bail!(
+            "--landmarks moves boundary points of --target disk (the four-point problem); --target {target} holds its boundary otherwise"
+        );
+    }
     if args.free_radius && args.target != TargetArg::Annulus {
         bail!(
             "--free-radius lets the inner radius of --target annulus move; --target {target} has none"
@@ -298,6 +308,13 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     );
     if let Some(weight) = args.normal_constraint {
         problem.constraints.push(Constraint::Normal { weight });
+    }
+    if let Some(path) = &args.landmarks {
+        problem.constraints.extend(
+            beltrami::landmarks::read_planar(path, mesh)?
+                .into_iter()
+                .map(Constraint::Landmark),
+        );
     }
     if let (TargetArg::Space, Some(path)) = (args.target, &args.boundary_map) {
         let held = beltrami::mapped::read_spatial(path, mesh, false)

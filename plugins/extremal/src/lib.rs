@@ -53,6 +53,7 @@
 
 mod flatten;
 pub mod forms;
+mod quadrilateral;
 mod solver;
 
 pub use solver::Extremal;

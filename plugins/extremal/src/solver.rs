@@ -2,9 +2,9 @@
 //! values, the start map, then Algorithm 1 of Weber, Myles and Zorin (2012).
 
 use beltrami_core::{
-    Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
-    Output, Problem, Progress, QuadraticDifferential, Report, Settings, Solution, Solver,
-    SolverError, Stop, THREADS, TargetKind, Topology,
+    Accepts, ConstraintKind, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind,
+    OptionSpec, Output, Problem, Progress, QuadraticDifferential, Report, Settings, Solution,
+    Solver, SolverError, Stop, THREADS, Target, TargetKind, Topology,
 };
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
@@ -18,16 +18,19 @@ use num_complex::Complex64;
 
 use crate::flatten::{Flattening, flatten};
 use crate::forms::{FormStep, HarmonicForms};
+use crate::quadrilateral::{Quadrilateral, quadrilateral};
 
 pub(crate) const NAME: &str = "extremal";
 
 /// The extremal quasiconformal map of a planar mesh with a prescribed boundary (crate
 /// docs).
 ///
-/// Reads: `target` (`Plane(Keep | Given)`: every boundary vertex of every loop fixed),
-/// `goal` (`Extremal`), `initial` (a planar start map, folded or not; its boundary
-/// values are replaced by the prescribed ones) and the options `init`, `tolerance`,
-/// `max-iters`, `inner-iters`, `threads`.
+/// Reads: `target` (`Plane(Keep | Given)`: every boundary vertex of every loop fixed;
+/// or `Disk`: the four-point problem, the boundary sliding on the unit circle with four
+/// `constraints` landmarks at points of it, [`crate::quadrilateral`]), `goal`
+/// (`Extremal`), `initial` (a planar start map, folded or not; its boundary values are
+/// replaced by the prescribed ones) and the options `init`, `tolerance`, `max-iters`,
+/// `inner-iters`, `threads`.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Extremal;
 
@@ -77,9 +80,13 @@ const ACCEPTS: Accepts = Accepts {
         Topology::Annulus,
         Topology::MultiplyConnected,
     ],
-    targets: &[TargetKind::PlaneKeep, TargetKind::PlaneGiven],
+    targets: &[
+        TargetKind::PlaneKeep,
+        TargetKind::PlaneGiven,
+        TargetKind::Disk,
+    ],
     goals: &[GoalKind::Extremal],
-    constraints: &[],
+    constraints: &[ConstraintKind::Landmark],
 };
 
 fn unsupported(message: impl Into<String>) -> SolverError {
@@ -125,7 +132,7 @@ impl Solver for Extremal {
     ) -> Result<Solution, SolverError> {
         let mesh = problem.source;
         let mut report = Report::new(NAME);
-        let fixed = setup(problem)?;
+        let boundary = setup(problem)?;
         let options = SolveOptions {
             threads: settings.int("threads"),
             ..SolveOptions::default()
@@ -142,7 +149,13 @@ impl Solver for Extremal {
         };
         let domain = flat.as_ref().map_or(mesh, |f| &f.mesh);
         let initial = context.stage("initial map", &mut report, || {
-            start_map(domain, problem, &fixed, settings.choice("init"), options)
+            start_map(
+                domain,
+                problem,
+                &boundary.start(domain),
+                settings.choice("init"),
+                options,
+            )
         })?;
         let parameters = Parameters {
             tolerance: settings.float("tolerance"),
@@ -151,7 +164,7 @@ impl Solver for Extremal {
             options,
         };
         let mut run = context.stage("setup", &mut report, || {
-            Algorithm::new(domain, &fixed, initial, parameters)
+            Algorithm::new(domain, &boundary, initial, parameters)
         })?;
         let initial_distortion = measure(mesh, flat.as_ref(), &run)?.stats;
         let outcome = report.time("iterations", || run.iterate(context))?;
@@ -196,9 +209,28 @@ impl Solver for Extremal {
     }
 }
 
-/// The capability check: a planar triangle mesh, the extremal goal, fixed values for
-/// every boundary vertex. Returns the fixed vertices with their images.
-fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError> {
+/// The boundary condition of a problem.
+enum Boundary {
+    /// Every boundary vertex fixed at its image.
+    Fixed(Vec<(VertexId, Complex64)>),
+    /// The four-point problem: the boundary slides on the unit circle.
+    Sliding(Quadrilateral),
+}
+
+impl Boundary {
+    /// The boundary of the start map: the fixed values, or the landmarks at their
+    /// destinations with each side spread along its arc.
+    fn start(&self, mesh: &Mesh) -> Vec<(VertexId, Complex64)> {
+        match self {
+            Boundary::Fixed(fixed) => fixed.clone(),
+            Boundary::Sliding(quad) => quad.start_boundary(mesh),
+        }
+    }
+}
+
+/// The capability check: a planar triangle mesh (or a curved disk), the extremal goal,
+/// fixed values for every boundary vertex or the four landmarks of the sliding disk.
+fn setup(problem: &Problem<'_>) -> Result<Boundary, SolverError> {
     let mesh = problem.source;
     if problem.goal != Goal::Extremal {
         return Err(unsupported(
@@ -213,11 +245,20 @@ fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverErro
             beltrami_core::topology::describe(mesh)
         )));
     }
-    let fixed = match problem.planar_boundary_values() {
-        Some(values) => values.map_err(invalid)?,
+    let landmarks = problem.constraints.landmarks().count();
+    let boundary = match problem.planar_boundary_values() {
+        Some(_) if landmarks > 0 => {
+            return Err(unsupported(
+                "landmarks move boundary points of the sliding disk (`--target disk`); with a prescribed boundary every boundary vertex is already placed",
+            ));
+        }
+        Some(values) => Boundary::Fixed(values.map_err(invalid)?),
+        None if matches!(problem.target, Target::Disk) => {
+            Boundary::Sliding(quadrilateral(problem, invalid)?)
+        }
         None => {
             return Err(unsupported(
-                "extremal needs the boundary values: keep the source's boundary or give a boundary map (`--boundary given --boundary-map MAP`)",
+                "extremal needs the boundary values: keep the source's boundary or give a boundary map (`--boundary given --boundary-map MAP`), or slide on the unit disk with four landmarks (`--target disk --landmarks FILE`)",
             ));
         }
     };
@@ -237,7 +278,7 @@ fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverErro
     } else if problem.initial.is_some() {
         return Err(unsupported("extremal starts from a planar map"));
     }
-    Ok(fixed)
+    Ok(boundary)
 }
 
 /// The start map on `mesh` (the source or its flat copy): the given one with the
@@ -316,7 +357,10 @@ struct Algorithm<'a> {
     pattern: Pattern,
     /// Per entry of the f-step operator: `(d/dz, d/dzbar)` of the shape function.
     derivative_entries: Vec<(Complex64, Complex64)>,
-    map_step: LeastSquaresSolver<Complex64>,
+    map_step: MapStep,
+    /// The four-point problem: the quadratic differential is fixed by the source
+    /// ([`crate::quadrilateral`]) and the h-steps are skipped.
+    fixed_form: bool,
     parameters: Parameters,
     map: Vec<Complex64>,
     fz: Vec<Complex64>,
@@ -343,10 +387,95 @@ fn floor_of(psi: &[Complex64]) -> f64 {
     1e-14 * psi.iter().fold(0.0_f64, |m, p| m.max(p.norm()))
 }
 
+/// The f-step's least-squares system.
+enum MapStep {
+    /// Every boundary vertex fixed: one complex system, factored symbolically once.
+    Fixed(Box<LeastSquaresSolver<Complex64>>),
+    /// The four-point problem: the real form with the landmarks fixed and the other
+    /// boundary vertices sliding.
+    Sliding(Box<SlidingStep>),
+}
+
+/// The f-step of the sliding disk: `x = [re, im]` per vertex, the landmarks fixed, every
+/// other boundary vertex `p` moving along the tangent `i p` of the unit circle and
+/// projected back onto it after the solve. The slide directions change with the map, so
+/// each step builds its DOF map and symbolic factorization anew.
+struct SlidingStep {
+    /// The real operator's pattern: four entries per complex entry.
+    pattern: Pattern,
+    landmarks: Vec<(VertexId, Complex64)>,
+    sliding: Vec<VertexId>,
+    /// The face areas, once per real row.
+    weights: Vec<f64>,
+    options: SolveOptions,
+}
+
+impl SlidingStep {
+    fn new(
+        rows: usize,
+        nodes: usize,
+        positions: &[(usize, usize)],
+        quad: &Quadrilateral,
+        areas: &[f64],
+        options: SolveOptions,
+    ) -> Result<Self, SolverError> {
+        let real: Vec<(usize, usize)> = positions
+            .iter()
+            .flat_map(|&(r, c)| {
+                [
+                    (2 * r, 2 * c),
+                    (2 * r, 2 * c + 1),
+                    (2 * r + 1, 2 * c),
+                    (2 * r + 1, 2 * c + 1),
+                ]
+            })
+            .collect();
+        Ok(Self {
+            pattern: Pattern::new(2 * rows, 2 * nodes, &real)?,
+            landmarks: quad.landmarks(),
+            sliding: quad.sliding(),
+            weights: areas.iter().flat_map(|&a| [a, a]).collect(),
+            options,
+        })
+    }
+
+    /// The least-squares map of the complex operator entries `values` (in the order of
+    /// the complex pattern) from `map`, written into `map`.
+    fn solve(&self, values: &[Complex64], map: &mut [Complex64]) -> Result<(), SolverError> {
+        // (c) (x + i y) = (c.re x - c.im y) + i (c.im x + c.re y).
+        let real: Vec<f64> = values
+            .iter()
+            .flat_map(|c| [c.re, -c.im, c.im, c.re])
+            .collect();
+        let operator = self.pattern.assemble(&real)?;
+        let mut constraints = DofConstraints::new();
+        for &(v, w) in &self.landmarks {
+            constraints.fix(v, w);
+        }
+        for &v in &self.sliding {
+            let p = map[v.idx()] / map[v.idx()].norm();
+            constraints.slide(v, p, Complex64::i() * p);
+        }
+        let dofs = DofMap::real(map.len(), &constraints)?;
+        let mut solver =
+            LeastSquaresSolver::new(self.pattern.symbolic().as_ref(), &dofs, self.options)?;
+        let mut x: Vec<f64> = map.iter().flat_map(|z| [z.re, z.im]).collect();
+        let zero = vec![0.0; operator.nrows()];
+        solver.solve_into(operator.as_ref(), Some(&self.weights), &zero, &mut x)?;
+        for (z, xy) in map.iter_mut().zip(x.chunks_exact(2)) {
+            *z = Complex64::new(xy[0], xy[1]);
+        }
+        for &v in &self.sliding {
+            map[v.idx()] /= map[v.idx()].norm();
+        }
+        Ok(())
+    }
+}
+
 impl<'a> Algorithm<'a> {
     fn new(
         mesh: &'a Mesh,
-        fixed: &[(VertexId, Complex64)],
+        boundary: &Boundary,
         map: Vec<Complex64>,
         parameters: Parameters,
     ) -> Result<Self, SolverError> {
@@ -371,13 +500,29 @@ impl<'a> Algorithm<'a> {
             }
         }
         let pattern = Pattern::new(elements.point_count(), mesh.vertex_count(), &positions)?;
-        let mut constraints = DofConstraints::new();
-        for &(v, z) in fixed {
-            constraints.fix(v, z);
-        }
-        let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
-        let map_step =
-            LeastSquaresSolver::new(pattern.symbolic().as_ref(), &dofs, parameters.options)?;
+        let map_step = match boundary {
+            Boundary::Fixed(fixed) => {
+                let mut constraints = DofConstraints::new();
+                for &(v, z) in fixed {
+                    constraints.fix(v, z);
+                }
+                let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
+                MapStep::Fixed(Box::new(LeastSquaresSolver::new(
+                    pattern.symbolic().as_ref(),
+                    &dofs,
+                    parameters.options,
+                )?))
+            }
+            Boundary::Sliding(quad) => MapStep::Sliding(Box::new(SlidingStep::new(
+                elements.point_count(),
+                mesh.vertex_count(),
+                &positions,
+                quad,
+                &areas,
+                parameters.options,
+            )?)),
+        };
+        let fixed_form = matches!(boundary, Boundary::Sliding(_));
         let mut algorithm = Self {
             mesh,
             elements,
@@ -387,6 +532,7 @@ impl<'a> Algorithm<'a> {
             pattern,
             derivative_entries,
             map_step,
+            fixed_form,
             parameters,
             map,
             fz: Vec::new(),
@@ -397,10 +543,16 @@ impl<'a> Algorithm<'a> {
             factorizations: 0,
         };
         algorithm.update_derivatives()?;
-        // Algorithm 1's start: h minimizing the energy with s = 1 and k = 1.
-        let b = algorithm.fz.clone();
-        algorithm.x = algorithm.solve_form(&b)?;
-        algorithm.psi = algorithm.forms.psi(&algorithm.x);
+        if let Boundary::Sliding(quad) = boundary {
+            algorithm.psi =
+                quad.quadratic_differential(mesh, &algorithm.elements, parameters.options)?;
+            algorithm.x = Vec::new();
+        } else {
+            // Algorithm 1's start: h minimizing the energy with s = 1 and k = 1.
+            let b = algorithm.fz.clone();
+            algorithm.x = algorithm.solve_form(&b)?;
+            algorithm.psi = algorithm.forms.psi(&algorithm.x);
+        }
         algorithm.update_k();
         Ok(algorithm)
     }
@@ -512,10 +664,14 @@ impl<'a> Algorithm<'a> {
                 values.push(dzbar - mu * dz);
             }
         }
-        let operator = self.pattern.assemble(&values)?;
-        let zero = vec![Complex64::new(0.0, 0.0); operator.nrows()];
-        self.map_step
-            .solve_into(operator.as_ref(), Some(&self.areas), &zero, &mut self.map)?;
+        match &mut self.map_step {
+            MapStep::Fixed(solver) => {
+                let operator = self.pattern.assemble(&values)?;
+                let zero = vec![Complex64::new(0.0, 0.0); operator.nrows()];
+                solver.solve_into(operator.as_ref(), Some(&self.areas), &zero, &mut self.map)?;
+            }
+            MapStep::Sliding(step) => step.solve(&values, &mut self.map)?,
+        }
         self.factorizations += 1;
         self.update_derivatives()?;
         self.update_k();
@@ -542,6 +698,7 @@ impl<'a> Algorithm<'a> {
                 break;
             }
             let before = energy;
+            let inner_iters = if self.fixed_form { 0 } else { inner_iters };
             for _ in 0..inner_iters {
                 let inner_before = energy;
                 step_sizes.push(self.form_step()?);
