@@ -340,23 +340,44 @@ def beltrami_flow(
     return _result(out, info)
 
 
+def _planar_landmarks(landmarks: Any) -> list:
+    """``[(vertex, (x, y))]`` or ``[(vertex, x + iy)]`` as ``[[vertex, x, y]]``."""
+    out = []
+    for k, pair in enumerate(landmarks):
+        try:
+            vertex, point = pair
+            w = complex(point) if np.ndim(point) == 0 else complex(float(point[0]), float(point[1]))
+        except (TypeError, ValueError, IndexError):
+            raise ConstraintError(f"landmark {k}: expected (vertex, (x, y))") from None
+        out.append([int(vertex), w.real, w.imag])
+    return out
+
+
 def _extremal_like(
     solver: str,
     V: ArrayLike,
     F: ArrayLike,
-    boundary_map: ArrayLike,
+    boundary_map: Optional[ArrayLike],
     init: Union[str, ArrayLike, None],
     flags: Dict[str, Any],
     options: Optional[Dict[str, Any]],
     progress: Optional[Progress],
     info: bool,
+    landmarks: Any = None,
 ) -> Any:
     initial = None
     if init is not None and not isinstance(init, str):
         initial, init = init, None
+    if (boundary_map is None) == (landmarks is None):
+        raise OptionError(
+            "give boundary_map (every boundary vertex placed) or landmarks (four boundary "
+            "vertices moved on the unit circle, the rest sliding), one of the two"
+        )
+    sliding = landmarks is not None
     spec = {
-        "target": "plane",
+        "target": "disk" if sliding else "plane",
         "boundary": "given",
+        "planar_landmarks": _planar_landmarks(landmarks) if sliding else [],
         "goal": {"kind": "extremal"},
         "options": _options(options, init=init, **flags),
         "defaults": _QC_DEFAULTS,
@@ -373,8 +394,9 @@ def _extremal_like(
 def extremal(
     V: ArrayLike,
     F: ArrayLike,
-    boundary_map: ArrayLike,
+    boundary_map: Optional[ArrayLike] = None,
     *,
+    landmarks: Any = None,
     init: Union[str, ArrayLike, None] = None,
     tolerance: Optional[float] = None,
     max_iters: Optional[int] = None,
@@ -389,11 +411,16 @@ def extremal(
     ``phi`` (Weber-Myles-Zorin 2012, Algorithm 1). ``init``: ``'harmonic'``, ``'tutte'``
     or an ``(n, 2)`` start map (it may fold). Returns ``UV`` ``(n, 2)``; with
     ``info=True`` the report has ``k`` and ``quadratic_differential`` (one complex value
-    per face). ``beltrami qc --solver extremal --boundary given``."""
+    per face). ``beltrami qc --solver extremal --boundary given``.
+
+    Instead of ``boundary_map``, ``landmarks`` ``[(vertex, (x, y)), ...]`` poses the
+    four-point problem: four boundary vertices moved to points of the unit circle, the
+    rest of the boundary sliding on it (``beltrami qc --solver extremal --target disk
+    --landmarks FILE``)."""
     return _extremal_like(
         "extremal", V, F, boundary_map, init,
         {"tolerance": tolerance, "max_iters": max_iters, "threads": threads},
-        options, progress, info,
+        options, progress, info, landmarks,
     )
 
 

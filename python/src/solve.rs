@@ -15,6 +15,7 @@
 //! | `pins` | input vertex indices held where the solver puts them |
 //! | `normal_constraint` | `space`: the weight of the normal constraint |
 //! | `landmarks` | `mesh`: the text of a landmarks file |
+//! | `planar_landmarks` | `disk`: `[[vertex, x, y], ...]`, boundary vertices moved to points of the unit circle |
 //! | `options` | solver options as text, `{name: value}` (`--option NAME=VALUE`) |
 //! | `defaults` | the command's defaults, set when the solver declares the option |
 //!
@@ -29,8 +30,8 @@ use std::time::Instant;
 use beltrami::landmarks::Landmarks;
 use beltrami::map_file::{self, Image};
 use beltrami_core::{
-    Constraint, Context, Goal, Map, Pin, PlanarBoundary, Position, Problem, Progress, Solution,
-    Target,
+    Constraint, Context, Goal, Landmark, Map, Pin, PlanarBoundary, Position, Problem, Progress,
+    Solution, Target,
 };
 use beltrami_fem::{BeltramiField, Expr, Frame};
 use beltrami_mesh::Mesh;
@@ -208,6 +209,30 @@ fn constraints(
                     })
                 }),
         );
+    }
+    for mark in spec
+        .get("planar_landmarks")
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+    {
+        let fields = mark.as_array().map(Vec::as_slice).unwrap_or_default();
+        let [v, x, y] = fields else {
+            return Err(errors::raise(
+                Kind::Constraint,
+                format!("landmark {mark}: expected (vertex, (x, y))"),
+            ));
+        };
+        let (Some(v), Some(x), Some(y)) = (v.as_i64(), x.as_f64(), y.as_f64()) else {
+            return Err(errors::raise(
+                Kind::Constraint,
+                format!("landmark {mark}: expected (vertex, (x, y))"),
+            ));
+        };
+        problem.constraints.push(Constraint::Landmark(Landmark {
+            vertex: arrays::vertex(mesh, v, "landmarks")?,
+            position: Position::Planar(Complex64::new(x, y)),
+        }));
     }
     if let (Some(source), Some(target)) = (text(spec, "landmarks"), target_mesh) {
         let marks = Landmarks::parse(Path::new("landmarks"), source, mesh, target)

@@ -238,3 +238,29 @@ def test_mesh_info_matches_info(cli, name):
     for key in ("vertices", "faces", "edges", "components", "euler_characteristic", "genus"):
         assert info[key] == expected[key], key
     assert info["boundary_loops"] == len(expected["boundary_loops"])
+
+
+def test_the_four_point_problem_matches_qc(cli, generated, tmp_path):
+    disk = generated("disk", 4)
+    V, F = beltrami.read_mesh(disk)
+    info = beltrami.mesh_info(V, F)
+    assert info["boundary_loops"] == 1
+    angles = np.arctan2(V[:, 1], V[:, 0])
+    on_circle = np.abs(np.hypot(V[:, 0], V[:, 1]) - 1.0) < 1e-9
+    phi = np.pi / 6
+    marks = []
+    for j, to in enumerate([phi, np.pi - phi, np.pi + phi, 2 * np.pi - phi]):
+        target = np.pi / 4 + j * np.pi / 2
+        gap = np.abs(np.angle(np.exp(1j * (angles - target))))
+        v = int(np.argmin(np.where(on_circle, gap, np.inf)))
+        marks.append((v, (float(np.cos(to)), float(np.sin(to)))))
+    path = tmp_path / "marks.txt"
+    path.write_text("".join(f"p {v} {x!r} {y!r}\n" for v, (x, y) in marks))
+    out, r = tmp_path / "out.obj", tmp_path / "r.json"
+    cli("qc", disk, "--solver", "extremal", "--target", "disk", "--landmarks", path, "-o", out,
+        "--report", r)
+    uv, report = beltrami.extremal(V, F, landmarks=marks, info=True)
+    close(uv, uv_of(out))
+    assert report["k"] == pytest.approx(report_of(r)["k"], abs=1e-12)
+    # The exact k of these points is 0.1225 (plugins/extremal/tests/four_point.rs).
+    assert report["k"] == pytest.approx(0.1225, rel=0.03)

@@ -223,3 +223,10 @@ def test_a_progress_callback_sees_every_step_and_can_stop_the_solve(disk):
 
     with pytest.raises(RuntimeError, match="enough"):
         beltrami.beltrami_flow(*disk, p=4, max_iters=50, progress=stop)
+
+
+def test_extremal_needs_a_boundary_map_or_landmarks(disk):
+    with pytest.raises(beltrami.OptionError, match="one of the two"):
+        beltrami.extremal(*disk)
+    with pytest.raises(beltrami.UnsupportedError, match="v0 is not on the boundary"):
+        beltrami.extremal(*disk, landmarks=[(0, (1.0, 0.0))])
