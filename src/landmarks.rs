@@ -252,22 +252,31 @@ fn parse_line(content: &str, source: &Mesh, target: &Mesh) -> Result<Parsed, Lin
     })
 }
 
+/// The text of the landmarks file `path`.
+fn read_text(path: &Path) -> Result<String, LandmarksError> {
+    beltrami_mesh::io::source::read_text(path).map_err(|error| LandmarksError::Io {
+        path: path.to_path_buf(),
+        error,
+    })
+}
+
+/// The 1-based number and content (comment removed, trimmed) of every line that has
+/// any.
+fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    text.lines()
+        .enumerate()
+        .map(|(k, raw)| (k + 1, raw.split('#').next().unwrap_or("").trim()))
+        .filter(|(_, content)| !content.is_empty())
+}
+
 /// Reads the landmarks of a map of `source` into the plane (module docs: `p SRC x y`
 /// lines) as [`Landmark`] constraints with planar positions, in file order; errors name
 /// the file and line.
 pub fn read_planar(path: &Path, source: &Mesh) -> Result<Vec<Landmark>, LandmarksError> {
-    let text = beltrami_mesh::io::source::read_text(path).map_err(|error| LandmarksError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let text = read_text(path)?;
     let mut out: Vec<Landmark> = Vec::new();
     let mut first_line: HashMap<VertexId, usize> = HashMap::new();
-    for (k, raw) in text.lines().enumerate() {
-        let line = k + 1;
-        let content = raw.split('#').next().unwrap_or("").trim();
-        if content.is_empty() {
-            continue;
-        }
+    for (line, content) in content_lines(&text) {
         let at = |error| LandmarksError::Line {
             path: path.to_path_buf(),
             line,
@@ -299,12 +308,7 @@ pub fn read_planar(path: &Path, source: &Mesh) -> Result<Vec<Landmark>, Landmark
 impl Landmarks {
     /// Reads and parses the file `path` against the source and target meshes.
     pub fn read(path: &Path, source: &Mesh, target: &Mesh) -> Result<Self, LandmarksError> {
-        let text =
-            beltrami_mesh::io::source::read_text(path).map_err(|error| LandmarksError::Io {
-                path: path.to_path_buf(),
-                error,
-            })?;
-        Self::parse(path, &text, source, target)
+        Self::parse(path, &read_text(path)?, source, target)
     }
 
     /// Parses `text`, the content of the file `path` (named in errors), against the
@@ -317,12 +321,7 @@ impl Landmarks {
     ) -> Result<Self, LandmarksError> {
         let mut out = Landmarks::default();
         let mut first_line: HashMap<VertexId, usize> = HashMap::new();
-        for (k, raw) in text.lines().enumerate() {
-            let line = k + 1;
-            let content = raw.split('#').next().unwrap_or("").trim();
-            if content.is_empty() {
-                continue;
-            }
+        for (line, content) in content_lines(text) {
             let at = |error| LandmarksError::Line {
                 path: path.to_path_buf(),
                 line,

@@ -198,17 +198,7 @@ fn constraints(
             ));
         };
         let held = arrays::spatial(mesh, map.as_array(), "boundary_map")?;
-        problem.constraints.extend(
-            mesh.boundary_loop_list()
-                .into_iter()
-                .flat_map(|l| l.vertices)
-                .map(|v| {
-                    Constraint::Pin(Pin {
-                        vertex: v,
-                        position: Some(Position::Spatial(held[v.idx()])),
-                    })
-                }),
-        );
+        problem.constraints.hold_boundary(mesh, &held);
     }
     for mark in spec
         .get("planar_landmarks")

@@ -14,8 +14,8 @@ use std::path::PathBuf;
 use anyhow::{Context as _, bail};
 use beltrami::map_file;
 use beltrami_core::{
-    Constraint, Goal, GoalKind, Map, OptionValue, Pin, PlanarBoundary, Position, Problem, Solver,
-    Target, TargetKind,
+    Constraint, Goal, GoalKind, Map, OptionValue, PlanarBoundary, Problem, Solver, Target,
+    TargetKind,
 };
 use beltrami_fem::{BeltramiField, Expr};
 use beltrami_mesh::Mesh;
@@ -319,17 +319,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     if let (TargetArg::Space, Some(path)) = (args.target, &args.boundary_map) {
         let held = beltrami::mapped::read_spatial(path, mesh, false)
             .with_context(|| format!("--boundary-map {}", path.display()))?;
-        problem.constraints.extend(
-            mesh.boundary_loop_list()
-                .into_iter()
-                .flat_map(|l| l.vertices)
-                .map(|v| {
-                    Constraint::Pin(Pin {
-                        vertex: v,
-                        position: Some(Position::Spatial(held[v.idx()])),
-                    })
-                }),
-        );
+        problem.constraints.hold_boundary(mesh, &held);
     }
     problem.options = mapping::solver_options(
         solver,

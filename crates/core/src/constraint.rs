@@ -346,6 +346,24 @@ impl Constraints {
         Self::default()
     }
 
+    /// Holds every boundary vertex of `mesh` (all loops) at its point in `held` (one
+    /// point of R^3 per mesh vertex, by [`VertexId`]): a [`Pin`] with a spatial position
+    /// each, as a map into space with a prescribed boundary needs.
+    pub fn hold_boundary(&mut self, mesh: &Mesh, held: &[Point3<f64>]) -> &mut Self {
+        self.extend(
+            mesh.boundary_loop_list()
+                .into_iter()
+                .flat_map(|l| l.vertices)
+                .map(|v| {
+                    Constraint::Pin(Pin {
+                        vertex: v,
+                        position: Some(Position::Spatial(held[v.idx()])),
+                    })
+                }),
+        );
+        self
+    }
+
     /// Appends `constraint`.
     pub fn push(&mut self, constraint: Constraint) -> &mut Self {
         self.list.push(constraint);
