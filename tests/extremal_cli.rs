@@ -215,7 +215,7 @@ fn a_folded_start_from_a_file_ends_without_flips() {
 #[test]
 fn refusals_name_the_problem_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let (input, mesh, _, map) = ring_with_map(dir.path(), 8);
+    let (input, _, _, _) = ring_with_map(dir.path(), 8);
     let out = dir.path().join("out.obj");
     // --qd with a solver that computes no quadratic differential.
     let run = beltrami(&[
@@ -250,7 +250,16 @@ fn refusals_name_the_problem_and_write_nothing() {
     assert!(!run.status.success());
     assert!(!out.exists(), "{}", text(&run.stderr));
     println!("{}", text(&run.stderr));
-    // A curved surface is refused with the way out.
+}
+
+/// A curved annulus (a bowl) is laid out conformally, its inner loop filled for the
+/// layout (the paper's way with several boundaries), and mapped with the ring map's
+/// boundary values, without flips.
+#[test]
+fn a_curved_ring_is_mapped_through_its_filled_layout() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, mesh, _, map) = ring_with_map(dir.path(), 8);
+    let out = dir.path().join("out.obj");
     let curved: Vec<Point3<f64>> = mesh
         .positions()
         .iter()
@@ -262,6 +271,7 @@ fn refusals_name_the_problem_and_write_nothing() {
         ..VertexAttributes::default()
     };
     io::write(&bowl, &mesh, &attributes).unwrap();
+    let report = dir.path().join("bowl.json");
     let run = beltrami(&[
         "qc",
         s(&bowl),
@@ -273,10 +283,15 @@ fn refusals_name_the_problem_and_write_nothing() {
         s(&map),
         "-o",
         s(&out),
+        "--report",
+        s(&report),
     ]);
-    assert!(!run.status.success());
-    assert!(!out.exists());
-    println!("{}", text(&run.stderr));
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let r = read_json(&report);
+    assert_eq!(r["flipped"], 0);
+    let k = r["k"].as_f64().unwrap();
+    assert!(k > 0.0 && k < 1.0, "k {k}");
+    assert!(r["notes"].to_string().contains("LSCM"));
 }
 
 /// `--target disk --landmarks`: the four-point problem through the command line. The

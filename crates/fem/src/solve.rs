@@ -325,6 +325,27 @@ impl<T: Scalar> LeastSquaresSolver<T> {
         })
     }
 
+    /// Takes `dofs` as the solver's map and keeps the symbolic phase (scatter maps,
+    /// pattern and symbolic Cholesky factorization of the normal equations) when its
+    /// `K` has the pattern of the current map: a map whose fixed values, slide points
+    /// and slide directions move between solves (a boundary sliding along a curve,
+    /// re-linearized at every step) but whose unknowns stay. Otherwise the symbolic
+    /// phase is redone for the new pattern. Returns whether it was kept.
+    pub fn update_dofs(&mut self, dofs: &DofMap<T>) -> Result<bool, SolveError> {
+        check_len(
+            "the length of the new map",
+            self.dofs.full_len(),
+            dofs.full_len(),
+        )?;
+        let same_columns = dofs.reduced_len() == self.dofs.reduced_len();
+        if same_columns && self.normal.set_k(dofs) {
+            self.dofs = dofs.clone();
+            return Ok(true);
+        }
+        *self = Self::new(self.a_pattern.as_ref(), dofs, self.options)?;
+        Ok(false)
+    }
+
     /// The DOF map the solver was built with.
     pub fn dofs(&self) -> &DofMap<T> {
         &self.dofs

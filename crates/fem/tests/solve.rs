@@ -178,6 +178,49 @@ fn fixed_nodes_end_exactly_at_their_values() {
     assert_eq!(x[1], c(2.0, 0.5));
 }
 
+/// A map whose slide moves between solves keeps the solver's symbolic phase, and the
+/// solve equals that of a solver built for the new map; a map with other unknowns does
+/// not keep it and still solves right.
+#[test]
+fn updated_maps_keep_the_symbolic_phase_and_solve_as_new_ones() {
+    let mut rng = Rng(9);
+    let first = DofMap::real(12, &constraints(true)).unwrap();
+    let Problem { a, w, b, .. } = random_problem(&mut rng, &first, 50);
+    let mut kept = LeastSquaresSolver::new(a.symbolic(), &first, SolveOptions::default()).unwrap();
+    kept.solve(a.as_ref(), Some(&w), &b).unwrap();
+
+    let mut moved = DofConstraints::new();
+    moved
+        .fix(v(0), c(-0.5, 1.0))
+        .fix(v(1), c(2.0, 0.5))
+        .share(v(2), v(5))
+        .share(v(7), v(5))
+        .slide(v(3), c(-2.0, 0.5), c(1.0, -2.0));
+    let second = DofMap::real(12, &moved).unwrap();
+    assert!(kept.update_dofs(&second).unwrap());
+    let x = kept.solve(a.as_ref(), Some(&w), &b).unwrap();
+    let mut fresh =
+        LeastSquaresSolver::new(a.symbolic(), &second, SolveOptions::default()).unwrap();
+    let y = fresh.solve(a.as_ref(), Some(&w), &b).unwrap();
+    let scale = y.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+    for (x, y) in x.iter().zip(&y) {
+        assert!((x - y).abs() <= 1e-12 * scale, "{x} != {y}");
+    }
+    assert_eq!(second.node_position(&x, v(0)).unwrap(), c(-0.5, 1.0));
+
+    // Node 3 fixed instead of sliding: one unknown fewer, a new symbolic phase.
+    let mut fixed = constraints(false);
+    fixed.fix(v(3), c(1.0, 1.0));
+    let third = DofMap::real(12, &fixed).unwrap();
+    assert!(!kept.update_dofs(&third).unwrap());
+    let x = kept.solve(a.as_ref(), Some(&w), &b).unwrap();
+    let mut fresh = LeastSquaresSolver::new(a.symbolic(), &third, SolveOptions::default()).unwrap();
+    let y = fresh.solve(a.as_ref(), Some(&w), &b).unwrap();
+    for (x, y) in x.iter().zip(&y) {
+        assert!((x - y).abs() <= 1e-12 * scale.max(1.0), "{x} != {y}");
+    }
+}
+
 #[test]
 fn sliding_node_ends_on_its_line() {
     let mut rng = Rng(2);

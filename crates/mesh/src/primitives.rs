@@ -291,12 +291,13 @@ pub fn annulus(inner: f64, rings: usize, sectors: usize) -> PolygonSoup {
     for r in 0..rings {
         for s in 0..sectors {
             let (a, b, c, d) = (id(s, r), id(s + 1, r), id(s + 1, r + 1), id(s, r + 1));
+            // Counter-clockwise: a -> d is outward, a -> b turns with the angle.
             if (r + s) % 2 == 0 {
-                soup.push_face(&[a, b, c]);
-                soup.push_face(&[a, c, d]);
+                soup.push_face(&[a, c, b]);
+                soup.push_face(&[a, d, c]);
             } else {
-                soup.push_face(&[a, b, d]);
-                soup.push_face(&[b, c, d]);
+                soup.push_face(&[a, d, b]);
+                soup.push_face(&[b, d, c]);
             }
         }
     }

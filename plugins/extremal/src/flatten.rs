@@ -9,12 +9,17 @@
 //! on the surface itself, in its face frames. A quadratic differential transforms as
 //! `phi dz^2`: on a face with frame coordinate `w` and flattening `c`, the surface's
 //! `phi_w = phi_c c_w^2`.
+//!
+//! A curved surface of genus 0 with several boundary loops is made a disk first, as the
+//! paper does: every loop but the longest is closed by a fan of triangles around a new
+//! vertex at the loop's centroid, the filled disk is laid out by LSCM, and the fill is
+//! removed (the source keeps its own faces, now at their planar images).
 
 use beltrami_core::{Context, PlanarBoundary, Problem, Solver, SolverError, Target};
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::{Elements, Frame};
 use beltrami_init::Lscm;
-use beltrami_mesh::{Mesh, Point3};
+use beltrami_mesh::{Mesh, Point3, PolygonSoup};
 use num_complex::Complex64;
 
 use crate::solver::NAME;
@@ -32,37 +37,77 @@ pub struct Flattening {
     pub mu_max: f64,
 }
 
-/// Lays `mesh` (a curved disk of triangles) out in the plane by LSCM; refuses a layout
-/// with flipped faces.
+/// `mesh` with every boundary loop but the longest closed by a fan around a new vertex
+/// at its centroid (the new vertices follow the mesh's own).
+fn filled(mesh: &Mesh) -> Result<Mesh, SolverError> {
+    let mut loops = mesh.boundary_loop_list();
+    let longest = (0..loops.len())
+        .max_by(|&a, &b| loops[a].length.total_cmp(&loops[b].length))
+        .unwrap_or(0);
+    loops.remove(longest);
+    let mut soup = PolygonSoup::new(mesh.positions().to_vec());
+    for f in mesh.faces() {
+        let face: Vec<u32> = mesh.face_vertices(f).map(|v| v.0).collect();
+        soup.push_face(&face);
+    }
+    for l in &loops {
+        let centre = l
+            .vertices
+            .iter()
+            .fold(Point3::origin(), |c, &v| c + mesh.position(v).coords)
+            / l.vertices.len() as f64;
+        let c = soup.positions.len() as u32;
+        soup.positions.push(centre);
+        // The surface is on the right of a boundary loop: the fan is on its left.
+        for (k, &a) in l.vertices.iter().enumerate() {
+            let b = l.vertices[(k + 1) % l.vertices.len()];
+            soup.push_face(&[a.0, b.0, c]);
+        }
+    }
+    Ok(Mesh::from_soup(&soup)?)
+}
+
+/// Lays `mesh` (a curved disk of triangles, or a curved genus-0 surface with several
+/// boundary loops, filled first: module docs) out in the plane by LSCM; refuses a
+/// layout with flipped faces of `mesh`.
 pub fn flatten(mesh: &Mesh) -> Result<Flattening, SolverError> {
-    let problem = Problem::new(mesh, Target::Plane(PlanarBoundary::Free));
+    let disk = if mesh.boundary_loop_count() > 1 {
+        Some(filled(mesh)?)
+    } else {
+        None
+    };
+    let layout = disk.as_ref().unwrap_or(mesh);
+    let problem = Problem::new(layout, Target::Plane(PlanarBoundary::Free));
     let solution = Lscm.solve(&problem, &mut Context::new())?;
     let uv = solution.planar().ok_or_else(|| SolverError::Unsupported {
         solver: NAME,
         message: "the conformal flattening gave no planar map".to_string(),
     })?;
-    let stats = solution.metrics.distortion.as_ref();
-    if let Some(s) = stats
-        && s.flipped > 0
-    {
+    let uv = &uv[..mesh.vertex_count()];
+    let elements = Elements::new(mesh, Frame::Face)?;
+    let derivatives = planar_map(&elements, mesh.vertex_count(), uv)?;
+    let flipped = derivatives
+        .iter()
+        .filter(|d| d.fz.norm_sqr() - d.fzbar.norm_sqr() <= 0.0)
+        .count();
+    if flipped > 0 {
         return Err(SolverError::Unsupported {
             solver: NAME,
             message: format!(
-                "the conformal flattening of the surface (LSCM) flips {} faces; flatten it with a bijective map first (e.g. `beltrami param --solver tutte`) and map the flat copy",
-                s.flipped
+                "the conformal flattening of the surface (LSCM) flips {flipped} faces; flatten it with a bijective map first (e.g. `beltrami param --solver tutte`) and map the flat copy"
             ),
         });
     }
-    let elements = Elements::new(mesh, Frame::Face)?;
-    let derivative = planar_map(&elements, mesh.vertex_count(), uv)?
+    let mus: Vec<f64> = derivatives
         .iter()
-        .map(|d| d.fz)
+        .map(|d| (d.fzbar / d.fz).norm())
         .collect();
+    let derivative = derivatives.iter().map(|d| d.fz).collect();
     let flat = mesh.with_positions(uv.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect())?;
     Ok(Flattening {
         mesh: flat,
         derivative,
-        mu_mean: stats.map_or(f64::NAN, |s| s.mu_mean),
-        mu_max: stats.map_or(f64::NAN, |s| s.mu_max),
+        mu_mean: mus.iter().sum::<f64>() / mus.len().max(1) as f64,
+        mu_max: mus.iter().copied().fold(0.0, f64::max),
     })
 }

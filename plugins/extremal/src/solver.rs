@@ -10,7 +10,7 @@ use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::element::{check_planar, is_planar};
 use beltrami_fem::{
-    BoundaryMap, Distortion, DofConstraints, DofMap, EdgeWeights, Elements, FemError, Frame,
+    BoundaryMap, Distortion, DofConstraints, DofMap, EdgeWeights, Elements, Frame,
     LeastSquaresSolver, SolveOptions, WeightedMeanSystem,
 };
 use beltrami_mesh::{Mesh, VertexId};
@@ -237,11 +237,9 @@ fn setup(problem: &Problem<'_>) -> Result<Boundary, SolverError> {
             "extremal computes the extremal map of a boundary condition; for a prescribed mu use lsqc or beltrami-flow",
         ));
     }
-    if let Err(FemError::NotPlanar { vertex, z }) = check_planar(mesh)
-        && Topology::of(mesh) != Topology::Disk
-    {
+    if check_planar(mesh).is_err() && mesh.genus() != Some(0) {
         return Err(unsupported(format!(
-            "extremal maps planar meshes (z = 0) and curved disks (laid out conformally first), but this curved mesh (vertex {vertex} has z = {z:e}) has {}: flatten it conformally first (distortion is conformally invariant) and map the flat copy",
+            "extremal maps planar meshes (z = 0) and curved surfaces of genus 0 (laid out conformally first), but this curved mesh has {}",
             beltrami_core::topology::describe(mesh)
         )));
     }
@@ -399,7 +397,8 @@ enum MapStep {
 /// The f-step of the sliding disk: `x = [re, im]` per vertex, the landmarks fixed, every
 /// other boundary vertex `p` moving along the tangent `i p` of the unit circle and
 /// projected back onto it after the solve. The slide directions change with the map, so
-/// each step builds its DOF map and symbolic factorization anew.
+/// each step builds its DOF map anew; the unknowns stay, so the symbolic factorization
+/// of the first step is kept ([`LeastSquaresSolver::update_dofs`]).
 struct SlidingStep {
     /// The real operator's pattern: four entries per complex entry.
     pattern: Pattern,
@@ -408,6 +407,7 @@ struct SlidingStep {
     /// The face areas, once per real row.
     weights: Vec<f64>,
     options: SolveOptions,
+    solver: Option<LeastSquaresSolver<f64>>,
 }
 
 impl SlidingStep {
@@ -436,12 +436,13 @@ impl SlidingStep {
             sliding: quad.sliding(),
             weights: areas.iter().flat_map(|&a| [a, a]).collect(),
             options,
+            solver: None,
         })
     }
 
     /// The least-squares map of the complex operator entries `values` (in the order of
     /// the complex pattern) from `map`, written into `map`.
-    fn solve(&self, values: &[Complex64], map: &mut [Complex64]) -> Result<(), SolverError> {
+    fn solve(&mut self, values: &[Complex64], map: &mut [Complex64]) -> Result<(), SolverError> {
         // (c) (x + i y) = (c.re x - c.im y) + i (c.im x + c.re y).
         let real: Vec<f64> = values
             .iter()
@@ -457,8 +458,17 @@ impl SlidingStep {
             constraints.slide(v, p, Complex64::i() * p);
         }
         let dofs = DofMap::real(map.len(), &constraints)?;
-        let mut solver =
-            LeastSquaresSolver::new(self.pattern.symbolic().as_ref(), &dofs, self.options)?;
+        let solver = match &mut self.solver {
+            Some(solver) => {
+                solver.update_dofs(&dofs)?;
+                solver
+            }
+            None => self.solver.insert(LeastSquaresSolver::new(
+                self.pattern.symbolic().as_ref(),
+                &dofs,
+                self.options,
+            )?),
+        };
         let mut x: Vec<f64> = map.iter().flat_map(|z| [z.re, z.im]).collect();
         let zero = vec![0.0; operator.nrows()];
         solver.solve_into(operator.as_ref(), Some(&self.weights), &zero, &mut x)?;

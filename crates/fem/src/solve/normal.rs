@@ -137,6 +137,8 @@ pub(super) struct NormalEquations<T: Scalar> {
     /// `K` row by row: the entries of row `l` (column `l` of `A`) are
     /// `k_values[k_row_ptr[l]..k_row_ptr[l + 1]]`, in increasing column order.
     k_row_ptr: Vec<usize>,
+    /// The reduced column of each entry of `k_values`.
+    k_col: Vec<usize>,
     k_values: Vec<T>,
     maps: AnyMaps,
     /// Values of `B`, row by row.
@@ -155,6 +157,33 @@ impl<T: Scalar> NormalEquations<T> {
         dofs: &DofMap<T>,
     ) -> Result<Self, SolveError> {
         Self::build(a, dofs, true)
+    }
+
+    /// Replaces the values of `K` by those of `dofs`, whose `K` must have the pattern of
+    /// the map the equations were built with (same reduced unknowns, same entries):
+    /// the scatter maps and the pattern of `N` stay. Returns false, changing nothing,
+    /// when the patterns differ.
+    pub(super) fn set_k(&mut self, dofs: &DofMap<T>) -> bool {
+        let k = dofs.k();
+        if k.row_idx().len() != self.k_values.len() || self.k_row_ptr.len() != k.nrows() + 1 {
+            return false;
+        }
+        let mut next = self.k_row_ptr[..k.nrows()].to_vec();
+        let mut values = vec![T::from_f64(0.0); self.k_values.len()];
+        for j in 0..k.ncols() {
+            for (&l, &coef) in k.row_idx_of_col_raw(j).iter().zip(k.val_of_col(j)) {
+                if next[l] >= self.k_row_ptr[l + 1] || self.k_col[next[l]] != j {
+                    return false;
+                }
+                values[next[l]] = coef;
+                next[l] += 1;
+            }
+        }
+        if next[..] != self.k_row_ptr[1..] {
+            return false;
+        }
+        self.k_values = values;
+        true
     }
 
     /// [`new`](Self::new), with `u32` indices only if `narrow` (tests build both
@@ -219,6 +248,7 @@ impl<T: Scalar> NormalEquations<T> {
         };
         Ok(Self {
             k_row_ptr,
+            k_col,
             k_values,
             maps,
             b_values: try_vec(b_len, zero)?,
