@@ -177,6 +177,14 @@ def _result(out: Dict[str, Any], info: bool) -> Any:
 # ---- initial maps (`beltrami param`) -------------------------------------------------
 
 
+def _param(solver: str, V: ArrayLike, F: ArrayLike, boundary: str, weights: Optional[str],
+           pins: Sequence[int], options: Optional[Dict[str, Any]], info: bool) -> Any:
+    """``beltrami param --solver SOLVER`` onto the plane with ``boundary``."""
+    spec = {"target": "plane", "boundary": boundary, "pins": _pins(pins),
+            "options": _options(options, weights=weights)}
+    return _result(_solve(solver, V, F, spec), info)
+
+
 def tutte(
     V: ArrayLike,
     F: ArrayLike,
@@ -192,9 +200,7 @@ def tutte(
     circle by arc length (``boundary='circle'``) or on the unit square. Bijective for a
     convex boundary (Tutte 1963, Floater 2003). Returns ``UV`` ``(n, 2)``.
     ``beltrami param --solver tutte``."""
-    spec = {"target": "plane", "boundary": boundary, "pins": _pins(pins),
-            "options": _options(options, weights=weights)}
-    return _result(_solve("tutte", V, F, spec), info)
+    return _param("tutte", V, F, boundary, weights, pins, options, info)
 
 
 def harmonic(
@@ -210,9 +216,7 @@ def harmonic(
     """The discrete harmonic map of a disk (cotangent weights, Pinkall-Polthier 1993)
     with the boundary on the unit circle by arc length or on the unit square. Returns
     ``UV`` ``(n, 2)``. ``beltrami param --solver harmonic``."""
-    spec = {"target": "plane", "boundary": boundary, "pins": _pins(pins),
-            "options": _options(options, weights=weights)}
-    return _result(_solve("harmonic", V, F, spec), info)
+    return _param("harmonic", V, F, boundary, weights, pins, options, info)
 
 
 def lscm(
@@ -227,9 +231,7 @@ def lscm(
     ``sum_f A_f |f_zbar|^2`` with a free boundary and two pinned vertices (``pins``; by
     default two boundary vertices far apart) sent to 0 and 1. Returns ``UV`` ``(n, 2)``.
     ``beltrami param --solver lscm``."""
-    spec = {"target": "plane", "boundary": "free", "pins": _pins(pins),
-            "options": _options(options)}
-    return _result(_solve("lscm", V, F, spec), info)
+    return _param("lscm", V, F, "free", None, pins, options, info)
 
 
 def sphere_map(
