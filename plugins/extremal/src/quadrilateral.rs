@@ -124,6 +124,17 @@ fn arc(a: Complex64, b: Complex64) -> f64 {
 }
 
 impl Quadrilateral {
+    /// Side `j` (from corner `j` to corner `j + 1`) as positions in `boundary`, the end
+    /// excluded and not yet reduced modulo the loop's length (the last side wraps).
+    fn side(&self, j: usize) -> std::ops::Range<usize> {
+        let (from, to) = (self.corners[j].0, self.corners[(j + 1) % 4].0);
+        from..if to <= from {
+            to + self.boundary.len()
+        } else {
+            to
+        }
+    }
+
     /// The boundary's start positions: landmarks at their destinations, the vertices of
     /// each side spread over the arc between its corners' destinations in proportion to
     /// their arc length on the source.
@@ -131,18 +142,17 @@ impl Quadrilateral {
         let n = self.boundary.len();
         let mut out = Vec::with_capacity(n);
         for j in 0..4 {
-            let (from, a) = self.corners[j];
-            let (to, b) = self.corners[(j + 1) % 4];
-            let to = if to <= from { to + n } else { to };
+            let (a, b) = (self.corners[j].1, self.corners[(j + 1) % 4].1);
+            let side = self.side(j);
             let length = |i: usize| {
                 let p = mesh.position(self.boundary[i % n]);
                 let q = mesh.position(self.boundary[(i + 1) % n]);
                 (q - p).norm()
             };
-            let total: f64 = (from..to).map(length).sum();
+            let total: f64 = side.clone().map(length).sum();
             let angle = arc(a, b);
             let mut walked = 0.0;
-            for i in from..to {
+            for i in side {
                 let t = if total > 0.0 { walked / total } else { 0.0 };
                 out.push((
                     self.boundary[i % n],
@@ -180,17 +190,13 @@ impl Quadrilateral {
         elements: &Elements,
         options: SolveOptions,
     ) -> Result<Vec<Complex64>, SolverError> {
-        let side = |j: usize| {
-            let n = self.boundary.len();
-            let (from, to) = (self.corners[j].0, self.corners[(j + 1) % 4].0);
-            let to = if to < from { to + n } else { to };
-            (from..=to).map(move |i| i % n)
-        };
+        let n = self.boundary.len();
         let mut vertices = Vec::new();
         let mut positions = Vec::new();
         for (j, value) in [(0, 0.0), (2, 1.0)] {
-            for i in side(j) {
-                vertices.push(self.boundary[i]);
+            let side = self.side(j);
+            for i in side.start..=side.end {
+                vertices.push(self.boundary[i % n]);
                 positions.push(Complex64::new(value, 0.0));
             }
         }

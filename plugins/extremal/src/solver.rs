@@ -356,9 +356,6 @@ struct Algorithm<'a> {
     /// Per entry of the f-step operator: `(d/dz, d/dzbar)` of the shape function.
     derivative_entries: Vec<(Complex64, Complex64)>,
     map_step: MapStep,
-    /// The four-point problem: the quadratic differential is fixed by the source
-    /// ([`crate::quadrilateral`]) and the h-steps are skipped.
-    fixed_form: bool,
     parameters: Parameters,
     map: Vec<Complex64>,
     fz: Vec<Complex64>,
@@ -532,7 +529,6 @@ impl<'a> Algorithm<'a> {
                 parameters.options,
             )?)),
         };
-        let fixed_form = matches!(boundary, Boundary::Sliding(_));
         let mut algorithm = Self {
             mesh,
             elements,
@@ -542,7 +538,6 @@ impl<'a> Algorithm<'a> {
             pattern,
             derivative_entries,
             map_step,
-            fixed_form,
             parameters,
             map,
             fz: Vec::new(),
@@ -708,7 +703,10 @@ impl<'a> Algorithm<'a> {
                 break;
             }
             let before = energy;
-            let inner_iters = if self.fixed_form { 0 } else { inner_iters };
+            // The four-point problem's quadratic differential is fixed by the source
+            // ([`crate::quadrilateral`]): no h-steps.
+            let sliding = matches!(self.map_step, MapStep::Sliding(_));
+            let inner_iters = if sliding { 0 } else { inner_iters };
             for _ in 0..inner_iters {
                 let inner_before = energy;
                 step_sizes.push(self.form_step()?);
