@@ -68,8 +68,11 @@ pub const ACCEPTS: Accepts = Accepts {
     topologies: &[
         Topology::Disk,
         Topology::Annulus,
+        Topology::MultiplyConnected,
         Topology::Sphere,
         Topology::Torus,
+        Topology::HigherGenus,
+        Topology::BoundedHigherGenus,
     ],
     targets: &[
         TargetKind::PlaneKeep,

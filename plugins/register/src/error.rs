@@ -44,7 +44,7 @@ pub enum RegisterError {
     },
     /// A topology the initial map does not handle.
     #[error(
-        "the {side} is {shape}; the initial map supports one connected component that is a disk (genus 0, one boundary loop), a closed genus-0 surface or a closed genus-1 surface"
+        "the {side} is {shape}; the initial map supports one connected surface (any genus, any number of boundary loops)"
     )]
     Unsupported {
         /// Which mesh.
@@ -70,6 +70,15 @@ pub enum RegisterError {
     NoSquare {
         /// Which mesh.
         side: Side,
+    },
+    /// The target's cut graph, drawn after the source's, does not cut the target in the
+    /// same pattern (the two meshes are too different in space for the placement).
+    #[error(
+        "matching the cuts of the two meshes: {reason}; add landmarks (at least three, spread over the surface, and one on each boundary loop) so that the meshes can be placed onto each other"
+    )]
+    Seams {
+        /// What did not match.
+        reason: String,
     },
     /// Cutting a mesh into a disk failed.
     #[error("cutting the {side}: {error}")]

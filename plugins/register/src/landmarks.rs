@@ -118,11 +118,13 @@ where
 /// A rough correspondence in space used when no landmark fixes an alignment: both meshes
 /// are centred at their area centroids and scaled to the same root-mean-square vertex
 /// distance from it (no rotation), and a source vertex's *spatial partner* is the closest
-/// point of the target to its moved position.
+/// point of the target to its moved position. [`SpatialMatch::fitted`] takes the
+/// similarity that best carries landmarks onto their targets instead.
 pub(crate) struct SpatialMatch {
     source_center: Point3<f64>,
     target_center: Point3<f64>,
     scale: f64,
+    rotation: Matrix3<f64>,
 }
 
 impl SpatialMatch {
@@ -139,12 +141,53 @@ impl SpatialMatch {
             source_center,
             target_center,
             scale,
+            rotation: Matrix3::identity(),
         }
+    }
+
+    /// The similarity `p -> c_t + s R (p - c_s)` minimizing the squared distances of the
+    /// moved points `from` to the points `to` (Umeyama 1991: centroids, `R` by Kabsch,
+    /// `s = sum (R a_i) . b_i / sum |a_i|^2` for the centred pairs), or `None` for fewer
+    /// than three pairs or pairs on one line.
+    pub(crate) fn fitted(from: &[Point3<f64>], to: &[Point3<f64>]) -> Option<Self> {
+        let n = from.len();
+        if n < 3 || to.len() != n {
+            return None;
+        }
+        let mean = |ps: &[Point3<f64>]| {
+            Point3::from(ps.iter().map(|p| p.coords).sum::<Vector3<f64>>() / n as f64)
+        };
+        let (source_center, target_center) = (mean(from), mean(to));
+        let pairs: Vec<(Vector3<f64>, Vector3<f64>)> = from
+            .iter()
+            .zip(to)
+            .map(|(a, b)| (a - source_center, b - target_center))
+            .collect();
+        let extent: f64 = pairs.iter().map(|(a, _)| a.norm_squared()).sum();
+        let spread = pairs
+            .iter()
+            .flat_map(|(a, _)| pairs.iter().map(move |(b, _)| a.cross(b).norm_squared()))
+            .fold(0.0, f64::max);
+        if extent.is_nan() || extent <= 0.0 || spread <= 1e-6 * extent * extent {
+            return None;
+        }
+        let rotation = best_rotation(&pairs);
+        let scale = pairs
+            .iter()
+            .map(|(a, b)| (rotation * a).dot(b))
+            .sum::<f64>()
+            / extent;
+        (scale > 0.0).then_some(Self {
+            source_center,
+            target_center,
+            scale,
+            rotation,
+        })
     }
 
     /// A source position moved into the target's frame.
     pub(crate) fn to_target(&self, p: &Point3<f64>) -> Point3<f64> {
-        self.target_center + (p - self.source_center) * self.scale
+        self.target_center + self.rotation * (p - self.source_center) * self.scale
     }
 }
 
@@ -310,4 +353,37 @@ impl SquareMap {
 pub(crate) fn periodic_distance(a: Complex64, b: Complex64) -> f64 {
     let d = a - b;
     Complex64::new(d.re - d.re.round(), d.im - d.im.round()).norm()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fitted_similarity_recovers_a_rotation_scale_and_shift() {
+        let rotation = Rotation3::from_euler_angles(0.3, -1.1, 2.0).into_inner();
+        let shift = Vector3::new(4.0, -2.0, 0.5);
+        let from = [
+            Point3::new(0.5, -11.3, 37.9),
+            Point3::new(-16.8, -15.9, 11.5),
+            Point3::new(19.7, -19.1, 10.2),
+            Point3::new(1.0, 2.0, 3.0),
+        ];
+        let to: Vec<Point3<f64>> = from
+            .iter()
+            .map(|p| Point3::from(rotation * p.coords * 1.7 + shift))
+            .collect();
+        for n in [3, 4] {
+            let fit = SpatialMatch::fitted(&from[..n], &to[..n]).unwrap();
+            for (p, q) in from.iter().zip(&to) {
+                assert!((fit.to_target(p) - q).norm() < 1e-9, "{n} points");
+            }
+        }
+        let line = [
+            Point3::origin(),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(2.0, 0.0, 0.0),
+        ];
+        assert!(SpatialMatch::fitted(&line, &line).is_none(), "collinear");
+    }
 }

@@ -17,9 +17,10 @@
 //! | disk (one boundary loop) | the target's Tutte disk (module `disk`) | boundary rotation |
 //! | closed genus 0 | the unit sphere (module `sphere`) | rotation or Moebius transformation |
 //! | closed genus 1 | the square `[0, 1]^2` glued periodically (module `torus`) | symmetry of the square |
+//! | any other (several boundary loops, genus 2 and more, genus 1 with boundary) | a polygon whose sides are the arcs of matched cut graphs (module `polygon`) | placement by landmarks or in space |
 //!
-//! Other topologies (genus 2 and more, several boundary loops, several components) are
-//! refused by [`check_topology`] before any work, as are meshes of different topologies.
+//! Meshes of several components are refused by [`check_topology`] before any work, as
+//! are meshes of different topologies.
 //!
 //! ```
 //! use beltrami_mesh::{Mesh, primitives};
@@ -41,6 +42,9 @@ mod disk;
 mod error;
 mod landmarks;
 mod param;
+mod polygon;
+mod routing;
+mod skeleton;
 mod solver;
 mod sphere;
 mod topology;
@@ -110,6 +114,9 @@ pub fn initial_map(
         Topology::Disk => disk::map(source, target, &marks, &mut notes)?,
         Topology::Sphere => sphere::map(source, target, &target_index, &marks, &mut notes)?,
         Topology::Torus => torus::map(source, target, &marks, &mut notes)?,
+        Topology::MultiplyConnected | Topology::HigherGenus => {
+            polygon::map(source, target, &target_index, &marks, &mut notes)?
+        }
     };
     let mut exact = vec![false; marks.len()];
     for &m in &honoured {

@@ -36,17 +36,32 @@ pub(crate) fn tutte(
 /// sits, starting with 0 at `vertices[0]` (the closing edge back to it included in the
 /// total). Values are in `[0, 1)` and increasing.
 pub(crate) fn arc_fractions(mesh: &Mesh, vertices: &[VertexId]) -> Vec<f64> {
+    let mut closed = vertices.to_vec();
+    if let Some(&first) = vertices.first() {
+        closed.push(first);
+    }
+    let mut fractions = path_fractions(mesh, &closed);
+    fractions.pop();
+    fractions
+}
+
+/// The fraction of the total length at which each vertex of the open path `vertices`
+/// sits: 0 at the first, 1 at the last (evenly spaced for a path of length 0).
+pub(crate) fn path_fractions(mesh: &Mesh, vertices: &[VertexId]) -> Vec<f64> {
     let n = vertices.len();
     let mut cumulative = Vec::with_capacity(n);
     let mut total = 0.0;
     for k in 0..n {
+        if k > 0 {
+            total += (mesh.position(vertices[k]) - mesh.position(vertices[k - 1])).norm();
+        }
         cumulative.push(total);
-        total += (mesh.position(vertices[(k + 1) % n]) - mesh.position(vertices[k])).norm();
     }
     if total > 0.0 {
         cumulative.iter().map(|s| s / total).collect()
     } else {
-        (0..n).map(|k| k as f64 / n as f64).collect()
+        let last = n.saturating_sub(1).max(1) as f64;
+        (0..n).map(|k| k as f64 / last).collect()
     }
 }
 

@@ -33,7 +33,15 @@ const NAME: &str = "register";
 
 const ACCEPTS: Accepts = Accepts {
     elements: &[Element::Triangle],
-    topologies: &[Topology::Disk, Topology::Sphere, Topology::Torus],
+    topologies: &[
+        Topology::Disk,
+        Topology::Annulus,
+        Topology::MultiplyConnected,
+        Topology::Sphere,
+        Topology::Torus,
+        Topology::HigherGenus,
+        Topology::BoundedHigherGenus,
+    ],
     targets: &[TargetKind::Mesh],
     goals: &[
         GoalKind::Conformal,

@@ -17,6 +17,12 @@ pub enum Topology {
     /// One closed component of genus 1: both meshes are cut into squares `[0, 1]^2` whose
     /// opposite sides are glued.
     Torus,
+    /// One component of genus 0 with two or more boundary loops: both meshes are cut into
+    /// disks along matched cut graphs, onto one polygon.
+    MultiplyConnected,
+    /// One component of genus 2 or more, or of genus 1 with boundary: cut along matched
+    /// cut graphs as [`Topology::MultiplyConnected`].
+    HigherGenus,
 }
 
 impl fmt::Display for Topology {
@@ -25,6 +31,8 @@ impl fmt::Display for Topology {
             Topology::Disk => "disk",
             Topology::Sphere => "closed genus 0",
             Topology::Torus => "closed genus 1",
+            Topology::MultiplyConnected => "genus 0 with several boundary loops",
+            Topology::HigherGenus => "genus 1 with boundary, or genus 2 or more",
         })
     }
 }
@@ -58,6 +66,8 @@ impl Shape {
             (1, 0, 1) => Some(Topology::Disk),
             (1, 0, 0) => Some(Topology::Sphere),
             (1, 1, 0) => Some(Topology::Torus),
+            (1, 0, _) => Some(Topology::MultiplyConnected),
+            (1, _, _) => Some(Topology::HigherGenus),
             _ => None,
         }
     }
@@ -83,13 +93,13 @@ impl fmt::Display for Shape {
 }
 
 /// Checks that `source` and `target` have the same topology and that it is one the
-/// initial map supports: a disk, a closed genus-0 or a closed genus-1 surface, each one
-/// connected component. Linear in the mesh sizes; no parameterization is computed.
+/// initial map supports: one connected component of any genus with any number of
+/// boundary loops. Linear in the mesh sizes; no parameterization is computed.
 ///
 /// # Errors
 /// [`RegisterError::TopologyMismatch`] when the genus, the number of boundary loops or
 /// the number of components differ (checked first, naming both), and
-/// [`RegisterError::Unsupported`] for a shared topology outside the three cases.
+/// [`RegisterError::Unsupported`] for meshes of several components.
 pub fn check_topology(source: &Mesh, target: &Mesh) -> Result<Topology, RegisterError> {
     let source_shape = Shape::of(source);
     let target_shape = Shape::of(target);

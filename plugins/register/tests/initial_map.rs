@@ -364,15 +364,34 @@ fn topology_mismatches_are_errors() {
     assert_eq!(check_topology(&sphere, &sphere).unwrap(), Topology::Sphere);
     assert_eq!(check_topology(&disk, &disk).unwrap(), Topology::Disk);
     if let Some(eight) = shared("g2_eight.obj") {
-        let err = initial_map(&eight, &eight, &[]).unwrap_err();
-        assert!(matches!(err, RegisterError::Unsupported { .. }));
-        assert!(err.to_string().contains("closed genus-1"), "{err}");
+        assert_eq!(
+            check_topology(&eight, &eight).unwrap(),
+            Topology::HigherGenus
+        );
     }
     let annulus = mesh(&primitives::annulus(0.4, 4, 16));
-    assert!(matches!(
-        check_topology(&annulus, &annulus),
-        Err(RegisterError::Unsupported { .. })
-    ));
+    assert_eq!(
+        check_topology(&annulus, &annulus).unwrap(),
+        Topology::MultiplyConnected
+    );
+    // Two spheres side by side: two components.
+    let one = primitives::icosphere(1);
+    let mut positions = one.positions.clone();
+    positions.extend(
+        one.positions
+            .iter()
+            .map(|p| p + nalgebra::Vector3::new(3.0, 0.0, 0.0)),
+    );
+    let mut pair = PolygonSoup::new(positions);
+    let n = one.positions.len() as u32;
+    for f in one.faces() {
+        pair.push_face(f);
+        pair.push_face(&f.iter().map(|&v| v + n).collect::<Vec<u32>>());
+    }
+    let pair = mesh(&pair);
+    let err = check_topology(&pair, &pair).unwrap_err();
+    assert!(matches!(err, RegisterError::Unsupported { .. }), "{err}");
+    assert!(err.to_string().contains("2 connected components"), "{err}");
 }
 
 #[test]

@@ -1,0 +1,1067 @@
+//! The target's cut graph, drawn after the source's: the same nodes and arcs, numbered
+//! alike, so that both meshes cut into disks that read the same word
+//! ([`crate::skeleton`]).
+//!
+//! 1. **Placement.** Source positions are carried into the target's frame by a
+//!    [`SpatialMatch`]: the similarity fitted to the landmarks when at least three (not
+//!    on one line) are given, otherwise the rough match of centroids and sizes.
+//! 2. **Boundary loops** are paired by the landmarks whose source and target are both on
+//!    a boundary loop (two landmarks pairing one loop with two others are refused, naming
+//!    them), then the rest by the smallest sum of distances between the placed source
+//!    loops and the target loops (the symmetric mean distance of their vertices, up to
+//!    256 of each; all pairings tried up to eight loops, nearest first beyond).
+//! 3. **Nodes** on a boundary loop keep their arc-length fractions along it, measured
+//!    from anchors: the landmarks on the loop (linear in arc length between them), or
+//!    else the best of 360 rotations of the placed loop moved onto its partner's
+//!    centroid (a loop placed off its partner still finds its turn). So their cyclic
+//!    order along the loop is kept, and landmarks on loops are made nodes. The
+//!    other nodes go to the nearest free interior target vertex of their placed
+//!    positions.
+//! 4. **Arcs** along a boundary loop follow the paired target loop in the same sense.
+//!    The other arcs, shortest first, are shortest paths on the target that avoid the
+//!    boundary, every node but their own two ends and every arc drawn before, for the
+//!    edge cost `|e| (1 + (d / s)^2)`: `d` the distance of the edge's far end from the
+//!    placed source arc, `s` 2% of the target's bounding-box diagonal (at least twice its
+//!    mean edge length). The penalty keeps a path in a corridor about the placed arc,
+//!    so it goes around the same handles and holes.
+//!
+//! The word of the target's cut is then compared with the source's by the caller: a
+//! geometry too different for the placement to find the same pattern is refused there,
+//! with landmarks as the way out.
+
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap, HashSet, VecDeque};
+
+use beltrami_mesh::{HalfedgeId, Mesh, Point3, VertexId};
+use beltrami_spatial::SurfaceIndex;
+use kiddo::SquaredEuclidean;
+use kiddo::kd_tree::KdTree;
+use kiddo::leaf_strategies::VecOfArenas;
+use kiddo::stem_strategies::eytzinger::Eytzinger;
+
+use crate::error::RegisterError;
+use crate::landmarks::{Resolved, SpatialMatch};
+use crate::param::arc_fractions;
+use crate::skeleton::{Arc, Skeleton, halfedge_between};
+
+/// Rotations of a boundary loop tried when no landmark anchors it.
+const LOOP_ROTATIONS: usize = 360;
+
+/// Vertices of a loop compared when pairing loops, at most.
+const LOOP_SAMPLES: usize = 256;
+
+/// Loop pairings tried exhaustively up to this many loops.
+const EXHAUSTIVE_LOOPS: usize = 8;
+
+/// A landmark target this close to a target boundary loop (relative to the target's
+/// diagonal) counts as on it.
+const ON_LOOP: f64 = 1e-9;
+
+/// The corridor width `s` of the arc cost, relative to the target's diagonal.
+const CORRIDOR: f64 = 0.02;
+
+/// The cost factor of a step through a node's 1-ring by an arc that does not end at
+/// that node (or further on after a step into the ring of its end): such steps take
+/// room the node's own arcs need, and are left for when there is no other way.
+const RING_COST: f64 = 50.0;
+
+/// Points per kd-tree leaf.
+const BUCKET: usize = 16;
+
+/// A kd-tree of the samples of a placed arc.
+type Tree = KdTree<f64, u32, Eytzinger, VecOfArenas<f64, u32, 3, BUCKET>, 3, BUCKET>;
+
+/// The boundary loops of a mesh: vertices in loop order and each boundary vertex's loop.
+pub(crate) struct Loops {
+    /// The loops' vertices, in `boundary_loop_list` order.
+    pub vertices: Vec<Vec<VertexId>>,
+    /// Per vertex, its loop (`usize::MAX` off the boundary).
+    pub of_vertex: Vec<usize>,
+}
+
+impl Loops {
+    /// The loops of `mesh`.
+    pub fn of(mesh: &Mesh) -> Self {
+        let vertices: Vec<Vec<VertexId>> = mesh
+            .boundary_loop_list()
+            .into_iter()
+            .map(|l| l.vertices)
+            .collect();
+        let mut of_vertex = vec![usize::MAX; mesh.vertex_count()];
+        for (k, l) in vertices.iter().enumerate() {
+            for v in l {
+                of_vertex[v.idx()] = k;
+            }
+        }
+        Self {
+            vertices,
+            of_vertex,
+        }
+    }
+}
+
+/// The similarity that places positions of the mesh with the cut graph in the frame of
+/// the other one (module docs), and whether the landmarks gave it.
+pub(crate) fn placement(from: &Mesh, onto: &Mesh, pins: &[Pin]) -> (SpatialMatch, bool) {
+    let a: Vec<Point3<f64>> = pins.iter().map(|p| p.from).collect();
+    let b: Vec<Point3<f64>> = pins.iter().map(|p| p.onto).collect();
+    match SpatialMatch::fitted(&a, &b) {
+        Some(fit) => (fit, true),
+        None => (SpatialMatch::new(from, onto), false),
+    }
+}
+
+/// The target loop paired with every source loop (module docs).
+///
+/// # Errors
+/// [`RegisterError::Landmark`] for a landmark with one end on a boundary loop and the
+/// other not, or one that pairs a loop already paired otherwise.
+pub(crate) fn pair_loops(
+    source: &Mesh,
+    target: &Mesh,
+    source_loops: &Loops,
+    target_loops: &Loops,
+    marks: &[Resolved],
+    place: &SpatialMatch,
+) -> Result<Vec<usize>, RegisterError> {
+    let k = source_loops.vertices.len();
+    let mut pair: Vec<Option<(usize, usize)>> = vec![None; k];
+    let mut taken: Vec<Option<usize>> = vec![None; k];
+    for mark in marks {
+        let s = source_loops.of_vertex[mark.source.idx()];
+        let t = target_loop_of(target, target_loops, mark);
+        let fail = |reason: String| RegisterError::Landmark {
+            index: mark.index,
+            vertex: mark.source,
+            reason,
+        };
+        match (s != usize::MAX, t) {
+            (false, None) => continue,
+            (true, None) => {
+                return Err(fail(
+                    "the source vertex is on a boundary loop but its target is not: boundary loops go onto boundary loops".to_string(),
+                ));
+            }
+            (false, Some(_)) => {
+                return Err(fail(
+                    "the source vertex is off the boundary but its target is on a boundary loop: boundary loops go onto boundary loops".to_string(),
+                ));
+            }
+            (true, Some(t)) => {
+                if let Some((other, index)) = pair[s]
+                    && other != t
+                {
+                    return Err(fail(format!(
+                        "it puts source boundary loop {s} onto target loop {t}, landmark {index} onto target loop {other}"
+                    )));
+                }
+                if let Some(index) = taken[t]
+                    && pair[s].is_none()
+                {
+                    return Err(fail(format!(
+                        "it puts source boundary loop {s} onto target loop {t}, which landmark {index} gives to another source loop"
+                    )));
+                }
+                pair[s] = Some((t, mark.index));
+                taken[t].get_or_insert(mark.index);
+            }
+        }
+    }
+    let samples = |mesh: &Mesh, vertices: &[VertexId], moved: bool| -> Vec<Point3<f64>> {
+        let step = vertices.len().div_ceil(LOOP_SAMPLES).max(1);
+        vertices
+            .iter()
+            .step_by(step)
+            .map(|&v| {
+                let p = mesh.position(v);
+                if moved { place.to_target(&p) } else { p }
+            })
+            .collect()
+    };
+    let free_sources: Vec<usize> = (0..k).filter(|&s| pair[s].is_none()).collect();
+    let free_targets: Vec<usize> = (0..k).filter(|&t| taken[t].is_none()).collect();
+    let target_samples: Vec<Vec<Point3<f64>>> = free_targets
+        .iter()
+        .map(|&t| samples(target, &target_loops.vertices[t], false))
+        .collect();
+    let cost: Vec<Vec<f64>> = free_sources
+        .iter()
+        .map(|&s| {
+            let a = samples(source, &source_loops.vertices[s], true);
+            target_samples.iter().map(|b| chamfer(&a, b)).collect()
+        })
+        .collect();
+    let chosen = cheapest_assignment(&cost);
+    let mut out: Vec<usize> = pair.iter().map(|p| p.map_or(usize::MAX, |p| p.0)).collect();
+    for (i, &s) in free_sources.iter().enumerate() {
+        out[s] = free_targets[chosen[i]];
+    }
+    Ok(out)
+}
+
+/// The symmetric mean distance between two point sets: the mean distance from each
+/// point of one to the nearest of the other, both ways, added.
+fn chamfer(a: &[Point3<f64>], b: &[Point3<f64>]) -> f64 {
+    let one_way = |x: &[Point3<f64>], y: &[Point3<f64>]| {
+        x.iter()
+            .map(|p| {
+                y.iter()
+                    .map(|q| (p - q).norm())
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .sum::<f64>()
+            / x.len().max(1) as f64
+    };
+    one_way(a, b) + one_way(b, a)
+}
+
+/// The target loop a landmark's target lies on, if any.
+fn target_loop_of(target: &Mesh, loops: &Loops, mark: &Resolved) -> Option<usize> {
+    if let Some(v) = mark.vertex {
+        let l = loops.of_vertex[v.idx()];
+        return (l != usize::MAX).then_some(l);
+    }
+    let (vertices, degree) = target.face_vertex_array(mark.target.face);
+    let tolerance = ON_LOOP * target.bounding_box().diagonal();
+    let p = mark.target.position(target);
+    let at_vertex = vertices[..degree].iter().find(|&&u| {
+        loops.of_vertex[u.idx()] != usize::MAX && (target.position(u) - p).norm() <= tolerance
+    });
+    if let Some(u) = at_vertex {
+        return Some(loops.of_vertex[u.idx()]);
+    }
+    (0..degree).find_map(|k| {
+        let (u, w) = (vertices[k], vertices[(k + 1) % degree]);
+        let h = halfedge_between(target, u, w)?;
+        if !target.is_boundary_edge(target.edge(h)) {
+            return None;
+        }
+        let c = beltrami_spatial::closest_point::closest_on_segment(
+            &p,
+            &target.position(u),
+            &target.position(w),
+        );
+        (c.distance() <= tolerance).then_some(loops.of_vertex[u.idx()])
+    })
+}
+
+/// The assignment of rows to distinct columns with the smallest total cost: every
+/// permutation up to [`EXHAUSTIVE_LOOPS`] rows, the cheapest remaining pair first beyond.
+fn cheapest_assignment(cost: &[Vec<f64>]) -> Vec<usize> {
+    let n = cost.len();
+    if n <= EXHAUSTIVE_LOOPS {
+        let mut best = (f64::INFINITY, (0..n).collect::<Vec<usize>>());
+        let mut current: Vec<usize> = (0..n).collect();
+        permute(&mut current, 0, cost, &mut best);
+        return best.1;
+    }
+    let mut out = vec![usize::MAX; n];
+    let mut used = vec![false; n];
+    let mut pairs: Vec<(f64, usize, usize)> = (0..n)
+        .flat_map(|r| (0..n).map(move |c| (r, c)))
+        .map(|(r, c)| (cost[r][c], r, c))
+        .collect();
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (_, r, c) in pairs {
+        if out[r] == usize::MAX && !used[c] {
+            out[r] = c;
+            used[c] = true;
+        }
+    }
+    out
+}
+
+fn permute(current: &mut [usize], k: usize, cost: &[Vec<f64>], best: &mut (f64, Vec<usize>)) {
+    if k == current.len() {
+        let total: f64 = current.iter().enumerate().map(|(r, &c)| cost[r][c]).sum();
+        if total < best.0 {
+            *best = (total, current.to_vec());
+        }
+        return;
+    }
+    for i in k..current.len() {
+        current.swap(k, i);
+        permute(current, k + 1, cost, best);
+        current.swap(k, i);
+    }
+}
+
+/// A landmark as the drawing reads it: its point on the mesh whose cut graph is drawn
+/// and its point on the mesh it is drawn onto (each a vertex when it is one).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Pin {
+    /// The point on the mesh with the cut graph.
+    pub from: Point3<f64>,
+    /// That point's vertex, when it is one.
+    pub from_vertex: Option<VertexId>,
+    /// The corresponding point on the other mesh.
+    pub onto: Point3<f64>,
+    /// That point's vertex, when it is one.
+    pub onto_vertex: Option<VertexId>,
+    /// The landmark's index, for messages.
+    pub index: usize,
+    /// The landmark's source vertex, for messages.
+    pub vertex: VertexId,
+}
+
+/// Everything the drawing of a cut graph onto the other mesh reads. The cut graph is
+/// the coarser mesh's, drawn onto the finer one, which has room for it (the caller
+/// chooses; "source" and "target" below are the registration's).
+pub(crate) struct Drawing<'a> {
+    /// The mesh whose cut graph is drawn.
+    pub from: &'a Mesh,
+    /// Which mesh of the registration it is, for messages.
+    pub from_side: crate::error::Side,
+    /// Its cut skeleton.
+    pub skeleton: &'a Skeleton,
+    /// The mesh it is drawn onto.
+    pub onto: &'a Mesh,
+    /// Its closest-point index.
+    pub onto_index: &'a SurfaceIndex<'a>,
+    /// The landmarks.
+    pub pins: &'a [Pin],
+    /// Positions of `from` into the frame of `onto`.
+    pub place: &'a SpatialMatch,
+    /// The boundary loops of `from`.
+    pub from_loops: &'a Loops,
+    /// The boundary loops of `onto`.
+    pub onto_loops: &'a Loops,
+    /// The loop of `onto` paired with every loop of `from`.
+    pub paired: &'a [usize],
+}
+
+impl Drawing<'_> {
+    /// The target's skeleton (module docs).
+    ///
+    /// # Errors
+    /// [`RegisterError::Seams`] when a node finds no free target vertex or an arc no path.
+    pub fn draw(&self) -> Result<Skeleton, RegisterError> {
+        let nodes = self.nodes()?;
+        let lengths: Vec<f64> = self
+            .skeleton
+            .arcs
+            .iter()
+            .map(|a| a.length(self.from))
+            .collect();
+        let mut order: Vec<usize> = (0..self.skeleton.arcs.len()).collect();
+        order.sort_by(|&a, &b| lengths[a].total_cmp(&lengths[b]));
+        // Boundary arcs first: they are fixed by the nodes.
+        order.sort_by_key(|&a| !self.skeleton.arcs[a].on_boundary(self.from));
+        let interior = order
+            .iter()
+            .filter(|&&a| !self.skeleton.arcs[a].on_boundary(self.from))
+            .count();
+        let mut failure = None;
+        for _ in 0..interior.max(1) {
+            match self.draw_in_order(&nodes, &order)? {
+                Ok(arcs) => return Ok(Skeleton { nodes, arcs }),
+                Err((a, error)) => {
+                    // Again, with the arc that found no way drawn before the others.
+                    failure = Some(error);
+                    let k = order.iter().position(|&x| x == a).unwrap_or(0);
+                    let first_interior = order.len() - interior;
+                    if k == first_interior {
+                        break;
+                    }
+                    order.remove(k);
+                    order.insert(first_interior, a);
+                }
+            }
+        }
+        Err(failure.unwrap_or_else(|| self.seams("no arc to draw".to_string())))
+    }
+
+    /// The arcs drawn in `order`, or the first arc that found no path and why.
+    #[allow(clippy::type_complexity)]
+    fn draw_in_order(
+        &self,
+        nodes: &[VertexId],
+        order: &[usize],
+    ) -> Result<Result<Vec<Arc>, (usize, RegisterError)>, RegisterError> {
+        let mut blocked = vec![false; self.onto.vertex_count()];
+        for l in &self.onto_loops.vertices {
+            for v in l {
+                blocked[v.idx()] = true;
+            }
+        }
+        for n in nodes {
+            blocked[n.idx()] = true;
+        }
+        // The 1-rings of the nodes are kept for the arcs that end there.
+        let mut rings: HashMap<VertexId, Vec<VertexId>> = HashMap::new();
+        for &n in nodes {
+            for w in self.onto.vertex_neighbors(n) {
+                rings.entry(w).or_default().push(n);
+            }
+        }
+        let mut used_edge = vec![false; self.onto.edge_count()];
+        let mut drawn_ends: HashMap<(usize, usize), HalfedgeId> = HashMap::new();
+        let mut arcs: Vec<Option<Arc>> = vec![None; self.skeleton.arcs.len()];
+        for &a in order {
+            let arc = &self.skeleton.arcs[a];
+            let [from, to] = arc.ends.map(|n| nodes[n]);
+            let vertices = if arc.on_boundary(self.from) {
+                self.along_loop(arc, from, to, nodes)?
+            } else {
+                let wedges = [0, 1].map(|end| self.wedge(a, end, nodes, &drawn_ends));
+                match self.route(a, [from, to], &blocked, &rings, &used_edge, &wedges) {
+                    Ok(path) => path,
+                    Err(RegisterError::Seams { reason }) => {
+                        return Ok(Err((a, RegisterError::Seams { reason })));
+                    }
+                    Err(other) => return Err(other),
+                }
+            };
+            let n = vertices.len();
+            for (end, pair) in [
+                (0, [vertices[0], vertices[1]]),
+                (1, [vertices[n - 1], vertices[n - 2]]),
+            ] {
+                if let Some(h) = halfedge_between(self.onto, pair[0], pair[1]) {
+                    drawn_ends.insert((a, end), h);
+                }
+            }
+            for pair in vertices.windows(2) {
+                if let Some(h) = halfedge_between(self.onto, pair[0], pair[1]) {
+                    used_edge[self.onto.edge(h).idx()] = true;
+                }
+            }
+            for v in &vertices {
+                blocked[v.idx()] = true;
+            }
+            arcs[a] = Some(Arc {
+                vertices,
+                ends: arc.ends,
+            });
+        }
+        Ok(Ok(arcs.into_iter().flatten().collect()))
+    }
+
+    /// The outgoing target halfedges at the node of end `end` (0 first, 1 last) of arc
+    /// `a` through which it may leave so that the arcs around the node keep the
+    /// source's cyclic order: those strictly between the drawn arcs that come before and
+    /// after it around the source's node. `None` when no arc there is drawn yet.
+    fn wedge(
+        &self,
+        a: usize,
+        end: usize,
+        nodes: &[VertexId],
+        drawn_ends: &HashMap<(usize, usize), HalfedgeId>,
+    ) -> Option<Vec<HalfedgeId>> {
+        let node = self.skeleton.arcs[a].ends[end];
+        let around = self.rotation_at(node);
+        let k = around.iter().position(|&x| x == (a, end))?;
+        let m = around.len();
+        // The undrawn ends between the drawn ones before and after this one: room is
+        // left for those before it and those after it.
+        let ahead = (1..m).find(|&i| drawn_ends.contains_key(&around[(k + i) % m]))?;
+        let behind = (1..m)
+            .find(|&i| drawn_ends.contains_key(&around[(k + m - i) % m]))
+            .unwrap_or(ahead);
+        let after = drawn_ends[&around[(k + ahead) % m]];
+        let before = drawn_ends[&around[(k + m - behind) % m]];
+        let (room_before, room_after) = (behind - 1, ahead - 1);
+        let target_around: Vec<HalfedgeId> = self.onto.outgoing_halfedges(nodes[node]).collect();
+        let t = target_around.len();
+        let start = target_around.iter().position(|&h| h == before)?;
+        let gap: Vec<HalfedgeId> = (1..t)
+            .map(|i| target_around[(start + i) % t])
+            .take_while(|&h| h != after || before == after)
+            .collect();
+        Some(
+            gap.iter()
+                .skip(room_before)
+                .take(gap.len().saturating_sub(room_before + room_after))
+                .copied()
+                .collect(),
+        )
+    }
+
+    /// The arc ends at source node `node` in the order of its outgoing halfedges.
+    fn rotation_at(&self, node: usize) -> Vec<(usize, usize)> {
+        let v = self.skeleton.nodes[node];
+        let mut out = Vec::new();
+        for h in self.from.outgoing_halfedges(v) {
+            let w = self.from.target(h);
+            for (a, arc) in self.skeleton.arcs.iter().enumerate() {
+                let n = arc.vertices.len();
+                if arc.vertices[0] == v && arc.vertices[1] == w {
+                    out.push((a, 0));
+                }
+                if arc.vertices[n - 1] == v && arc.vertices[n - 2] == w {
+                    out.push((a, 1));
+                }
+            }
+        }
+        out
+    }
+
+    /// The target vertex of every source node (module docs, step 3).
+    fn nodes(&self) -> Result<Vec<VertexId>, RegisterError> {
+        let mut out = vec![None; self.skeleton.nodes.len()];
+        let mut taken = vec![false; self.onto.vertex_count()];
+        // Nodes on boundary loops, loop by loop.
+        for (s, loop_vertices) in self.from_loops.vertices.iter().enumerate() {
+            let on_loop: Vec<(usize, usize)> = self
+                .skeleton
+                .nodes
+                .iter()
+                .enumerate()
+                .filter_map(|(n, v)| {
+                    loop_vertices
+                        .iter()
+                        .position(|w| w == v)
+                        .map(|position| (n, position))
+                })
+                .collect();
+            if on_loop.is_empty() {
+                continue;
+            }
+            let target_loop = &self.onto_loops.vertices[self.paired[s]];
+            let sigma = arc_fractions(self.from, loop_vertices);
+            let tau = arc_fractions(self.onto, target_loop);
+            let anchors = self.loop_anchors(s, loop_vertices, &sigma, target_loop, &tau)?;
+            let shift = if anchors.is_empty() {
+                self.best_rotation(loop_vertices, &sigma, target_loop, &tau)
+            } else {
+                0.0
+            };
+            for &(_, position) in &on_loop {
+                if let Some(a) = anchors.iter().find(|a| a.position == position) {
+                    taken[target_loop[a.target].idx()] = true;
+                }
+            }
+            for (n, position) in on_loop {
+                if let Some(a) = anchors.iter().find(|a| a.position == position) {
+                    out[n] = Some(target_loop[a.target]);
+                    continue;
+                }
+                let want = if anchors.is_empty() {
+                    (sigma[position] + shift).rem_euclid(1.0)
+                } else {
+                    along_anchors(&anchors, &sigma, &tau, sigma[position])
+                };
+                let nearest = (0..target_loop.len())
+                    .filter(|&j| !taken[target_loop[j].idx()])
+                    .min_by(|&i, &j| {
+                        circular(tau[i], want).total_cmp(&circular(tau[j], want))
+                    })
+                    .ok_or_else(|| self.seams(format!(
+                        "target boundary loop {} has fewer vertices than the source's cut graph meets it",
+                        self.paired[s]
+                    )))?;
+                taken[target_loop[nearest].idx()] = true;
+                out[n] = Some(target_loop[nearest]);
+            }
+        }
+        // Interior nodes: the nearest free interior vertex, by rings around the located face.
+        for (n, &v) in self.skeleton.nodes.iter().enumerate() {
+            if out[n].is_some() {
+                continue;
+            }
+            let p = self.place.to_target(&self.from.position(v));
+            let face = self.onto_index.locate(&p)?.point.face;
+            let chosen = self.nearest_free(&p, face, &taken).ok_or_else(|| {
+                self.seams(format!(
+                    "no free interior target vertex for the cut graph's node at source vertex {}",
+                    self.from.vertex_map().to_input(v)
+                ))
+            })?;
+            taken[chosen.idx()] = true;
+            out[n] = Some(chosen);
+        }
+        Ok(out.into_iter().flatten().collect())
+    }
+
+    /// The landmarks on source loop `s` (its vertices `source_loop` at fractions
+    /// `sigma`) with their target loop vertices, in loop order from the first one.
+    ///
+    /// # Errors
+    /// [`RegisterError::Landmark`] when two of them are in a different order along the
+    /// target loop, or share a target vertex.
+    fn loop_anchors(
+        &self,
+        s: usize,
+        source_loop: &[VertexId],
+        sigma: &[f64],
+        target_loop: &[VertexId],
+        tau: &[f64],
+    ) -> Result<Vec<Anchor>, RegisterError> {
+        let mut anchors: Vec<Anchor> = Vec::new();
+        for pin in self.pins {
+            let Some(position) = pin
+                .from_vertex
+                .and_then(|v| source_loop.iter().position(|&w| w == v))
+            else {
+                continue;
+            };
+            let p = pin.onto;
+            let target = match pin
+                .onto_vertex
+                .and_then(|v| target_loop.iter().position(|&w| w == v))
+            {
+                Some(j) => j,
+                None => (0..target_loop.len())
+                    .min_by(|&i, &j| {
+                        (self.onto.position(target_loop[i]) - p)
+                            .norm_squared()
+                            .total_cmp(&(self.onto.position(target_loop[j]) - p).norm_squared())
+                    })
+                    .unwrap_or(0),
+            };
+            anchors.push(Anchor {
+                position,
+                target,
+                index: pin.index,
+                vertex: pin.vertex,
+            });
+        }
+        let Some(first) = anchors.first().copied() else {
+            return Ok(anchors);
+        };
+        let from_first = |a: &Anchor| (sigma[a.position] - sigma[first.position]).rem_euclid(1.0);
+        anchors.sort_by(|a, b| from_first(a).total_cmp(&from_first(b)));
+        let first = anchors[0];
+        let mut previous = 0.0;
+        for pair in anchors.windows(2) {
+            let t = (tau[pair[1].target] - tau[first.target]).rem_euclid(1.0);
+            if t <= previous {
+                return Err(RegisterError::Landmark {
+                    index: pair[1].index,
+                    vertex: pair[1].vertex,
+                    reason: format!(
+                        "it and landmark {} are in one order along a boundary loop of one mesh and in the other (or at one vertex) along the paired loop of the other (loop {s} and loop {})",
+                        pair[0].index, self.paired[s]
+                    ),
+                });
+            }
+            previous = t;
+        }
+        Ok(anchors)
+    }
+
+    /// The shift of arc-length fractions from a source loop onto its target loop that
+    /// best matches the placed positions, of [`LOOP_ROTATIONS`] tried.
+    fn best_rotation(
+        &self,
+        source_loop: &[VertexId],
+        sigma: &[f64],
+        target_loop: &[VertexId],
+        tau: &[f64],
+    ) -> f64 {
+        // Each loop about its own centroid: a loop placed off its partner still finds
+        // its rotation.
+        let centroid = |points: &[Point3<f64>]| {
+            Point3::from(
+                points
+                    .iter()
+                    .map(|p| p.coords)
+                    .sum::<nalgebra::Vector3<f64>>()
+                    / points.len().max(1) as f64,
+            )
+        };
+        let placed: Vec<Point3<f64>> = source_loop
+            .iter()
+            .map(|&v| self.place.to_target(&self.from.position(v)))
+            .collect();
+        let partner: Vec<Point3<f64>> =
+            target_loop.iter().map(|&v| self.onto.position(v)).collect();
+        let offset = centroid(&partner) - centroid(&placed);
+        let moved: Vec<Point3<f64>> = placed.iter().map(|p| p + offset).collect();
+        let point_at = |t: f64| -> Point3<f64> {
+            let t = t.rem_euclid(1.0);
+            let j = tau.partition_point(|&x| x <= t).saturating_sub(1);
+            let next = (j + 1) % tau.len();
+            let end = if next == 0 { 1.0 } else { tau[next] };
+            let span = end - tau[j];
+            let lambda = if span > 0.0 {
+                ((t - tau[j]) / span).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let (a, b) = (
+                self.onto.position(target_loop[j]),
+                self.onto.position(target_loop[next]),
+            );
+            a + (b - a) * lambda
+        };
+        (0..LOOP_ROTATIONS)
+            .map(|k| k as f64 / LOOP_ROTATIONS as f64)
+            .map(|d| {
+                let cost: f64 = moved
+                    .iter()
+                    .zip(sigma)
+                    .map(|(p, s)| (p - point_at(s + d)).norm_squared())
+                    .sum();
+                (d, cost)
+            })
+            .fold(
+                (0.0, f64::INFINITY),
+                |best, c| if c.1 < best.1 { c } else { best },
+            )
+            .0
+    }
+
+    /// The free interior target vertex nearest to `p`, searched ring by ring from the
+    /// vertices of `face` until a ring has one.
+    fn nearest_free(
+        &self,
+        p: &Point3<f64>,
+        face: beltrami_mesh::FaceId,
+        taken: &[bool],
+    ) -> Option<VertexId> {
+        let mesh = self.onto;
+        let mut ring: Vec<VertexId> = mesh.face_vertices(face).collect();
+        let mut seen: HashSet<VertexId> = ring.iter().copied().collect();
+        let mut queue = VecDeque::new();
+        while !ring.is_empty() {
+            let best = ring
+                .iter()
+                .filter(|v| !taken[v.idx()] && !mesh.is_boundary_vertex(**v))
+                .min_by(|a, b| {
+                    (mesh.position(**a) - p)
+                        .norm_squared()
+                        .total_cmp(&(mesh.position(**b) - p).norm_squared())
+                });
+            if let Some(&v) = best {
+                return Some(v);
+            }
+            queue.extend(ring.drain(..));
+            while let Some(v) = queue.pop_front() {
+                for w in mesh.vertex_neighbors(v) {
+                    if seen.insert(w) {
+                        ring.push(w);
+                    }
+                }
+            }
+        }
+        None
+    }
+
+    /// The target path along the loop of `from` and `to` in the sense of the source arc.
+    fn along_loop(
+        &self,
+        arc: &Arc,
+        from: VertexId,
+        to: VertexId,
+        nodes: &[VertexId],
+    ) -> Result<Vec<VertexId>, RegisterError> {
+        let source_loop =
+            &self.from_loops.vertices[self.from_loops.of_vertex[arc.vertices[0].idx()]];
+        let n = source_loop.len();
+        let i = source_loop
+            .iter()
+            .position(|&v| v == arc.vertices[0])
+            .unwrap_or(0);
+        let with_loop = source_loop[(i + 1) % n] == arc.vertices[1];
+        let l = self.onto_loops.of_vertex[from.idx()];
+        let target_loop = &self.onto_loops.vertices[l];
+        let m = target_loop.len();
+        let mut j = target_loop.iter().position(|&v| v == from).unwrap_or(0);
+        let mut out = vec![from];
+        for _ in 0..m {
+            j = if with_loop {
+                (j + 1) % m
+            } else {
+                (j + m - 1) % m
+            };
+            let v = target_loop[j];
+            out.push(v);
+            if v == to {
+                return Ok(out);
+            }
+            if nodes.contains(&v) {
+                break;
+            }
+        }
+        Err(self.seams(format!(
+            "the nodes of the cut graph on target boundary loop {l} are not in the source's order along it"
+        )))
+    }
+
+    /// A path for arc `a` from `from` to `to` (module docs, step 4): through waypoints,
+    /// the free target vertices nearest to the placed interior vertices of the arc in
+    /// order, each leg the cheapest path in the arc's corridor that avoids what is drawn
+    /// (the legs before it included). A waypoint no leg can reach is skipped.
+    fn route(
+        &self,
+        a: usize,
+        [from, to]: [VertexId; 2],
+        blocked: &[bool],
+        rings: &HashMap<VertexId, Vec<VertexId>>,
+        used_edge: &[bool],
+        wedges: &[Option<Vec<HalfedgeId>>; 2],
+    ) -> Result<Vec<VertexId>, RegisterError> {
+        let [first, last] = wedges.each_ref().map(Option::as_deref);
+        let arc = &self.skeleton.arcs[a];
+        let corridor = Corridor::new(self, arc);
+        let mut blocked = blocked.to_vec();
+        let mut used_edge = used_edge.to_vec();
+        let mut legs: Vec<Vec<VertexId>> = Vec::new();
+        let inner = &arc.vertices[1..arc.vertices.len().saturating_sub(1)];
+        for &v in inner {
+            let p = self.place.to_target(&self.from.position(v));
+            let face = self.onto_index.locate(&p)?.point.face;
+            // A waypoint by a node is left out: the corridor leads past it.
+            let Some(via) = self.nearest_free(&p, face, &blocked) else {
+                continue;
+            };
+            if rings.contains_key(&via) {
+                continue;
+            }
+            let last = legs.last().and_then(|l| l.last().copied()).unwrap_or(from);
+            if via == last {
+                continue;
+            }
+            let leaving = if legs.is_empty() { first } else { None };
+            if let Some(leg) = corridor.shortest(
+                self.onto,
+                [last, via],
+                (&blocked, rings),
+                &used_edge,
+                [leaving, None],
+            ) {
+                self.take(&leg, &mut blocked, &mut used_edge, true);
+                legs.push(leg);
+            }
+        }
+        // The last leg; when the legs before wall `to` off, drop them from the end.
+        loop {
+            let start = legs.last().and_then(|l| l.last().copied()).unwrap_or(from);
+            let leaving = if legs.is_empty() { first } else { None };
+            if let Some(leg) = corridor.shortest(
+                self.onto,
+                [start, to],
+                (&blocked, rings),
+                &used_edge,
+                [leaving, last],
+            ) {
+                legs.push(leg);
+                break;
+            }
+            let Some(dropped) = legs.pop() else {
+                return Err(self.seams(format!(
+                    "no path on the other mesh for the cut graph's arc from vertex {} to vertex {} of the {} that avoids the arcs drawn before it",
+                    self.from.vertex_map().to_input(arc.vertices[0]),
+                    self.from
+                        .vertex_map()
+                        .to_input(*arc.vertices.last().unwrap_or(&arc.vertices[0])),
+                    self.from_side
+                )));
+            };
+            self.take(&dropped, &mut blocked, &mut used_edge, false);
+        }
+        let mut path = vec![from];
+        for leg in legs {
+            path.extend_from_slice(&leg[1..]);
+        }
+        Ok(path)
+    }
+
+    /// Marks the vertices (but the first) and edges of `leg` as drawn, or, with
+    /// `drawn` false, as free again.
+    fn take(&self, leg: &[VertexId], blocked: &mut [bool], used_edge: &mut [bool], drawn: bool) {
+        for pair in leg.windows(2) {
+            if let Some(h) = halfedge_between(self.onto, pair[0], pair[1]) {
+                used_edge[self.onto.edge(h).idx()] = drawn;
+            }
+            blocked[pair[1].idx()] = drawn;
+        }
+    }
+
+    fn seams(&self, reason: String) -> RegisterError {
+        RegisterError::Seams { reason }
+    }
+}
+
+/// The placed source arc and the cost of target edges about it (module docs, step 4).
+struct Corridor {
+    tree: Option<Tree>,
+    width: f64,
+}
+
+impl Corridor {
+    fn new(drawing: &Drawing<'_>, arc: &Arc) -> Self {
+        let mesh = drawing.onto;
+        let mean_edge = mesh.edge_lengths().iter().sum::<f64>() / mesh.edge_count().max(1) as f64;
+        let width = (CORRIDOR * mesh.bounding_box().diagonal()).max(2.0 * mean_edge);
+        // The placed arc, sampled at most width / 4 apart.
+        let placed: Vec<Point3<f64>> = arc
+            .vertices
+            .iter()
+            .map(|&v| drawing.place.to_target(&drawing.from.position(v)))
+            .collect();
+        let mut samples: Vec<[f64; 3]> = Vec::new();
+        for pair in placed.windows(2) {
+            let (p, q) = (pair[0], pair[1]);
+            let pieces = ((q - p).norm() / (0.25 * width)).ceil().max(1.0) as usize;
+            for k in 0..pieces {
+                let x = p + (q - p) * (k as f64 / pieces as f64);
+                samples.push([x.x, x.y, x.z]);
+            }
+        }
+        if let Some(x) = placed.last() {
+            samples.push([x.x, x.y, x.z]);
+        }
+        Self {
+            tree: Tree::new_from_slice(&samples).ok(),
+            width,
+        }
+    }
+
+    /// The cost factor `1 + (d / s)^2` at `p`.
+    fn penalty(&self, p: &Point3<f64>) -> f64 {
+        let d2 = self.tree.as_ref().map_or(0.0, |tree| {
+            tree.query(&[p.x, p.y, p.z])
+                .nearest_one::<SquaredEuclidean<f64>>()
+                .execute()
+                .distance
+        });
+        1.0 + d2 / (self.width * self.width)
+    }
+
+    /// The cheapest path from `from` to `to` (`from != to`) through unblocked vertices
+    /// (a vertex of a node's 1-ring, other than as the first step from that node or the
+    /// last one into it, at [`RING_COST`] times the cost) and unused interior edges, each edge costing its length times the mean of the
+    /// penalties at its middle and far end; leaving `from` only through the halfedges of
+    /// `wedges[0]` and entering `to` only against those of `wedges[1]` (outgoing
+    /// halfedges of `to`), when given.
+    fn shortest(
+        &self,
+        mesh: &Mesh,
+        [from, to]: [VertexId; 2],
+        (blocked, rings): (&[bool], &HashMap<VertexId, Vec<VertexId>>),
+        used_edge: &[bool],
+        wedges: [Option<&[HalfedgeId]>; 2],
+    ) -> Option<Vec<VertexId>> {
+        // Per reached vertex: cost, predecessor, settled. A leg explores a neighbourhood
+        // of its corridor, so a map keeps the work proportional to it.
+        let mut state: HashMap<VertexId, (f64, Option<VertexId>, bool)> = HashMap::new();
+        let mut heap = BinaryHeap::new();
+        state.insert(from, (0.0, None, false));
+        heap.push(Entry(0.0, from));
+        while let Some(Entry(d, x)) = heap.pop() {
+            let entry = state.entry(x).or_insert((d, None, false));
+            if std::mem::replace(&mut entry.2, true) {
+                continue;
+            }
+            if x == to {
+                break;
+            }
+            if x != from && blocked[x.idx()] {
+                continue;
+            }
+            // In a node's ring after the first step: only on into `to`.
+            let cornered = x != from
+                && rings.contains_key(&x)
+                && state.get(&x).and_then(|s| s.1) != Some(from);
+            for h in mesh.outgoing_halfedges(x) {
+                let w = mesh.target(h);
+                let e = mesh.edge(h);
+                if used_edge[e.idx()]
+                    || mesh.is_boundary_edge(e)
+                    || (blocked[w.idx()] && w != to)
+                    || (x == from && wedges[0].is_some_and(|allowed| !allowed.contains(&h)))
+                    || (w == to
+                        && wedges[1].is_some_and(|allowed| !allowed.contains(&mesh.twin(h))))
+                {
+                    continue;
+                }
+                let (pw, px) = (mesh.position(w), mesh.position(x));
+                let middle = Point3::from((pw.coords + px.coords) * 0.5);
+                let mut cost = 0.5 * (self.penalty(&middle) + self.penalty(&pw));
+                // Passing by a node through its ring takes room its own arcs need.
+                let intrudes = rings.get(&w).is_some_and(|owners| {
+                    !(owners.contains(&to) || x == from && owners.contains(&from))
+                });
+                if intrudes || (cornered && w != to) {
+                    cost *= RING_COST;
+                }
+                let dw = d + mesh.edge_length(e) * cost;
+                let slot = state.entry(w).or_insert((f64::INFINITY, None, false));
+                if !slot.2 && dw < slot.0 {
+                    *slot = (dw, Some(x), false);
+                    heap.push(Entry(dw, w));
+                }
+            }
+        }
+        if !state.get(&to).is_some_and(|s| s.2) {
+            return None;
+        }
+        let mut path = vec![to];
+        let mut x = to;
+        while x != from {
+            x = state.get(&x)?.1?;
+            path.push(x);
+        }
+        path.reverse();
+        Some(path)
+    }
+}
+
+/// A landmark on a boundary loop: its source vertex's position in the source loop and
+/// its target's in the target loop.
+#[derive(Debug, Clone, Copy)]
+struct Anchor {
+    position: usize,
+    target: usize,
+    index: usize,
+    vertex: VertexId,
+}
+
+/// The target loop fraction of source loop fraction `f`: linear in arc length between
+/// the two anchors about it (`anchors` in loop order, at least one).
+fn along_anchors(anchors: &[Anchor], sigma: &[f64], tau: &[f64], f: f64) -> f64 {
+    let n = anchors.len();
+    let first = sigma[anchors[0].position];
+    let offset = |x: f64| (x - first).rem_euclid(1.0);
+    let k = anchors
+        .partition_point(|a| offset(sigma[a.position]) <= offset(f))
+        .saturating_sub(1);
+    let (a, b) = (anchors[k], anchors[(k + 1) % n]);
+    let span_s = if n == 1 {
+        1.0
+    } else {
+        (sigma[b.position] - sigma[a.position]).rem_euclid(1.0)
+    };
+    let span_t = if n == 1 {
+        1.0
+    } else {
+        (tau[b.target] - tau[a.target]).rem_euclid(1.0)
+    };
+    let part = if span_s > 0.0 {
+        (f - sigma[a.position]).rem_euclid(1.0) / span_s
+    } else {
+        0.0
+    };
+    (tau[a.target] + part * span_t).rem_euclid(1.0)
+}
+
+/// The distance between two fractions of a loop, going either way round.
+fn circular(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(1.0);
+    d.min(1.0 - d)
+}
+
+/// A heap entry ordered so that `BinaryHeap` pops the smallest cost first.
+struct Entry(f64, VertexId);
+
+impl PartialEq for Entry {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Entry {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .0
+            .total_cmp(&self.0)
+            .then_with(|| other.1.cmp(&self.1))
+    }
+}
