@@ -65,6 +65,9 @@ const CORRIDOR: f64 = 0.02;
 /// room the node's own arcs need, and are left for when there is no other way.
 const RING_COST: f64 = 50.0;
 
+/// Points of every boundary loop that refine the placement ([`Warp`]), at most.
+const WARP_LOOP_SAMPLES: usize = 32;
+
 /// Points per kd-tree leaf.
 const BUCKET: usize = 16;
 
@@ -336,7 +339,7 @@ impl Drawing<'_> {
     /// # Errors
     /// [`RegisterError::Seams`] when a node finds no free target vertex or an arc no path.
     pub fn draw(&self) -> Result<Skeleton, RegisterError> {
-        let nodes = self.nodes()?;
+        let (nodes, warp) = self.nodes()?;
         let lengths: Vec<f64> = self
             .skeleton
             .arcs
@@ -353,7 +356,7 @@ impl Drawing<'_> {
             .count();
         let mut failure = None;
         for _ in 0..interior.max(1) {
-            match self.draw_in_order(&nodes, &order)? {
+            match self.draw_in_order(&nodes, &warp, &order)? {
                 Ok(arcs) => return Ok(Skeleton { nodes, arcs }),
                 Err((a, error)) => {
                     // Again, with the arc that found no way drawn before the others.
@@ -376,6 +379,7 @@ impl Drawing<'_> {
     fn draw_in_order(
         &self,
         nodes: &[VertexId],
+        warp: &Warp<'_>,
         order: &[usize],
     ) -> Result<Result<Vec<Arc>, (usize, RegisterError)>, RegisterError> {
         let mut blocked = vec![false; self.onto.vertex_count()];
@@ -404,7 +408,7 @@ impl Drawing<'_> {
                 self.along_loop(arc, from, to, nodes)?
             } else {
                 let wedges = [0, 1].map(|end| self.wedge(a, end, nodes, &drawn_ends));
-                match self.route(a, [from, to], &blocked, &rings, &used_edge, &wedges) {
+                match self.route(a, [from, to], warp, (&blocked, &rings), &used_edge, &wedges) {
                     Ok(path) => path,
                     Err(RegisterError::Seams { reason }) => {
                         return Ok(Err((a, RegisterError::Seams { reason })));
@@ -497,11 +501,36 @@ impl Drawing<'_> {
     }
 
     /// The target vertex of every source node (module docs, step 3).
-    fn nodes(&self) -> Result<Vec<VertexId>, RegisterError> {
+    fn nodes(&self) -> Result<(Vec<VertexId>, Warp<'_>), RegisterError> {
         let mut out = vec![None; self.skeleton.nodes.len()];
         let mut taken = vec![false; self.onto.vertex_count()];
+        let mut pairs: Vec<(Point3<f64>, Point3<f64>)> =
+            self.pins.iter().map(|p| (p.from, p.onto)).collect();
         // Nodes on boundary loops, loop by loop.
         for (s, loop_vertices) in self.from_loops.vertices.iter().enumerate() {
+            let target_loop = &self.onto_loops.vertices[self.paired[s]];
+            let sigma = arc_fractions(self.from, loop_vertices);
+            let tau = arc_fractions(self.onto, target_loop);
+            let anchors = self.loop_anchors(s, loop_vertices, &sigma, target_loop, &tau)?;
+            let shift = if anchors.is_empty() {
+                self.best_rotation(loop_vertices, &sigma, target_loop, &tau)
+            } else {
+                0.0
+            };
+            let fraction = |position: usize| {
+                if anchors.is_empty() {
+                    (sigma[position] + shift).rem_euclid(1.0)
+                } else {
+                    along_anchors(&anchors, &sigma, &tau, sigma[position])
+                }
+            };
+            let step = loop_vertices.len().div_ceil(WARP_LOOP_SAMPLES).max(1);
+            for position in (0..loop_vertices.len()).step_by(step) {
+                pairs.push((
+                    self.from.position(loop_vertices[position]),
+                    loop_point(self.onto, target_loop, &tau, fraction(position)),
+                ));
+            }
             let on_loop: Vec<(usize, usize)> = self
                 .skeleton
                 .nodes
@@ -514,18 +543,6 @@ impl Drawing<'_> {
                         .map(|position| (n, position))
                 })
                 .collect();
-            if on_loop.is_empty() {
-                continue;
-            }
-            let target_loop = &self.onto_loops.vertices[self.paired[s]];
-            let sigma = arc_fractions(self.from, loop_vertices);
-            let tau = arc_fractions(self.onto, target_loop);
-            let anchors = self.loop_anchors(s, loop_vertices, &sigma, target_loop, &tau)?;
-            let shift = if anchors.is_empty() {
-                self.best_rotation(loop_vertices, &sigma, target_loop, &tau)
-            } else {
-                0.0
-            };
             for &(_, position) in &on_loop {
                 if let Some(a) = anchors.iter().find(|a| a.position == position) {
                     taken[target_loop[a.target].idx()] = true;
@@ -536,11 +553,7 @@ impl Drawing<'_> {
                     out[n] = Some(target_loop[a.target]);
                     continue;
                 }
-                let want = if anchors.is_empty() {
-                    (sigma[position] + shift).rem_euclid(1.0)
-                } else {
-                    along_anchors(&anchors, &sigma, &tau, sigma[position])
-                };
+                let want = fraction(position);
                 let nearest = (0..target_loop.len())
                     .filter(|&j| !taken[target_loop[j].idx()])
                     .min_by(|&i, &j| {
@@ -554,12 +567,13 @@ impl Drawing<'_> {
                 out[n] = Some(target_loop[nearest]);
             }
         }
+        let warp = Warp::new(self.place, &pairs);
         // Interior nodes: the nearest free interior vertex, by rings around the located face.
         for (n, &v) in self.skeleton.nodes.iter().enumerate() {
             if out[n].is_some() {
                 continue;
             }
-            let p = self.place.to_target(&self.from.position(v));
+            let p = warp.to_target(&self.from.position(v));
             let face = self.onto_index.locate(&p)?.point.face;
             let chosen = self.nearest_free(&p, face, &taken).ok_or_else(|| {
                 self.seams(format!(
@@ -570,7 +584,7 @@ impl Drawing<'_> {
             taken[chosen.idx()] = true;
             out[n] = Some(chosen);
         }
-        Ok(out.into_iter().flatten().collect())
+        Ok((out.into_iter().flatten().collect(), warp))
     }
 
     /// The landmarks on source loop `s` (its vertices `source_loop` at fractions
@@ -668,23 +682,7 @@ impl Drawing<'_> {
             target_loop.iter().map(|&v| self.onto.position(v)).collect();
         let offset = centroid(&partner) - centroid(&placed);
         let moved: Vec<Point3<f64>> = placed.iter().map(|p| p + offset).collect();
-        let point_at = |t: f64| -> Point3<f64> {
-            let t = t.rem_euclid(1.0);
-            let j = tau.partition_point(|&x| x <= t).saturating_sub(1);
-            let next = (j + 1) % tau.len();
-            let end = if next == 0 { 1.0 } else { tau[next] };
-            let span = end - tau[j];
-            let lambda = if span > 0.0 {
-                ((t - tau[j]) / span).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let (a, b) = (
-                self.onto.position(target_loop[j]),
-                self.onto.position(target_loop[next]),
-            );
-            a + (b - a) * lambda
-        };
+        let point_at = |t: f64| loop_point(self.onto, target_loop, tau, t);
         (0..LOOP_ROTATIONS)
             .map(|k| k as f64 / LOOP_ROTATIONS as f64)
             .map(|d| {
@@ -787,20 +785,20 @@ impl Drawing<'_> {
         &self,
         a: usize,
         [from, to]: [VertexId; 2],
-        blocked: &[bool],
-        rings: &HashMap<VertexId, Vec<VertexId>>,
+        warp: &Warp<'_>,
+        (blocked, rings): (&[bool], &HashMap<VertexId, Vec<VertexId>>),
         used_edge: &[bool],
         wedges: &[Option<Vec<HalfedgeId>>; 2],
     ) -> Result<Vec<VertexId>, RegisterError> {
         let [first, last] = wedges.each_ref().map(Option::as_deref);
         let arc = &self.skeleton.arcs[a];
-        let corridor = Corridor::new(self, arc);
+        let corridor = Corridor::new(self, warp, arc);
         let mut blocked = blocked.to_vec();
         let mut used_edge = used_edge.to_vec();
         let mut legs: Vec<Vec<VertexId>> = Vec::new();
         let inner = &arc.vertices[1..arc.vertices.len().saturating_sub(1)];
         for &v in inner {
-            let p = self.place.to_target(&self.from.position(v));
+            let p = warp.to_target(&self.from.position(v));
             let face = self.onto_index.locate(&p)?.point.face;
             // A waypoint by a node is left out: the corridor leads past it.
             let Some(via) = self.nearest_free(&p, face, &blocked) else {
@@ -881,7 +879,7 @@ struct Corridor {
 }
 
 impl Corridor {
-    fn new(drawing: &Drawing<'_>, arc: &Arc) -> Self {
+    fn new(drawing: &Drawing<'_>, warp: &Warp<'_>, arc: &Arc) -> Self {
         let mesh = drawing.onto;
         let mean_edge = mesh.edge_lengths().iter().sum::<f64>() / mesh.edge_count().max(1) as f64;
         let width = (CORRIDOR * mesh.bounding_box().diagonal()).max(2.0 * mean_edge);
@@ -889,7 +887,7 @@ impl Corridor {
         let placed: Vec<Point3<f64>> = arc
             .vertices
             .iter()
-            .map(|&v| drawing.place.to_target(&drawing.from.position(v)))
+            .map(|&v| warp.to_target(&drawing.from.position(v)))
             .collect();
         let mut samples: Vec<[f64; 3]> = Vec::new();
         for pair in placed.windows(2) {
@@ -1035,6 +1033,66 @@ fn along_anchors(anchors: &[Anchor], sigma: &[f64], tau: &[f64], f: f64) -> f64 
         0.0
     };
     (tau[a.target] + part * span_t).rem_euclid(1.0)
+}
+
+/// The point of the closed loop `vertices` of `mesh` at arc-length fraction `t`, the
+/// vertices being at the increasing fractions `tau`.
+fn loop_point(mesh: &Mesh, vertices: &[VertexId], tau: &[f64], t: f64) -> Point3<f64> {
+    let t = t.rem_euclid(1.0);
+    let j = tau.partition_point(|&x| x <= t).saturating_sub(1);
+    let next = (j + 1) % tau.len();
+    let end = if next == 0 { 1.0 } else { tau[next] };
+    let span = end - tau[j];
+    let lambda = if span > 0.0 {
+        ((t - tau[j]) / span).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (a, b) = (mesh.position(vertices[j]), mesh.position(vertices[next]));
+    a + (b - a) * lambda
+}
+
+/// The placement refined by the correspondences known before any arc is drawn (the
+/// landmarks and points of every paired boundary loop, matched by the loop's anchors or
+/// rotation): the similarity's image moved by Shepard's interpolation of the residual
+/// displacements, `sum_i w_i d_i / sum_i w_i` with `w_i = 1 / |q - a_i|^2` (`q` the
+/// similarity's image, `a_i` those of the corresponding points, `d_i` their residuals),
+/// so that the corresponding points land exactly on their partners. With no
+/// correspondence it is the similarity.
+pub(crate) struct Warp<'a> {
+    similarity: &'a SpatialMatch,
+    residuals: Vec<(Point3<f64>, nalgebra::Vector3<f64>)>,
+}
+
+impl<'a> Warp<'a> {
+    fn new(similarity: &'a SpatialMatch, pairs: &[(Point3<f64>, Point3<f64>)]) -> Self {
+        Self {
+            similarity,
+            residuals: pairs
+                .iter()
+                .map(|(a, b)| {
+                    let q = similarity.to_target(a);
+                    (q, b - q)
+                })
+                .collect(),
+        }
+    }
+
+    /// A position of the mesh with the cut graph in the frame of the other one.
+    pub(crate) fn to_target(&self, p: &Point3<f64>) -> Point3<f64> {
+        let q = self.similarity.to_target(p);
+        let mut sum = nalgebra::Vector3::zeros();
+        let mut weight = 0.0;
+        for (a, d) in &self.residuals {
+            let r2 = (q - a).norm_squared();
+            if r2 == 0.0 {
+                return q + d;
+            }
+            sum += d / r2;
+            weight += 1.0 / r2;
+        }
+        if weight > 0.0 { q + sum / weight } else { q }
+    }
 }
 
 /// The distance between two fractions of a loop, going either way round.
