@@ -564,3 +564,281 @@ fn contradictory_landmarks_and_curves_are_refused_before_any_work() {
         assert!(!out.exists());
     }
 }
+
+/// The annulus `inner <= |z| <= 1` of `rings` rings and `sectors` sectors.
+fn annulus(dir: &Path, name: &str, inner: f64, rings: usize, sectors: usize) -> PathBuf {
+    write(
+        dir,
+        name,
+        &Mesh::from_soup(&primitives::annulus(inner, rings, sectors)).unwrap(),
+    )
+}
+
+/// Runs `register` expecting a failure; returns the message and checks that nothing
+/// was written.
+fn refused(source: &Path, target: &Path, extra: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let mut args = vec!["register", s(source), s(target), "-o", s(&out)];
+    args.extend_from_slice(extra);
+    let run = beltrami(&args);
+    assert!(!run.status.success(), "{extra:?} was accepted");
+    assert!(!out.exists());
+    text(&run.stderr)
+}
+
+#[test]
+fn annuli_of_different_moduli_stay_near_the_teichmueller_bound() {
+    // Grötzsch: every quasiconformal map between the annuli r < |z| < 1 of radii 0.4 and
+    // 0.3 has K >= log(1/0.3) / log(1/0.4) somewhere, so sup |mu| >= k = (K-1)/(K+1);
+    // the radial stretch reaches it with |mu| = k everywhere.
+    let big_k = (1.0f64 / 0.3).ln() / (1.0f64 / 0.4).ln();
+    let k = (big_k - 1.0) / (big_k + 1.0);
+    let dir = tempfile::tempdir().unwrap();
+    let pairs = [
+        (
+            annulus(dir.path(), "a.obj", 0.4, 8, 64),
+            annulus(dir.path(), "b.obj", 0.3, 12, 96),
+        ),
+        (
+            annulus(dir.path(), "c.obj", 0.3, 10, 80),
+            annulus(dir.path(), "d.obj", 0.4, 6, 48),
+        ),
+    ];
+    for (source, target) in &pairs {
+        let (_, r) = register(source, target, &[], 1.01);
+        let mean = r["mu_mean"].as_f64().unwrap();
+        let max = r["mu_max"].as_f64().unwrap();
+        assert!((mean - k).abs() < 0.03, "mean |mu| {mean} vs k {k}");
+        assert!(max >= 0.95 * k, "max |mu| {max} below the bound {k}");
+        let notes = r["notes"].to_string();
+        assert!(notes.contains("cut graphs"), "{notes}");
+    }
+}
+
+/// The unit disk minus two disks, edges about `h` long: three boundary loops.
+fn two_holes(h: f64) -> Mesh {
+    use beltrami_remesh::circle_domain::{Hole, circle_domain};
+    let hole = |x: f64, y: f64, radius: f64| Hole {
+        center: num_complex::Complex64::new(x, y),
+        radius,
+    };
+    circle_domain(&[hole(-0.4, 0.0, 0.22), hole(0.35, 0.3, 0.18)], h).unwrap()
+}
+
+#[test]
+fn a_domain_with_two_holes_onto_its_moebius_image() {
+    // The disk automorphism f(z) = (z - a) / (1 - conj(a) z) is conformal, and a domain
+    // with three boundary loops has no conformal self-map but the identity: the
+    // conformal registration onto the image mesh is f at the vertices, up to the
+    // discretization, which falls under refinement.
+    let a = num_complex::Complex64::new(0.25, 0.1);
+    let f = |p: &Point3<f64>| {
+        let z = num_complex::Complex64::new(p.x, p.y);
+        let w = (z - a) / (1.0 - a.conj() * z);
+        Point3::new(w.re, w.im, 0.0)
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mut errors = Vec::new();
+    for (level, h) in [(1, 0.08), (2, 0.04)] {
+        let source = two_holes(h);
+        assert_eq!(source.boundary_loop_count(), 3);
+        let image: Vec<Point3<f64>> = source.positions().iter().map(f).collect();
+        let target = source.with_positions(image.clone()).unwrap();
+        let (s_path, t_path) = (
+            write(dir.path(), &format!("s{level}.obj"), &source),
+            write(dir.path(), &format!("t{level}.obj"), &target),
+        );
+        let (mapped, r) = register(&s_path, &t_path, &[], 1.0);
+        let error = mapped
+            .iter()
+            .zip(&image)
+            .map(|(p, q)| (p - q).norm())
+            .fold(0.0, f64::max);
+        let mean = r["mu_mean"].as_f64().unwrap();
+        let _ = writeln!(
+            std::io::stderr(),
+            "level {level}: vertex error {error:.3e}, mean |mu| {mean:.4}, {} {}",
+            r["iterations"],
+            r["notes"]
+        );
+        errors.push(error);
+    }
+    // Second order: the error falls about fourfold when h halves.
+    assert!(errors[1] < 0.4 * errors[0], "{errors:?}");
+    assert!(errors[1] < 3e-3, "{errors:?}");
+}
+
+#[test]
+fn landmarks_that_break_the_order_of_a_boundary_loop_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = annulus(dir.path(), "a.obj", 0.4, 4, 32);
+    let target = annulus(dir.path(), "b.obj", 0.3, 6, 48);
+    let loops = read(&source).boundary_loop_list();
+    let target_loops = read(&target).boundary_loop_list();
+    let outer = |l: &[beltrami_mesh::BoundaryLoop]| {
+        l.iter()
+            .max_by(|x, y| x.length.total_cmp(&y.length))
+            .unwrap()
+            .vertices
+            .clone()
+    };
+    let inner = |l: &[beltrami_mesh::BoundaryLoop]| {
+        l.iter()
+            .min_by(|x, y| x.length.total_cmp(&y.length))
+            .unwrap()
+            .vertices
+            .clone()
+    };
+    let (so, to, ti) = (outer(&loops), outer(&target_loops), inner(&target_loops));
+    let cases = [
+        // Three landmarks along the outer loop, their targets in the other turn.
+        (
+            format!(
+                "v {} {}\nv {} {}\nv {} {}\n",
+                so[0].0, to[0].0, so[8].0, to[32].0, so[16].0, to[16].0
+            ),
+            "in one order along a boundary loop",
+        ),
+        // The outer loop onto both target loops.
+        (
+            format!("v {} {}\nv {} {}\n", so[0].0, to[0].0, so[16].0, ti[0].0),
+            "puts source boundary loop",
+        ),
+        // A boundary vertex onto an interior point.
+        (
+            format!("p {} 0.6 0.1 0\n", so[0].0),
+            "boundary loops go onto boundary loops",
+        ),
+    ];
+    for (landmarks, expected) in cases {
+        let file = dir.path().join("landmarks.txt");
+        std::fs::write(&file, &landmarks).unwrap();
+        let message = refused(
+            &source,
+            &target,
+            &["--landmarks", s(&file), "--progress-lines"],
+        );
+        assert!(message.contains(expected), "{landmarks:?}: {message}");
+        assert!(!message.contains("initial map"), "work started: {message}");
+    }
+}
+
+/// `mesh` remeshed by `beltrami remesh` to about `vertices` vertices, its positions then
+/// moved by `deform`.
+fn remeshed(
+    dir: &Path,
+    mesh: &Path,
+    vertices: usize,
+    deform: impl Fn(&Point3<f64>) -> Point3<f64>,
+) -> PathBuf {
+    let name = mesh.file_stem().unwrap().to_str().unwrap();
+    let out = dir.join(format!("{name}-remeshed.obj"));
+    let n = vertices.to_string();
+    let run = beltrami(&["remesh", s(mesh), "--vertices", &n, "-o", s(&out), "-q"]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let remeshed = read(&out);
+    let moved = remeshed.positions().iter().map(deform).collect();
+    write(
+        dir,
+        &format!("{name}-target.obj"),
+        &remeshed.with_positions(moved).unwrap(),
+    )
+}
+
+#[test]
+fn higher_genus_onto_remeshed_copies_both_ways() {
+    let Some(shared) = shared_meshes("higher_genus_onto_remeshed_copies_both_ways") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    for (file, vertices) in [("g2_eight.obj", 3000), ("g2b1_eight_hole.obj", 2000)] {
+        let source = shared.join(file);
+        let target = remeshed(dir.path(), &source, vertices, |p| *p);
+        let scale = read(&source).bounding_box().diagonal();
+        // The same surface: the conformal registration is the identity.
+        for (from, onto) in [(&source, &target), (&target, &source)] {
+            let (image, r) = register(from, onto, &[], 0.2);
+            let mean = r["mu_mean"].as_f64().unwrap();
+            assert!(mean < 0.01, "{file}: mean |mu| {mean}");
+            let farthest = image
+                .iter()
+                .zip(read(from).positions())
+                .map(|(p, q)| (p - q).norm())
+                .fold(0.0, f64::max);
+            assert!(
+                farthest < 0.01 * scale,
+                "{file}: a vertex moved {farthest:.3e}"
+            );
+            assert!(r["notes"].to_string().contains("cut graphs"), "{r}");
+        }
+        // A smooth bend of the copy: the map stays a bijection.
+        let bent = remeshed(dir.path(), &source, vertices, |p| {
+            Point3::new(p.x, p.y, p.z + 0.15 * (1.5 * p.y).sin() + 0.1 * p.x * p.x)
+        });
+        let (_, r) = register(&source, &bent, &[], 0.5);
+        let _ = writeln!(
+            std::io::stderr(),
+            "{file} onto the bent copy: mean |mu| {}",
+            r["mu_mean"]
+        );
+    }
+}
+
+#[test]
+fn the_four_boundary_faces_with_their_landmarks() {
+    let Some(shared) = shared_meshes("the_four_boundary_faces_with_their_landmarks") else {
+        return;
+    };
+    let pairs = json(&shared.join("mc4_face_pair_landmarks.json"));
+    let ids = |side: &str, key: &str| -> Vec<u64> {
+        let value = &pairs[side][key];
+        match value.as_array().unwrap().first() {
+            Some(serde_json::Value::Array(_)) => value
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|l| l.as_array().unwrap().iter().map(|v| v.as_u64().unwrap()))
+                .collect(),
+            _ => value
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_u64().unwrap())
+                .collect(),
+        }
+    };
+    let mut a = ids("face_a", "boundary_landmarks");
+    a.extend(ids("face_a", "interior_landmarks"));
+    let mut b = ids("face_b", "boundary_landmarks");
+    b.extend(ids("face_b", "interior_landmarks"));
+    let dir = tempfile::tempdir().unwrap();
+    let (face_a, face_b) = (shared.join("mc4_face_a.obj"), shared.join("mc4_face_b.obj"));
+    for (source, target, from, onto) in [(&face_a, &face_b, &a, &b), (&face_b, &face_a, &b, &a)] {
+        let file = dir.path().join("landmarks.txt");
+        let lines: String = from
+            .iter()
+            .zip(onto)
+            .map(|(x, y)| format!("v {x} {y}\n"))
+            .collect();
+        std::fs::write(&file, lines).unwrap();
+        let (image, r) = register(source, target, &["--landmarks", s(&file)], 0.9);
+        let target_mesh = read(target);
+        for (&x, &y) in from.iter().zip(onto) {
+            let want = target_mesh.position(beltrami_mesh::VertexId(y as u32));
+            let miss = (image[x as usize] - want).norm();
+            assert!(
+                miss < 1e-9,
+                "landmark {x} -> {y}: {miss:.3e} off; {}",
+                r["notes"]
+            );
+        }
+        let _ = writeln!(
+            std::io::stderr(),
+            "{}: mean |mu| {}, max {}",
+            s(source),
+            r["mu_mean"],
+            r["mu_max"]
+        );
+    }
+}

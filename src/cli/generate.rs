@@ -6,6 +6,7 @@ use anyhow::bail;
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_mesh::primitives::{self, ModifiedTorus};
 use beltrami_mesh::{Mesh, PolygonSoup};
+use beltrami_remesh::circle_domain::Hole;
 use clap::{Args, ValueEnum};
 
 /// The generated shapes.
@@ -28,6 +29,10 @@ pub enum Shape {
     Torus1,
     /// The modified torus phi_2 of section 5.4 (r1 = 4, r2 = 1.5, r3 = 0.4), same grid.
     Torus2,
+    /// A circle domain: the unit disk minus the disks of `--holes`, edges about
+    /// 2^-(level+2) long (spade's constrained Delaunay triangulation of the sampled
+    /// circles and a hexagonal lattice), for `qcmc` and multiply-connected registration.
+    CircleDomain,
 }
 
 #[derive(Debug, Args)]
@@ -41,6 +46,9 @@ pub struct GenerateArgs {
     /// The annulus's inner radius.
     #[arg(long, default_value_t = 0.4)]
     pub inner: f64,
+    /// The circle domain's holes, `x,y,r` each, separated by `;`.
+    #[arg(long, default_value = "-0.4,0,0.2;0.35,0.3,0.15")]
+    pub holes: String,
     /// Output mesh (.obj, .gltf, .glb).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -52,7 +60,27 @@ pub fn run(args: &GenerateArgs, quiet: bool) -> anyhow::Result<()> {
     if args.level > 10 {
         bail!("--level {} is too fine (at most 10)", args.level);
     }
-    let soup: PolygonSoup = match args.shape {
+    let mesh = if args.shape == Shape::CircleDomain {
+        let h = 0.25 * 0.5f64.powi(args.level as i32);
+        beltrami_remesh::circle_domain::circle_domain(&holes(&args.holes)?, h)?
+    } else {
+        Mesh::from_soup(&soup(args)?)?
+    };
+    io::write(&args.output, &mesh, &VertexAttributes::default())?;
+    if !quiet {
+        println!(
+            "{}: {} vertices, {} faces",
+            args.output.display(),
+            mesh.vertex_count(),
+            mesh.face_count()
+        );
+    }
+    Ok(())
+}
+
+/// The polygon soup of a primitive shape (every shape but the circle domain).
+fn soup(args: &GenerateArgs) -> anyhow::Result<PolygonSoup> {
+    Ok(match args.shape {
         Shape::Disk => primitives::disk(args.level),
         Shape::Sphere => primitives::octahedral_sphere(args.level),
         Shape::Annulus => {
@@ -73,16 +101,27 @@ pub fn run(args: &GenerateArgs, quiet: bool) -> anyhow::Result<()> {
             };
             primitives::modified_torus(kind, 40 << args.level, 16 << args.level)
         }
-    };
-    let mesh = Mesh::from_soup(&soup)?;
-    io::write(&args.output, &mesh, &VertexAttributes::default())?;
-    if !quiet {
-        println!(
-            "{}: {} vertices, {} faces",
-            args.output.display(),
-            mesh.vertex_count(),
-            mesh.face_count()
-        );
-    }
-    Ok(())
+        Shape::CircleDomain => bail!("a circle domain is not a primitive soup"),
+    })
+}
+
+/// The holes of `--holes`: `x,y,r` triples separated by `;`.
+fn holes(text: &str) -> anyhow::Result<Vec<Hole>> {
+    text.split(';')
+        .filter(|part| !part.trim().is_empty())
+        .map(|part| {
+            let numbers: Vec<f64> = part
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|e| anyhow::anyhow!("--holes: `{part}`: {e}"))?;
+            let [x, y, r] = numbers[..] else {
+                bail!("--holes: `{part}` is not `x,y,r`");
+            };
+            Ok(Hole {
+                center: num_complex::Complex64::new(x, y),
+                radius: r,
+            })
+        })
+        .collect()
 }

@@ -43,6 +43,7 @@
 
 pub mod boundary;
 pub mod chart;
+pub mod circle_domain;
 pub mod domain;
 mod error;
 mod options;

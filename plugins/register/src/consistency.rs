@@ -10,7 +10,11 @@
 //! - feature curves (a source chain onto a target chain, Wong-Zhao 2014 section 5.3)
 //!   must meet on both sides or on neither: chains that share a vertex on one mesh and
 //!   none on the other cross on one side only, and a bijection maps crossing curves to
-//!   crossing curves.
+//!   crossing curves;
+//! - on a mesh with several boundary loops or handles, a landmark on a boundary loop
+//!   must go onto a boundary loop, each loop onto one loop, and the landmarks along
+//!   paired loops must come in the same cyclic order
+//!   ([`crate::routing::check_boundary_landmarks`]).
 
 use beltrami_core::Problem;
 use beltrami_mesh::{Mesh, Point3, VertexId};
@@ -66,6 +70,25 @@ pub(crate) fn check(problem: &Problem<'_>, target: &Mesh) -> Result<(), Register
                 });
             }
             located.push(q);
+        }
+        if matches!(
+            crate::Shape::of(problem.source).topology(),
+            Some(crate::Topology::MultiplyConnected | crate::Topology::HigherGenus)
+        ) && problem.source.boundary_loop_count() > 0
+        {
+            let resolved: Vec<crate::landmarks::Resolved> = marks
+                .iter()
+                .enumerate()
+                .map(|(i, mark)| -> Result<_, RegisterError> {
+                    Ok(crate::landmarks::Resolved {
+                        index: i,
+                        source: mark.vertex,
+                        target: index.locate(&mark.position.to_point())?.point,
+                        vertex: None,
+                    })
+                })
+                .collect::<Result<_, _>>()?;
+            crate::routing::check_boundary_landmarks(problem.source, target, &resolved)?;
         }
     }
     let curves: Vec<_> = problem.constraints.curves().collect();

@@ -25,9 +25,10 @@
 //! on the right.
 //!
 //! Landmarks pick the placement, the pairing of the boundary loops and the anchors
-//! along them (see [`crate::routing`]). A landmark on a boundary loop is made a node of
-//! the source's cut graph, drawn on the target at its target's vertex: a corner of the
-//! polygon, mapped exactly. The flow pulls the others onto their targets.
+//! along them (see [`crate::routing`]). Every landmark is made a node of the cut graph
+//! (one inside the surface at the tip of a slit, the shortest path joining it to the
+//! cut graph), drawn on the other mesh at its partner's vertex: a corner of the
+//! polygon, mapped exactly.
 
 use std::f64::consts::TAU;
 
@@ -40,8 +41,8 @@ use crate::compose;
 use crate::error::{RegisterError, Side};
 use crate::landmarks::Resolved;
 use crate::param::{arc_fractions, domain_mesh, path_fractions, planar_points, tutte};
-use crate::routing::{Drawing, Loops, Pin, pair_loops, placement};
-use crate::skeleton::{Skeleton, Word};
+use crate::routing::{Drawing, Loops, Pin, forward_pins, pair_loops, placement};
+use crate::skeleton::{Skeleton, Word, with_slits};
 
 /// The source's images on the target and the landmarks honoured exactly (indices into
 /// `marks`): those on boundary loops whose targets are target vertices.
@@ -53,17 +54,7 @@ pub(crate) fn map(
     notes: &mut Vec<String>,
 ) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
     // The pairing of the loops is the registration's, source onto target.
-    let forward: Vec<Pin> = marks
-        .iter()
-        .map(|m| Pin {
-            from: source.position(m.source),
-            from_vertex: Some(m.source),
-            onto: m.target.position(target),
-            onto_vertex: m.vertex.or_else(|| vertex_at(target, &m.target)),
-            index: m.index,
-            vertex: m.source,
-        })
-        .collect();
+    let forward = forward_pins(source, target, marks);
     let source_loops = Loops::of(source);
     let target_loops = Loops::of(target);
     let (place, fitted) = placement(source, target, &forward);
@@ -250,14 +241,12 @@ fn matched_cuts(
         }
     };
     let graph = cut_graph(from);
-    // Landmarks on boundary loops become nodes: corners of the polygon, mapped exactly.
-    let on_loops: Vec<VertexId> = pins
-        .iter()
-        .filter_map(|p| p.from_vertex)
-        .filter(|&v| from.is_boundary_vertex(v))
-        .collect();
-    let skeleton = Skeleton::of(from, &graph.edges, &on_loops);
-    let from_cut = cut_along(from, &graph.edges).map_err(|error| RegisterError::Cut {
+    // Landmarks become nodes, corners of the polygon mapped exactly: those off the cut
+    // graph at the tip of a slit joining them to it.
+    let tips: Vec<VertexId> = pins.iter().filter_map(|p| p.from_vertex).collect();
+    let edges = with_slits(from, &graph.edges, &tips);
+    let skeleton = Skeleton::of(from, &edges, &tips);
+    let from_cut = cut_along(from, &edges).map_err(|error| RegisterError::Cut {
         side: side(from),
         error,
     })?;
@@ -301,14 +290,6 @@ fn matched_cuts(
         words: [from_word, onto_word],
         shift,
     })
-}
-
-/// The vertex a surface point sits on, if it is within rounding of one.
-fn vertex_at(mesh: &Mesh, point: &SurfacePoint) -> Option<VertexId> {
-    let (vertices, degree) = mesh.face_vertex_array(point.face);
-    (0..degree)
-        .find(|&k| point.coords[k] >= 1.0 - 1e-9)
-        .map(|k| vertices[k])
 }
 
 /// The source disk's boundary on the unit circle: side `k` of the source's word onto

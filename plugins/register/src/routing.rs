@@ -511,7 +511,15 @@ impl Drawing<'_> {
             let target_loop = &self.onto_loops.vertices[self.paired[s]];
             let sigma = arc_fractions(self.from, loop_vertices);
             let tau = arc_fractions(self.onto, target_loop);
-            let anchors = self.loop_anchors(s, loop_vertices, &sigma, target_loop, &tau)?;
+            let anchors = loop_anchors(
+                self.onto,
+                self.pins,
+                &LoopPair {
+                    indices: [s, self.paired[s]],
+                    vertices: [loop_vertices, target_loop],
+                    fractions: [&sigma, &tau],
+                },
+            )?;
             let shift = if anchors.is_empty() {
                 self.best_rotation(loop_vertices, &sigma, target_loop, &tau)
             } else {
@@ -568,7 +576,30 @@ impl Drawing<'_> {
             }
         }
         let warp = Warp::new(self.place, &pairs);
-        // Interior nodes: the nearest free interior vertex, by rings around the located face.
+        // Landmarks inside: at their partners' vertices.
+        for (n, &v) in self.skeleton.nodes.iter().enumerate() {
+            if out[n].is_some() {
+                continue;
+            }
+            if let Some(pin) = self.pins.iter().find(|p| p.from_vertex == Some(v)) {
+                let vertex = pin.onto_vertex.unwrap_or_else(|| {
+                    self.onto
+                        .vertices()
+                        .filter(|&w| !self.onto.is_boundary_vertex(w))
+                        .min_by(|&a, &b| {
+                            (self.onto.position(a) - pin.onto)
+                                .norm_squared()
+                                .total_cmp(&(self.onto.position(b) - pin.onto).norm_squared())
+                        })
+                        .unwrap_or(v)
+                });
+                if !std::mem::replace(&mut taken[vertex.idx()], true) {
+                    out[n] = Some(vertex);
+                }
+            }
+        }
+        // Other interior nodes: the nearest free interior vertex, by rings around the
+        // located face.
         for (n, &v) in self.skeleton.nodes.iter().enumerate() {
             if out[n].is_some() {
                 continue;
@@ -585,73 +616,6 @@ impl Drawing<'_> {
             out[n] = Some(chosen);
         }
         Ok((out.into_iter().flatten().collect(), warp))
-    }
-
-    /// The landmarks on source loop `s` (its vertices `source_loop` at fractions
-    /// `sigma`) with their target loop vertices, in loop order from the first one.
-    ///
-    /// # Errors
-    /// [`RegisterError::Landmark`] when two of them are in a different order along the
-    /// target loop, or share a target vertex.
-    fn loop_anchors(
-        &self,
-        s: usize,
-        source_loop: &[VertexId],
-        sigma: &[f64],
-        target_loop: &[VertexId],
-        tau: &[f64],
-    ) -> Result<Vec<Anchor>, RegisterError> {
-        let mut anchors: Vec<Anchor> = Vec::new();
-        for pin in self.pins {
-            let Some(position) = pin
-                .from_vertex
-                .and_then(|v| source_loop.iter().position(|&w| w == v))
-            else {
-                continue;
-            };
-            let p = pin.onto;
-            let target = match pin
-                .onto_vertex
-                .and_then(|v| target_loop.iter().position(|&w| w == v))
-            {
-                Some(j) => j,
-                None => (0..target_loop.len())
-                    .min_by(|&i, &j| {
-                        (self.onto.position(target_loop[i]) - p)
-                            .norm_squared()
-                            .total_cmp(&(self.onto.position(target_loop[j]) - p).norm_squared())
-                    })
-                    .unwrap_or(0),
-            };
-            anchors.push(Anchor {
-                position,
-                target,
-                index: pin.index,
-                vertex: pin.vertex,
-            });
-        }
-        let Some(first) = anchors.first().copied() else {
-            return Ok(anchors);
-        };
-        let from_first = |a: &Anchor| (sigma[a.position] - sigma[first.position]).rem_euclid(1.0);
-        anchors.sort_by(|a, b| from_first(a).total_cmp(&from_first(b)));
-        let first = anchors[0];
-        let mut previous = 0.0;
-        for pair in anchors.windows(2) {
-            let t = (tau[pair[1].target] - tau[first.target]).rem_euclid(1.0);
-            if t <= previous {
-                return Err(RegisterError::Landmark {
-                    index: pair[1].index,
-                    vertex: pair[1].vertex,
-                    reason: format!(
-                        "it and landmark {} are in one order along a boundary loop of one mesh and in the other (or at one vertex) along the paired loop of the other (loop {s} and loop {})",
-                        pair[0].index, self.paired[s]
-                    ),
-                });
-            }
-            previous = t;
-        }
-        Ok(anchors)
     }
 
     /// The shift of arc-length fractions from a source loop onto its target loop that
@@ -1093,6 +1057,140 @@ impl<'a> Warp<'a> {
         }
         if weight > 0.0 { q + sum / weight } else { q }
     }
+}
+
+/// One paired boundary loop as the anchors read it: the loop of the mesh with the cut
+/// graph (`from`, its index `s`) and its partner on the other mesh (`onto`, index `t`),
+/// each with its vertices and their arc-length fractions.
+pub(crate) struct LoopPair<'a> {
+    /// The loop's index on `from` and its partner's on `onto`.
+    pub indices: [usize; 2],
+    /// The vertices of both loops.
+    pub vertices: [&'a [VertexId]; 2],
+    /// Their arc-length fractions.
+    pub fractions: [&'a [f64]; 2],
+}
+
+/// The landmarks on a loop of `from` (`pair`) with their vertices on the partner loop
+/// of `onto`, in loop order from the first one.
+///
+/// # Errors
+/// [`RegisterError::Landmark`] when two of them are in a different order along the
+/// partner loop, or share a vertex there.
+fn loop_anchors(
+    onto: &Mesh,
+    pins: &[Pin],
+    pair: &LoopPair<'_>,
+) -> Result<Vec<Anchor>, RegisterError> {
+    let [source_loop, target_loop] = pair.vertices;
+    let [sigma, tau] = pair.fractions;
+    let [s, t] = pair.indices;
+    let mut anchors: Vec<Anchor> = Vec::new();
+    for pin in pins {
+        let Some(position) = pin
+            .from_vertex
+            .and_then(|v| source_loop.iter().position(|&w| w == v))
+        else {
+            continue;
+        };
+        let p = pin.onto;
+        let target = match pin
+            .onto_vertex
+            .and_then(|v| target_loop.iter().position(|&w| w == v))
+        {
+            Some(j) => j,
+            None => (0..target_loop.len())
+                .min_by(|&i, &j| {
+                    (onto.position(target_loop[i]) - p)
+                        .norm_squared()
+                        .total_cmp(&(onto.position(target_loop[j]) - p).norm_squared())
+                })
+                .unwrap_or(0),
+        };
+        anchors.push(Anchor {
+            position,
+            target,
+            index: pin.index,
+            vertex: pin.vertex,
+        });
+    }
+    let Some(first) = anchors.first().copied() else {
+        return Ok(anchors);
+    };
+    let from_first = |a: &Anchor| (sigma[a.position] - sigma[first.position]).rem_euclid(1.0);
+    anchors.sort_by(|a, b| from_first(a).total_cmp(&from_first(b)));
+    let first = anchors[0];
+    let mut previous = 0.0;
+    for pair in anchors.windows(2) {
+        let turn = (tau[pair[1].target] - tau[first.target]).rem_euclid(1.0);
+        if turn <= previous {
+            return Err(RegisterError::Landmark {
+                index: pair[1].index,
+                vertex: pair[1].vertex,
+                reason: format!(
+                    "it and landmark {} are in one order along a boundary loop of one mesh and in the other (or at one vertex) along the paired loop of the other (loop {s} and loop {t})",
+                    pair[0].index
+                ),
+            });
+        }
+        previous = turn;
+    }
+    Ok(anchors)
+}
+
+/// Checks the landmarks on boundary loops before any work: boundary onto boundary,
+/// each source loop onto one target loop, and the same cyclic order along paired loops
+/// (see [`pair_loops`]).
+///
+/// # Errors
+/// [`RegisterError::Landmark`] naming the landmark that breaks one of these.
+pub(crate) fn check_boundary_landmarks(
+    source: &Mesh,
+    target: &Mesh,
+    marks: &[Resolved],
+) -> Result<(), RegisterError> {
+    let pins = forward_pins(source, target, marks);
+    let source_loops = Loops::of(source);
+    let target_loops = Loops::of(target);
+    let (place, _) = placement(source, target, &pins);
+    let paired = pair_loops(source, target, &source_loops, &target_loops, marks, &place)?;
+    for (s, &t) in paired.iter().enumerate() {
+        let (a, b) = (&source_loops.vertices[s], &target_loops.vertices[t]);
+        let fractions = [arc_fractions(source, a), arc_fractions(target, b)];
+        loop_anchors(
+            target,
+            &pins,
+            &LoopPair {
+                indices: [s, t],
+                vertices: [a, b],
+                fractions: [&fractions[0], &fractions[1]],
+            },
+        )?;
+    }
+    Ok(())
+}
+
+/// The landmarks as pins from the source onto the target.
+pub(crate) fn forward_pins(source: &Mesh, target: &Mesh, marks: &[Resolved]) -> Vec<Pin> {
+    marks
+        .iter()
+        .map(|m| Pin {
+            from: source.position(m.source),
+            from_vertex: Some(m.source),
+            onto: m.target.position(target),
+            onto_vertex: m.vertex.or_else(|| vertex_at(target, &m.target)),
+            index: m.index,
+            vertex: m.source,
+        })
+        .collect()
+}
+
+/// The vertex a surface point sits on, if it is within rounding of one.
+pub(crate) fn vertex_at(mesh: &Mesh, point: &beltrami_mesh::SurfacePoint) -> Option<VertexId> {
+    let (vertices, degree) = mesh.face_vertex_array(point.face);
+    (0..degree)
+        .find(|&k| point.coords[k] >= 1.0 - 1e-9)
+        .map(|k| vertices[k])
 }
 
 /// The distance between two fractions of a loop, going either way round.

@@ -97,6 +97,79 @@ impl Word {
     }
 }
 
+/// The cut graph `edges` of `mesh` with a slit to every vertex of `tips` off it: the
+/// shortest path (by edge length) from the tip to the graph as it stands, tip by tip.
+/// Cutting along a slit keeps a disk a disk: the slit opens into two sides meeting at
+/// the tip.
+pub(crate) fn with_slits(mesh: &Mesh, edges: &[EdgeId], tips: &[VertexId]) -> Vec<EdgeId> {
+    let mut out = edges.to_vec();
+    let mut on_graph = vec![false; mesh.vertex_count()];
+    for &e in edges {
+        for v in mesh.edge_vertices(e) {
+            on_graph[v.idx()] = true;
+        }
+    }
+    for &tip in tips {
+        if on_graph[tip.idx()] {
+            continue;
+        }
+        // Dijkstra from the tip until a vertex of the graph is settled.
+        let mut dist = std::collections::HashMap::new();
+        let mut pred: std::collections::HashMap<VertexId, HalfedgeId> =
+            std::collections::HashMap::new();
+        let mut heap = std::collections::BinaryHeap::new();
+        dist.insert(tip, 0.0);
+        heap.push(std::cmp::Reverse((Ordered(0.0), tip)));
+        let mut reached = None;
+        while let Some(std::cmp::Reverse((Ordered(d), x))) = heap.pop() {
+            if dist.get(&x).is_some_and(|&best| d > best) {
+                continue;
+            }
+            if on_graph[x.idx()] {
+                reached = Some(x);
+                break;
+            }
+            for h in mesh.outgoing_halfedges(x) {
+                let w = mesh.target(h);
+                let dw = d + mesh.edge_length(mesh.edge(h));
+                if dist.get(&w).is_none_or(|&best| dw < best) {
+                    dist.insert(w, dw);
+                    pred.insert(w, h);
+                    heap.push(std::cmp::Reverse((Ordered(dw), w)));
+                }
+            }
+        }
+        let Some(mut x) = reached else {
+            continue;
+        };
+        while x != tip {
+            let h = pred[&x];
+            out.push(mesh.edge(h));
+            on_graph[x.idx()] = true;
+            x = mesh.origin(h);
+        }
+        on_graph[tip.idx()] = true;
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// A float ordered by `total_cmp`, for the heap of [`with_slits`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Ordered(f64);
+impl Eq for Ordered {}
+impl PartialOrd for Ordered {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Ordered {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
 /// The halfedge from `u` to `w`, if they are joined by an edge.
 pub(crate) fn halfedge_between(mesh: &Mesh, u: VertexId, w: VertexId) -> Option<HalfedgeId> {
     mesh.outgoing_halfedges(u).find(|&h| mesh.target(h) == w)

@@ -1,73 +1,25 @@
-//! Circle-domain meshes for the tests (spade's constrained Delaunay triangulation) and
+//! Circle-domain meshes for the tests (`beltrami_remesh::circle_domain`) and
 //! what the tests compare.
 #![allow(dead_code)]
 
 use beltrami_core::{Context, Goal, Problem, Solution, Solver, Target};
-use beltrami_mesh::{Mesh, Point3, PolygonSoup};
+use beltrami_mesh::Mesh;
 use beltrami_qcmc::Qcmc;
 use beltrami_qcmc::moebius::{DiskAutomorphism, PlaneCircle};
+use beltrami_remesh::circle_domain::Hole;
 use num_complex::Complex64;
-use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
 /// A triangle mesh of the unit disk minus the closed disks `holes`, edges about `h`
-/// long: the circles sampled evenly (as constraint edges), a hexagonal lattice of
-/// spacing `h` inside, at least `h / 2` from the circles.
+/// long ([`beltrami_remesh::circle_domain::circle_domain`]).
 pub fn circle_domain(holes: &[PlaneCircle], h: f64) -> Mesh {
-    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
-    let mut circle = |c: Complex64, r: f64| {
-        let n = ((2.0 * std::f64::consts::PI * r / h).ceil() as usize).max(8);
-        let handles: Vec<_> = (0..n)
-            .map(|i| {
-                let z = c + r * Complex64::cis(2.0 * std::f64::consts::PI * i as f64 / n as f64);
-                cdt.insert(Point2::new(z.re, z.im)).unwrap()
-            })
-            .collect();
-        for i in 0..n {
-            cdt.add_constraint(handles[i], handles[(i + 1) % n]);
-        }
-    };
-    circle(Complex64::new(0.0, 0.0), 1.0);
-    for hole in holes {
-        circle(hole.center, hole.radius);
-    }
-    let inside = |z: Complex64, margin: f64| {
-        z.norm() < 1.0 - margin
-            && holes
-                .iter()
-                .all(|c| (z - c.center).norm() > c.radius + margin)
-    };
-    let rows = (2.0 / (h * 0.75f64.sqrt())).ceil() as i64;
-    for j in -rows..=rows {
-        for i in -rows..=rows {
-            let z = Complex64::new(
-                h * (i as f64 + 0.5 * (j.rem_euclid(2)) as f64),
-                h * 0.75f64.sqrt() * j as f64,
-            );
-            if inside(z, 0.5 * h) {
-                cdt.insert(Point2::new(z.re, z.im)).unwrap();
-            }
-        }
-    }
-    let positions: Vec<Point3<f64>> = cdt
-        .vertices()
-        .map(|v| Point3::new(v.position().x, v.position().y, 0.0))
+    let holes: Vec<Hole> = holes
+        .iter()
+        .map(|c| Hole {
+            center: c.center,
+            radius: c.radius,
+        })
         .collect();
-    let mut soup = PolygonSoup::new(positions);
-    for f in cdt.inner_faces() {
-        let [a, b, c] = f.vertices();
-        let centroid = Complex64::new(
-            (a.position().x + b.position().x + c.position().x) / 3.0,
-            (a.position().y + b.position().y + c.position().y) / 3.0,
-        );
-        if inside(centroid, 0.0) {
-            soup.push_face(&[
-                a.fix().index() as u32,
-                b.fix().index() as u32,
-                c.fix().index() as u32,
-            ]);
-        }
-    }
-    Mesh::from_soup(&soup).unwrap()
+    beltrami_remesh::circle_domain::circle_domain(&holes, h).unwrap()
 }
 
 /// Runs qcmc on `mesh` with `goal` and the options `options` (name, text).
