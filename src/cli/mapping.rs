@@ -10,6 +10,7 @@ use beltrami::report;
 use beltrami_core::{Context, OptionValue, Options, Pin, Problem, Progress, Solution, Solver};
 use beltrami_mesh::Mesh;
 use beltrami_mesh::io::{self, Format};
+use beltrami_fem::ReferenceNormal;
 use beltrami_render::{Layout, Scene, Style, check_png_path};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde_json::{Map as JsonMap, Value, json};
@@ -248,11 +249,20 @@ pub fn write_png(
     let Some(map) = solution.map() else {
         bail!("--png draws maps of the source's vertices only");
     };
-    let image = match map_file::image(mesh, map, target)? {
-        Image::Uv(uv) => Layout::plane_from_vertices(mesh, &uv)?,
-        Image::Positions(p) => Layout::space(mesh, p)?,
+    // A map onto a target mesh is judged against the target's normals at the images,
+    // as the report judges it.
+    let (image, normals) = match map_file::image(mesh, map, target)? {
+        Image::Uv(uv) => (Layout::plane_from_vertices(mesh, &uv)?, None),
+        Image::Positions(p) => {
+            let normals = match target {
+                Some(target) => Some(beltrami::mapped::target_normals(target, mesh, &p)?.normals),
+                None => None,
+            };
+            (Layout::space(mesh, p)?, normals)
+        }
     };
-    let scene = Scene::new(mesh, Some(image))?;
+    let reference = normals.as_deref().map(ReferenceNormal::PerFace);
+    let scene = Scene::with_reference(mesh, Some(image), reference)?;
     beltrami_render::render(&scene, &Style::default())?
         .write_png(path)
         .with_context(|| format!("cannot write the picture {}", path.display()))?;
