@@ -532,7 +532,8 @@ def register(
     info: bool = False,
 ) -> Any:
     """A bijective map of the mesh ``V, F`` onto the mesh ``TV, TF`` of the same topology
-    (disk, closed genus 0 or 1), as conformal as the ``landmarks`` allow (smallest
+    (one connected surface of any genus with any number of boundary loops), as conformal
+    as the ``landmarks`` allow (smallest
     ``L^p`` norm of mu) or with the Beltrami coefficient ``mu`` (face frames): an initial
     bijection through a common parameter domain, then the Beltrami flow on the target
     (Wong-Zhao 2014). ``landmarks`` is a landmarks file (``v``, ``p`` and ``c`` lines) or

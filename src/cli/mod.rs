@@ -47,7 +47,7 @@ pub enum Command {
     /// A quasiconformal map with a prescribed Beltrami coefficient or the most conformal
     /// one (lsqc, beltrami-flow) onto the plane, a disk, an annulus or the sphere.
     Qc(qc::QcArgs),
-    /// Map one mesh onto another of the same topology (disk, closed genus 0 or 1),
+    /// Map one mesh onto another of the same topology (any genus, any number of boundary loops),
     /// bijectively and as conformally as the constraints allow, with landmarks and
     /// feature curves: an initial bijection, then the Beltrami flow on the target.
     Register(register::RegisterArgs),
