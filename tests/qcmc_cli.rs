@@ -191,3 +191,50 @@ fn qcmc_and_the_flow_find_the_same_annulus_for_a_prescribed_mu() {
     }
     assert!(gaps[0] < 5e-4 && gaps[1] < 0.5 * gaps[0], "{gaps:?}");
 }
+
+#[test]
+fn a_generated_circle_domain_maps_onto_a_circle_domain() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = dir.path().join("domain.obj");
+    let run = beltrami(&[
+        "generate",
+        "circle-domain",
+        "--level",
+        "2",
+        "--holes=-0.4,0,0.2;0.35,0.3,0.15",
+        "-o",
+        s(&mesh),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("report.json");
+    let run = beltrami(&[
+        "param",
+        s(&mesh),
+        "--solver",
+        "qcmc",
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let json = read_json(&report);
+    assert_eq!(json["circles"].as_array().unwrap().len(), 3);
+    assert_eq!(json["flipped"], 0);
+    // A circle domain is conformally a circle domain: only discretization error remains
+    // (edges of 1/16 here).
+    let mean = json["mu_mean"].as_f64().unwrap();
+    assert!(mean < 0.03, "mean |mu| {mean}");
+    for holes in ["0,0,0.99", "-0.2,0,0.2;0.2,0,0.2", "0,0"] {
+        let run = beltrami(&[
+            "generate",
+            "circle-domain",
+            &format!("--holes={holes}"),
+            "-o",
+            s(&dir.path().join("bad.obj")),
+        ]);
+        assert!(!run.status.success(), "{holes} was accepted");
+        assert!(text(&run.stderr).contains("hole"), "{}", text(&run.stderr));
+    }
+}
