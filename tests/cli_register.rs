@@ -842,3 +842,28 @@ fn the_four_boundary_faces_with_their_landmarks() {
         );
     }
 }
+
+#[test]
+fn tori_of_revolution_of_different_moduli_respect_the_teichmueller_bound() {
+    // A torus of revolution (radii R > r) is conformally the rectangle 2 pi by
+    // T = 2 pi r / sqrt(R^2 - r^2) glued periodically (dt = ds / (R + r cos s)), so its
+    // modulus is tau = i r / sqrt(R^2 - r^2). Between rectangular tori with the meridians
+    // paired, the extremal map is the affine stretch: K = tau_2 / tau_1 (or its inverse),
+    // a lower bound for sup |mu| of every map in the class.
+    let tau = |big: f64, small: f64| small / (big * big - small * small).sqrt();
+    let (a, b) = (tau(3.0, 1.0), tau(2.0, 1.0));
+    let k = (b - a).abs() / (a + b);
+    let dir = tempfile::tempdir().unwrap();
+    let torus = |name: &str, big: f64, small: f64, nu: usize, nv: usize| {
+        let soup = primitives::torus(nu, nv, big, small, Cells::Triangles);
+        write(dir.path(), name, &Mesh::from_soup(&soup).unwrap())
+    };
+    let (thin, fat) = (torus("thin.obj", 3.0, 1.0, 72, 24), torus("fat.obj", 2.0, 1.0, 60, 30));
+    for (source, target) in [(&thin, &fat), (&fat, &thin)] {
+        let (_, r) = register(source, target, &["--max-iters", "60"], 1.01);
+        let (mean, max) = (r["mu_mean"].as_f64().unwrap(), r["mu_max"].as_f64().unwrap());
+        let _ = writeln!(std::io::stderr(), "{}: mean {mean:.4}, max {max:.4}, k {k:.4}", s(source));
+        assert!(max >= 0.95 * k, "max |mu| {max} below the bound {k}");
+        assert!(mean <= k + 0.05, "mean |mu| {mean} more than 0.05 above the bound {k}");
+    }
+}

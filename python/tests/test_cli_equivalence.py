@@ -169,6 +169,21 @@ def test_register_matches_the_command_with_its_correspondence(cli, tmp_path):
     close(np.einsum("ij,ijk->ik", bary, TV[TF[face]]), P, 1e-12)
 
 
+def test_register_of_a_multiply_connected_pair_matches_the_command(cli, generated, tmp_path):
+    # Genus 0 with two boundary loops: the matched cut graphs of the initial map.
+    source = generated("annulus", "1")
+    target = generated("annulus", "2", "--inner", "0.3")
+    out = tmp_path / "out.obj"
+    cli("register", source, target, "--max-iters", "5", "-o", out)
+    V, F = beltrami.read_mesh(source)
+    TV, TF = beltrami.read_mesh(target)
+    P, face, bary = beltrami.register(V, F, TV, TF, max_iters=5)
+    close(P, positions_of(out))
+    info = beltrami.register(V, F, TV, TF, max_iters=5, info=True)[-1]
+    assert any("cut graphs" in note for note in info["notes"])
+    assert info["flipped"] == 0
+
+
 def test_beltrami_coefficient_and_distortion_match_the_command(cli, hemisphere, tmp_path):
     V, F = beltrami.read_mesh(hemisphere)
     uv = beltrami.tutte(V, F)
