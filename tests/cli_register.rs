@@ -858,12 +858,25 @@ fn tori_of_revolution_of_different_moduli_respect_the_teichmueller_bound() {
         let soup = primitives::torus(nu, nv, big, small, Cells::Triangles);
         write(dir.path(), name, &Mesh::from_soup(&soup).unwrap())
     };
-    let (thin, fat) = (torus("thin.obj", 3.0, 1.0, 72, 24), torus("fat.obj", 2.0, 1.0, 60, 30));
+    let (thin, fat) = (
+        torus("thin.obj", 3.0, 1.0, 72, 24),
+        torus("fat.obj", 2.0, 1.0, 60, 30),
+    );
     for (source, target) in [(&thin, &fat), (&fat, &thin)] {
         let (_, r) = register(source, target, &["--max-iters", "60"], 1.01);
-        let (mean, max) = (r["mu_mean"].as_f64().unwrap(), r["mu_max"].as_f64().unwrap());
-        let _ = writeln!(std::io::stderr(), "{}: mean {mean:.4}, max {max:.4}, k {k:.4}", s(source));
+        let (mean, max) = (
+            r["mu_mean"].as_f64().unwrap(),
+            r["mu_max"].as_f64().unwrap(),
+        );
+        let _ = writeln!(
+            std::io::stderr(),
+            "{}: mean {mean:.4}, max {max:.4}, k {k:.4}",
+            s(source)
+        );
         assert!(max >= 0.95 * k, "max |mu| {max} below the bound {k}");
-        assert!(mean <= k + 0.05, "mean |mu| {mean} more than 0.05 above the bound {k}");
+        assert!(
+            mean <= k + 0.05,
+            "mean |mu| {mean} more than 0.05 above the bound {k}"
+        );
     }
 }

@@ -17,7 +17,9 @@
 //! These half-planes meet in the kernel of the star polygon. When it is not empty, the
 //! vertex moves to the kernel's centroid (an interior point, away from every link edge)
 //! projected back onto the target, and the move is kept if its star has fewer flipped
-//! faces than before. A round visits the free vertices of every flipped face; a later
+//! faces than before; otherwise (or when the kernel is empty) the mean of its link's
+//! images, projected, is tried the same way: across a fold of the target, the tangent
+//! plane at one image says little about where the others are. A round visits the free vertices of every flipped face; a later
 //! round also their free neighbours, whose moves can open an empty kernel. Boundary,
 //! curve and fixed vertices never move. The flow runs again afterwards to restore
 //! conformality, from a map with fewer flips, and keeps them at most as many.
@@ -182,21 +184,35 @@ pub fn untangle<G: TargetGeometry>(
                     break;
                 }
             }
-            let Some(p) = centroid(&polygon) else {
-                continue;
-            };
-            let moved = target.project(Role::Free, &(origin + u * p.x + w * p.y));
-            let (old_normal, old_faces): (Vector3<f64>, Vec<ImageFace>) =
-                (normals[v], star.iter().map(|&f| faces[f]).collect());
-            image[v] = moved;
-            normals[v] = target.normal(&moved);
+            // Candidates: the kernel's centroid in the tangent plane at the image, then
+            // the mean of the link's images (across a fold of the target the tangent
+            // plane at one corner says little about the others).
+            let kernel = centroid(&polygon).map(|p| origin + u * p.x + w * p.y);
+            let mut link = Vector3::zeros();
+            let mut links = 0usize;
             for &f in star {
-                faces[f] = image_face(elements, normals, image, FaceId(f as u32));
+                for &k in &triangles[f] {
+                    if k != v {
+                        link += image[k].coords;
+                        links += 1;
+                    }
+                }
             }
-            let after = star.iter().filter(|&&f| faces[f].flipped()).count();
-            if after < flips || (flips == 0 && after == 0) {
-                done.moves += 1;
-            } else {
+            let mean = (links > 0).then(|| Point3::from(link / links as f64));
+            for candidate in [kernel, mean].into_iter().flatten() {
+                let moved = target.project(Role::Free, &candidate);
+                let (old_normal, old_faces): (Vector3<f64>, Vec<ImageFace>) =
+                    (normals[v], star.iter().map(|&f| faces[f]).collect());
+                image[v] = moved;
+                normals[v] = target.normal(&moved);
+                for &f in star {
+                    faces[f] = image_face(elements, normals, image, FaceId(f as u32));
+                }
+                let after = star.iter().filter(|&&f| faces[f].flipped()).count();
+                if after < flips || (flips == 0 && after == 0) {
+                    done.moves += 1;
+                    break;
+                }
                 image[v] = origin;
                 normals[v] = old_normal;
                 for (&f, face) in star.iter().zip(old_faces) {
