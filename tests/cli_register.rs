@@ -752,13 +752,17 @@ fn higher_genus_onto_remeshed_copies_both_ways() {
         return;
     };
     let dir = tempfile::tempdir().unwrap();
-    for (file, vertices) in [("g2_eight.obj", 3000), ("g2b1_eight_hole.obj", 2000)] {
+    for (file, vertices) in [
+        ("g2_eight.obj", 3000),
+        ("g2b1_eight_hole.obj", 2000),
+        ("g4_fertility.obj", 8000),
+    ] {
         let source = shared.join(file);
         let target = remeshed(dir.path(), &source, vertices, |p| *p);
         let scale = read(&source).bounding_box().diagonal();
         // The same surface: the conformal registration is the identity.
         for (from, onto) in [(&source, &target), (&target, &source)] {
-            let (image, r) = register(from, onto, &[], 0.2);
+            let (image, r) = register(from, onto, &[], 1.0);
             let mean = r["mu_mean"].as_f64().unwrap();
             assert!(mean < 0.01, "{file}: mean |mu| {mean}");
             let farthest = image
@@ -771,6 +775,9 @@ fn higher_genus_onto_remeshed_copies_both_ways() {
                 "{file}: a vertex moved {farthest:.3e}"
             );
             assert!(r["notes"].to_string().contains("cut graphs"), "{r}");
+        }
+        if file == "g4_fertility.obj" {
+            continue;
         }
         // A smooth bend of the copy: the map stays a bijection.
         let bent = remeshed(dir.path(), &source, vertices, |p| {

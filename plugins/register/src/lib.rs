@@ -43,6 +43,7 @@ mod error;
 mod landmarks;
 mod param;
 mod polygon;
+mod projection;
 mod routing;
 mod skeleton;
 mod solver;
@@ -115,7 +116,12 @@ pub fn initial_map(
         Topology::Sphere => sphere::map(source, target, &target_index, &marks, &mut notes)?,
         Topology::Torus => torus::map(source, target, &marks, &mut notes)?,
         Topology::MultiplyConnected | Topology::HigherGenus => {
-            polygon::map(source, target, &target_index, &marks, &mut notes)?
+            let cut = polygon::map(source, target, &target_index, &marks, &mut notes);
+            if marks.is_empty() && target.boundary_loop_count() == 0 {
+                projection::better(source, target, &target_index, cut, &mut notes)?
+            } else {
+                cut?
+            }
         }
     };
     let mut exact = vec![false; marks.len()];

@@ -426,3 +426,42 @@ fn bad_landmarks_name_their_index() {
         Err(RegisterError::Landmark { index: 1, .. })
     ));
 }
+
+#[test]
+fn genus_two_onto_a_turned_copy_through_matched_cuts() {
+    // A quarter turn about z: four landmarks fit the turn, the matched cut graphs (with
+    // the landmarks as slit tips) give a bijection with no flipped face, and every
+    // landmark lands exactly.
+    let Some(eight) = shared("g2_eight.obj") else {
+        return;
+    };
+    let turned: Vec<Point3<f64>> = eight
+        .positions()
+        .iter()
+        .map(|p| Point3::new(-p.y, p.x, p.z))
+        .collect();
+    let target = eight.with_positions(turned).unwrap();
+    let marks: Vec<Landmark> = [0u32, 200, 400, 600]
+        .iter()
+        .map(|&v| Landmark {
+            source: VertexId(v),
+            target: LandmarkTarget::Vertex(VertexId(v)),
+        })
+        .collect();
+    let map = initial_map(&eight, &target, &marks).unwrap();
+    check_on_target(&eight, &target, &map);
+    assert_eq!(map.topology, Topology::HigherGenus);
+    assert_eq!(map.flipped(), 0, "{:?}", map.notes);
+    assert!(
+        map.notes.iter().any(|n| n.contains("cut graphs")),
+        "{:?}",
+        map.notes
+    );
+    for mark in &marks {
+        let LandmarkTarget::Vertex(v) = mark.target else {
+            unreachable!()
+        };
+        let miss = (map.positions[mark.source.idx()] - target.position(v)).norm();
+        assert!(miss < 1e-12, "landmark {}: {miss:.3e}", mark.source);
+    }
+}
