@@ -26,15 +26,17 @@ fn annulus(dir: &std::path::Path) -> std::path::PathBuf {
     path
 }
 
-#[test]
-fn param_maps_an_annulus_onto_its_own_circles() {
-    let dir = tempfile::tempdir().unwrap();
-    let mesh = annulus(dir.path());
-    let out = dir.path().join("out.obj");
-    let report = dir.path().join("report.json");
+/// `beltrami param MESH --solver qcmc -o DIR/out.obj --report DIR/report.json`; the
+/// run, and the report's path.
+fn param_qcmc(
+    dir: &std::path::Path,
+    mesh: &std::path::Path,
+) -> (std::process::Output, std::path::PathBuf) {
+    let out = dir.join("out.obj");
+    let report = dir.join("report.json");
     let run = beltrami(&[
         "param",
-        s(&mesh),
+        s(mesh),
         "--solver",
         "qcmc",
         "-o",
@@ -43,6 +45,14 @@ fn param_maps_an_annulus_onto_its_own_circles() {
         s(&report),
     ]);
     assert!(run.status.success(), "{}", text(&run.stderr));
+    (run, report)
+}
+
+#[test]
+fn param_maps_an_annulus_onto_its_own_circles() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = annulus(dir.path());
+    let (run, report) = param_qcmc(dir.path(), &mesh);
     let stdout = text(&run.stdout);
     assert!(
         stdout.contains("circle centre") && stdout.contains("Moebius normalization"),
@@ -59,7 +69,7 @@ fn param_maps_an_annulus_onto_its_own_circles() {
     assert!((r - 0.4).abs() < 2e-3, "{r}");
     assert!(circles[1]["deviation"].as_f64().unwrap() < 1e-12);
     assert!(
-        std::fs::read_to_string(&out)
+        std::fs::read_to_string(dir.path().join("out.obj"))
             .unwrap()
             .lines()
             .any(|l| l.starts_with("vt "))
@@ -206,19 +216,7 @@ fn a_generated_circle_domain_maps_onto_a_circle_domain() {
         s(&mesh),
     ]);
     assert!(run.status.success(), "{}", text(&run.stderr));
-    let out = dir.path().join("out.obj");
-    let report = dir.path().join("report.json");
-    let run = beltrami(&[
-        "param",
-        s(&mesh),
-        "--solver",
-        "qcmc",
-        "-o",
-        s(&out),
-        "--report",
-        s(&report),
-    ]);
-    assert!(run.status.success(), "{}", text(&run.stderr));
+    let (_, report) = param_qcmc(dir.path(), &mesh);
     let json = read_json(&report);
     assert_eq!(json["circles"].as_array().unwrap().len(), 3);
     assert_eq!(json["flipped"], 0);

@@ -29,7 +29,7 @@
 //! geometry too different for the placement to find the same pattern is refused there,
 //! with landmarks as the way out.
 
-use std::cmp::Ordering;
+use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap, HashSet, VecDeque};
 
 use beltrami_mesh::{HalfedgeId, Mesh, Point3, VertexId};
@@ -42,7 +42,7 @@ use kiddo::stem_strategies::eytzinger::Eytzinger;
 use crate::error::RegisterError;
 use crate::landmarks::{Resolved, SpatialMatch};
 use crate::param::arc_fractions;
-use crate::skeleton::{Arc, Skeleton, halfedge_between};
+use crate::skeleton::{Arc, Ordered, Skeleton, halfedge_between};
 
 /// Rotations of a boundary loop tried when no landmark anchors it.
 const LOOP_ROTATIONS: usize = 360;
@@ -901,8 +901,8 @@ impl Corridor {
         let mut state: HashMap<VertexId, (f64, Option<VertexId>, bool)> = HashMap::new();
         let mut heap = BinaryHeap::new();
         state.insert(from, (0.0, None, false));
-        heap.push(Entry(0.0, from));
-        while let Some(Entry(d, x)) = heap.pop() {
+        heap.push(Reverse((Ordered(0.0), from)));
+        while let Some(Reverse((Ordered(d), x))) = heap.pop() {
             let entry = state.entry(x).or_insert((d, None, false));
             if std::mem::replace(&mut entry.2, true) {
                 continue;
@@ -943,7 +943,7 @@ impl Corridor {
                 let slot = state.entry(w).or_insert((f64::INFINITY, None, false));
                 if !slot.2 && dw < slot.0 {
                     *slot = (dw, Some(x), false);
-                    heap.push(Entry(dw, w));
+                    heap.push(Reverse((Ordered(dw), w)));
                 }
             }
         }
@@ -1197,27 +1197,4 @@ pub(crate) fn vertex_at(mesh: &Mesh, point: &beltrami_mesh::SurfacePoint) -> Opt
 fn circular(a: f64, b: f64) -> f64 {
     let d = (a - b).rem_euclid(1.0);
     d.min(1.0 - d)
-}
-
-/// A heap entry ordered so that `BinaryHeap` pops the smallest cost first.
-struct Entry(f64, VertexId);
-
-impl PartialEq for Entry {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Entry {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .0
-            .total_cmp(&self.0)
-            .then_with(|| other.1.cmp(&self.1))
-    }
 }

@@ -155,9 +155,10 @@ pub(crate) fn with_slits(mesh: &Mesh, edges: &[EdgeId], tips: &[VertexId]) -> Ve
     out
 }
 
-/// A float ordered by `total_cmp`, for the heap of [`with_slits`].
+/// A float ordered by `total_cmp`, for the shortest-path heaps of the cut graphs
+/// (`std::cmp::Reverse` of it pops the smallest first).
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Ordered(f64);
+pub(crate) struct Ordered(pub f64);
 impl Eq for Ordered {}
 impl PartialOrd for Ordered {
     fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
