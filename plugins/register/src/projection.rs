@@ -2,9 +2,10 @@
 //! in space (a remeshed or slightly moved copy): every source vertex onto the target point
 //! closest to its placed position.
 //!
-//! A map of a closed connected surface onto another of the same genus that flips no face
-//! is a local homeomorphism, hence a covering, and of degree 1 between surfaces of equal
-//! Euler characteristic: a bijection. So the projection is kept only when no face is
+//! A map of a closed connected surface onto another of the same genus `g >= 2` (the
+//! only closed surfaces that come here) that flips no face is a local homeomorphism,
+//! hence a covering, of degree `chi(S) / chi(T) = 1` since `chi = 2 - 2g` is not 0: a
+//! bijection. So the projection is kept only when no face is
 //! flipped (judged as every initial map is, against the target's normals at the images),
 //! and only when it beats the matched-cut map: fewer flips, or as few and a smaller mean
 //! |mu|. On meshes of one surface it is close to the identity, where the cut map's
@@ -62,7 +63,7 @@ pub(crate) fn better(
         Err(error) => format!("the matched cuts, which failed ({error})"),
     };
     notes.push(format!(
-        "initial map: the closest points of the placed source (no flipped face, mean |mu| {:.4}) instead of {instead}; a flip-free map between closed surfaces of one genus is a bijection",
+        "initial map: the closest points of the placed source (no flipped face, mean |mu| {:.4}) instead of {instead}; a flip-free map between closed surfaces of one genus >= 2 is a bijection",
         by_projection.mu_mean
     ));
     Ok((projected, Vec::new()))
