@@ -4,7 +4,7 @@ use std::sync::LazyLock;
 
 use beltrami_core::{
     Accepts, ConstraintKind, Context, Element, GoalKind, Map, OptionKind, OptionSpec, Position,
-    Problem, Report, Settings, Solution, Solver, SolverError, Target, TargetKind, Topology,
+    Problem, Report, Settings, Solution, Solver, SolverError, Target, TargetKind,
 };
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
@@ -33,15 +33,8 @@ const NAME: &str = "register";
 
 const ACCEPTS: Accepts = Accepts {
     elements: &[Element::Triangle],
-    topologies: &[
-        Topology::Disk,
-        Topology::Annulus,
-        Topology::MultiplyConnected,
-        Topology::Sphere,
-        Topology::Torus,
-        Topology::HigherGenus,
-        Topology::BoundedHigherGenus,
-    ],
+    // Every connected topology: those of the flow on a target mesh.
+    topologies: beltrami_flow_engine::ACCEPTS.topologies,
     targets: &[TargetKind::Mesh],
     goals: &[
         GoalKind::Conformal,
