@@ -16,8 +16,12 @@ use beltrami_spatial::SurfaceIndex;
 use crate::RemeshError;
 use crate::refine::smallest_sine;
 
-/// Smallest angle, in degrees, below which a face's vertices are moved.
-pub const ANGLE_LIMIT: f64 = 20.0;
+/// Smallest angle, in degrees, below which a face's vertices are moved. At 20 (the
+/// refinement's limit) the eight shared meshes of the pymeshlab comparison ended at
+/// 20.1-26.4 degrees; at 26 at 24.8-28.8, with fewer angles under 30 and the same
+/// Hausdorff distances; at 28 and 30 the scanned face's Hausdorff distance grew from
+/// 0.31% to 0.44% of the diagonal.
+pub const ANGLE_LIMIT: f64 = 26.0;
 
 /// Sweeps at most.
 const SWEEPS: usize = 4;
