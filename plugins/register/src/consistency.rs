@@ -37,6 +37,7 @@ pub(crate) fn check(problem: &Problem<'_>, target: &Mesh) -> Result<(), Register
     if !marks.is_empty() {
         let index = SurfaceIndex::new(target)?;
         let mut located = Vec::with_capacity(marks.len());
+        let mut points = Vec::with_capacity(marks.len());
         for (i, mark) in marks.iter().enumerate() {
             let p = mark.position.to_point();
             let found = index.locate(&p)?;
@@ -70,6 +71,7 @@ pub(crate) fn check(problem: &Problem<'_>, target: &Mesh) -> Result<(), Register
                 });
             }
             located.push(q);
+            points.push(found.point);
         }
         if matches!(
             crate::Shape::of(problem.source).topology(),
@@ -78,16 +80,15 @@ pub(crate) fn check(problem: &Problem<'_>, target: &Mesh) -> Result<(), Register
         {
             let resolved: Vec<crate::landmarks::Resolved> = marks
                 .iter()
+                .zip(points)
                 .enumerate()
-                .map(|(i, mark)| -> Result<_, RegisterError> {
-                    Ok(crate::landmarks::Resolved {
-                        index: i,
-                        source: mark.vertex,
-                        target: index.locate(&mark.position.to_point())?.point,
-                        vertex: None,
-                    })
+                .map(|(i, (mark, target))| crate::landmarks::Resolved {
+                    index: i,
+                    source: mark.vertex,
+                    target,
+                    vertex: None,
                 })
-                .collect::<Result<_, _>>()?;
+                .collect();
             crate::routing::check_boundary_landmarks(problem.source, target, &resolved)?;
         }
     }

@@ -45,7 +45,8 @@ use crate::routing::{Drawing, Loops, Pin, forward_pins, pair_loops, placement};
 use crate::skeleton::{Skeleton, Word, with_slits};
 
 /// The source's images on the target and the landmarks honoured exactly (indices into
-/// `marks`): those on boundary loops whose targets are target vertices.
+/// `marks`): every one whose target is a target vertex (each landmark is a corner of
+/// the polygon).
 pub(crate) fn map(
     source: &Mesh,
     target: &Mesh,

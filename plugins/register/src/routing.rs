@@ -346,17 +346,20 @@ impl Drawing<'_> {
             .iter()
             .map(|a| a.length(self.from))
             .collect();
+        let on_boundary: Vec<bool> = self
+            .skeleton
+            .arcs
+            .iter()
+            .map(|a| a.on_boundary(self.from))
+            .collect();
         let mut order: Vec<usize> = (0..self.skeleton.arcs.len()).collect();
         order.sort_by(|&a, &b| lengths[a].total_cmp(&lengths[b]));
         // Boundary arcs first: they are fixed by the nodes.
-        order.sort_by_key(|&a| !self.skeleton.arcs[a].on_boundary(self.from));
-        let interior = order
-            .iter()
-            .filter(|&&a| !self.skeleton.arcs[a].on_boundary(self.from))
-            .count();
+        order.sort_by_key(|&a| !on_boundary[a]);
+        let interior = on_boundary.iter().filter(|&&b| !b).count();
         let mut failure = None;
         for _ in 0..interior.max(1) {
-            match self.draw_in_order(&nodes, &warp, &order)? {
+            match self.draw_in_order(&nodes, &warp, &order, &on_boundary)? {
                 Ok(arcs) => return Ok(Skeleton { nodes, arcs }),
                 Err((a, error)) => {
                     // Again, with the arc that found no way drawn before the others.
@@ -374,13 +377,15 @@ impl Drawing<'_> {
         Err(failure.unwrap_or_else(|| self.seams("no arc to draw".to_string())))
     }
 
-    /// The arcs drawn in `order`, or the first arc that found no path and why.
+    /// The arcs drawn in `order` (`on_boundary` telling the arcs along boundary loops),
+    /// or the first arc that found no path and why.
     #[allow(clippy::type_complexity)]
     fn draw_in_order(
         &self,
         nodes: &[VertexId],
         warp: &Warp<'_>,
         order: &[usize],
+        on_boundary: &[bool],
     ) -> Result<Result<Vec<Arc>, (usize, RegisterError)>, RegisterError> {
         let mut blocked = vec![false; self.onto.vertex_count()];
         for l in &self.onto_loops.vertices {
@@ -404,7 +409,7 @@ impl Drawing<'_> {
         for &a in order {
             let arc = &self.skeleton.arcs[a];
             let [from, to] = arc.ends.map(|n| nodes[n]);
-            let vertices = if arc.on_boundary(self.from) {
+            let vertices = if on_boundary[a] {
                 self.along_loop(arc, from, to, nodes)?
             } else {
                 let wedges = [0, 1].map(|end| self.wedge(a, end, nodes, &drawn_ends));
@@ -575,7 +580,7 @@ impl Drawing<'_> {
                 out[n] = Some(target_loop[nearest]);
             }
         }
-        let warp = Warp::new(self.place, &pairs);
+        let warp = Warp::new(self.place, &pairs, self.onto);
         // Landmarks inside: at their partners' vertices.
         for (n, &v) in self.skeleton.nodes.iter().enumerate() {
             if out[n].is_some() {
@@ -760,6 +765,11 @@ impl Drawing<'_> {
         let mut blocked = blocked.to_vec();
         let mut used_edge = used_edge.to_vec();
         let mut legs: Vec<Vec<VertexId>> = Vec::new();
+        // Where the next leg starts, and the wedge it must leave by (only at `from`).
+        let leg_start = |legs: &[Vec<VertexId>]| match legs.last().and_then(|l| l.last()) {
+            Some(&end) => (end, None),
+            None => (from, first),
+        };
         let inner = &arc.vertices[1..arc.vertices.len().saturating_sub(1)];
         for &v in inner {
             let p = warp.to_target(&self.from.position(v));
@@ -771,14 +781,13 @@ impl Drawing<'_> {
             if rings.contains_key(&via) {
                 continue;
             }
-            let last = legs.last().and_then(|l| l.last().copied()).unwrap_or(from);
-            if via == last {
+            let (start, leaving) = leg_start(&legs);
+            if via == start {
                 continue;
             }
-            let leaving = if legs.is_empty() { first } else { None };
             if let Some(leg) = corridor.shortest(
                 self.onto,
-                [last, via],
+                [start, via],
                 (&blocked, rings),
                 &used_edge,
                 [leaving, None],
@@ -789,8 +798,7 @@ impl Drawing<'_> {
         }
         // The last leg; when the legs before wall `to` off, drop them from the end.
         loop {
-            let start = legs.last().and_then(|l| l.last().copied()).unwrap_or(from);
-            let leaving = if legs.is_empty() { first } else { None };
+            let (start, leaving) = leg_start(&legs);
             if let Some(leg) = corridor.shortest(
                 self.onto,
                 [start, to],
@@ -844,9 +852,7 @@ struct Corridor {
 
 impl Corridor {
     fn new(drawing: &Drawing<'_>, warp: &Warp<'_>, arc: &Arc) -> Self {
-        let mesh = drawing.onto;
-        let mean_edge = mesh.edge_lengths().iter().sum::<f64>() / mesh.edge_count().max(1) as f64;
-        let width = (CORRIDOR * mesh.bounding_box().diagonal()).max(2.0 * mean_edge);
+        let width = warp.corridor_width;
         // The placed arc, sampled at most width / 4 apart.
         let placed: Vec<Point3<f64>> = arc
             .vertices
@@ -1026,11 +1032,20 @@ fn loop_point(mesh: &Mesh, vertices: &[VertexId], tau: &[f64], t: f64) -> Point3
 pub(crate) struct Warp<'a> {
     similarity: &'a SpatialMatch,
     residuals: Vec<(Point3<f64>, nalgebra::Vector3<f64>)>,
+    /// The corridor width `s` of the arcs drawn with it (module docs, step 4): 2% of the
+    /// other mesh's diagonal, at least twice its mean edge length.
+    corridor_width: f64,
 }
 
 impl<'a> Warp<'a> {
-    fn new(similarity: &'a SpatialMatch, pairs: &[(Point3<f64>, Point3<f64>)]) -> Self {
+    fn new(
+        similarity: &'a SpatialMatch,
+        pairs: &[(Point3<f64>, Point3<f64>)],
+        onto: &Mesh,
+    ) -> Self {
+        let mean_edge = onto.edge_lengths().iter().sum::<f64>() / onto.edge_count().max(1) as f64;
         Self {
+            corridor_width: (CORRIDOR * onto.bounding_box().diagonal()).max(2.0 * mean_edge),
             similarity,
             residuals: pairs
                 .iter()
