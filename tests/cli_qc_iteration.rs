@@ -1,7 +1,7 @@
 //! `beltrami qc --solver qc-iteration` against exact answers: the ring map between two
 //! annuli is the Teichmueller map of its boundary values, `k = (K - 1) / (K + 1)`; the
-//! QC iteration converges to it under refinement and agrees with the `extremal` solver
-//! on the same Dirichlet problems (two methods, one answer).
+//! QC iteration converges to it at second order under refinement and agrees with the
+//! `extremal` solver on the same Dirichlet problems (two methods, one answer).
 
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
@@ -102,15 +102,23 @@ fn the_qc_iteration_reaches_the_ring_maps_k_and_agrees_with_extremal() {
         );
         assert_eq!(flips, 0);
         assert!(
-            (k - k_exact).abs() < 0.01 * k_exact,
+            (k - k_exact).abs() < 0.005 * k_exact,
             "k {k}, exact {k_exact}"
         );
+        // Both converge to the exact k; the QC iteration is the closer at every level,
+        // and the two agree to 1% once the extremal solver's coarse-mesh error is small.
         assert!(
-            (k - k_extremal).abs() < 0.01 * k_exact,
-            "qc-iteration {k}, extremal {k_extremal}"
+            (k - k_exact).abs() <= (k_extremal - k_exact).abs(),
+            "qc-iteration {k}, extremal {k_extremal}, exact {k_exact}"
         );
+        if rings >= 12 {
+            assert!(
+                (k - k_extremal).abs() < 0.01 * k_exact,
+                "qc-iteration {k}, extremal {k_extremal}"
+            );
+        }
         if let Some(e) = last {
-            assert!(error < 0.6 * e, "vertex error {error} after {e}");
+            assert!(error < 0.35 * e, "vertex error {error} after {e}: not second order");
         }
         last = Some(error);
     }

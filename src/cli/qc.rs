@@ -116,6 +116,10 @@ pub struct QcArgs {
     /// 2022, section 4.1, linearized), a penalty of weight W > 0 (e.g. 1e4).
     #[arg(long = "normal-constraint", value_name = "W")]
     pub normal_constraint: Option<f64>,
+    /// space: keep the surface's area to first order (Gruber-Aulisa 2022, section 4.2:
+    /// the first variation of the area vanishes), one equality for the whole surface.
+    #[arg(long = "area-constraint")]
+    pub area_constraint: bool,
     /// extremal: write the quadratic differential phi per face here (`# qd
     /// frame=global faces=N`, then `re im` per face in the input's face order).
     #[arg(long)]
@@ -253,6 +257,11 @@ fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
             bail!("--normal-constraint {w}: the weight must be a positive number");
         }
     }
+    if args.area_constraint && args.target != TargetArg::Space {
+        bail!(
+            "--area-constraint keeps the area of a map into space: it needs --target space"
+        );
+    }
     if args.target == TargetArg::Space && args.boundary != Some(QcBoundaryArg::Given) {
         bail!(
             "--target space holds the boundary at the positions of a map: add --boundary given --boundary-map MAP"
@@ -308,6 +317,9 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     );
     if let Some(weight) = args.normal_constraint {
         problem.constraints.push(Constraint::Normal { weight });
+    }
+    if args.area_constraint {
+        problem.constraints.push(Constraint::Area);
     }
     if let Some(path) = &args.landmarks {
         problem.constraints.extend(

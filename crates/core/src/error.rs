@@ -97,3 +97,14 @@ pub enum SolverError {
     #[error(transparent)]
     Solve(#[from] SolveError),
 }
+
+impl From<beltrami_fem::quaternionic_lsqc::SpaceError> for SolverError {
+    fn from(e: beltrami_fem::quaternionic_lsqc::SpaceError) -> Self {
+        use beltrami_fem::quaternionic_lsqc::SpaceError;
+        match e {
+            SpaceError::Fem(e) => e.into(),
+            SpaceError::Dof(e) => e.into(),
+            SpaceError::Solve(e) => e.into(),
+        }
+    }
+}

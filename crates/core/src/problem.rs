@@ -166,4 +166,35 @@ impl<'a> Problem<'a> {
             _ => None,
         }
     }
+
+    /// The vertices held at points of R^3 by the pins of a map into space
+    /// (`Target::Surface`): each pin's vertex with its point. The error says which pin
+    /// cannot hold a vertex in space (a vertex out of range, no position, a position in
+    /// the plane, a non-finite point), for the solver to wrap in its own error.
+    pub fn spatial_pins(&self) -> Result<Vec<(VertexId, Point3<f64>)>, String> {
+        let count = self.source.vertex_count();
+        self.constraints
+            .pins()
+            .map(|pin| {
+                let v = pin.vertex;
+                match pin.position {
+                    _ if v.idx() >= count => Err(format!(
+                        "a pin is on vertex {v}, but the mesh has {count} vertices"
+                    )),
+                    Some(Position::Spatial(p)) if p.coords.iter().all(|x| x.is_finite()) => {
+                        Ok((v, p))
+                    }
+                    Some(Position::Spatial(_)) => Err(format!(
+                        "the position of the pin on vertex {v} is not finite"
+                    )),
+                    Some(Position::Planar(_)) => Err(format!(
+                        "a map into space holds vertices at points of R^3, but the pin on vertex {v} has a position in the plane"
+                    )),
+                    None => Err(format!(
+                        "a map into space holds vertices at points of R^3, but the pin on vertex {v} has no position"
+                    )),
+                }
+            })
+            .collect()
+    }
 }

@@ -131,6 +131,85 @@ fn reference_rule(n: usize) -> &'static [(f64, f64, f64)] {
     if n == 3 { &TRI } else { &QUAD }
 }
 
+/// The reference polygon of face `f` with corners `p` (`n` of them) and corner angles
+/// `beta`, placed in the face's plane ([`Elements::with_reference_angles`]).
+fn reference_polygon(
+    f: FaceId,
+    p: &[Point3<f64>; 4],
+    n: usize,
+    beta: &[f64],
+) -> Result<[Point3<f64>; 4], FemError> {
+    use std::f64::consts::PI;
+    let sum: f64 = beta.iter().sum();
+    let (what, full) = if n == 3 {
+        ("triangle", PI)
+    } else {
+        ("convex quad", 2.0 * PI)
+    };
+    let invalid = FemError::ReferenceAngles { face: f, what, sum };
+    if (sum - full).abs() > 1e-6 || beta.iter().any(|b| !(*b > 0.0 && *b < PI)) {
+        return Err(invalid);
+    }
+    let (x1, x2) = if n == 3 {
+        (p[1] - p[0], p[2] - p[0])
+    } else {
+        ((p[1] - p[0] + (p[2] - p[3])) * 0.5, (p[3] - p[0] + (p[2] - p[1])) * 0.5)
+    };
+    let normal = x1.cross(&x2).normalize();
+    let first = p[1] - p[0];
+    let e1 = (first - first.dot(&normal) * normal).normalize();
+    let e2 = normal.cross(&e1);
+    // The polygon in the plane, first side along the x axis, counter-clockwise.
+    let mut local = [Vector2::zeros(); 4];
+    if n == 3 {
+        let (s1, s2) = (beta[1].sin(), beta[2].sin());
+        local[1] = Vector2::new(s2, 0.0);
+        local[2] = Vector2::new(beta[0].cos(), beta[0].sin()) * s1;
+    } else {
+        let directions: [Vector2<f64>; 4] = std::array::from_fn(|k| {
+            let turn: f64 = beta[1..=k].iter().map(|b| PI - b).sum();
+            Vector2::new(turn.cos(), turn.sin())
+        });
+        let t: [f64; 4] = std::array::from_fn(|k| (p[(k + 1) % 4] - p[k]).norm());
+        let closure: Vector2<f64> = (0..4).map(|k| directions[k] * t[k]).sum();
+        let mut gram = nalgebra::Matrix2::zeros();
+        for d in &directions {
+            gram += d * d.transpose();
+        }
+        let lambda = gram.try_inverse().ok_or(invalid.clone())? * closure;
+        let lengths: [f64; 4] = std::array::from_fn(|k| t[k] - directions[k].dot(&lambda));
+        let mean = lengths.iter().sum::<f64>() / 4.0;
+        if lengths.iter().any(|l| !(*l > 0.01 * mean)) {
+            return Err(invalid);
+        }
+        for k in 1..4 {
+            local[k] = local[k - 1] + directions[k - 1] * lengths[k - 1];
+        }
+    }
+    let shoelace = |q: &[Vector2<f64>]| {
+        (0..q.len())
+            .map(|k| q[k].perp(&q[(k + 1) % q.len()]))
+            .sum::<f64>()
+            * 0.5
+    };
+    let area = if n == 3 {
+        0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm()
+    } else {
+        let centre = (p[0].coords + p[1].coords + p[2].coords + p[3].coords) * 0.25;
+        (0..4)
+            .map(|k| 0.5 * (p[k].coords - centre).cross(&(p[(k + 1) % 4].coords - centre)).dot(&normal))
+            .sum::<f64>()
+    };
+    let scale = (area.abs() / shoelace(&local[..n])).sqrt();
+    if !scale.is_finite() {
+        return Err(FemError::DegenerateElement { face: f, det: area });
+    }
+    Ok(std::array::from_fn(|k| {
+        let q = local[k.min(n - 1)] * scale;
+        p[0] + e1 * q.x + e2 * q.y
+    }))
+}
+
 /// Checks that every vertex has z = 0 up to `1e-12` times the bounding-box diagonal.
 pub fn check_planar(mesh: &Mesh) -> Result<(), FemError> {
     let tol = 1e-12 * mesh.bounding_box().diagonal();
@@ -157,6 +236,8 @@ pub struct Elements {
     /// Vertices of each face (unused entries repeat the first).
     nodes: Vec<[VertexId; 4]>,
     degree: Vec<u8>,
+    /// Sides `p_(k+1) - p_k` of each face in the frame of its first point.
+    sides: Vec<[Vector2<f64>; 4]>,
     frame: Frame,
 }
 
@@ -170,14 +251,60 @@ impl Elements {
         if frame == Frame::Global {
             check_planar(mesh)?;
         }
+        Self::build(mesh, frame, |_, p, _| Ok(*p))
+    }
+
+    /// Elements whose shapes are reference polygons with given corner angles, placed in
+    /// the planes of the faces (Gruber-Aulisa 2022, section 6.2): derivatives and
+    /// weights measure a map from the reference metric `g_ref`, normals and frames are
+    /// the surface's ([`Frame::Face`]: `e1` along the first edge). `angles` holds the
+    /// corner angle of every face corner at the halfedge leaving its vertex inside the
+    /// face (the layout of `Constraint::ReferenceAngles`).
+    ///
+    /// A triangle with angles `b0, b1, b2` has the sides `sin b2 : sin b0 : sin b1`
+    /// (law of sines) and the face's area. A quad's sides turn by `pi - b_k`; their
+    /// lengths are the face's own edge lengths `t` moved least in the Euclidean norm to
+    /// close the polygon, `l = t - D^T (D D^T)^-1 D t` with `D` the 2 x 4 matrix of unit
+    /// side directions, scaled to the face's area; its plane is the bilinear tangent
+    /// plane at the centre.
+    ///
+    /// Errors: [`FemError::Length`] when `angles` has not one entry per halfedge,
+    /// [`FemError::ReferenceAngles`] when a face's angles do not sum to `pi` (`2 pi`)
+    /// within `1e-6` or a quad side comes out shorter than a hundredth of the mean.
+    pub fn with_reference_angles(mesh: &Mesh, angles: &[f64]) -> Result<Self, FemError> {
+        if angles.len() != mesh.halfedge_count() {
+            return Err(FemError::Length {
+                what: "reference angles",
+                expected: mesh.halfedge_count(),
+                got: angles.len(),
+            });
+        }
+        Self::build(mesh, Frame::Face, |f, p, n| {
+            let beta: Vec<f64> = mesh.face_halfedges(f).map(|h| angles[h.idx()]).collect();
+            reference_polygon(f, p, n, &beta)
+        })
+    }
+
+    /// The elements of `mesh` with the corners of face `f` at `corners(f, positions,
+    /// degree)` (unused entries repeat the last corner).
+    fn build(
+        mesh: &Mesh,
+        frame: Frame,
+        corners: impl Fn(FaceId, &[Point3<f64>; 4], usize) -> Result<[Point3<f64>; 4], FemError>,
+    ) -> Result<Self, FemError> {
         let mut points = Vec::with_capacity(mesh.face_count() * 4);
         let mut offsets = Vec::with_capacity(mesh.face_count() + 1);
         let mut nodes = Vec::with_capacity(mesh.face_count());
         let mut degree = Vec::with_capacity(mesh.face_count());
+        let mut sides = Vec::with_capacity(mesh.face_count());
         offsets.push(0);
         for f in mesh.faces() {
             let (v, n) = mesh.face_vertex_array(f);
-            let p: [Point3<f64>; 4] = std::array::from_fn(|k| mesh.position(v[k.min(n - 1)]));
+            let p = corners(
+                f,
+                &std::array::from_fn(|k| mesh.position(v[k.min(n - 1)])),
+                n,
+            )?;
             let first_edge = p[1] - p[0];
             let size2 = first_edge.norm_squared().max((p[2] - p[0]).norm_squared());
             for &(u, w, ref_weight) in reference_rule(n) {
@@ -224,6 +351,14 @@ impl Elements {
                     metric: [[x1.norm_squared(), g12], [g12, x2.norm_squared()]],
                 });
             }
+            let first = points[points.len() - reference_rule(n).len()].frame;
+            sides.push(std::array::from_fn(|k| {
+                if k < n {
+                    first.local(&(p[(k + 1) % n] - p[k]))
+                } else {
+                    Vector2::zeros()
+                }
+            }));
             offsets.push(points.len() as u32);
             nodes.push(std::array::from_fn(|k| v[if k < n { k } else { 0 }]));
             degree.push(n as u8);
@@ -233,6 +368,7 @@ impl Elements {
             offsets,
             nodes,
             degree,
+            sides,
             frame,
         })
     }
@@ -278,6 +414,13 @@ impl Elements {
     /// The quadrature points of face `f` (1 for a triangle, 4 for a quad).
     pub fn face_points(&self, f: FaceId) -> &[QuadraturePoint] {
         &self.points[self.face_points_range(f)]
+    }
+
+    /// The sides of face `f` in the frame of its first quadrature point: side `k` runs
+    /// from node `k` to node `k + 1` (the face's halfedge `k`); for reference elements,
+    /// the reference polygon's sides.
+    pub fn sides(&self, f: FaceId) -> &[Vector2<f64>] {
+        &self.sides[f.idx()][..self.degree[f.idx()] as usize]
     }
 
     /// The vertices of face `f` (its nodes) in order.

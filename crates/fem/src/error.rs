@@ -40,6 +40,19 @@ pub enum FemError {
         /// Index of the value.
         index: usize,
     },
+    /// Reference corner angles that do not make a polygon: their sum is not `pi` (a
+    /// triangle) or `2 pi` (a quad), or a quad with them has a side of length `<= 0`.
+    #[error(
+        "the reference angles of face {face} make no {what} (angle sum {sum:.6} rad); give angles in (0, pi) summing to pi for a triangle, 2 pi for a quad"
+    )]
+    ReferenceAngles {
+        /// The face.
+        face: FaceId,
+        /// `triangle` or `convex quad`.
+        what: &'static str,
+        /// The sum of its angles.
+        sum: f64,
+    },
     /// Building a sparse matrix failed (index overflow or allocation).
     #[error("sparse matrix assembly failed: {0}")]
     Assembly(String),

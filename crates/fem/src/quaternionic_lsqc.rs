@@ -15,7 +15,7 @@
 //! frame (`Frame::Face`): for a map that stays in the source's tangent planes it is the
 //! intrinsic Beltrami coefficient.
 
-use beltrami_mesh::Mesh;
+use beltrami_mesh::{Mesh, Point3, VertexId};
 use faer::sparse::SparseColMat;
 use nalgebra::{Quaternion, Vector3};
 use num_complex::Complex64;
@@ -130,4 +130,199 @@ pub fn row_weights(elements: &Elements) -> Vec<f64> {
         .iter()
         .flat_map(|q| [q.weight; ROWS_PER_POINT])
         .collect()
+}
+
+/// The linearized area constraint of section 4.2: the first variation of the area at
+/// the source vanishes, `int_M <d1_M, dv> dS = 0` for the displacement `v = f - 1_M`,
+/// i.e. the single linear equation `<c, x> = <c, p>` on the `3 V` image coordinates `x`
+/// (`p` the source positions), with
+///
+/// ```text
+/// c_j = sum_q w_q sum_a g_j,a dX(e_a),   dX(e_a) = sum_i p_i g_i,a,
+/// ```
+///
+/// `g_j` the shape gradient of vertex `j` in the point's frame `(e1, e2)`. On the
+/// surface's own elements `dX(e_a) = e_a` and `c_j = int grad phi_j`, the area gradient
+/// (the integrated mean-curvature normal, `<c, p> = 2 A`); on reference elements
+/// ([`crate::Elements::with_reference_angles`]) `dX` is the map from the reference
+/// shapes. One multiplier for the whole surface, eliminated by
+/// [`crate::LeastSquaresSolver::solve_with_equality`].
+#[derive(Debug, Clone)]
+pub struct AreaConstraint {
+    /// `c` (`3 V`, ordered `[x_0, y_0, z_0, x_1, ...]`).
+    pub gradient: Vec<f64>,
+    /// `<c, p>`: the right-hand side.
+    pub value: f64,
+}
+
+impl AreaConstraint {
+    /// The constraint of `elements` at the source positions `positions`.
+    pub fn new(elements: &Elements, positions: &[beltrami_mesh::Point3<f64>]) -> Self {
+        let mut gradient = vec![0.0; 3 * positions.len()];
+        for q in elements.points() {
+            let nodes = elements.nodes(q.face);
+            let (mut d1, mut d2) = (Vector3::zeros(), Vector3::zeros());
+            for (k, v) in nodes.iter().enumerate() {
+                d1 += positions[v.idx()].coords * q.grad[k].x;
+                d2 += positions[v.idx()].coords * q.grad[k].y;
+            }
+            for (k, v) in nodes.iter().enumerate() {
+                let c = (d1 * q.grad[k].x + d2 * q.grad[k].y) * q.weight;
+                for axis in 0..3 {
+                    gradient[3 * v.idx() + axis] += c[axis];
+                }
+            }
+        }
+        let value = positions
+            .iter()
+            .enumerate()
+            .map(|(v, p)| {
+                (0..3)
+                    .map(|axis| gradient[3 * v + axis] * p[axis])
+                    .sum::<f64>()
+            })
+            .sum();
+        Self { gradient, value }
+    }
+}
+
+/// Why a [`SpaceSystem`] could not be built or solved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpaceError {
+    /// An element quantity or the operator failed.
+    #[error(transparent)]
+    Fem(#[from] FemError),
+    /// The held vertices could not be turned into a DOF map.
+    #[error(transparent)]
+    Dof(#[from] crate::DofError),
+    /// The least-squares solve failed.
+    #[error(transparent)]
+    Solve(#[from] crate::SolveError),
+}
+
+/// The least-squares quasiconformal map into R^3 of a coefficient `mu` per face
+/// (Algorithm 1): [`quaternionic_operator`] on `elements`, held vertices, the optional
+/// normal penalty ([`NormalConstraint`]) and area equality ([`AreaConstraint`]). The
+/// symbolic factorization is built once; each [`solve`](Self::solve) refills the
+/// operator's values for a new `mu` (the QC iteration solves one per iteration).
+#[derive(Debug)]
+pub struct SpaceSystem {
+    elements: Elements,
+    vertex_count: usize,
+    normal: Option<NormalConstraint>,
+    area: Option<AreaConstraint>,
+    solver: crate::LeastSquaresSolver<f64>,
+    weights: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
+impl SpaceSystem {
+    /// The system of `elements` on `vertex_count` vertices, `held` vertices at their
+    /// points, the other vertices free.
+    pub fn new(
+        elements: Elements,
+        vertex_count: usize,
+        held: &[(VertexId, Point3<f64>)],
+        normal: Option<NormalConstraint>,
+        area: Option<AreaConstraint>,
+        options: crate::SolveOptions,
+    ) -> Result<Self, SpaceError> {
+        let zero = vec![Complex64::new(0.0, 0.0); elements.face_count()];
+        let operator = quaternionic_operator(&elements, vertex_count, &zero, normal.as_ref())?;
+        let mut builder = crate::DofBuilder::<f64>::new(vertex_count, 3)?;
+        let mut is_held = vec![false; vertex_count];
+        for &(v, p) in held {
+            builder.origin(v, &[p.x, p.y, p.z])?;
+            is_held[v.idx()] = true;
+        }
+        for v in (0..vertex_count).filter(|&v| !is_held[v]) {
+            builder.free(&[VertexId(v as u32)])?;
+        }
+        let solver = crate::LeastSquaresSolver::new(operator.symbolic(), &builder.build()?, options)?;
+        let mut weights = row_weights(&elements);
+        let mut rhs = vec![0.0; weights.len()];
+        if let Some(normal) = &normal {
+            weights.extend(&normal.weights);
+            rhs.extend(&normal.rhs);
+        }
+        Ok(Self {
+            elements,
+            vertex_count,
+            normal,
+            area,
+            solver,
+            weights,
+            rhs,
+        })
+    }
+
+    /// The elements the system was built on.
+    pub fn elements(&self) -> &Elements {
+        &self.elements
+    }
+
+    /// The minimizer for `mu` (one value per face, in the elements' frames): the image of
+    /// every vertex.
+    pub fn solve(&mut self, mu: &[Complex64]) -> Result<Vec<Point3<f64>>, SpaceError> {
+        let operator =
+            quaternionic_operator(&self.elements, self.vertex_count, mu, self.normal.as_ref())?;
+        let x = match &self.area {
+            Some(area) => self.solver.solve_with_equality(
+                operator.as_ref(),
+                Some(&self.weights),
+                &self.rhs,
+                &area.gradient,
+                area.value,
+            )?,
+            None => self
+                .solver
+                .solve(operator.as_ref(), Some(&self.weights), &self.rhs)?,
+        };
+        Ok(x
+            .chunks_exact(3)
+            .map(|c| Point3::new(c[0], c[1], c[2]))
+            .collect())
+    }
+
+    /// The residual `df^- - mu df^+` of `image` at every quadrature point, four
+    /// components per point, each times the square root of its weight: its squared norm
+    /// is the distortion `QC_mu(image)` (section 4).
+    pub fn residual(
+        &self,
+        mu: &[Complex64],
+        image: &[Point3<f64>],
+    ) -> Result<Vec<f64>, SpaceError> {
+        let operator = quaternionic_operator(&self.elements, self.vertex_count, mu, None)?;
+        let mut r = vec![0.0; operator.nrows()];
+        for (j, x) in image.iter().flat_map(|p| p.coords.iter().copied()).enumerate() {
+            for (i, a) in operator.row_idx_of_col(j).zip(operator.val_of_col(j)) {
+                r[i] += a * x;
+            }
+        }
+        for (r, w) in r.iter_mut().zip(&self.weights) {
+            *r *= w.sqrt();
+        }
+        Ok(r)
+    }
+}
+
+/// Why `held` held vertices with the given constraints leave a map into space
+/// undetermined, or `None` when they fix it. `QC_mu` is zero for the zero map and for
+/// every translate and dilate of a map (it is homogeneous and sees only derivatives):
+/// three held vertices fix those; the normal penalty alone fixes them (it pins every
+/// vertex to its tangent plane); the area equality fixes the scale, so that one held
+/// vertex then fixes the rest (Gruber-Aulisa 2022, section 4.2).
+pub fn undetermined(held: usize, normal: bool, area: bool, closed: bool) -> Option<String> {
+    if held >= 3 || normal || (area && held >= 1) {
+        return None;
+    }
+    Some(format!(
+        "a map into space needs vertices held at points of R^3 (the boundary of a boundary map, `--boundary given --boundary-map MAP`, or pins), the normal constraint, or the area constraint with one held vertex: the distortion is zero for the zero map, and {held} held vertices{} do not fix the image{}",
+        if area { " with the area constraint" } else { "" },
+        if closed {
+            "; this surface has no boundary, so pin a vertex (`--pin v0`) or add --normal-constraint"
+        } else {
+            ""
+        }
+    ))
 }

@@ -46,7 +46,9 @@ pub use saddle::{SaddlePointSolution, SaddlePointSolver, solve_saddle_point};
 use crate::dof::{DofMap, Scalar};
 use beltrami_mesh::VertexId;
 use cholesky::{Cholesky, FactorFailure};
-use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::sparse::{
+    FaerError, SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef, Triplet,
+};
 use faer::{Mat, MatMut, MatRef, Par};
 use normal::NormalEquations;
 use std::fmt;
@@ -382,22 +384,7 @@ impl<T: Scalar> LeastSquaresSolver<T> {
     ) -> Result<(), SolveError> {
         self.check_inputs(a, weights, b)?;
         check_len("the length of x", self.dofs.full_len(), x.len())?;
-
-        // Right-hand side of the problem in y: b - A x0 (only the columns with a
-        // nonzero x0, the fixed and sliding node unknowns, contribute).
-        self.residual.copy_from_slice(b);
-        let zero = T::from_f64(0.0);
-        for (l, &x0) in self.dofs.x0().iter().enumerate() {
-            if x0 != zero {
-                let minus_x0 = -x0;
-                for (i, &a_il) in a.row_idx_of_col(l).zip(a.val_of_col(l)) {
-                    self.residual[i] += a_il * minus_x0;
-                }
-            }
-        }
-        self.normal
-            .assemble(a, weights, &self.residual, &mut self.y);
-
+        self.assemble(a, weights, b);
         if let Some(cholesky) = &mut self.cholesky {
             let tolerance = self.options.tolerance(self.y.len());
             cholesky
@@ -427,6 +414,144 @@ impl<T: Scalar> LeastSquaresSolver<T> {
                 expected: self.dofs.full_len(),
                 got: x.len(),
             })
+    }
+
+    /// The normal equations of `A`, `W`, `b` in `y`: the matrix `K^H A^H W A K` and,
+    /// in `self.y`, the right-hand side `K^H A^H W (b - A x0)` (only the columns with a
+    /// nonzero `x0`, the fixed and sliding node unknowns, contribute to `A x0`).
+    fn assemble(&mut self, a: SparseColMatRef<'_, usize, T>, weights: Option<&[f64]>, b: &[T]) {
+        self.residual.copy_from_slice(b);
+        let zero = T::from_f64(0.0);
+        for (l, &x0) in self.dofs.x0().iter().enumerate() {
+            if x0 != zero {
+                let minus_x0 = -x0;
+                for (i, &a_il) in a.row_idx_of_col(l).zip(a.val_of_col(l)) {
+                    self.residual[i] += a_il * minus_x0;
+                }
+            }
+        }
+        self.normal
+            .assemble(a, weights, &self.residual, &mut self.y);
+    }
+
+    /// [`solve`](Self::solve) under one more linear equality on the full vector,
+    /// `<c, x> = d` (`c^H x` in the complex case). In the reduced unknowns it reads
+    /// `<K^H c, y> = d - <c, x0>`. When the normal matrix `M = K^H A^H W A K` is
+    /// definite, the rank-one border is eliminated with its Cholesky factorization and
+    /// one extra solve, so a dense constraint row (a total area) costs no fill: with
+    /// `y_u = M^-1 g` and `z = M^-1 K^H c`,
+    ///
+    /// ```text
+    /// y = y_u - z (<K^H c, y_u> - d + <c, x0>) / <K^H c, z>.
+    /// ```
+    ///
+    /// When `M` is singular (the equality is what fixes the solution: a closed surface
+    /// held at one vertex, whose scale only the area fixes) the saddle-point system of
+    /// `M` and the border is solved instead ([`solve_saddle_point`]).
+    ///
+    /// Errors as [`solve`](Self::solve); [`SolveError::Unconstrained`] (index
+    /// `dofs.reduced_len()`) when `c` does not involve the unknowns (`K^H c = 0`);
+    /// [`SolveError::IllConditioned`] when neither `M` nor the border fixes the
+    /// solution.
+    pub fn solve_with_equality(
+        &mut self,
+        a: SparseColMatRef<'_, usize, T>,
+        weights: Option<&[f64]>,
+        b: &[T],
+        c: &[T],
+        d: T,
+    ) -> Result<Vec<T>, SolveError> {
+        self.check_inputs(a, weights, b)?;
+        check_len("the length of c", self.dofs.full_len(), c.len())?;
+        check_finite("c", c)?;
+        check_finite("d", std::slice::from_ref(&d))?;
+        let n = self.y.len();
+        let zero = T::from_f64(0.0);
+        let dot = |u: &[T], v: &[T]| {
+            u.iter()
+                .zip(v)
+                .fold(zero, |acc, (a, b)| acc + a.conjugate() * *b)
+        };
+        let k = self.dofs.k();
+        let kc: Vec<T> = (0..n)
+            .map(|j| {
+                k.row_idx_of_col(j)
+                    .zip(k.val_of_col(j))
+                    .fold(zero, |acc, (i, &kij)| acc + kij.conjugate() * c[i])
+            })
+            .collect();
+        if kc.iter().all(|&v| v == zero) {
+            return Err(SolveError::Unconstrained {
+                index: n,
+                node: None,
+            });
+        }
+        let reduced_d = d - dot(c, self.dofs.x0());
+        self.assemble(a, weights, b);
+        let Some(cholesky) = &mut self.cholesky else {
+            unreachable!("K^H c has an entry, so there is an unknown")
+        };
+        let tolerance = self.options.tolerance(n);
+        match cholesky.factorize(self.normal.matrix(), tolerance) {
+            Ok(()) => {
+                let mut z = kc.clone();
+                cholesky.solve_in_place(column_mut(&mut self.y))?;
+                cholesky.solve_in_place(column_mut(&mut z))?;
+                let t = (dot(&kc, &self.y) - reduced_d)
+                    * faer::traits::ComplexField::recip_impl(&dot(&kc, &z));
+                for (y, z) in self.y.iter_mut().zip(&z) {
+                    *y -= *z * t;
+                }
+            }
+            Err(_) => {
+                let lower = self.normal.matrix();
+                let mut triplets = Vec::with_capacity(2 * lower.compute_nnz());
+                for j in 0..n {
+                    for (i, &v) in lower.row_idx_of_col(j).zip(lower.val_of_col(j)) {
+                        triplets.push(Triplet::new(i, j, v));
+                        if i != j {
+                            triplets.push(Triplet::new(j, i, v.conjugate()));
+                        }
+                    }
+                }
+                let h = SparseColMat::try_new_from_triplets(n, n, &triplets)
+                    .map_err(|_| SolveError::Length {
+                        what: "the normal matrix",
+                        expected: n,
+                        got: n,
+                    })?;
+                let border: Vec<Triplet<usize, usize, T>> = kc
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, v)| **v != zero)
+                    .map(|(j, v)| Triplet::new(0, j, v.conjugate()))
+                    .collect();
+                let c_row = SparseColMat::try_new_from_triplets(1, n, &border)
+                    .map_err(|_| SolveError::Length {
+                        what: "the constraint row",
+                        expected: n,
+                        got: n,
+                    })?;
+                let solution = solve_saddle_point(
+                    h.as_ref(),
+                    &self.y,
+                    c_row.as_ref(),
+                    &[reduced_d],
+                    self.options,
+                )?;
+                self.y = solution.x;
+            }
+        }
+        check_finite_solution(&self.y)?;
+        let mut x = vec![zero; self.dofs.full_len()];
+        self.dofs
+            .expand_into(&self.y, &mut x)
+            .map_err(|_| SolveError::Length {
+                what: "the length of x",
+                expected: self.dofs.full_len(),
+                got: x.len(),
+            })?;
+        Ok(x)
     }
 
     fn check_inputs(

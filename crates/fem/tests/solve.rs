@@ -1092,3 +1092,103 @@ fn bad_solver_inputs_give_typed_errors() {
         Err(SolveError::Length { .. })
     ));
 }
+
+/// The minimizer under `<c, x> = d` from the dense saddle-point system of the reduced
+/// problem (real form): `[N, K^T c; c^T K, 0] [y; l] = [K^T A^T W (b - A x0); d - <c, x0>]`.
+fn dense_equality_reference(
+    a: &SparseColMat<usize, f64>,
+    weights: &[f64],
+    b: &[f64],
+    dofs: &DofMap<f64>,
+    c: &[f64],
+    d: f64,
+) -> Vec<f64> {
+    let to_na = |m: Mat<f64>| DMatrix::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)]);
+    let a = to_na(a.to_dense());
+    let k = to_na(dofs.k().to_dense());
+    let x0 = DVector::from_column_slice(dofs.x0());
+    let w = DMatrix::from_diagonal(&DVector::from_column_slice(weights));
+    let ak = &a * &k;
+    let n = k.ncols();
+    let kc = k.transpose() * DVector::from_column_slice(c);
+    let mut kkt = DMatrix::zeros(n + 1, n + 1);
+    kkt.view_mut((0, 0), (n, n))
+        .copy_from(&(ak.transpose() * &w * &ak));
+    kkt.view_mut((0, n), (n, 1)).copy_from(&kc);
+    kkt.view_mut((n, 0), (1, n)).copy_from(&kc.transpose());
+    let mut rhs = DVector::zeros(n + 1);
+    rhs.rows_mut(0, n)
+        .copy_from(&(ak.transpose() * &w * (DVector::from_column_slice(b) - &a * &x0)));
+    rhs[n] = d - DVector::from_column_slice(c).dot(&x0);
+    let y = kkt.lu().solve(&rhs).unwrap();
+    (k * y.rows(0, n) + x0).iter().copied().collect()
+}
+
+#[test]
+fn one_equality_is_met_exactly_whether_or_not_the_energy_alone_fixes_the_solution() {
+    let mut rng = Rng(21);
+    // Definite normal matrix: the rank-one elimination.
+    let dofs = DofMap::real(12, &constraints(true)).unwrap();
+    let Problem { a, w, b, .. } = random_problem(&mut rng, &dofs, 50);
+    let c: Vec<f64> = (0..dofs.full_len()).map(|_| rng.uniform()).collect();
+    let d = 0.7;
+    let mut solver = LeastSquaresSolver::new(a.symbolic(), &dofs, SolveOptions::default()).unwrap();
+    let x = solver
+        .solve_with_equality(a.as_ref(), Some(&w), &b, &c, d)
+        .unwrap();
+    let reference = dense_equality_reference(&a, &w, &b, &dofs, &c, d);
+    let gap = x
+        .iter()
+        .zip(&reference)
+        .map(|(p, q)| (p - q).abs())
+        .fold(0.0, f64::max);
+    assert!(gap < 1e-9, "rank-one elimination off by {gap}");
+    let met: f64 = c.iter().zip(&x).map(|(c, x)| c * x).sum();
+    assert!((met - d).abs() < 1e-10, "<c, x> = {met}, asked {d}");
+    // A difference operator on free nodes: the x translation is free (the y one is
+    // anchored by one row), and the equality fixes it through the saddle-point system.
+    let free = DofMap::real(6, &DofConstraints::new()).unwrap();
+    let mut positions = Vec::new();
+    let mut values = Vec::new();
+    let mut row = 0;
+    for (i, j) in [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (0, 3), (1, 4)] {
+        for axis in 0..2 {
+            positions.extend([(row, 2 * i + axis), (row, 2 * j + axis)]);
+            values.extend([1.0, -1.0]);
+            row += 1;
+        }
+    }
+    positions.push((row, 1));
+    values.push(1.0);
+    row += 1;
+    let a = assemble(row, free.full_len(), &positions, &values);
+    let w = random_weights(&mut rng, row);
+    let b: Vec<f64> = random_values(&mut rng, row);
+    let c: Vec<f64> = (0..free.full_len())
+        .map(|l| if l % 2 == 0 { 1.0 } else { 0.0 })
+        .collect();
+    let mut solver = LeastSquaresSolver::new(a.symbolic(), &free, SolveOptions::default()).unwrap();
+    assert!(matches!(
+        solver.solve(a.as_ref(), Some(&w), &b),
+        Err(SolveError::Singular { .. })
+    ));
+    let x = solver
+        .solve_with_equality(a.as_ref(), Some(&w), &b, &c, 1.5)
+        .unwrap();
+    let reference = dense_equality_reference(&a, &w, &b, &free, &c, 1.5);
+    let gap = x
+        .iter()
+        .zip(&reference)
+        .map(|(p, q)| (p - q).abs())
+        .fold(0.0, f64::max);
+    assert!(gap < 1e-9, "saddle-point path off by {gap}");
+    // An equality on fixed unknowns only cannot be met by moving anything.
+    let mut only_fixed = vec![0.0; dofs.full_len()];
+    only_fixed[0] = 1.0;
+    let Problem { a, w, b, .. } = random_problem(&mut rng, &dofs, 50);
+    let mut solver = LeastSquaresSolver::new(a.symbolic(), &dofs, SolveOptions::default()).unwrap();
+    assert!(matches!(
+        solver.solve_with_equality(a.as_ref(), Some(&w), &b, &only_fixed, 1.0),
+        Err(SolveError::Unconstrained { .. })
+    ));
+}

@@ -59,6 +59,7 @@ const ACCEPTS: Accepts = Accepts {
         ConstraintKind::Hold,
         ConstraintKind::Pin,
         ConstraintKind::Normal,
+        ConstraintKind::Area,
     ],
 };
 
@@ -229,10 +230,10 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
     if problem
         .constraints
         .iter()
-        .any(|c| matches!(c, Constraint::Normal { .. }))
+        .any(|c| matches!(c, Constraint::Normal { .. } | Constraint::Area))
     {
         return Err(unsupported(
-            "the normal constraint keeps a map into space near the surface's normals; it has no meaning in the plane: use --target space".to_string(),
+            "the normal and area constraints keep a map into space near the surface; they have no meaning in the plane: use --target space".to_string(),
         ));
     }
     let pins = pins(problem, planar.is_ok())?;

@@ -5,21 +5,25 @@
 //! `sum_q w_q |df^- - mu df^+|^2` ([`beltrami_fem::quaternionic_lsqc`]), `mu = mu1 + mu2 N`
 //! from a Beltrami field in the face frames (`mu = 0` for `--conformal`). Pins with
 //! positions in space hold vertices (the boundary of a boundary map, or any vertices);
-//! one sparse solve (the normal equations' Cholesky, AMD order). The energy is
-//! homogeneous in the images (the zero map has none), so a map needs held vertices:
-//! without them the problem is refused.
+//! one sparse solve (the normal equations' Cholesky, AMD order), with the normal penalty
+//! of section 4.1 and the area equality of section 4.2 when asked
+//! ([`beltrami_fem::quaternionic_lsqc::SpaceSystem`]). The energy is homogeneous in the
+//! images (the zero map has none), so a map needs held vertices or constraints that fix
+//! it ([`beltrami_fem::quaternionic_lsqc::undetermined`]): otherwise the problem is
+//! refused.
 
 use beltrami_core::{
-    Constraint, Context, Extras, Goal, Map, Metrics, Output, Position, Problem, Report, Settings,
+    Constraint, Context, Extras, Goal, Map, Metrics, Output, Problem, Report, Settings,
     Solution, SolverError,
 };
 use beltrami_fem::beltrami::face_mu;
 use beltrami_fem::distortion::measure_surface;
-use beltrami_fem::dof::DofBuilder;
 use beltrami_fem::quaternion::quaternionic_mu;
-use beltrami_fem::quaternionic_lsqc::{NormalConstraint, quaternionic_operator, row_weights};
+use beltrami_fem::quaternionic_lsqc::{
+    AreaConstraint, NormalConstraint, SpaceSystem, undetermined,
+};
 use beltrami_fem::{
-    BeltramiField, Elements, Frame, LeastSquaresSolver, MuError, ReferenceNormal, SolveOptions,
+    BeltramiField, Elements, Frame, MuError, ReferenceNormal, SolveOptions,
 };
 use beltrami_mesh::{Point3, VertexId};
 
@@ -62,46 +66,15 @@ pub(crate) fn setup(problem: &Problem<'_>) -> Result<SpaceSetup, SolverError> {
             "lsqc does not make vertices follow curves yet".to_string(),
         ));
     }
-    let mut held = Vec::new();
-    for pin in problem.constraints.pins() {
-        let v = pin.vertex;
-        if v.idx() >= mesh.vertex_count() {
-            return Err(invalid(format!(
-                "a pin is on vertex {v}, but the mesh has {} vertices",
-                mesh.vertex_count()
-            )));
-        }
-        match pin.position {
-            Some(Position::Spatial(p)) if p.coords.iter().all(|x| x.is_finite()) => {
-                held.push((v, p));
-            }
-            Some(Position::Spatial(_)) => {
-                return Err(invalid(format!(
-                    "the position of the pin on vertex {v} is not finite"
-                )));
-            }
-            Some(Position::Planar(_)) | None => {
-                return Err(unsupported(format!(
-                    "a map into space holds vertices at points of R^3, but the pin on vertex {v} has {}",
-                    if pin.position.is_none() {
-                        "no position"
-                    } else {
-                        "a position in the plane"
-                    }
-                )));
-            }
-        }
-    }
-    if held.len() < 3 {
-        return Err(unsupported(format!(
-            "a map into space needs vertices held at points of R^3 (the boundary of a boundary map, `--boundary given --boundary-map MAP`, or pins): the energy is zero for the zero map, and {} held vertices do not fix the image{}",
-            held.len(),
-            if mesh.boundary_loop_list().is_empty() {
-                "; this surface has no boundary, so pin vertices with positions"
-            } else {
-                ""
-            }
-        )));
+    let held = problem.spatial_pins().map_err(invalid)?;
+    let has = |kind: fn(&Constraint) -> bool| problem.constraints.iter().any(kind);
+    if let Some(message) = undetermined(
+        held.len(),
+        has(|c| matches!(c, Constraint::Normal { .. })),
+        has(|c| matches!(c, Constraint::Area)),
+        mesh.boundary_loop_list().is_empty(),
+    ) {
+        return Err(unsupported(message));
     }
     Ok(SpaceSetup { field, held })
 }
@@ -121,44 +94,25 @@ pub(crate) fn run(
         Constraint::Normal { weight } => Some(NormalConstraint::new(mesh, *weight)),
         _ => None,
     });
-    let (elements, operator, mut solver) = context.stage("assembly", &mut report, || {
+    let area = problem.constraints.iter().any(|c| matches!(c, Constraint::Area));
+    let mut system = context.stage("assembly", &mut report, || {
         let elements = Elements::new(mesh, Frame::Face)?;
-        let operator = quaternionic_operator(&elements, n, &field.mu, normal.as_ref())?;
-        let mut builder = DofBuilder::<f64>::new(n, 3)?;
-        let mut is_held = vec![false; n];
-        for &(v, p) in &held {
-            builder.origin(v, &[p.x, p.y, p.z])?;
-            is_held[v.idx()] = true;
-        }
-        for v in mesh.vertices().filter(|v| !is_held[v.idx()]) {
-            builder.free(&[v])?;
-        }
-        let dofs = builder.build()?;
+        let area = area.then(|| AreaConstraint::new(&elements, mesh.positions()));
         let options = SolveOptions {
             threads: settings.int("threads"),
             ..SolveOptions::default()
         };
-        let solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, options)?;
-        Ok((elements, operator, solver))
+        Ok(SpaceSystem::new(
+            elements, n, &held, normal, area, options,
+        )?)
     })?;
-    let mut weights = row_weights(&elements);
-    let mut rhs = vec![0.0; weights.len()];
-    if let Some(normal) = &normal {
-        weights.extend(&normal.weights);
-        rhs.extend(&normal.rhs);
-    }
-    let x = context.stage("solve", &mut report, || {
-        Ok(solver.solve(operator.as_ref(), Some(&weights), &rhs)?)
-    })?;
-    let image: Vec<Point3<f64>> = x
-        .chunks_exact(3)
-        .map(|c| Point3::new(c[0], c[1], c[2]))
-        .collect();
+    let image = context.stage("solve", &mut report, || Ok(system.solve(&field.mu)?))?;
+    let elements = system.elements();
     let distortion = context.stage("distortion", &mut report, || {
         Ok(measure_surface(mesh, &image, ReferenceNormal::Source)?)
     })?;
-    let quaternionic = face_mu(&elements, &quaternionic_mu(&elements, n, &image)?);
-    metrics.mu_error = Some(MuError::new(&elements, &quaternionic, &field.mu)?);
+    let quaternionic = face_mu(elements, &quaternionic_mu(elements, n, &image)?);
+    metrics.mu_error = Some(MuError::new(elements, &quaternionic, &field.mu)?);
     if distortion.stats.flipped > 0 {
         report.notes.push(format!(
             "{} of {} faces turn against the source's normals: the least-squares map is not guaranteed to be a bijection",

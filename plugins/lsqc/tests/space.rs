@@ -3,16 +3,20 @@
 //! conformal (`df^- = 0`) and comes back from its own boundary; an affine planar map
 //! comes back from its own measured mu (the complex special case), triangles and quads;
 //! the solve commutes with rotations of R^3 (frames and normals handled consistently);
-//! a problem that fixes nothing is refused.
+//! a map between coaxial cylinders that keeps every normal comes back from its
+//! developed mu under refinement (a developable surface); the frame rule of Lemma 3.4;
+//! the area constraint (section 4.2) keeps the area to second order and fixes a closed
+//! surface with one pin; a problem that fixes nothing is refused.
 
 use beltrami_core::{Constraint, Context, Goal, Map, Pin, Position, Problem, Solver, Target};
-use beltrami_fem::beltrami::face_mu;
+use beltrami_fem::beltrami::{face_mu, rotate_frame};
 use beltrami_fem::quaternion::quaternionic_mu;
 use beltrami_fem::{BeltramiField, Elements, Frame};
 use beltrami_lsqc::Lsqc;
 use beltrami_mesh::primitives::{Cells, jittered_grid};
 use beltrami_mesh::{Mesh, Point3, Vector3};
 use nalgebra::{Rotation3, Unit};
+use num_complex::Complex64;
 
 /// A jittered grid bent onto a paraboloid cap `z = 0.4 (x^2 + y^2)` (curved, not
 /// developable).
@@ -198,4 +202,176 @@ fn the_normal_constraint_keeps_a_sphere_on_the_sphere_to_second_order() {
             "not second order in the displacement: {held:?}"
         );
     }
+}
+
+/// The developed coefficient of the linear map `(s, t) -> (a s, b s + c t)`:
+/// `f_zbar / f_z` with `f_z = ((a + c) + i b) / 2`, `f_zbar = ((a - c) + i b) / 2`.
+fn developed_mu(a: f64, b: f64, c: f64) -> Complex64 {
+    Complex64::new(a - c, b) / Complex64::new(a + c, b)
+}
+
+/// A jittered `n x n` grid rolled onto the cylinder of radius 1 about the z axis
+/// (`theta = 1.2 x`, `z = y`), and its developed coordinates `(s, t) = (theta, z)`.
+fn cylinder(n: usize, cells: Cells) -> (Mesh, Vec<(f64, f64)>) {
+    let soup = jittered_grid(n, n, cells, 0.3, 11);
+    let developed: Vec<(f64, f64)> = soup.positions.iter().map(|p| (1.2 * p.x, p.y)).collect();
+    let rolled: Vec<Point3<f64>> = developed
+        .iter()
+        .map(|&(s, t)| Point3::new(s.cos(), s.sin(), t))
+        .collect();
+    let mut rolled_soup = soup.clone();
+    rolled_soup.positions = rolled;
+    (Mesh::from_soup(&rolled_soup).unwrap(), developed)
+}
+
+/// The largest vertex error of lsqc on the cylinder of [`cylinder`] for the map onto the
+/// coaxial cylinder of radius `a` with height `b s + c t` (developed: the linear map
+/// `(s, t) -> (a s, b s + c t)`), given its developed coefficient in the face frames and
+/// its boundary.
+fn cylinder_error(n: usize, cells: Cells) -> f64 {
+    let (a, b, c) = (1.3, 0.4, 0.8);
+    let (mesh, developed) = cylinder(n, cells);
+    let exact: Vec<Point3<f64>> = developed
+        .iter()
+        .map(|&(s, t)| Point3::new(a * s.cos(), a * s.sin(), b * s + c * t))
+        .collect();
+    let mu = mesh
+        .faces()
+        .map(|f| {
+            let h = mesh.face_halfedge(f);
+            let (p, q) = (
+                developed[mesh.origin(h).idx()],
+                developed[mesh.target(h).idx()],
+            );
+            rotate_frame(developed_mu(a, b, c), (q.1 - p.1).atan2(q.0 - p.0))
+        })
+        .collect();
+    let got = image(&problem(
+        &mesh,
+        Some(BeltramiField::new(Frame::Face, mu)),
+        &exact,
+    ));
+    largest_distance(&got, &exact)
+}
+
+#[test]
+fn a_developable_surface_map_comes_back_under_refinement() {
+    // The map of a cylinder patch onto a coaxial cylinder that keeps every normal,
+    // developed the linear map (s, t) -> (1.3 s, 0.4 s + 0.8 t) (|mu| = 0.32): its
+    // quaternionic mu is the developed one (mu1 + mu2 N with N the common normal), so
+    // with that mu and its boundary the least-squares map reproduces it up to the
+    // chords' error, which halves at least as the mesh does. (An unrolling into the
+    // plane would not do: its image's tangent planes are not the source's, so df^- is
+    // not mu df^+ for any normal-valued mu.)
+    for cells in [Cells::Triangles, Cells::Quads] {
+        let errors: Vec<f64> = [8, 16, 32].iter().map(|&n| cylinder_error(n, cells)).collect();
+        println!("{cells:?}: vertex errors {errors:?}");
+        for w in errors.windows(2) {
+            assert!(w[1] < 0.5 * w[0], "{cells:?}: {errors:?}");
+        }
+        assert!(errors[2] < 2e-3, "{cells:?}: {errors:?}");
+    }
+}
+
+#[test]
+fn the_frame_rule_a_faces_first_edge_changed_gives_the_same_map() {
+    // Listing a face from another corner turns its frame by the angle theta between the
+    // old and the new first edge; by Lemma 3.4 its coefficient turns by e^{-2 i theta}
+    // and the map stays.
+    let mesh = cap(8, Cells::Triangles);
+    let bent: Vec<Point3<f64>> = mesh
+        .positions()
+        .iter()
+        .map(|p| Point3::new(p.x + 0.3 * p.y * p.y, p.y, p.z + 0.2 * p.x))
+        .collect();
+    let mu: Vec<Complex64> = (0..mesh.face_count())
+        .map(|f| Complex64::from_polar(0.3, 0.7 * f as f64))
+        .collect();
+    let before = image(&problem(
+        &mesh,
+        Some(BeltramiField::new(Frame::Face, mu.clone())),
+        &bent,
+    ));
+    let elements = Elements::new(&mesh, Frame::Face).unwrap();
+    let mut soup = beltrami_mesh::PolygonSoup::new(mesh.positions().to_vec());
+    let mut turned = Vec::with_capacity(mu.len());
+    for f in mesh.faces() {
+        let corners: Vec<u32> = mesh.face_vertices(f).map(|v| v.0).collect();
+        let shift = f.idx() % 3;
+        let listed: Vec<u32> = (0..3).map(|k| corners[(k + shift) % 3]).collect();
+        soup.push_face(&listed);
+        let frame = elements.face_points(f)[0].frame;
+        let edge = mesh.position(beltrami_mesh::VertexId(listed[1]))
+            - mesh.position(beltrami_mesh::VertexId(listed[0]));
+        let theta = edge.dot(&frame.e2).atan2(edge.dot(&frame.e1));
+        turned.push(rotate_frame(mu[f.idx()], theta));
+    }
+    let relisted = Mesh::from_soup(&soup).unwrap();
+    assert!(relisted.faces().any(|f| relisted.face_vertices(f).next()
+        != mesh.face_vertices(f).next()));
+    let after = image(&problem(
+        &relisted,
+        Some(BeltramiField::new(Frame::Face, turned)),
+        &bent,
+    ));
+    let error = largest_distance(&after, &before);
+    assert!(error < 1e-10, "the map moved by {error}");
+}
+
+/// The relative area change of the map of a paraboloid cap with boundary held in place
+/// and `mu = amplitude e^{i 0.5 f}` per face, with or without the area constraint.
+fn area_change(amplitude: f64, area: bool) -> f64 {
+    let mesh = cap(12, Cells::Triangles);
+    let own = mesh.positions().to_vec();
+    let mu = (0..mesh.face_count())
+        .map(|f| Complex64::from_polar(amplitude, 0.5 * f as f64))
+        .collect();
+    let mut problem = problem(&mesh, Some(BeltramiField::new(Frame::Face, mu)), &own);
+    if area {
+        problem.constraints.push(Constraint::Area);
+    }
+    let got = image(&problem);
+    let moved = mesh.with_positions(got).unwrap();
+    let total = |m: &Mesh| m.faces().map(|f| m.face_area(f)).sum::<f64>();
+    (total(&moved) - total(&mesh)).abs() / total(&mesh)
+}
+
+#[test]
+fn the_area_constraint_keeps_the_area_to_second_order() {
+    // The constraint makes the first variation of the area vanish (section 4.2). With
+    // the boundary held and a mostly tangential displacement the area change is of
+    // second order either way, but the constraint removes most of it.
+    let amplitudes = [0.2, 0.1, 0.05];
+    let free: Vec<f64> = amplitudes.iter().map(|&a| area_change(a, false)).collect();
+    let kept: Vec<f64> = amplitudes.iter().map(|&a| area_change(a, true)).collect();
+    println!("relative area change: without {free:?}, with the area constraint {kept:?}");
+    for (k, f) in kept.iter().zip(&free) {
+        assert!(k < &(0.05 * f), "with {k}, without {f}");
+    }
+    for w in kept.windows(2) {
+        assert!(w[1] < 0.35 * w[0], "not second order: {kept:?}");
+    }
+}
+
+#[test]
+fn the_area_constraint_fixes_a_closed_surface_with_one_pin() {
+    // An ellipsoid, conformal goal, one vertex held: translations are fixed by the pin,
+    // the scale by the area; the identity (zero distortion, the area kept) comes back.
+    let mut soup = beltrami_mesh::primitives::icosphere(3);
+    for p in &mut soup.positions {
+        *p = Point3::new(1.5 * p.x, p.y, 0.7 * p.z);
+    }
+    let mesh = Mesh::from_soup(&soup).unwrap();
+    let mut problem = Problem::new(&mesh, Target::Surface);
+    problem.goal = Goal::Conformal { p: 2.0 };
+    problem.constraints.push(Constraint::Pin(Pin {
+        vertex: beltrami_mesh::VertexId(0),
+        position: Some(Position::Spatial(mesh.position(beltrami_mesh::VertexId(0)))),
+    }));
+    let error = Lsqc.check(&problem).unwrap_err().to_string();
+    assert!(error.contains("pin a vertex"), "{error}");
+    problem.constraints.push(Constraint::Area);
+    let got = image(&problem);
+    let error = largest_distance(&got, mesh.positions());
+    assert!(error < 1e-8, "identity off by {error}");
 }

@@ -1,25 +1,33 @@
 //! [`QcIteration`]: the solver behind `--solver qc-iteration` (crate docs).
 
 use beltrami_core::{
-    Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
-    Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, Stop, THREADS,
-    TargetKind, Topology,
+    Accepts, Constraint, ConstraintKind, Context, Element, Extras, Goal, GoalKind, Metrics,
+    OptionKind, OptionSpec, Output, Problem, Progress, Report, Settings, Solution, Solver,
+    SolverError, Stop, THREADS, Target, TargetKind, Topology,
 };
-use beltrami_fem::beltrami::{face_mu, planar_map};
 use beltrami_fem::element::check_planar;
 use beltrami_fem::operators::beltrami_operator;
-use beltrami_fem::{
-    Distortion, DofConstraints, DofMap, Elements, FemError, Frame, LeastSquaresSolver, SolveOptions,
+use beltrami_fem::quaternionic_lsqc::{
+    AreaConstraint, NormalConstraint, SpaceSystem, undetermined,
 };
-use beltrami_mesh::{Mesh, VertexId};
+use beltrami_fem::{
+    DofConstraints, DofMap, Elements, FemError, Frame, LeastSquaresSolver, SolveOptions,
+};
+use beltrami_mesh::{Point3, VertexId};
 use num_complex::Complex64;
+
+use crate::line_search::best_step;
+use crate::system::{Linearized, Planar, Space};
+use crate::transport::Transport;
 
 const NAME: &str = "qc-iteration";
 
 /// The QC iteration (crate docs).
 ///
-/// Reads: `target` (`Plane(Keep | Given)`: every boundary vertex held), `goal`
-/// (`Extremal`) and the options `tolerance`, `max-iters`, `threads`.
+/// Reads: `target` (`Plane(Keep | Given)`: every boundary vertex held; `Surface`: the
+/// pins' points), `goal` (`Extremal`), the constraints `Pin`, `Normal`, `Area` and
+/// `ReferenceAngles` (into space), and the options `tolerance`, `max-iters`,
+/// `line-search`, `threads`.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct QcIteration;
 
@@ -42,19 +50,37 @@ const OPTIONS: &[OptionSpec] = &[
         },
         help: "iterations at most",
     },
+    OptionSpec {
+        name: "line-search",
+        kind: OptionKind::Bool { default: true },
+        help: "take the best coefficient between the last and the smoothed one (Gruber-Aulisa 2022, section 5.4)",
+    },
     THREADS,
 ];
 
 const ACCEPTS: Accepts = Accepts {
-    elements: &[Element::Triangle],
+    elements: &[Element::Triangle, Element::Quad],
     topologies: &[
         Topology::Disk,
         Topology::Annulus,
         Topology::MultiplyConnected,
+        Topology::Sphere,
+        Topology::Torus,
+        Topology::HigherGenus,
+        Topology::BoundedHigherGenus,
     ],
-    targets: &[TargetKind::PlaneKeep, TargetKind::PlaneGiven],
+    targets: &[
+        TargetKind::PlaneKeep,
+        TargetKind::PlaneGiven,
+        TargetKind::Surface,
+    ],
     goals: &[GoalKind::Extremal],
-    constraints: &[],
+    constraints: &[
+        ConstraintKind::Pin,
+        ConstraintKind::Normal,
+        ConstraintKind::Area,
+        ConstraintKind::ReferenceAngles,
+    ],
 };
 
 impl Solver for QcIteration {
@@ -63,7 +89,7 @@ impl Solver for QcIteration {
     }
 
     fn description(&self) -> &'static str {
-        "QC iteration towards the Teichmueller map of a boundary condition (Lui et al. 2014; Gruber-Aulisa 2022, planar case)"
+        "QC iteration towards the Teichmueller map of a boundary condition, in the plane or into R^3 (Lui et al. 2014; Gruber-Aulisa 2022)"
     }
 
     fn accepts(&self) -> Accepts {
@@ -84,129 +110,242 @@ impl Solver for QcIteration {
         settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
-        let mesh = problem.source;
         let mut report = Report::new(NAME);
-        let fixed = setup(problem)?;
-        let tolerance = settings.float("tolerance");
-        let max_iters = settings.int("max-iters");
-        let elements = Elements::new(mesh, Frame::Global)?;
-        let areas = elements.face_areas();
-        let neighbours = face_neighbours(mesh);
-        let mut mu = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
-        let mut solver = context.stage("assembly", &mut report, || {
-            let mut constraints = DofConstraints::new();
-            for &(v, z) in &fixed {
-                constraints.fix(v, z);
-            }
-            let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
-            let operator = beltrami_operator(mesh, &elements, &mu)?;
-            let options = SolveOptions {
-                threads: settings.int("threads"),
-                ..SolveOptions::default()
-            };
-            Ok(LeastSquaresSolver::new(
-                operator.symbolic(),
-                &dofs,
-                options,
-            )?)
-        })?;
-        let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
-        let zero = vec![Complex64::new(0.0, 0.0); elements.point_count()];
-        let mut solve = |mu: &[Complex64]| -> Result<Vec<Complex64>, SolverError> {
-            let operator = beltrami_operator(mesh, &elements, mu)?;
-            Ok(solver.solve(operator.as_ref(), Some(&weights), &zero)?)
+        let options = SolveOptions {
+            threads: settings.int("threads"),
+            ..SolveOptions::default()
         };
-        let mut map = solve(&mu)?;
-        let mut metrics = Metrics {
-            initial_distortion: Some(measure(mesh, &elements, &map)?.stats),
-            ..Metrics::default()
-        };
-        let mut k = 0.0;
-        let mut stop = Stop::IterationLimit;
-        let iterate = std::time::Instant::now();
-        for iteration in 0..max_iters {
-            if context.is_cancelled() {
-                stop = Stop::Cancelled;
-                break;
-            }
-            let measured = measured_mu(&elements, &map)?;
-            let smoothed = smooth(&measured, &neighbours);
-            k = weighted_mean(smoothed.iter().map(|m| m.norm()), &areas);
-            let next: Vec<Complex64> = smoothed
-                .iter()
-                .map(|m| {
-                    if m.norm() > 0.0 {
-                        m * (k / m.norm())
-                    } else {
-                        *m
+        match setup(problem)? {
+            Setup::Planar(fixed) => {
+                let mesh = problem.source;
+                let mut system = context.stage("assembly", &mut report, || {
+                    let elements = Elements::new(mesh, Frame::Global)?;
+                    let mut constraints = DofConstraints::new();
+                    for &(v, z) in &fixed {
+                        constraints.fix(v, z);
                     }
-                })
-                .collect();
-            let change = next
-                .iter()
-                .zip(&mu)
-                .map(|(a, b)| (a - b).norm())
-                .fold(0.0, f64::max);
-            mu = next;
-            map = solve(&mu)?;
-            let spread =
-                weighted_mean(measured.iter().map(|m| (m.norm() - k).powi(2)), &areas).sqrt();
-            metrics.energy_history.push(spread);
-            metrics.iterations = iteration + 1;
-            context.report(&Progress {
-                stage: "iteration",
-                done: iteration + 1,
-                total: Some(max_iters),
-                energy: Some(spread),
-            });
-            if change <= tolerance {
-                stop = Stop::Converged { tolerance };
-                break;
+                    let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
+                    let zero = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
+                    let operator = beltrami_operator(mesh, &elements, &zero)?;
+                    let solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, options)?;
+                    let weights = elements.points().iter().map(|q| q.weight).collect();
+                    Ok(Planar {
+                        mesh,
+                        elements,
+                        solver,
+                        weights,
+                        map: Vec::new(),
+                    })
+                })?;
+                iterate(problem, &mut system, settings, context, report)
+            }
+            Setup::Space(space) => {
+                let mesh = problem.source;
+                let mut system = context.stage("assembly", &mut report, || {
+                    let elements = match &space.reference {
+                        Some(angles) => Elements::with_reference_angles(mesh, angles)?,
+                        None => Elements::new(mesh, Frame::Face)?,
+                    };
+                    let normal = space.normal.map(|w| NormalConstraint::new(mesh, w));
+                    let area = space
+                        .area
+                        .then(|| AreaConstraint::new(&elements, mesh.positions()));
+                    Ok(Space {
+                        system: SpaceSystem::new(
+                            elements,
+                            mesh.vertex_count(),
+                            &space.held,
+                            normal,
+                            area,
+                            options,
+                        )?,
+                        vertex_count: mesh.vertex_count(),
+                        image: Vec::new(),
+                    })
+                })?;
+                if space.reference.is_some() {
+                    report.notes.push(
+                        "|mu| is measured from the reference shapes (the corner angles asked for) to the image".to_string(),
+                    );
+                }
+                iterate(problem, &mut system, settings, context, report)
             }
         }
-        report
-            .timings
-            .push(("iterations".to_string(), iterate.elapsed().as_secs_f64()));
-        let distortion = measure(mesh, &elements, &map)?;
-        if distortion.stats.flipped > 0 {
-            report.notes.push(format!(
-                "{} of {} faces are flipped",
-                distortion.stats.flipped,
-                mesh.face_count()
-            ));
-        }
-        metrics.k = Some(k);
-        metrics.stop = Some(stop);
-        metrics.mu = Some(distortion.field);
-        metrics.distortion = Some(distortion.stats);
-        Ok(Solution {
-            output: Output::Map(Map::Planar(map)),
-            metrics,
-            extras: Extras::default(),
-            report,
-        })
     }
 }
 
-/// The capability check: a planar mesh, the extremal goal, every boundary vertex held.
-/// Returns the held vertices with their images.
-fn setup(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError> {
+/// The iteration itself (crate docs), on either linearized problem.
+fn iterate(
+    problem: &Problem<'_>,
+    system: &mut dyn Linearized,
+    settings: &Settings,
+    context: &mut Context<'_>,
+    mut report: Report,
+) -> Result<Solution, SolverError> {
+    let mesh = problem.source;
+    let tolerance = settings.float("tolerance");
+    let max_iters = settings.int("max-iters");
+    let line_search = settings.flag("line-search");
+    let areas = system.elements().face_areas();
+    let transport = Transport::new(mesh, system.elements());
+    let mut mu = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
+    system.solve(&mu)?;
+    let mut metrics = Metrics {
+        initial_distortion: Some(system.distortion()?.stats),
+        ..Metrics::default()
+    };
+    let mut k = 0.0;
+    let mut stop = Stop::IterationLimit;
+    let started = std::time::Instant::now();
+    for iteration in 0..max_iters {
+        if context.is_cancelled() {
+            stop = Stop::Cancelled;
+            break;
+        }
+        let measured = system.measured()?;
+        k = weighted_mean(measured.iter().map(|m| m.norm()), &areas);
+        let mut next: Vec<Complex64> = transport
+            .smooth(&measured)
+            .into_iter()
+            .map(|m| if m.norm() > 0.0 { m * (k / m.norm()) } else { m })
+            .collect();
+        let mut step = 1.0;
+        if line_search {
+            step = best_step(&system.residual(&mu)?, &system.residual(&next)?);
+            for (n, m) in next.iter_mut().zip(&mu) {
+                *n = m + (*n - m) * step;
+            }
+        }
+        let change = next
+            .iter()
+            .zip(&mu)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        mu = next;
+        system.solve(&mu)?;
+        let spread = weighted_mean(measured.iter().map(|m| (m.norm() - k).powi(2)), &areas).sqrt();
+        metrics.energy_history.push(spread);
+        metrics.step_sizes.push(step);
+        metrics.iterations = iteration + 1;
+        context.report(&Progress {
+            stage: "iteration",
+            done: iteration + 1,
+            total: Some(max_iters),
+            energy: Some(spread),
+        });
+        if change <= tolerance {
+            stop = Stop::Converged { tolerance };
+            break;
+        }
+    }
+    report
+        .timings
+        .push(("iterations".to_string(), started.elapsed().as_secs_f64()));
+    let distortion = system.distortion()?;
+    if distortion.stats.flipped > 0 {
+        report.notes.push(format!(
+            "{} of {} faces are flipped",
+            distortion.stats.flipped,
+            mesh.face_count()
+        ));
+    }
+    metrics.k = Some(k);
+    metrics.stop = Some(stop);
+    metrics.mu = Some(distortion.field);
+    metrics.distortion = Some(distortion.stats);
+    Ok(Solution {
+        output: Output::Map(system.map()),
+        metrics,
+        extras: Extras::default(),
+        report,
+    })
+}
+
+/// What the capability check finds.
+enum Setup {
+    /// A planar mesh with its held boundary values.
+    Planar(Vec<(VertexId, Complex64)>),
+    /// A map into R^3.
+    Space(SpaceSetup),
+}
+
+/// The held vertices and constraints of a map into R^3.
+struct SpaceSetup {
+    held: Vec<(VertexId, Point3<f64>)>,
+    /// The normal penalty's weight.
+    normal: Option<f64>,
+    area: bool,
+    /// Corner angles per halfedge.
+    reference: Option<Vec<f64>>,
+}
+
+/// The capability check (crate docs).
+fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
     let mesh = problem.source;
     if problem.goal != Goal::Extremal {
         return Err(unsupported(
             "the QC iteration looks for the Teichmueller map of a boundary condition (no --mu, --mu-expr or --conformal); for a prescribed mu use lsqc",
         ));
     }
+    if matches!(problem.target, Target::Surface) {
+        let held = problem
+            .spatial_pins()
+            .map_err(|message| SolverError::InvalidInput {
+                solver: NAME,
+                message,
+            })?;
+        let mut space = SpaceSetup {
+            held,
+            normal: None,
+            area: false,
+            reference: None,
+        };
+        for c in problem.constraints.iter() {
+            match c {
+                Constraint::Normal { weight } => space.normal = Some(*weight),
+                Constraint::Area => space.area = true,
+                Constraint::ReferenceAngles(angles) => space.reference = Some(angles.clone()),
+                _ => {}
+            }
+        }
+        if let Some(message) = undetermined(
+            space.held.len(),
+            space.normal.is_some(),
+            space.area,
+            mesh.boundary_loop_list().is_empty(),
+        ) {
+            return Err(unsupported(message));
+        }
+        return Ok(Setup::Space(space));
+    }
+    if let Some(c) = problem.constraints.iter().find(|c| {
+        matches!(
+            c,
+            Constraint::Normal { .. } | Constraint::Area | Constraint::ReferenceAngles(_)
+        )
+    }) {
+        return Err(unsupported(format!(
+            "the {} constraint shapes a map into space; use --target space",
+            c.kind().name()
+        )));
+    }
+    if mesh.quad_count() > 0 {
+        return Err(unsupported(
+            "the QC iteration in the plane maps triangle meshes; map a quad mesh with --target space",
+        ));
+    }
     if let Err(FemError::NotPlanar { vertex, z }) = check_planar(mesh) {
         return Err(unsupported(format!(
-            "the QC iteration maps planar meshes (z = 0), but vertex {vertex} has z = {z:e}; flatten the surface first or use extremal, which flattens curved disks"
+            "the QC iteration in the plane maps planar meshes (z = 0), but vertex {vertex} has z = {z:e}; map the surface into space (--target space) or use extremal, which flattens curved disks"
         )));
     }
     match problem.planar_boundary_values() {
-        Some(values) => values.map_err(|message| SolverError::InvalidInput {
-            solver: NAME,
-            message,
-        }),
+        Some(values) => values
+            .map(Setup::Planar)
+            .map_err(|message| SolverError::InvalidInput {
+                solver: NAME,
+                message,
+            }),
         None => Err(unsupported(
             "the QC iteration needs the boundary values: keep the source's boundary or give a boundary map (`--boundary given --boundary-map MAP`)",
         )),
@@ -218,45 +357,6 @@ fn unsupported(message: impl Into<String>) -> SolverError {
         solver: NAME,
         message: message.into(),
     }
-}
-
-/// `mu` of the planar map per face (global frame).
-fn measured_mu(elements: &Elements, map: &[Complex64]) -> Result<Vec<Complex64>, SolverError> {
-    let point_mu: Vec<Complex64> = planar_map(elements, map.len(), map)?
-        .iter()
-        .map(|d| d.mu())
-        .collect();
-    Ok(face_mu(elements, &point_mu))
-}
-
-/// `|mu|` statistics and flips of the planar map.
-fn measure(mesh: &Mesh, elements: &Elements, map: &[Complex64]) -> Result<Distortion, SolverError> {
-    let d = planar_map(elements, mesh.vertex_count(), map)?;
-    Ok(Distortion::from_derivatives(elements, &d)?)
-}
-
-/// Per face, the faces across its edges.
-fn face_neighbours(mesh: &Mesh) -> Vec<Vec<usize>> {
-    mesh.faces()
-        .map(|f| {
-            mesh.face_halfedges(f)
-                .filter_map(|h| mesh.face(mesh.twin(h)))
-                .map(|g| g.idx())
-                .collect()
-        })
-        .collect()
-}
-
-/// One Jacobi step of the face graph: each face's value averaged with its neighbours'.
-fn smooth(values: &[Complex64], neighbours: &[Vec<usize>]) -> Vec<Complex64> {
-    values
-        .iter()
-        .zip(neighbours)
-        .map(|(&v, around)| {
-            let sum: Complex64 = around.iter().map(|&g| values[g]).sum::<Complex64>() + v;
-            sum / (around.len() + 1) as f64
-        })
-        .collect()
 }
 
 /// `sum_f a_f x_f / sum_f a_f`.
