@@ -155,6 +155,69 @@ pub fn remesh(
     }
 }
 
+/// The report of an in-place remeshing by reference angles (`beltrami remesh --method
+/// qc-angles`): the reference and constraint, the angles before and after, the
+/// distance to the input (also relative to its bounding-box diagonal), the QC
+/// iteration's `k`, `|mu|` statistics (from the reference shapes), iterations, stop and
+/// `|mu|` spread history, flips, seconds and timings.
+pub fn remesh_in_place(
+    input: &Mesh,
+    result: &beltrami_remesh::in_place::InPlace,
+    options: &beltrami_remesh::in_place::InPlaceOptions,
+    before: &beltrami_remesh::Quality,
+    after: &beltrami_remesh::Quality,
+    seconds: f64,
+) -> JsonMap<String, Value> {
+    let metrics = &result.solution.metrics;
+    let angles = |q: &beltrami_remesh::Quality| {
+        json!({
+            "min_angle": q.min_angle,
+            "mean_angle": q.mean_angle,
+            "share_below_30": q.share_below_30,
+            "edge_spread": q.edge_spread,
+        })
+    };
+    let timings: JsonMap<String, Value> = result
+        .solution
+        .report
+        .timings
+        .iter()
+        .map(|(name, s)| (name.to_string(), json!(s)))
+        .collect();
+    let value = json!({
+        "method": "qc-angles",
+        "reference": options.reference.name(),
+        "constraint": options.keep.name(),
+        "projected": options.project,
+        "topology": beltrami_core::topology::describe(input),
+        "vertices": input.vertex_count(),
+        "faces": input.face_count(),
+        "before": angles(before),
+        "after": angles(after),
+        "min_angle": after.min_angle,
+        "share_below_30": after.share_below_30,
+        "hausdorff": after.hausdorff,
+        "mean_distance": after.mean_distance,
+        "diagonal": after.diagonal,
+        "hausdorff_over_diagonal": after.hausdorff / after.diagonal,
+        "k": metrics.k,
+        "mu_mean": metrics.distortion.as_ref().map(|d| d.mu_mean),
+        "mu_std": metrics.distortion.as_ref().map(|d| d.mu_std),
+        "mu_max": metrics.distortion.as_ref().map(|d| d.mu_max),
+        "iterations": metrics.iterations,
+        "stop": metrics.stop.as_ref().map(|s| s.name()),
+        "mu_spread_history": metrics.energy_history,
+        "flipped": result.flipped,
+        "seconds": seconds,
+        "timings": timings,
+        "notes": result.solution.report.notes,
+    });
+    match value {
+        Value::Object(map) => map,
+        _ => JsonMap::new(),
+    }
+}
+
 /// A circle of a circle-domain map with how far its boundary loop's images are from it:
 /// `deviation` is the largest `| |g - c| - r | / r` over the loop's images `g` (NaN when
 /// the loop index is not one of `mesh`'s loops).

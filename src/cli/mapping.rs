@@ -161,7 +161,7 @@ fn progress_line(p: &Progress) -> String {
 }
 
 /// A progress bar that appears only once a run has lasted a second.
-struct LateBar {
+pub(super) struct LateBar {
     bar: ProgressBar,
     start: Instant,
     shown: bool,
@@ -169,7 +169,7 @@ struct LateBar {
 }
 
 impl LateBar {
-    fn new(enabled: bool) -> Self {
+    pub(super) fn new(enabled: bool) -> Self {
         let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
         bar.set_style(
             ProgressStyle::with_template("{spinner} {msg} [{elapsed}]")
@@ -183,7 +183,7 @@ impl LateBar {
         }
     }
 
-    fn update(&mut self, p: &Progress) {
+    pub(super) fn update(&mut self, p: &Progress) {
         if !self.enabled {
             return;
         }
@@ -195,7 +195,7 @@ impl LateBar {
         self.bar.set_message(progress_line(p));
     }
 
-    fn finish(&self) {
+    pub(super) fn finish(&self) {
         self.bar.finish_and_clear();
     }
 }

@@ -7,19 +7,42 @@ use std::time::Instant;
 use anyhow::{Context as _, bail};
 use beltrami_core::Context;
 use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_remesh::in_place::{InPlaceOptions, Keep, remesh_in_place};
+use beltrami_remesh::reference_angles::Reference;
 use beltrami_remesh::{Quality, RemeshOptions, Remeshing, Resolution, SizeField};
 use beltrami_render::{ColorBy, Scene, Style, View};
 use clap::{Args, ValueEnum};
 use serde_json::{Value, json};
 
 use super::load::load_mesh;
-use super::mapping::{check_output_format, png_path};
+use super::mapping::{LateBar, check_output_format, png_path};
 
 /// Remeshing methods of `--method`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum MethodArg {
     /// Parameterize, triangulate the parameter domain (spade), lift back.
     Param,
+    /// Same vertices and faces, the vertices moved along the surface towards reference
+    /// angles by the QC iteration (Gruber-Aulisa 2022, section 6.2).
+    QcAngles,
+}
+
+/// Reference shapes of `--reference`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ReferenceArg {
+    /// Angles adapted to the vertex valences (Gruber-Aulisa 2022, Algorithm 5).
+    Optimized,
+    /// Equilateral triangles and squares.
+    Equiangular,
+}
+
+/// Constraints of `--constraint`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum KeepArg {
+    /// Every displacement tangent to the surface (section 4.1).
+    Normal,
+    /// The area kept to first order (section 4.2).
+    Area,
 }
 
 /// Size fields of `--size-field`.
@@ -32,7 +55,7 @@ pub enum SizeFieldArg {
 }
 
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("resolution").required(true).args(["edge_length", "vertices"])))]
+#[command(group(clap::ArgGroup::new("resolution").args(["edge_length", "vertices"])))]
 pub struct RemeshArgs {
     /// Mesh file (.obj, .gltf, .glb): one connected surface of any genus, with or
     /// without boundary.
@@ -44,9 +67,26 @@ pub struct RemeshArgs {
     /// surface's area with N vertices).
     #[arg(long, value_name = "N")]
     pub vertices: Option<usize>,
-    /// How to remesh.
+    /// How to remesh: `param` makes a new mesh with the asked edge length (needs
+    /// --edge-length or --vertices); `qc-angles` moves the vertices of this one.
     #[arg(long, value_enum, default_value = "param")]
     pub method: MethodArg,
+    /// qc-angles: the reference shapes the elements move towards.
+    #[arg(long, value_enum, default_value = "optimized")]
+    pub reference: ReferenceArg,
+    /// qc-angles: how the moved vertices stay on the surface.
+    #[arg(long, value_enum, default_value = "normal")]
+    pub constraint: KeepArg,
+    /// qc-angles: most QC iterations.
+    #[arg(long = "max-iters", value_name = "N", default_value_t = 200)]
+    pub max_iters: usize,
+    /// qc-angles: stop when no face's mu moves by more than this in an iteration.
+    #[arg(long, value_name = "T", default_value_t = 1e-4)]
+    pub tolerance: f64,
+    /// qc-angles: leave the moved vertices where the map puts them instead of moving
+    /// them onto the input surface.
+    #[arg(long = "no-project")]
+    pub no_project: bool,
     /// The parameterizer, any registered solver that maps into the plane (`beltrami
     /// solvers` lists them), or `auto`: lscm on a disk, on a closed genus-0 surface
     /// slit open and on any other surface cut to a disk (qcmc for several boundary
@@ -109,14 +149,22 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
         ("--png", args.png.as_deref()),
         ("--report", args.report.as_deref()),
     ])?;
+    match args.method {
+        MethodArg::Param if args.edge_length.is_none() && args.vertices.is_none() => {
+            bail!("--method param makes a new mesh: give its size with --edge-length L or --vertices N")
+        }
+        MethodArg::QcAngles if args.edge_length.is_some() || args.vertices.is_some() => {
+            bail!("--method qc-angles keeps the input's vertices and faces: drop --edge-length and --vertices")
+        }
+        MethodArg::QcAngles => return run_in_place(args, quiet),
+        MethodArg::Param => {}
+    }
     let options = args.options();
     options.validate()?;
     let registry = beltrami::registry();
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
     let mesh = &loaded.mesh.mesh;
-    let solvers = match args.method {
-        MethodArg::Param => beltrami_remesh::param::chosen(&registry, mesh, &args.param)?,
-    };
+    let solvers = beltrami_remesh::param::chosen(&registry, mesh, &args.param)?;
 
     let start = Instant::now();
     let mut context = Context::new().with_cancel_flag(super::interrupt::cancel_flag());
@@ -126,30 +174,139 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     let out = &result.remeshed.mesh;
     io::write(&args.output, out, &VertexAttributes::default())?;
     let quality = beltrami_remesh::quality::measure(mesh, out)?;
-
-    if let Some(path) = &args.png {
-        let scene = Scene::new(out, None)?;
-        let style = Style {
-            view: View::Surface,
-            color: ColorBy::Plain,
-            wire: true,
-            ..Style::default()
-        };
-        beltrami_render::render(&scene, &style)?
-            .write_png(path)
-            .with_context(|| format!("cannot write the picture {}", path.display()))?;
-    }
-
+    write_png(args.png.as_deref(), out)?;
     let report = report_json(args, mesh, &result, &quality, seconds);
+    finish(args, &report, quiet, || {
+        print_summary(args, &result, &quality, seconds)
+    })
+}
+
+/// `--method qc-angles` ([`beltrami_remesh::in_place`]).
+fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
+    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
+        bail!("--tolerance {}: give a positive number", args.tolerance);
+    }
+    if args.max_iters == 0 {
+        bail!("--max-iters 0: give at least one iteration");
+    }
+    let registry = beltrami::registry();
+    let solver = registry.get("qc-iteration")?;
+    let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
+    let mesh = &loaded.mesh.mesh;
+    let options = InPlaceOptions {
+        reference: match args.reference {
+            ReferenceArg::Optimized => Reference::Optimized,
+            ReferenceArg::Equiangular => Reference::Equiangular,
+        },
+        keep: match args.constraint {
+            KeepArg::Normal => Keep::Normal,
+            KeepArg::Area => Keep::Area,
+        },
+        max_iters: args.max_iters,
+        tolerance: args.tolerance,
+        project: !args.no_project,
+    };
+    let start = Instant::now();
+    let mut bar = LateBar::new(!(quiet || args.json));
+    let result = {
+        let mut context = Context::new()
+            .with_progress(|p: &beltrami_core::Progress| bar.update(p))
+            .with_cancel_flag(super::interrupt::cancel_flag());
+        remesh_in_place(mesh, solver, &options, &mut context)
+    };
+    bar.finish();
+    let result = result.with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
+    let seconds = start.elapsed().as_secs_f64();
+    io::write(&args.output, &result.mesh, &VertexAttributes::default())?;
+    let before = beltrami_remesh::quality::measure(mesh, mesh)?;
+    let after = beltrami_remesh::quality::measure(mesh, &result.mesh)?;
+    write_png(args.png.as_deref(), &result.mesh)?;
+    let mut report = serde_json::Map::new();
+    report.insert("mesh".into(), json!(args.mesh.display().to_string()));
+    report.insert("output".into(), json!(args.output.display().to_string()));
+    report.extend(beltrami::report::remesh_in_place(
+        mesh, &result, &options, &before, &after, seconds,
+    ));
+    finish(args, &Value::Object(report), quiet, || {
+        println!(
+            "{} -> {} (qc-angles, {} reference, {} constraint, {seconds:.3} s)",
+            args.mesh.display(),
+            args.output.display(),
+            options.reference.name(),
+            options.keep.name()
+        );
+        println!(
+            "  vertices        {}  faces {}",
+            mesh.vertex_count(),
+            mesh.face_count()
+        );
+        for (name, q) in [("before", &before), ("after", &after)] {
+            println!(
+                "  angles {name:<8} min {:.2}  mean {:.2}  under 30: {:.3}%",
+                q.min_angle,
+                q.mean_angle,
+                100.0 * q.share_below_30
+            );
+        }
+        println!(
+            "  distance        Hausdorff {:.4e} ({:.3}% of the diagonal)  mean {:.4e}",
+            after.hausdorff,
+            100.0 * after.hausdorff / after.diagonal,
+            after.mean_distance
+        );
+        let m = &result.solution.metrics;
+        if let (Some(k), Some(d)) = (m.k, &m.distortion) {
+            println!(
+                "  |mu|            k {k:.4}  mean {:.4}  std {:.4}  max {:.4}",
+                d.mu_mean, d.mu_std, d.mu_max
+            );
+        }
+        println!(
+            "  iterations      {} ({})",
+            m.iterations,
+            m.stop.as_ref().map_or("", |s| s.name())
+        );
+        println!("  flipped         {}", result.flipped);
+        for note in &result.solution.report.notes {
+            println!("  note: {note}");
+        }
+    })
+}
+
+/// `--png`: the mesh in 3D with its edges.
+fn write_png(path: Option<&std::path::Path>, mesh: &beltrami_mesh::Mesh) -> anyhow::Result<()> {
+    let Some(path) = path else {
+        return Ok(());
+    };
+    let scene = Scene::new(mesh, None)?;
+    let style = Style {
+        view: View::Surface,
+        color: ColorBy::Plain,
+        wire: true,
+        ..Style::default()
+    };
+    beltrami_render::render(&scene, &style)?
+        .write_png(path)
+        .with_context(|| format!("cannot write the picture {}", path.display()))
+}
+
+/// Writes `--report`, prints the report (`--json`) or the summary, and fails after an
+/// interruption.
+fn finish(
+    args: &RemeshArgs,
+    report: &Value,
+    quiet: bool,
+    summary: impl FnOnce(),
+) -> anyhow::Result<()> {
     if let Some(path) = &args.report {
-        let text = serde_json::to_string_pretty(&report)?;
+        let text = serde_json::to_string_pretty(report)?;
         io::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
             .with_context(|| format!("cannot write the report {}", path.display()))?;
     }
     if args.json {
         println!("{report}");
     } else if !quiet {
-        print_summary(args, &result, &quality, seconds);
+        summary();
     }
     if super::interrupt::interrupted() {
         bail!("interrupted");

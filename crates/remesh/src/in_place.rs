@@ -1,0 +1,170 @@
+//! Remeshing in place by reference angles (Gruber-Aulisa 2022, section 6.2): the same
+//! vertices and faces, the vertices moved along the surface so that the elements take
+//! the shapes of reference polygons as closely as a quasiconformal map allows.
+//!
+//! The QC iteration (the `qc-iteration` solver, Algorithms 2-4) looks for the
+//! Teichmueller map from the conformal structure of the reference shapes
+//! ([`crate::reference_angles`]) to the surface, the boundary held in place and the
+//! image kept on the surface by the normal constraint (section 4.1, every displacement
+//! tangent to the surface to first order) or near it by the area constraint (section
+//! 4.2, the first variation of the area vanishes; a closed surface is then held at one
+//! vertex). Its image is the new vertex positions; with `project`, each moved vertex
+//! then goes to its closest point on the input surface (the linearized constraint
+//! leaves it on its tangent plane, off a curved surface by the square of the move).
+
+use beltrami_core::{
+    Constraint, Context, Goal, Map, OptionValue, Pin, Position, Problem, Solution, Solver,
+    SolverError, Stop, Target,
+};
+use beltrami_mesh::{Mesh, Point3, VertexId};
+use beltrami_spatial::SurfaceIndex;
+
+use crate::RemeshError;
+use crate::reference_angles::{Reference, reference_angles};
+
+/// How the image is kept near the surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Keep {
+    /// The normal constraint (section 4.1): displacements tangent to the surface.
+    Normal,
+    /// The area constraint (section 4.2): the area kept to first order.
+    Area,
+}
+
+impl Keep {
+    /// `normal` or `area`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Keep::Normal => "normal",
+            Keep::Area => "area",
+        }
+    }
+}
+
+/// The weight of the normal constraint times the squared mean edge length: a normal
+/// move of a vertex by `d` costs `NORMAL_STIFFNESS (d / h)^2` times its area, ten
+/// thousand times what a tangential move of the same size costs the distortion energy.
+pub const NORMAL_STIFFNESS: f64 = 1e4;
+
+/// The options of [`remesh_in_place`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InPlaceOptions {
+    /// The reference shapes.
+    pub reference: Reference,
+    /// How the image stays near the surface.
+    pub keep: Keep,
+    /// Most iterations of the QC iteration.
+    pub max_iters: usize,
+    /// Its tolerance (the largest change of `mu` in an iteration).
+    pub tolerance: f64,
+    /// Move the vertices onto the input surface afterwards.
+    pub project: bool,
+}
+
+impl Default for InPlaceOptions {
+    fn default() -> Self {
+        Self {
+            reference: Reference::Optimized,
+            keep: Keep::Normal,
+            max_iters: 200,
+            tolerance: 1e-4,
+            project: true,
+        }
+    }
+}
+
+/// The result of [`remesh_in_place`].
+#[derive(Debug)]
+pub struct InPlace {
+    /// The input's connectivity at the new positions.
+    pub mesh: Mesh,
+    /// The QC iteration's solution (iterations, `k`, `|mu|` from the reference shapes).
+    pub solution: Solution,
+    /// Faces whose normal turned by more than 90 degrees from the input's.
+    pub flipped: usize,
+}
+
+/// Remeshes `mesh` in place (module docs) with `solver` (the `qc-iteration` solver of
+/// the registry).
+pub fn remesh_in_place(
+    mesh: &Mesh,
+    solver: &dyn Solver,
+    options: &InPlaceOptions,
+    context: &mut Context<'_>,
+) -> Result<InPlace, RemeshError> {
+    let mut problem = Problem::new(mesh, Target::Surface);
+    problem.goal = Goal::Extremal;
+    problem.constraints.push(Constraint::ReferenceAngles(reference_angles(
+        mesh,
+        options.reference,
+    )));
+    problem.constraints.hold_boundary(mesh, mesh.positions());
+    match options.keep {
+        Keep::Normal => {
+            let lengths = mesh.edge_lengths();
+            let mean = lengths.iter().sum::<f64>() / lengths.len().max(1) as f64;
+            problem.constraints.push(Constraint::Normal {
+                weight: NORMAL_STIFFNESS / (mean * mean),
+            });
+        }
+        Keep::Area => {
+            problem.constraints.push(Constraint::Area);
+            if mesh.boundary_loop_list().is_empty() {
+                problem.constraints.push(Constraint::Pin(Pin {
+                    vertex: VertexId(0),
+                    position: Some(Position::Spatial(mesh.position(VertexId(0)))),
+                }));
+            }
+        }
+    }
+    problem
+        .options
+        .set("max-iters", OptionValue::Int(options.max_iters))
+        .set("tolerance", OptionValue::Float(options.tolerance));
+    let solution = solver
+        .solve(&problem, context)
+        .map_err(|error| match error {
+            SolverError::Cancelled => RemeshError::Cancelled,
+            error => RemeshError::Solve {
+                solver: solver.name(),
+                error,
+            },
+        })?;
+    if let Some(Stop::Cancelled) = solution.metrics.stop {
+        return Err(RemeshError::Cancelled);
+    }
+    let Some(Map::Spatial(image)) = solution.map() else {
+        return Err(RemeshError::Parameterizer {
+            solver: solver.name(),
+            message: "it gave no map into space".to_string(),
+        });
+    };
+    let mut positions = image.clone();
+    if options.project {
+        let index = SurfaceIndex::new(mesh)?;
+        let moved: Vec<usize> = mesh
+            .vertices()
+            .filter(|&v| !mesh.is_boundary_vertex(v))
+            .map(|v| v.idx())
+            .collect();
+        let points: Vec<Point3<f64>> = moved.iter().map(|&v| positions[v]).collect();
+        for (v, located) in moved.iter().zip(index.locate_all(&points)?) {
+            positions[*v] = located.position;
+        }
+    }
+    let remeshed = mesh
+        .with_positions(positions)
+        .map_err(|error| RemeshError::Build {
+            what: "moved mesh",
+            error,
+        })?;
+    let flipped = mesh
+        .faces()
+        .filter(|&f| remeshed.face_vector_area(f).dot(&mesh.face_vector_area(f)) <= 0.0)
+        .count();
+    Ok(InPlace {
+        mesh: remeshed,
+        solution,
+        flipped,
+    })
+}
