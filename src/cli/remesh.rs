@@ -186,9 +186,6 @@ fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
         bail!("--tolerance {}: give a positive number", args.tolerance);
     }
-    if args.max_iters == 0 {
-        bail!("--max-iters 0: give at least one iteration");
-    }
     let registry = beltrami::registry();
     let solver = registry.get("qc-iteration")?;
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;

@@ -30,13 +30,111 @@ pub const ROWS_PER_POINT: usize = 4;
 /// The operator `x -> df^- - mu df^+` (module docs) of `elements` (built with
 /// `Frame::Face`) for the coefficients `mu` per face (`mu1 + i mu2`), on `vertex_count`
 /// vertices: `4 Q` rows, `3 vertex_count` columns, followed by the rows of `extra`
-/// (e.g. [`NormalConstraint`]).
+/// (e.g. [`NormalConstraint`]). One-shot; [`QuaternionicOperator`] keeps the pattern
+/// for repeated assemblies.
 pub fn quaternionic_operator(
     elements: &Elements,
     vertex_count: usize,
     mu: &[Complex64],
     extra: Option<&NormalConstraint>,
 ) -> Result<SparseColMat<usize, f64>, FemError> {
+    QuaternionicOperator::new(elements, vertex_count, extra)?.assemble(elements, mu, extra)
+}
+
+/// The pattern of [`quaternionic_operator`], sorted once; each [`assemble`](Self::assemble)
+/// only recomputes the values for a new `mu`.
+#[derive(Debug, Clone)]
+pub struct QuaternionicOperator {
+    pattern: Pattern,
+}
+
+impl QuaternionicOperator {
+    /// The pattern for `elements` on `vertex_count` vertices, with the rows of `extra`.
+    pub fn new(
+        elements: &Elements,
+        vertex_count: usize,
+        extra: Option<&NormalConstraint>,
+    ) -> Result<Self, FemError> {
+        let mut positions = Vec::with_capacity(elements.point_count() * 4 * 4 * 3);
+        for (q_index, q) in elements.points().iter().enumerate() {
+            for v in elements.nodes(q.face) {
+                for axis in 0..3 {
+                    for c in 0..ROWS_PER_POINT {
+                        positions.push((ROWS_PER_POINT * q_index + c, 3 * v.idx() + axis));
+                    }
+                }
+            }
+        }
+        let first = ROWS_PER_POINT * elements.point_count();
+        let mut rows = first;
+        if let Some(extra) = extra {
+            for r in 0..extra.normals.len() {
+                for axis in 0..3 {
+                    positions.push((first + r, 3 * r + axis));
+                }
+            }
+            rows += extra.normals.len();
+        }
+        Ok(Self {
+            pattern: Pattern::new(rows, 3 * vertex_count, &positions)?,
+        })
+    }
+
+    /// The symbolic structure of the operator.
+    pub fn symbolic(&self) -> &faer::sparse::SymbolicSparseColMat<usize> {
+        self.pattern.symbolic()
+    }
+
+    /// The operator for `mu` (one value per face): the same `elements` and `extra` as
+    /// [`new`](Self::new).
+    pub fn assemble(
+        &self,
+        elements: &Elements,
+        mu: &[Complex64],
+        extra: Option<&NormalConstraint>,
+    ) -> Result<SparseColMat<usize, f64>, FemError> {
+        if mu.len() != elements.face_count() {
+            return Err(FemError::Length {
+                what: "Beltrami coefficient",
+                expected: elements.face_count(),
+                got: mu.len(),
+            });
+        }
+        let mut values = Vec::with_capacity(self.pattern.entry_count());
+        for q in elements.points() {
+            let normal = q.frame.normal;
+            let m = mu[q.face.idx()];
+            let coefficient = Quaternion::from_parts(m.re, normal * m.im);
+            for k in 0..elements.nodes(q.face).len() {
+                let g = q.grad[k];
+                for axis in 0..3 {
+                    // The residual of the map that moves vertex v by the unit vector of
+                    // `axis`: column 3 v + axis of the operator.
+                    let e = Vector3::ith(axis, 1.0);
+                    let (plus, minus) = conformal_parts(&normal, &(e * g.x), &(e * g.y));
+                    let r = minus - coefficient * plus;
+                    values.extend([r.w, r.i, r.j, r.k]);
+                }
+            }
+        }
+        if let Some(extra) = extra {
+            for normal in &extra.normals {
+                values.extend(normal.iter());
+            }
+        }
+        self.pattern.assemble(&values)
+    }
+}
+
+/// The residual `df^- - mu df^+` of the map `image` at every quadrature point of
+/// `elements`, its four components `(w, i, j, k)` each times the square root of the
+/// point's weight: the squared norm is the distortion `QC_mu(image)` of section 4 (the
+/// operator's rows applied to the image, without assembling them).
+pub fn quaternionic_residual(
+    elements: &Elements,
+    image: &[Point3<f64>],
+    mu: &[Complex64],
+) -> Result<Vec<f64>, FemError> {
     if mu.len() != elements.face_count() {
         return Err(FemError::Length {
             what: "Beltrami coefficient",
@@ -44,40 +142,17 @@ pub fn quaternionic_operator(
             got: mu.len(),
         });
     }
-    let mut positions = Vec::with_capacity(elements.point_count() * 4 * 4 * 3);
-    let mut values = Vec::with_capacity(positions.capacity());
-    for (q_index, q) in elements.points().iter().enumerate() {
+    let derivatives = crate::beltrami::spatial_derivatives(elements, image.len(), image)?;
+    let mut r = Vec::with_capacity(ROWS_PER_POINT * elements.point_count());
+    for (q, d) in elements.points().iter().zip(derivatives) {
         let normal = q.frame.normal;
         let m = mu[q.face.idx()];
         let coefficient = Quaternion::from_parts(m.re, normal * m.im);
-        for (k, v) in elements.nodes(q.face).iter().enumerate() {
-            let g = q.grad[k];
-            for axis in 0..3 {
-                // The residual of the map that moves vertex v by the unit vector of
-                // `axis`: column 3 v + axis of the operator.
-                let e = Vector3::ith(axis, 1.0);
-                let (plus, minus) = conformal_parts(&normal, &(e * g.x), &(e * g.y));
-                let r = minus - coefficient * plus;
-                let components = [r.w, r.i, r.j, r.k];
-                for (c, &value) in components.iter().enumerate() {
-                    positions.push((ROWS_PER_POINT * q_index + c, 3 * v.idx() + axis));
-                    values.push(value);
-                }
-            }
-        }
+        let (plus, minus) = conformal_parts(&normal, &d.dx, &d.dy);
+        let residual = (minus - coefficient * plus) * q.weight.sqrt();
+        r.extend([residual.w, residual.i, residual.j, residual.k]);
     }
-    let first = ROWS_PER_POINT * elements.point_count();
-    let mut rows = first;
-    if let Some(extra) = extra {
-        for (r, normal) in extra.normals.iter().enumerate() {
-            for axis in 0..3 {
-                positions.push((first + r, 3 * r + axis));
-                values.push(normal[axis]);
-            }
-        }
-        rows += extra.normals.len();
-    }
-    Pattern::new(rows, 3 * vertex_count, &positions)?.assemble(&values)
+    Ok(r)
 }
 
 /// The linearized normal constraint of section 4.1: the displacement of every vertex
@@ -208,7 +283,7 @@ pub enum SpaceError {
 #[derive(Debug)]
 pub struct SpaceSystem {
     elements: Elements,
-    vertex_count: usize,
+    operator: QuaternionicOperator,
     normal: Option<NormalConstraint>,
     area: Option<AreaConstraint>,
     solver: crate::LeastSquaresSolver<f64>,
@@ -227,8 +302,7 @@ impl SpaceSystem {
         area: Option<AreaConstraint>,
         options: crate::SolveOptions,
     ) -> Result<Self, SpaceError> {
-        let zero = vec![Complex64::new(0.0, 0.0); elements.face_count()];
-        let operator = quaternionic_operator(&elements, vertex_count, &zero, normal.as_ref())?;
+        let operator = QuaternionicOperator::new(&elements, vertex_count, normal.as_ref())?;
         let mut builder = crate::DofBuilder::<f64>::new(vertex_count, 3)?;
         let mut is_held = vec![false; vertex_count];
         for &(v, p) in held {
@@ -238,7 +312,7 @@ impl SpaceSystem {
         for v in (0..vertex_count).filter(|&v| !is_held[v]) {
             builder.free(&[VertexId(v as u32)])?;
         }
-        let solver = crate::LeastSquaresSolver::new(operator.symbolic(), &builder.build()?, options)?;
+        let solver = crate::LeastSquaresSolver::new(operator.symbolic().as_ref(), &builder.build()?, options)?;
         let mut weights = row_weights(&elements);
         let mut rhs = vec![0.0; weights.len()];
         if let Some(normal) = &normal {
@@ -247,7 +321,7 @@ impl SpaceSystem {
         }
         Ok(Self {
             elements,
-            vertex_count,
+            operator,
             normal,
             area,
             solver,
@@ -264,8 +338,9 @@ impl SpaceSystem {
     /// The minimizer for `mu` (one value per face, in the elements' frames): the image of
     /// every vertex.
     pub fn solve(&mut self, mu: &[Complex64]) -> Result<Vec<Point3<f64>>, SpaceError> {
-        let operator =
-            quaternionic_operator(&self.elements, self.vertex_count, mu, self.normal.as_ref())?;
+        let operator = self
+            .operator
+            .assemble(&self.elements, mu, self.normal.as_ref())?;
         let x = match &self.area {
             Some(area) => self.solver.solve_with_equality(
                 operator.as_ref(),
@@ -284,25 +359,13 @@ impl SpaceSystem {
             .collect())
     }
 
-    /// The residual `df^- - mu df^+` of `image` at every quadrature point, four
-    /// components per point, each times the square root of its weight: its squared norm
-    /// is the distortion `QC_mu(image)` (section 4).
+    /// [`quaternionic_residual`] of `image` on the system's elements.
     pub fn residual(
         &self,
         mu: &[Complex64],
         image: &[Point3<f64>],
     ) -> Result<Vec<f64>, SpaceError> {
-        let operator = quaternionic_operator(&self.elements, self.vertex_count, mu, None)?;
-        let mut r = vec![0.0; operator.nrows()];
-        for (j, x) in image.iter().flat_map(|p| p.coords.iter().copied()).enumerate() {
-            for (i, a) in operator.row_idx_of_col(j).zip(operator.val_of_col(j)) {
-                r[i] += a * x;
-            }
-        }
-        for (r, w) in r.iter_mut().zip(&self.weights) {
-            *r *= w.sqrt();
-        }
-        Ok(r)
+        Ok(quaternionic_residual(&self.elements, image, mu)?)
     }
 }
 

@@ -45,10 +45,10 @@ const OPTIONS: &[OptionSpec] = &[
         name: "max-iters",
         kind: OptionKind::Int {
             default: 500,
-            min: 1,
+            min: 0,
             max: 1_000_000,
         },
-        help: "iterations at most",
+        help: "iterations at most (0: the least-squares conformal map, mu = 0)",
     },
     OptionSpec {
         name: "line-search",

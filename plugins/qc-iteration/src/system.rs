@@ -62,16 +62,16 @@ impl Linearized for Planar<'_> {
     }
 
     fn residual(&self, mu: &[Complex64]) -> Result<Vec<f64>, SolverError> {
-        let operator = beltrami_operator(self.mesh, &self.elements, mu)?;
-        let mut r = vec![Complex64::new(0.0, 0.0); operator.nrows()];
-        for (j, &x) in self.map.iter().enumerate() {
-            for (i, &a) in operator.row_idx_of_col(j).zip(operator.val_of_col(j)) {
-                r[i] += a * x;
-            }
-        }
-        Ok(r.iter()
-            .zip(&self.weights)
-            .flat_map(|(r, w)| [r.re * w.sqrt(), r.im * w.sqrt()])
+        let d = planar_map(&self.elements, self.map.len(), &self.map)?;
+        Ok(self
+            .elements
+            .points()
+            .iter()
+            .zip(d)
+            .flat_map(|(q, d)| {
+                let r = (d.fzbar - mu[q.face.idx()] * d.fz) * q.weight.sqrt();
+                [r.re, r.im]
+            })
             .collect())
     }
 
