@@ -78,7 +78,7 @@ pub struct RemeshArgs {
     #[arg(long, value_enum, default_value = "normal")]
     pub constraint: KeepArg,
     /// qc-angles: most QC iterations.
-    #[arg(long = "max-iters", value_name = "N", default_value_t = 200)]
+    #[arg(long = "max-iters", value_name = "N", default_value_t = 10)]
     pub max_iters: usize,
     /// qc-angles: stop when no face's mu moves by more than this in an iteration.
     #[arg(long, value_name = "T", default_value_t = 1e-4)]
@@ -87,6 +87,10 @@ pub struct RemeshArgs {
     /// them onto the input surface.
     #[arg(long = "no-project")]
     pub no_project: bool,
+    /// qc-angles: hold the vertices of edges whose faces' normals differ by more than A
+    /// degrees (sharp creases and corners); 180 holds none.
+    #[arg(long = "feature-angle", value_name = "A", default_value_t = 60.0)]
+    pub feature_angle: f64,
     /// The parameterizer, any registered solver that maps into the plane (`beltrami
     /// solvers` lists them), or `auto`: lscm on a disk, on a closed genus-0 surface
     /// slit open and on any other surface cut to a disk (qcmc for several boundary
@@ -183,6 +187,12 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
 
 /// `--method qc-angles` ([`beltrami_remesh::in_place`]).
 fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
+    if !(args.feature_angle > 0.0 && args.feature_angle <= 180.0) {
+        bail!(
+            "--feature-angle {}: give an angle in (0, 180] degrees",
+            args.feature_angle
+        );
+    }
     if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
         bail!("--tolerance {}: give a positive number", args.tolerance);
     }
@@ -202,6 +212,7 @@ fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
         max_iters: args.max_iters,
         tolerance: args.tolerance,
         project: !args.no_project,
+        feature_angle: args.feature_angle,
     };
     let start = Instant::now();
     let mut bar = LateBar::new(!(quiet || args.json));
@@ -264,6 +275,7 @@ fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
             m.stop.as_ref().map_or("", |s| s.name())
         );
         println!("  flipped         {}", result.flipped);
+        println!("  held features   {} vertices", result.features);
         for note in &result.solution.report.notes {
             println!("  note: {note}");
         }

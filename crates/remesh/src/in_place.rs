@@ -8,7 +8,10 @@
 //! image kept on the surface by the normal constraint (section 4.1, every displacement
 //! tangent to the surface to first order) or near it by the area constraint (section
 //! 4.2, the first variation of the area vanishes; a closed surface is then held at one
-//! vertex). Its image is the new vertex positions; with `project`, each moved vertex
+//! vertex). Vertices on sharp features (an edge whose faces' normals differ by more
+//! than `feature_angle`) are held too: the linearized constraint sees a crease only
+//! through the averaged vertex normal and would let vertices slide across it. The
+//! image is the new vertex positions; with `project`, each moved vertex
 //! then goes to its closest point on the input surface (the linearized constraint
 //! leaves it on its tangent plane, off a curved surface by the square of the move).
 
@@ -59,6 +62,9 @@ pub struct InPlaceOptions {
     pub tolerance: f64,
     /// Move the vertices onto the input surface afterwards.
     pub project: bool,
+    /// Vertices on an edge whose faces' normals differ by more than this (degrees) stay
+    /// in place, so that sharp creases and corners keep their shape.
+    pub feature_angle: f64,
 }
 
 impl Default for InPlaceOptions {
@@ -66,9 +72,10 @@ impl Default for InPlaceOptions {
         Self {
             reference: Reference::Optimized,
             keep: Keep::Normal,
-            max_iters: 200,
+            max_iters: 10,
             tolerance: 1e-4,
             project: true,
+            feature_angle: 60.0,
         }
     }
 }
@@ -82,6 +89,8 @@ pub struct InPlace {
     pub solution: Solution,
     /// Faces whose normal turned by more than 90 degrees from the input's.
     pub flipped: usize,
+    /// Vertices held on sharp features.
+    pub features: usize,
 }
 
 /// Remeshes `mesh` in place (module docs) with `solver` (the `qc-iteration` solver of
@@ -99,6 +108,13 @@ pub fn remesh_in_place(
         options.reference,
     )));
     problem.constraints.hold_boundary(mesh, mesh.positions());
+    let held = feature_vertices(mesh, options.feature_angle);
+    for &v in &held {
+        problem.constraints.push(Constraint::Pin(Pin {
+            vertex: v,
+            position: Some(Position::Spatial(mesh.position(v))),
+        }));
+    }
     match options.keep {
         Keep::Normal => {
             let lengths = mesh.edge_lengths();
@@ -166,5 +182,24 @@ pub fn remesh_in_place(
         mesh: remeshed,
         solution,
         flipped,
+        features: held.len(),
     })
+}
+
+/// The vertices, off the boundary, of the edges whose two faces' normals differ by more
+/// than `angle_degrees`: the sharp features.
+fn feature_vertices(mesh: &Mesh, angle_degrees: f64) -> Vec<VertexId> {
+    let limit = angle_degrees.to_radians().cos();
+    let mut on = vec![false; mesh.vertex_count()];
+    for e in mesh.edges() {
+        if let [Some(f), Some(g)] = mesh.edge_faces(e) {
+            let (a, b) = (mesh.face_vector_area(f), mesh.face_vector_area(g));
+            if a.dot(&b) < limit * a.norm() * b.norm() {
+                for v in mesh.edge_vertices(e) {
+                    on[v.idx()] = !mesh.is_boundary_vertex(v);
+                }
+            }
+        }
+    }
+    mesh.vertices().filter(|v| on[v.idx()]).collect()
 }
