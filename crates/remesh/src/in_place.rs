@@ -19,7 +19,7 @@ use beltrami_core::{
     Constraint, Context, Goal, Map, OptionValue, Pin, Position, Problem, Solution, Solver,
     SolverError, Stop, Target,
 };
-use beltrami_mesh::{Mesh, Point3, VertexId};
+use beltrami_mesh::{Mesh, Point3, Vector3, VertexId};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::RemeshError;
@@ -87,10 +87,20 @@ pub struct InPlace {
     pub mesh: Mesh,
     /// The QC iteration's solution (iterations, `k`, `|mu|` from the reference shapes).
     pub solution: Solution,
-    /// Faces whose normal turned by more than 90 degrees from the input's.
+    /// Faces turned against the input surface: the normal of the face and the input's
+    /// normal (interpolated from its vertex normals) at the point of the input closest
+    /// to the face's centroid make an angle of 90 degrees or more.
     pub flipped: usize,
+    /// Faces of the input turned against its own surface in the same sense (slivers
+    /// whose normal disagrees with the vertex normals): the pull-back never makes a
+    /// face turn that was not turned in the input.
+    pub input_flipped: usize,
     /// Vertices held on sharp features.
     pub features: usize,
+    /// Vertices pulled back towards their input position (halving their move up to six
+    /// times, then to the input) because a face of theirs had turned against the
+    /// surface: the least-squares map is not bijective by construction.
+    pub pulled: usize,
 }
 
 /// Remeshes `mesh` in place (module docs) with `solver` (the `qc-iteration` solver of
@@ -155,46 +165,125 @@ pub fn remesh_in_place(
             message: "it gave no map into space".to_string(),
         });
     };
+    let index = SurfaceIndex::new(mesh)?;
     let mut positions = image.clone();
     if options.project {
-        let index = SurfaceIndex::new(mesh)?;
-        let moved: Vec<usize> = mesh
-            .vertices()
-            .filter(|&v| !mesh.is_boundary_vertex(v))
-            .map(|v| v.idx())
-            .collect();
-        let points: Vec<Point3<f64>> = moved.iter().map(|&v| positions[v]).collect();
-        for (v, located) in moved.iter().zip(index.locate_all(&points)?) {
-            positions[*v] = located.position;
-        }
+        project(mesh, &index, &mut positions)?;
     }
+    let was_flipped = flipped_faces(mesh, &index, mesh.positions())?;
+    let mut pulled = 0;
+    let mut flipped = flipped_faces(mesh, &index, &positions)?;
+    let target = positions.clone();
+    let mut share = vec![1.0; mesh.vertex_count()];
+    for _ in 0..PULL_BACK_ROUNDS {
+        let bad: Vec<_> = mesh
+            .faces()
+            .filter(|f| flipped[f.idx()] && !was_flipped[f.idx()])
+            .collect();
+        if bad.is_empty() {
+            break;
+        }
+        for f in bad {
+            for v in mesh.face_vertices(f) {
+                let s = &mut share[v.idx()];
+                if *s == 1.0 {
+                    pulled += 1;
+                }
+                *s = if *s > 1.0 / 64.0 { *s / 2.0 } else { 0.0 };
+                let from = mesh.position(v);
+                positions[v.idx()] = from + (target[v.idx()] - from) * *s;
+            }
+        }
+        if options.project {
+            project(mesh, &index, &mut positions)?;
+        }
+        flipped = flipped_faces(mesh, &index, &positions)?;
+    }
+    let count = |faces: &[bool]| faces.iter().filter(|&&f| f).count();
+    let (flipped, input_flipped) = (count(&flipped), count(&was_flipped));
     let remeshed = mesh
         .with_positions(positions)
         .map_err(|error| RemeshError::Build {
             what: "moved mesh",
             error,
         })?;
-    let flipped = mesh
-        .faces()
-        .filter(|&f| remeshed.face_vector_area(f).dot(&mesh.face_vector_area(f)) <= 0.0)
-        .count();
     Ok(InPlace {
         mesh: remeshed,
         solution,
         flipped,
+        input_flipped,
         features: held.len(),
+        pulled,
     })
 }
 
+/// Rounds of pulling the vertices of turned faces back towards the input.
+const PULL_BACK_ROUNDS: usize = 12;
+
+/// Moves every vertex off the boundary to its closest point on `mesh`.
+fn project(
+    mesh: &Mesh,
+    index: &SurfaceIndex<'_>,
+    positions: &mut [Point3<f64>],
+) -> Result<(), RemeshError> {
+    let moved: Vec<usize> = mesh
+        .vertices()
+        .filter(|&v| !mesh.is_boundary_vertex(v))
+        .map(|v| v.idx())
+        .collect();
+    let points: Vec<Point3<f64>> = moved.iter().map(|&v| positions[v]).collect();
+    for (v, located) in moved.iter().zip(index.locate_all(&points)?) {
+        positions[*v] = located.position;
+    }
+    Ok(())
+}
+
+/// Per face of `mesh` at `positions`: whether it is turned against the surface of
+/// `index` ([`InPlace::flipped`]).
+fn flipped_faces(
+    mesh: &Mesh,
+    index: &SurfaceIndex<'_>,
+    positions: &[Point3<f64>],
+) -> Result<Vec<bool>, RemeshError> {
+    let corners = |f| mesh.face_vertices(f).map(|v: VertexId| positions[v.idx()]);
+    let centroids: Vec<Point3<f64>> = mesh
+        .faces()
+        .map(|f| {
+            let n = mesh.face_degree(f) as f64;
+            Point3::from(corners(f).map(|p| p.coords).sum::<Vector3<f64>>() / n)
+        })
+        .collect();
+    mesh.faces()
+        .zip(index.locate_all(&centroids)?)
+        .map(|(f, located)| {
+            let p: Vec<Point3<f64>> = corners(f).collect();
+            let area: Vector3<f64> = (0..p.len())
+                .map(|k| p[k].coords.cross(&p[(k + 1) % p.len()].coords))
+                .sum();
+            Ok(area.dot(&index.normal(&located.point)?) <= 0.0)
+        })
+        .collect()
+}
+
 /// The vertices, off the boundary, of the edges whose two faces' normals differ by more
-/// than `angle_degrees`: the sharp features.
+/// than `angle_degrees`: the sharp features. A face with a corner under
+/// [`SLIVER_ANGLE`] makes no crease: a sliver's normal says little about the surface,
+/// and the badly shaped faces are the ones to move.
 fn feature_vertices(mesh: &Mesh, angle_degrees: f64) -> Vec<VertexId> {
     let limit = angle_degrees.to_radians().cos();
+    let sliver = SLIVER_ANGLE.to_radians();
+    let well_shaped: Vec<bool> = mesh
+        .faces()
+        .map(|f| mesh.face_halfedges(f).all(|h| mesh.corner_angle(h) >= sliver))
+        .collect();
     let mut on = vec![false; mesh.vertex_count()];
     for e in mesh.edges() {
         if let [Some(f), Some(g)] = mesh.edge_faces(e) {
             let (a, b) = (mesh.face_vector_area(f), mesh.face_vector_area(g));
-            if a.dot(&b) < limit * a.norm() * b.norm() {
+            if well_shaped[f.idx()]
+                && well_shaped[g.idx()]
+                && a.dot(&b) < limit * a.norm() * b.norm()
+            {
                 for v in mesh.edge_vertices(e) {
                     on[v.idx()] = !mesh.is_boundary_vertex(v);
                 }
@@ -203,3 +292,6 @@ fn feature_vertices(mesh: &Mesh, angle_degrees: f64) -> Vec<VertexId> {
     }
     mesh.vertices().filter(|v| on[v.idx()]).collect()
 }
+
+/// The smallest corner angle (degrees) of a face whose normal can mark a crease.
+pub const SLIVER_ANGLE: f64 = 15.0;
