@@ -118,7 +118,10 @@ fn the_qc_iteration_reaches_the_ring_maps_k_and_agrees_with_extremal() {
             );
         }
         if let Some(e) = last {
-            assert!(error < 0.35 * e, "vertex error {error} after {e}: not second order");
+            assert!(
+                error < 0.35 * e,
+                "vertex error {error} after {e}: not second order"
+            );
         }
         last = Some(error);
     }
@@ -163,4 +166,89 @@ fn a_prescribed_goal_or_a_curved_mesh_is_refused() {
         text(&run.stderr)
     );
     assert!(!out.exists());
+}
+
+#[test]
+fn the_qc_iteration_maps_a_curved_patch_into_space() {
+    // A cylinder patch onto a coaxial cylinder, developed the affine map
+    // (s, t) -> (1.3 s, 0.4 s + 0.8 t): the Teichmueller map of its own boundary values
+    // (plugins/qc-iteration/tests/surface.rs has the convergence study).
+    let dir = tempfile::tempdir().unwrap();
+    let mut soup = beltrami_mesh::primitives::jittered_grid(
+        10,
+        10,
+        beltrami_mesh::primitives::Cells::Triangles,
+        0.3,
+        7,
+    );
+    let developed: Vec<(f64, f64)> = soup.positions.iter().map(|p| (1.2 * p.x, p.y)).collect();
+    for (p, &(s, t)) in soup.positions.iter_mut().zip(&developed) {
+        *p = Point3::new(s.cos(), s.sin(), t);
+    }
+    let mesh = Mesh::from_soup(&soup).unwrap();
+    let exact: Vec<Point3<f64>> = developed
+        .iter()
+        .map(|&(s, t)| Point3::new(1.3 * s.cos(), 1.3 * s.sin(), 0.4 * s + 0.8 * t))
+        .collect();
+    let input = dir.path().join("patch.obj");
+    let map = dir.path().join("map.obj");
+    io::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let attributes = VertexAttributes {
+        positions: Some(&exact),
+        ..VertexAttributes::default()
+    };
+    io::write(&map, &mesh, &attributes).unwrap();
+    let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
+    let run = beltrami(&[
+        "qc",
+        s(&input),
+        "--solver",
+        "qc-iteration",
+        "--target",
+        "space",
+        "--boundary",
+        "given",
+        "--boundary-map",
+        s(&map),
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let k_exact = (Complex64::new(0.5, 0.4) / Complex64::new(2.1, 0.4)).norm();
+    let k = r["k"].as_f64().unwrap();
+    assert!(
+        (k - k_exact).abs() < 0.01 * k_exact,
+        "k {k}, exact {k_exact}"
+    );
+    assert_eq!(r["flipped"], 0);
+    let image = io::read(&out, &BuildOptions::default()).unwrap().mesh;
+    let error = image
+        .positions()
+        .iter()
+        .zip(&exact)
+        .map(|(p, q)| (p - q).norm())
+        .fold(0.0, f64::max);
+    assert!(error < 2e-3, "vertex error {error}");
+    // The area constraint is a flag of the space target only.
+    let bad = dir.path().join("bad.obj");
+    let run = beltrami(&[
+        "qc",
+        s(&input),
+        "--solver",
+        "qc-iteration",
+        "--area-constraint",
+        "-o",
+        s(&bad),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("--target space"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!bad.exists());
 }

@@ -138,7 +138,7 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
     let output = dir.path().join("out.obj");
     write_soup(&input, &disk(3));
     write_soup(&sphere, &icosphere(2));
-    let cases: [(&[&str], &str); 9] = [
+    let cases: [(&[&str], &str); 11] = [
         (&["--edge-length", "0"], "edge-length"),
         (&["--edge-length", "-0.1"], "edge-length"),
         (&["--edge-length", "NaN"], "edge-length"),
@@ -151,9 +151,17 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
         ),
         (
             &["--edge-length", "0.1", "--method", "qc-angles"],
-            "invalid value 'qc-angles'",
+            "drop --edge-length",
         ),
-        (&[], "--edge-length <L>"),
+        (
+            &["--method", "qc-angles", "--tolerance", "0"],
+            "--tolerance",
+        ),
+        (
+            &["--method", "qc-angles", "--feature-angle", "200"],
+            "--feature-angle",
+        ),
+        (&[], "--edge-length L or --vertices N"),
     ];
     for (extra, expected) in cases {
         let mut args = vec!["remesh", s(&input), "-o", s(&output)];
@@ -240,4 +248,55 @@ fn eight_small_holes_are_remeshed_through_their_circle_domain() {
         "mc8_peaks: {} vertices, min angle {}, Hausdorff {} of the diagonal",
         r["vertices"], r["min_angle"], r["hausdorff_over_diagonal"]
     );
+}
+
+#[test]
+fn qc_angles_moves_the_vertices_towards_better_angles() {
+    // spot (bundled): the same vertices and faces, the smallest angle up from 10
+    // degrees, few angles under 30, the cow still where it was.
+    let dir = tempfile::tempdir().unwrap();
+    let input = Path::new("meshes/spot.obj");
+    let output = dir.path().join("out.obj");
+    let report = dir.path().join("r.json");
+    let run = beltrami(&[
+        "remesh",
+        s(input),
+        "--method",
+        "qc-angles",
+        "-o",
+        s(&output),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let (mesh, result) = (read(input), read(&output));
+    assert_eq!(result.vertex_count(), mesh.vertex_count());
+    assert!(
+        mesh.faces()
+            .all(|f| mesh.face_vertices(f).eq(result.face_vertices(f)))
+    );
+    let number = |path: &[&str]| {
+        path.iter()
+            .fold(&r, |v, k| &v[*k])
+            .as_f64()
+            .unwrap_or_else(|| panic!("{path:?} in {r}"))
+    };
+    let (before, after) = (
+        number(&["before", "min_angle"]),
+        number(&["after", "min_angle"]),
+    );
+    let (share_before, share_after) = (
+        number(&["before", "share_below_30"]),
+        number(&["after", "share_below_30"]),
+    );
+    println!("min angle {before:.2} -> {after:.2}, under 30 {share_before:.4} -> {share_after:.4}");
+    assert!(after > before + 5.0);
+    assert!(share_after < 0.2 * share_before);
+    assert!(number(&["hausdorff_over_diagonal"]) < 0.006);
+    assert_eq!(r["flipped"], 0);
+    assert_eq!(r["reference"], "optimized");
+    assert_eq!(r["constraint"], "normal");
+    assert!(number(&["k"]) > 0.0 && number(&["iterations"]) >= 1.0);
 }

@@ -258,9 +258,7 @@ fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
         }
     }
     if args.area_constraint && args.target != TargetArg::Space {
-        bail!(
-            "--area-constraint keeps the area of a map into space: it needs --target space"
-        );
+        bail!("--area-constraint keeps the area of a map into space: it needs --target space");
     }
     if args.target == TargetArg::Space && args.boundary != Some(QcBoundaryArg::Given) {
         bail!(

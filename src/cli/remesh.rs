@@ -155,10 +155,14 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     ])?;
     match args.method {
         MethodArg::Param if args.edge_length.is_none() && args.vertices.is_none() => {
-            bail!("--method param makes a new mesh: give its size with --edge-length L or --vertices N")
+            bail!(
+                "--method param makes a new mesh: give its size with --edge-length L or --vertices N"
+            )
         }
         MethodArg::QcAngles if args.edge_length.is_some() || args.vertices.is_some() => {
-            bail!("--method qc-angles keeps the input's vertices and faces: drop --edge-length and --vertices")
+            bail!(
+                "--method qc-angles keeps the input's vertices and faces: drop --edge-length and --vertices"
+            )
         }
         MethodArg::QcAngles => return run_in_place(args, quiet),
         MethodArg::Param => {}

@@ -153,7 +153,10 @@ fn reference_polygon(
     let (x1, x2) = if n == 3 {
         (p[1] - p[0], p[2] - p[0])
     } else {
-        ((p[1] - p[0] + (p[2] - p[3])) * 0.5, (p[3] - p[0] + (p[2] - p[1])) * 0.5)
+        (
+            (p[1] - p[0] + (p[2] - p[3])) * 0.5,
+            (p[3] - p[0] + (p[2] - p[1])) * 0.5,
+        )
     };
     let normal = x1.cross(&x2).normalize();
     let first = p[1] - p[0];
@@ -179,7 +182,7 @@ fn reference_polygon(
         let lambda = gram.try_inverse().ok_or(invalid.clone())? * closure;
         let lengths: [f64; 4] = std::array::from_fn(|k| t[k] - directions[k].dot(&lambda));
         let mean = lengths.iter().sum::<f64>() / 4.0;
-        if lengths.iter().any(|l| !(*l > 0.01 * mean)) {
+        if lengths.iter().any(|l| l.is_nan() || *l <= 0.01 * mean) {
             return Err(invalid);
         }
         for k in 1..4 {
@@ -197,7 +200,11 @@ fn reference_polygon(
     } else {
         let centre = (p[0].coords + p[1].coords + p[2].coords + p[3].coords) * 0.25;
         (0..4)
-            .map(|k| 0.5 * (p[k].coords - centre).cross(&(p[(k + 1) % 4].coords - centre)).dot(&normal))
+            .map(|k| {
+                0.5 * (p[k].coords - centre)
+                    .cross(&(p[(k + 1) % 4].coords - centre))
+                    .dot(&normal)
+            })
             .sum::<f64>()
     };
     let scale = (area.abs() / shoelace(&local[..n])).sqrt();

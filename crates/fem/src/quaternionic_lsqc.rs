@@ -312,7 +312,11 @@ impl SpaceSystem {
         for v in (0..vertex_count).filter(|&v| !is_held[v]) {
             builder.free(&[VertexId(v as u32)])?;
         }
-        let solver = crate::LeastSquaresSolver::new(operator.symbolic().as_ref(), &builder.build()?, options)?;
+        let solver = crate::LeastSquaresSolver::new(
+            operator.symbolic().as_ref(),
+            &builder.build()?,
+            options,
+        )?;
         let mut weights = row_weights(&elements);
         let mut rhs = vec![0.0; weights.len()];
         if let Some(normal) = &normal {
@@ -353,8 +357,7 @@ impl SpaceSystem {
                 .solver
                 .solve(operator.as_ref(), Some(&self.weights), &self.rhs)?,
         };
-        Ok(x
-            .chunks_exact(3)
+        Ok(x.chunks_exact(3)
             .map(|c| Point3::new(c[0], c[1], c[2]))
             .collect())
     }
@@ -381,7 +384,11 @@ pub fn undetermined(held: usize, normal: bool, area: bool, closed: bool) -> Opti
     }
     Some(format!(
         "a map into space needs vertices held at points of R^3 (the boundary of a boundary map, `--boundary given --boundary-map MAP`, or pins), the normal constraint, or the area constraint with one held vertex: the distortion is zero for the zero map, and {held} held vertices{} do not fix the image{}",
-        if area { " with the area constraint" } else { "" },
+        if area {
+            " with the area constraint"
+        } else {
+            ""
+        },
         if closed {
             "; this surface has no boundary, so pin a vertex (`--pin v0`) or add --normal-constraint"
         } else {

@@ -47,7 +47,8 @@ use crate::dof::{DofMap, Scalar};
 use beltrami_mesh::VertexId;
 use cholesky::{Cholesky, FactorFailure};
 use faer::sparse::{
-    FaerError, SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef, Triplet,
+    FaerError, SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef,
+    Triplet,
 };
 use faer::{Mat, MatMut, MatRef, Par};
 use normal::NormalEquations;
@@ -514,24 +515,26 @@ impl<T: Scalar> LeastSquaresSolver<T> {
                         }
                     }
                 }
-                let h = SparseColMat::try_new_from_triplets(n, n, &triplets)
-                    .map_err(|_| SolveError::Length {
+                let h = SparseColMat::try_new_from_triplets(n, n, &triplets).map_err(|_| {
+                    SolveError::Length {
                         what: "the normal matrix",
                         expected: n,
                         got: n,
-                    })?;
+                    }
+                })?;
                 let border: Vec<Triplet<usize, usize, T>> = kc
                     .iter()
                     .enumerate()
                     .filter(|(_, v)| **v != zero)
                     .map(|(j, v)| Triplet::new(0, j, v.conjugate()))
                     .collect();
-                let c_row = SparseColMat::try_new_from_triplets(1, n, &border)
-                    .map_err(|_| SolveError::Length {
+                let c_row = SparseColMat::try_new_from_triplets(1, n, &border).map_err(|_| {
+                    SolveError::Length {
                         what: "the constraint row",
                         expected: n,
                         got: n,
-                    })?;
+                    }
+                })?;
                 let solution = solve_saddle_point(
                     h.as_ref(),
                     &self.y,

@@ -113,10 +113,12 @@ pub fn remesh_in_place(
 ) -> Result<InPlace, RemeshError> {
     let mut problem = Problem::new(mesh, Target::Surface);
     problem.goal = Goal::Extremal;
-    problem.constraints.push(Constraint::ReferenceAngles(reference_angles(
-        mesh,
-        options.reference,
-    )));
+    problem
+        .constraints
+        .push(Constraint::ReferenceAngles(reference_angles(
+            mesh,
+            options.reference,
+        )));
     problem.constraints.hold_boundary(mesh, mesh.positions());
     let held = feature_vertices(mesh, options.feature_angle);
     for &v in &held {
@@ -274,7 +276,10 @@ fn feature_vertices(mesh: &Mesh, angle_degrees: f64) -> Vec<VertexId> {
     let sliver = SLIVER_ANGLE.to_radians();
     let well_shaped: Vec<bool> = mesh
         .faces()
-        .map(|f| mesh.face_halfedges(f).all(|h| mesh.corner_angle(h) >= sliver))
+        .map(|f| {
+            mesh.face_halfedges(f)
+                .all(|h| mesh.corner_angle(h) >= sliver)
+        })
         .collect();
     let mut on = vec![false; mesh.vertex_count()];
     for e in mesh.edges() {

@@ -60,19 +60,21 @@ pub fn reference_angles(mesh: &Mesh, reference: Reference) -> Vec<f64> {
         let largest = alpha.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let leaders = alpha.iter().filter(|&&a| a == largest).count();
         let room = (n - 1) as f64 * 15f64.to_radians();
-        let lead = (leaders == 1 && largest < full - room).then(|| {
-            alpha
-                .iter()
-                .position(|&a| a == largest)
-                .unwrap_or_default()
-        });
+        let lead = (leaders == 1 && largest < full - room)
+            .then(|| alpha.iter().position(|&a| a == largest).unwrap_or_default());
         let beta: Vec<f64> = match lead {
             Some(i) => {
                 let rest = alpha.iter().sum::<f64>() - largest;
                 alpha
                     .iter()
                     .enumerate()
-                    .map(|(j, &a)| if j == i { a } else { a * (full - largest) / rest })
+                    .map(|(j, &a)| {
+                        if j == i {
+                            a
+                        } else {
+                            a * (full - largest) / rest
+                        }
+                    })
                     .collect()
             }
             None => {
@@ -151,9 +153,10 @@ mod tests {
             }
         }
         let equiangular = reference_angles(&mesh, Reference::Equiangular);
-        assert!(mesh
-            .faces()
-            .flat_map(|f| mesh.face_halfedges(f))
-            .all(|h| equiangular[h.idx()] == PI / 2.0));
+        assert!(
+            mesh.faces()
+                .flat_map(|f| mesh.face_halfedges(f))
+                .all(|h| equiangular[h.idx()] == PI / 2.0)
+        );
     }
 }

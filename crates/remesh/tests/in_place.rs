@@ -21,7 +21,10 @@ fn shaken_sphere(amount: f64) -> Mesh {
         let n = p.coords.normalize();
         let a = Vector3::new(0.3, 0.5, 0.8).cross(&n).normalize();
         let b = n.cross(&a);
-        let (s, t) = (((i * 7919) % 101) as f64 / 50.0 - 1.0, ((i * 104729) % 97) as f64 / 48.0 - 1.0);
+        let (s, t) = (
+            ((i * 7919) % 101) as f64 / 50.0 - 1.0,
+            ((i * 104729) % 97) as f64 / 48.0 - 1.0,
+        );
         *p = Point3::from((n + (a * s + b * t) * amount * h).normalize());
     }
     Mesh::from_soup(&soup).unwrap()
@@ -53,12 +56,18 @@ fn a_shaken_sphere_gets_its_shapes_back_and_stays_a_sphere() {
         let after = quality::measure(&mesh, &out).unwrap();
         println!(
             "{reference:?}: min angle {:.2} -> {:.2}, under 30 {:.3} -> {:.3}, Hausdorff {:.2e}",
-            before.min_angle, after.min_angle, before.share_below_30, after.share_below_30,
+            before.min_angle,
+            after.min_angle,
+            before.share_below_30,
+            after.share_below_30,
             after.hausdorff
         );
         assert_eq!(out.face_count(), mesh.face_count());
         assert!(after.min_angle > before.min_angle + 10.0, "{after:?}");
-        assert!(after.share_below_30 < 0.2 * before.share_below_30, "{after:?}");
+        assert!(
+            after.share_below_30 < 0.2 * before.share_below_30,
+            "{after:?}"
+        );
         // On the sphere: every vertex projected, every face centroid within the
         // chord error of the sphere.
         let off = out
@@ -86,11 +95,17 @@ fn a_bumpy_disk_is_remeshed_with_its_boundary_held() {
     let after = quality::measure(&mesh, &out).unwrap();
     println!(
         "min angle {:.2} -> {:.2}, under 30 {:.3} -> {:.3}, Hausdorff {:.2e}",
-        before.min_angle, after.min_angle, before.share_below_30, after.share_below_30,
+        before.min_angle,
+        after.min_angle,
+        before.share_below_30,
+        after.share_below_30,
         after.hausdorff
     );
     assert!(after.min_angle > before.min_angle);
-    assert!(after.share_below_30 < 0.1 * before.share_below_30, "{after:?}");
+    assert!(
+        after.share_below_30 < 0.1 * before.share_below_30,
+        "{after:?}"
+    );
     assert!(after.hausdorff < 0.005 * after.diagonal, "{after:?}");
     for v in mesh.vertices().filter(|&v| mesh.is_boundary_vertex(v)) {
         assert_eq!(out.position(v), mesh.position(v));
@@ -113,8 +128,12 @@ fn the_area_constraint_remeshes_a_closed_surface_held_at_one_vertex() {
             ..InPlaceOptions::default()
         },
     );
-    let mean_radius =
-        image.positions().iter().map(|p| p.coords.norm()).sum::<f64>() / image.vertex_count() as f64;
+    let mean_radius = image
+        .positions()
+        .iter()
+        .map(|p| p.coords.norm())
+        .sum::<f64>()
+        / image.vertex_count() as f64;
     let out = run(
         &mesh,
         &InPlaceOptions {
@@ -129,7 +148,10 @@ fn the_area_constraint_remeshes_a_closed_surface_held_at_one_vertex() {
     );
     assert!((mean_radius - 1.0).abs() < 0.2, "{mean_radius}");
     assert!(after.min_angle > before.min_angle + 10.0, "{after:?}");
-    assert!(after.share_below_30 < 0.2 * before.share_below_30, "{after:?}");
+    assert!(
+        after.share_below_30 < 0.2 * before.share_below_30,
+        "{after:?}"
+    );
 }
 
 #[test]

@@ -13,8 +13,8 @@
 //! refused.
 
 use beltrami_core::{
-    Constraint, Context, Extras, Goal, Map, Metrics, Output, Problem, Report, Settings,
-    Solution, SolverError,
+    Constraint, Context, Extras, Goal, Map, Metrics, Output, Problem, Report, Settings, Solution,
+    SolverError,
 };
 use beltrami_fem::beltrami::face_mu;
 use beltrami_fem::distortion::measure_surface;
@@ -22,9 +22,7 @@ use beltrami_fem::quaternion::quaternionic_mu;
 use beltrami_fem::quaternionic_lsqc::{
     AreaConstraint, NormalConstraint, SpaceSystem, undetermined,
 };
-use beltrami_fem::{
-    BeltramiField, Elements, Frame, MuError, ReferenceNormal, SolveOptions,
-};
+use beltrami_fem::{BeltramiField, Elements, Frame, MuError, ReferenceNormal, SolveOptions};
 use beltrami_mesh::{Point3, VertexId};
 
 use crate::lsqc::{NAME, invalid, unsupported};
@@ -94,7 +92,10 @@ pub(crate) fn run(
         Constraint::Normal { weight } => Some(NormalConstraint::new(mesh, *weight)),
         _ => None,
     });
-    let area = problem.constraints.iter().any(|c| matches!(c, Constraint::Area));
+    let area = problem
+        .constraints
+        .iter()
+        .any(|c| matches!(c, Constraint::Area));
     let mut system = context.stage("assembly", &mut report, || {
         let elements = Elements::new(mesh, Frame::Face)?;
         let area = area.then(|| AreaConstraint::new(&elements, mesh.positions()));
@@ -102,9 +103,7 @@ pub(crate) fn run(
             threads: settings.int("threads"),
             ..SolveOptions::default()
         };
-        Ok(SpaceSystem::new(
-            elements, n, &held, normal, area, options,
-        )?)
+        Ok(SpaceSystem::new(elements, n, &held, normal, area, options)?)
     })?;
     let image = context.stage("solve", &mut report, || Ok(system.solve(&field.mu)?))?;
     let elements = system.elements();

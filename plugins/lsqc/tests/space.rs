@@ -264,7 +264,10 @@ fn a_developable_surface_map_comes_back_under_refinement() {
     // plane would not do: its image's tangent planes are not the source's, so df^- is
     // not mu df^+ for any normal-valued mu.)
     for cells in [Cells::Triangles, Cells::Quads] {
-        let errors: Vec<f64> = [8, 16, 32].iter().map(|&n| cylinder_error(n, cells)).collect();
+        let errors: Vec<f64> = [8, 16, 32]
+            .iter()
+            .map(|&n| cylinder_error(n, cells))
+            .collect();
         println!("{cells:?}: vertex errors {errors:?}");
         for w in errors.windows(2) {
             assert!(w[1] < 0.5 * w[0], "{cells:?}: {errors:?}");
@@ -307,8 +310,11 @@ fn the_frame_rule_a_faces_first_edge_changed_gives_the_same_map() {
         turned.push(rotate_frame(mu[f.idx()], theta));
     }
     let relisted = Mesh::from_soup(&soup).unwrap();
-    assert!(relisted.faces().any(|f| relisted.face_vertices(f).next()
-        != mesh.face_vertices(f).next()));
+    assert!(
+        relisted
+            .faces()
+            .any(|f| relisted.face_vertices(f).next() != mesh.face_vertices(f).next())
+    );
     let after = image(&problem(
         &relisted,
         Some(BeltramiField::new(Frame::Face, turned)),

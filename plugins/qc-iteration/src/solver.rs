@@ -207,7 +207,13 @@ fn iterate(
         let mut next: Vec<Complex64> = transport
             .smooth(&measured)
             .into_iter()
-            .map(|m| if m.norm() > 0.0 { m * (k / m.norm()) } else { m })
+            .map(|m| {
+                if m.norm() > 0.0 {
+                    m * (k / m.norm())
+                } else {
+                    m
+                }
+            })
             .collect();
         let mut step = 1.0;
         if line_search {

@@ -71,7 +71,10 @@ fn the_iteration_finds_the_affine_map_of_a_developable_patch() {
             println!("{cells:?} {n}x{n}: k {k:.6} (exact {k_exact:.6}), vertex error {error:.3e}");
             assert!(converged, "{cells:?} {n}: not converged");
             assert_eq!(flips, 0);
-            assert!((k - k_exact).abs() < 0.01 * k_exact, "k {k}, exact {k_exact}");
+            assert!(
+                (k - k_exact).abs() < 0.01 * k_exact,
+                "k {k}, exact {k_exact}"
+            );
             if let Some(e) = last {
                 assert!(error < 0.5 * e, "{cells:?}: vertex error {error} after {e}");
             }
