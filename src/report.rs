@@ -208,6 +208,8 @@ pub fn remesh_in_place(
         "stop": metrics.stop.as_ref().map(|s| s.name()),
         "mu_spread_history": metrics.energy_history,
         "flipped": result.flipped,
+        "input_flipped": result.input_flipped,
+        "pulled_back": result.pulled,
         "feature_angle": options.feature_angle,
         "feature_vertices": result.features,
         "seconds": seconds,

@@ -91,6 +91,10 @@ pub struct RemeshArgs {
     /// degrees (sharp creases and corners); 180 holds none.
     #[arg(long = "feature-angle", value_name = "A", default_value_t = 60.0)]
     pub feature_angle: f64,
+    /// qc-angles: write the result even when faces end turned against the surface that
+    /// were not turned in the input (otherwise an error names the first).
+    #[arg(long = "allow-flips")]
+    pub allow_flips: bool,
     /// The parameterizer, any registered solver that maps into the plane (`beltrami
     /// solvers` lists them), or `auto`: lscm on a disk, on a closed genus-0 surface
     /// slit open and on any other surface cut to a disk (qcmc for several boundary
@@ -217,6 +221,7 @@ fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
         tolerance: args.tolerance,
         project: !args.no_project,
         feature_angle: args.feature_angle,
+        allow_flips: args.allow_flips,
     };
     let start = Instant::now();
     let mut bar = LateBar::new(!(quiet || args.json));
@@ -278,7 +283,10 @@ fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
             m.iterations,
             m.stop.as_ref().map_or("", |s| s.name())
         );
-        println!("  flipped         {}", result.flipped);
+        println!(
+            "  flipped         {} (input {}; {} vertices pulled back)",
+            result.flipped, result.input_flipped, result.pulled
+        );
         println!("  held features   {} vertices", result.features);
         for note in &result.solution.report.notes {
             println!("  note: {note}");

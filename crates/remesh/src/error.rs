@@ -95,6 +95,19 @@ pub enum RemeshError {
         /// The limit.
         limit: usize,
     },
+    /// In-place remeshing left faces turned against the surface that were not turned in
+    /// the input, after pulling their vertices back.
+    #[error(
+        "{turned} faces end turned against the surface (first: face {first}) although the input had {input}; try another --max-iters or --reference, or --allow-flips to write the result anyway"
+    )]
+    Turned {
+        /// Faces turned in the result.
+        turned: usize,
+        /// Faces turned in the input (by the same measure).
+        input: usize,
+        /// The first face turned in the result but not in the input.
+        first: FaceId,
+    },
     /// The remeshing was cancelled.
     #[error("cancelled")]
     Cancelled,

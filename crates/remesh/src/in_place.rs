@@ -65,6 +65,9 @@ pub struct InPlaceOptions {
     /// Vertices on an edge whose faces' normals differ by more than this (degrees) stay
     /// in place, so that sharp creases and corners keep their shape.
     pub feature_angle: f64,
+    /// Return the result even when faces end turned that were not turned in the input
+    /// (otherwise [`RemeshError::Turned`]).
+    pub allow_flips: bool,
 }
 
 impl Default for InPlaceOptions {
@@ -76,6 +79,7 @@ impl Default for InPlaceOptions {
             tolerance: 1e-4,
             project: true,
             feature_angle: 60.0,
+            allow_flips: false,
         }
     }
 }
@@ -202,7 +206,17 @@ pub fn remesh_in_place(
         flipped = flipped_faces(mesh, &index, &positions)?;
     }
     let count = |faces: &[bool]| faces.iter().filter(|&&f| f).count();
+    let new = mesh
+        .faces()
+        .find(|f| flipped[f.idx()] && !was_flipped[f.idx()]);
     let (flipped, input_flipped) = (count(&flipped), count(&was_flipped));
+    if let (Some(first), false) = (new, options.allow_flips) {
+        return Err(RemeshError::Turned {
+            turned: flipped,
+            input: input_flipped,
+            first,
+        });
+    }
     let remeshed = mesh
         .with_positions(positions)
         .map_err(|error| RemeshError::Build {
@@ -219,8 +233,9 @@ pub fn remesh_in_place(
     })
 }
 
-/// Rounds of pulling the vertices of turned faces back towards the input.
-const PULL_BACK_ROUNDS: usize = 12;
+/// Rounds of pulling the vertices of turned faces back towards the input (a vertex is
+/// back at its input position after seven).
+const PULL_BACK_ROUNDS: usize = 40;
 
 /// Moves every vertex off the boundary to its closest point on `mesh`.
 fn project(
