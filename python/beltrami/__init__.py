@@ -66,6 +66,7 @@ __all__ = [
     "read_mesh",
     "register",
     "remesh",
+    "remesh_in_place",
     "solvers",
     "sphere_map",
     "tutte",
@@ -267,6 +268,7 @@ def lsqc(
     boundary_map: Optional[ArrayLike] = None,
     pins: Sequence[int] = (),
     normal_constraint: Optional[float] = None,
+    area_constraint: bool = False,
     threads: Optional[int] = None,
     options: Optional[Dict[str, Any]] = None,
     info: bool = False,
@@ -281,7 +283,8 @@ def lsqc(
     (default, with ``pins``), ``'keep'`` (the input's own boundary) or ``'given'``
     (``boundary_map`` ``(n, 2)``); ``target='space'`` maps a surface into R^3 with its
     boundary held at ``boundary_map`` ``(n, 3)`` (the quaternionic map of Gruber-Aulisa
-    2022), optionally with the normal constraint of weight ``normal_constraint``.
+    2022), optionally with the normal constraint of weight ``normal_constraint`` and the
+    area constraint (``area_constraint=True``, section 4.2).
     Returns ``UV`` ``(n, 2)`` or ``X`` ``(n, 3)``. ``beltrami qc --solver lsqc``."""
     if target not in ("plane", "space"):
         raise OptionError(f"lsqc maps into the plane or space, not target={target!r}")
@@ -291,6 +294,7 @@ def lsqc(
         "goal": _goal(mu, mu_expr, mu_frame, None),
         "pins": _pins(pins),
         "normal_constraint": normal_constraint,
+        "area_constraint": area_constraint,
         "options": _options(options, threads=threads),
         "defaults": _QC_DEFAULTS,
     }
@@ -617,6 +621,33 @@ def remesh(
         V, F, edge_length, vertices, param, float(min_angle), size_field, int(max_vertices)
     )
     return (V2, F2, json.loads(report)) if info else (V2, F2)
+
+
+def remesh_in_place(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    reference: str = "optimized",
+    constraint: str = "normal",
+    max_iters: int = 10,
+    tolerance: float = 1e-4,
+    feature_angle: float = 60.0,
+    project: bool = True,
+    allow_flips: bool = False,
+    info: bool = False,
+) -> Any:
+    """The same vertices and faces moved along the surface towards reference angles
+    (``reference``: ``optimized``, Gruber-Aulisa 2022 Algorithm 5, or ``equiangular``) by
+    the QC iteration into R^3 with the ``constraint`` ``normal`` or ``area``, vertices on
+    creases sharper than ``feature_angle`` degrees held, moved vertices projected onto
+    the input (docs/remesh-in-place.md). Returns ``V2`` ``(n, 3)`` (the faces are ``F``).
+    ``beltrami remesh --method qc-angles``."""
+    V, F = _mesh(V, F)
+    V2, report = _native.remesh_in_place(
+        V, F, reference, constraint, int(max_iters), float(tolerance), float(feature_angle),
+        bool(project), bool(allow_flips),
+    )
+    return (V2, json.loads(report)) if info else V2
 
 
 def cut_to_disk(V: ArrayLike, F: ArrayLike, *, info: bool = False) -> Any:

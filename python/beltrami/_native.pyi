@@ -41,4 +41,15 @@ def remesh(
     size_field: str = "uniform",
     max_vertices: int = 5000000,
 ) -> Tuple[Floats, Ints, str]: ...
+def remesh_in_place(
+    v: Floats,
+    f: Ints,
+    reference: str = "optimized",
+    constraint: str = "normal",
+    max_iters: int = 10,
+    tolerance: float = 1e-4,
+    feature_angle: float = 60.0,
+    project: bool = True,
+    allow_flips: bool = False,
+) -> Tuple[Floats, str]: ...
 def cut_to_disk(v: Floats, f: Ints) -> Tuple[Floats, Ints, Ints, str]: ...

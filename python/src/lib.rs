@@ -31,6 +31,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve::solve, m)?)?;
     m.add_function(wrap_pyfunction!(solve::solvers, m)?)?;
     m.add_function(wrap_pyfunction!(surgery::remesh, m)?)?;
+    m.add_function(wrap_pyfunction!(surgery::remesh_in_place, m)?)?;
     m.add_function(wrap_pyfunction!(surgery::cut_to_disk, m)?)?;
     Ok(())
 }

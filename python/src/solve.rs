@@ -14,6 +14,7 @@
 //! | `goal` | `{"kind": "conformal", "p": P}`, `{"kind": "mu", "frame": F}` (`mu`), `{"kind": "mu_expr", "expr": E}`, `{"kind": "extremal"}` |
 //! | `pins` | input vertex indices held where the solver puts them |
 //! | `normal_constraint` | `space`: the weight of the normal constraint |
+//! | `area_constraint` | `space`: `true` keeps the area to first order |
 //! | `landmarks` | `mesh`: the text of a landmarks file |
 //! | `planar_landmarks` | `disk`: `[[vertex, x, y], ...]`, boundary vertices moved to points of the unit circle |
 //! | `options` | solver options as text, `{name: value}` (`--option NAME=VALUE`) |
@@ -164,8 +165,8 @@ fn goal(spec: &JsonMap<String, Value>, mesh: &Mesh, inputs: &Inputs<'_>) -> PyRe
     }))
 }
 
-/// The constraints of the description: pins, the normal constraint, the held boundary
-/// of `space`, landmarks.
+/// The constraints of the description: pins, the normal and area constraints, the held
+/// boundary of `space`, landmarks.
 fn constraints(
     spec: &JsonMap<String, Value>,
     problem: &mut Problem<'_>,
@@ -189,6 +190,9 @@ fn constraints(
     }
     if let Some(weight) = spec.get("normal_constraint").and_then(Value::as_f64) {
         problem.constraints.push(Constraint::Normal { weight });
+    }
+    if spec.get("area_constraint").and_then(Value::as_bool) == Some(true) {
+        problem.constraints.push(Constraint::Area);
     }
     if text(spec, "target") == Some("space") {
         let Some(map) = &inputs.boundary_map else {

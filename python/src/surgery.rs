@@ -96,6 +96,92 @@ pub fn remesh<'py>(
     ))
 }
 
+/// The surface `V`, `F` remeshed in place by reference angles (`beltrami remesh --method
+/// qc-angles`, [`beltrami_remesh::in_place`]): returns the moved positions and the JSON
+/// report of `--report`.
+#[pyfunction]
+#[pyo3(signature = (v, f, reference="optimized", constraint="normal", max_iters=10, tolerance=1e-4, feature_angle=60.0, project=true, allow_flips=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn remesh_in_place<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'_, f64>,
+    f: PyReadonlyArray2<'_, i64>,
+    reference: &str,
+    constraint: &str,
+    max_iters: usize,
+    tolerance: f64,
+    feature_angle: f64,
+    project: bool,
+    allow_flips: bool,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, String)> {
+    use beltrami_remesh::in_place::{InPlaceOptions, Keep, remesh_in_place};
+    use beltrami_remesh::reference_angles::Reference;
+    let reference = match reference {
+        "optimized" => Reference::Optimized,
+        "equiangular" => Reference::Equiangular,
+        other => {
+            return Err(errors::raise(
+                Kind::Option,
+                format!("reference={other:?}: expected 'optimized' or 'equiangular'"),
+            ));
+        }
+    };
+    let keep = match constraint {
+        "normal" => Keep::Normal,
+        "area" => Keep::Area,
+        other => {
+            return Err(errors::raise(
+                Kind::Option,
+                format!("constraint={other:?}: expected 'normal' or 'area'"),
+            ));
+        }
+    };
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return Err(errors::raise(
+            Kind::Option,
+            format!("tolerance={tolerance}: give a positive number"),
+        ));
+    }
+    if !(feature_angle > 0.0 && feature_angle <= 180.0) {
+        return Err(errors::raise(
+            Kind::Option,
+            format!("feature_angle={feature_angle}: give an angle in (0, 180] degrees"),
+        ));
+    }
+    let options = InPlaceOptions {
+        reference,
+        keep,
+        max_iters,
+        tolerance,
+        project,
+        feature_angle,
+        allow_flips,
+    };
+    let mesh = arrays::mesh(v.as_array(), f.as_array())?;
+    let registry = beltrami::registry();
+    let solver = registry
+        .get("qc-iteration")
+        .map_err(|e| errors::from_error(Kind::Unsupported, &e))?;
+    let start = Instant::now();
+    let result = py.detach(|| {
+        let mut context = Context::new();
+        let result = remesh_in_place(&mesh, solver, &options, &mut context)?;
+        let before = beltrami_remesh::quality::measure(&mesh, &mesh)?;
+        let after = beltrami_remesh::quality::measure(&mesh, &result.mesh)?;
+        Ok((result, before, after))
+    });
+    let (result, before, after) =
+        result.map_err(|e: beltrami_remesh::RemeshError| errors::from_error(Kind::Solver, &e))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let report =
+        beltrami::report::remesh_in_place(&mesh, &result, &options, &before, &after, seconds);
+    let (v, _) = mesh_arrays(&result.mesh)?;
+    Ok((
+        v.into_pyarray(py),
+        serde_json::Value::Object(report).to_string(),
+    ))
+}
+
 /// The surface `V`, `F` (genus >= 1 or several boundary loops) cut into a topological
 /// disk along a greedy shortest system of loops (`beltrami cut`): returns the cut
 /// mesh's positions and faces (face `i` is face `i` of `F`), the input vertex of every

@@ -79,6 +79,15 @@ def test_lsqc_into_space_matches_qc(cli, hemisphere, tmp_path):
     V, F = beltrami.read_mesh(hemisphere)
     X = beltrami.lsqc(V, F, target="space", boundary_map=V)
     close(X, positions_of(out))
+    # The area constraint, with a boundary stretched in x.
+    stretched = V * np.array([1.3, 1.0, 1.0])
+    moved = tmp_path / "stretched.obj"
+    beltrami.write_mesh(moved, stretched, F)
+    cli("qc", hemisphere, "--target", "space", "--boundary", "given", "--boundary-map", moved,
+        "--conformal", "--area-constraint", "-o", out)
+    X = beltrami.lsqc(V, F, target="space", boundary_map=stretched, area_constraint=True)
+    close(X, positions_of(out))
+    assert np.abs(X - beltrami.lsqc(V, F, target="space", boundary_map=stretched)).max() > 1e-6
 
 
 @pytest.mark.parametrize(
@@ -210,6 +219,21 @@ def test_remesh_matches_the_command(cli, hemisphere, tmp_path):
     np.testing.assert_array_equal(F2, G)
     assert report["min_angle"] == pytest.approx(report_of(r)["min_angle"], abs=1e-12)
     assert report["min_angle"] >= 20.0
+
+
+def test_remesh_in_place_matches_the_command(cli, tmp_path):
+    spot = MESHES / "spot.obj"
+    out, r = tmp_path / "out.obj", tmp_path / "r.json"
+    cli("remesh", spot, "--method", "qc-angles", "-o", out, "--report", r)
+    V, F = beltrami.read_mesh(spot)
+    V2, report = beltrami.remesh_in_place(V, F, info=True)
+    W, G = beltrami.read_mesh(out)
+    close(V2, W)
+    np.testing.assert_array_equal(F, G)
+    assert report["after"]["min_angle"] == pytest.approx(report_of(r)["after"]["min_angle"], abs=1e-9)
+    assert report["after"]["min_angle"] > report["before"]["min_angle"] + 5.0
+    with pytest.raises(beltrami.OptionError, match="reference"):
+        beltrami.remesh_in_place(V, F, reference="round")
 
 
 def test_cut_to_disk_matches_the_command(cli, generated, tmp_path):
