@@ -16,11 +16,11 @@ Needs `pip install pymeshlab numpy`. Prints one markdown table row per mesh and 
 import argparse
 import json
 import shlex
-import subprocess
 import sys
-import time
 
 import numpy as np
+
+from peer_pymeshlab import timed
 
 
 def relax(mesh, out, iterations):
@@ -75,15 +75,6 @@ def distances(source, result):
                                      sampleedge=True, sampleface=True, samplenum=samples)
     diag = ms.mesh(0).bounding_box().diagonal()
     return max(there["max"], back["max"]) / diag, (there["mean"] + back["mean"]) / 2 / diag
-
-
-def timed(cmd):
-    start = time.perf_counter()
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    seconds = time.perf_counter() - start
-    if done.returncode != 0:
-        sys.exit(f"{' '.join(cmd)} failed:\n{done.stderr}")
-    return seconds
 
 
 def row(name, tool, source, result, seconds):

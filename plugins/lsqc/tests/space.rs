@@ -55,6 +55,14 @@ fn image(problem: &Problem<'_>) -> Vec<Point3<f64>> {
     }
 }
 
+/// Held points for the cap's boundary: the cap sheared and bent.
+fn bent(mesh: &Mesh) -> Vec<Point3<f64>> {
+    mesh.positions()
+        .iter()
+        .map(|p| Point3::new(p.x + 0.3 * p.y * p.y, p.y, p.z + 0.2 * p.x))
+        .collect()
+}
+
 fn largest_distance(a: &[Point3<f64>], b: &[Point3<f64>]) -> f64 {
     a.iter()
         .zip(b)
@@ -105,11 +113,7 @@ fn a_planar_map_with_its_own_measured_mu_comes_back() {
 #[test]
 fn the_solve_commutes_with_rotations() {
     let mesh = cap(8, Cells::Triangles);
-    let bent: Vec<Point3<f64>> = mesh
-        .positions()
-        .iter()
-        .map(|p| Point3::new(p.x + 0.3 * p.y * p.y, p.y, p.z + 0.2 * p.x))
-        .collect();
+    let bent = bent(&mesh);
     let field = BeltramiField::new(
         Frame::Face,
         vec![num_complex::Complex64::new(0.2, -0.1); mesh.face_count()],
@@ -282,11 +286,7 @@ fn the_frame_rule_a_faces_first_edge_changed_gives_the_same_map() {
     // old and the new first edge; by Lemma 3.4 its coefficient turns by e^{-2 i theta}
     // and the map stays.
     let mesh = cap(8, Cells::Triangles);
-    let bent: Vec<Point3<f64>> = mesh
-        .positions()
-        .iter()
-        .map(|p| Point3::new(p.x + 0.3 * p.y * p.y, p.y, p.z + 0.2 * p.x))
-        .collect();
+    let bent = bent(&mesh);
     let mu: Vec<Complex64> = (0..mesh.face_count())
         .map(|f| Complex64::from_polar(0.3, 0.7 * f as f64))
         .collect();
