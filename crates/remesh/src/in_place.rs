@@ -151,34 +151,106 @@ pub fn remesh_in_place(
     }
     problem
         .options
-        .set("max-iters", OptionValue::Int(options.max_iters))
         .set("tolerance", OptionValue::Float(options.tolerance));
-    let solution = solver
-        .solve(&problem, context)
-        .map_err(|error| match error {
-            SolverError::Cancelled => RemeshError::Cancelled,
-            error => RemeshError::Solve {
-                solver: solver.name(),
-                error,
-            },
-        })?;
-    if let Some(Stop::Cancelled) = solution.metrics.stop {
-        return Err(RemeshError::Cancelled);
-    }
-    let Some(Map::Spatial(image)) = solution.map() else {
-        return Err(RemeshError::Parameterizer {
-            solver: solver.name(),
-            message: "it gave no map into space".to_string(),
-        });
-    };
     let index = SurfaceIndex::new(mesh)?;
-    let mut positions = image.clone();
-    if options.project {
-        project(mesh, &index, &mut positions)?;
-    }
     let was_flipped = flipped_faces(mesh, &index, mesh.positions())?;
+    // More iterations even out |mu|, which removes the folds of a hard mesh: a result
+    // with faces turned is tried again with RETRY_FACTOR times the iterations.
+    let mut attempts = vec![options.max_iters];
+    if options.max_iters > 0 && !options.allow_flips {
+        attempts.push(RETRY_FACTOR * options.max_iters);
+    }
+    let mut earlier = None;
+    for (attempt, &iterations) in attempts.iter().enumerate() {
+        problem
+            .options
+            .set("max-iters", OptionValue::Int(iterations));
+        let mut solution = solver
+            .solve(&problem, context)
+            .map_err(|error| match error {
+                SolverError::Cancelled => RemeshError::Cancelled,
+                error => RemeshError::Solve {
+                    solver: solver.name(),
+                    error,
+                },
+            })?;
+        if let Some(Stop::Cancelled) = solution.metrics.stop {
+            return Err(RemeshError::Cancelled);
+        }
+        let Some(Map::Spatial(image)) = solution.map() else {
+            return Err(RemeshError::Parameterizer {
+                solver: solver.name(),
+                message: "it gave no map into space".to_string(),
+            });
+        };
+        let settled = settle(mesh, &index, image, &was_flipped, options.project)?;
+        let count = |faces: &[bool]| faces.iter().filter(|&&f| f).count();
+        let (flipped, input_flipped) = (count(&settled.flipped), count(&was_flipped));
+        let new = mesh
+            .faces()
+            .find(|f| settled.flipped[f.idx()] && !was_flipped[f.idx()]);
+        if let (Some(first), false) = (new, options.allow_flips) {
+            if attempt + 1 < attempts.len() {
+                earlier = Some((iterations, flipped));
+                continue;
+            }
+            return Err(RemeshError::Turned {
+                turned: flipped,
+                input: input_flipped,
+                first,
+            });
+        }
+        if let Some((iterations, turned)) = earlier {
+            solution.report.notes.push(format!(
+                "with {iterations} iterations {turned} faces ended turned against the surface; {} iterations left none",
+                solution.metrics.iterations
+            ));
+        }
+        let remeshed =
+            mesh.with_positions(settled.positions)
+                .map_err(|error| RemeshError::Build {
+                    what: "moved mesh",
+                    error,
+                })?;
+        return Ok(InPlace {
+            mesh: remeshed,
+            solution,
+            flipped,
+            input_flipped,
+            features: held.len(),
+            pulled: settled.pulled,
+        });
+    }
+    unreachable!("the last attempt returns")
+}
+
+/// How many times the iterations a second attempt runs when faces end turned.
+pub const RETRY_FACTOR: usize = 3;
+
+/// The vertex positions of a map's image after the projection onto the input and the
+/// pull-back of turned faces, with the faces still turned and the vertices pulled.
+struct Settled {
+    positions: Vec<Point3<f64>>,
+    flipped: Vec<bool>,
+    pulled: usize,
+}
+
+/// Projects `image` onto the input (with `project`) and pulls back the vertices of every
+/// face turned that was not turned in the input (`was_flipped`): their moves halved up to
+/// six times, then undone.
+fn settle(
+    mesh: &Mesh,
+    index: &SurfaceIndex<'_>,
+    image: &[Point3<f64>],
+    was_flipped: &[bool],
+    project_onto_input: bool,
+) -> Result<Settled, RemeshError> {
+    let mut positions = image.to_vec();
+    if project_onto_input {
+        project(mesh, index, &mut positions)?;
+    }
     let mut pulled = 0;
-    let mut flipped = flipped_faces(mesh, &index, &positions)?;
+    let mut flipped = flipped_faces(mesh, index, &positions)?;
     let target = positions.clone();
     let mut share = vec![1.0; mesh.vertex_count()];
     for _ in 0..PULL_BACK_ROUNDS {
@@ -200,35 +272,14 @@ pub fn remesh_in_place(
                 positions[v.idx()] = from + (target[v.idx()] - from) * *s;
             }
         }
-        if options.project {
-            project(mesh, &index, &mut positions)?;
+        if project_onto_input {
+            project(mesh, index, &mut positions)?;
         }
-        flipped = flipped_faces(mesh, &index, &positions)?;
+        flipped = flipped_faces(mesh, index, &positions)?;
     }
-    let count = |faces: &[bool]| faces.iter().filter(|&&f| f).count();
-    let new = mesh
-        .faces()
-        .find(|f| flipped[f.idx()] && !was_flipped[f.idx()]);
-    let (flipped, input_flipped) = (count(&flipped), count(&was_flipped));
-    if let (Some(first), false) = (new, options.allow_flips) {
-        return Err(RemeshError::Turned {
-            turned: flipped,
-            input: input_flipped,
-            first,
-        });
-    }
-    let remeshed = mesh
-        .with_positions(positions)
-        .map_err(|error| RemeshError::Build {
-            what: "moved mesh",
-            error,
-        })?;
-    Ok(InPlace {
-        mesh: remeshed,
-        solution,
+    Ok(Settled {
+        positions,
         flipped,
-        input_flipped,
-        features: held.len(),
         pulled,
     })
 }
