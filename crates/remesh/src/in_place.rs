@@ -14,6 +14,13 @@
 //! image is the new vertex positions; with `project`, each moved vertex
 //! then goes to its closest point on the input surface (the linearized constraint
 //! leaves it on its tangent plane, off a curved surface by the square of the move).
+//!
+//! The least-squares map is not bijective by construction: the vertices of a face
+//! turned against the input surface (and not turned in the input) are pulled back
+//! towards their input positions, their moves halved up to six times, then undone. If
+//! faces stay turned, the iteration runs again with [`RETRY_FACTOR`] times the
+//! iterations (a more even `|mu|` folds less); faces turned after that are
+//! [`RemeshError::Turned`] unless `allow_flips`.
 
 use beltrami_core::{
     Constraint, Context, Goal, Map, OptionValue, Pin, Position, Problem, Solution, Solver,
