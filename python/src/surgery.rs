@@ -166,7 +166,7 @@ pub fn remesh_in_place<'py>(
     let result = py.detach(|| {
         let mut context = Context::new();
         let result = remesh_in_place(&mesh, solver, &options, &mut context)?;
-        let before = beltrami_remesh::quality::measure(&mesh, &mesh)?;
+        let before = beltrami_remesh::quality::shape(&mesh);
         let after = beltrami_remesh::quality::measure(&mesh, &result.mesh)?;
         Ok((result, before, after))
     });

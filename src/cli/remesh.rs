@@ -235,7 +235,7 @@ fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     let result = result.with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
     let seconds = start.elapsed().as_secs_f64();
     io::write(&args.output, &result.mesh, &VertexAttributes::default())?;
-    let before = beltrami_remesh::quality::measure(mesh, mesh)?;
+    let before = beltrami_remesh::quality::shape(mesh);
     let after = beltrami_remesh::quality::measure(mesh, &result.mesh)?;
     write_png(args.png.as_deref(), &result.mesh)?;
     let mut report = serde_json::Map::new();

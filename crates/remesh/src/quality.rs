@@ -43,22 +43,6 @@ pub struct Quality {
 /// `(4,1,1)/6` on a triangle); from the input, its vertices
 /// and face centroids.
 pub fn measure(input: &Mesh, output: &Mesh) -> Result<Quality, RemeshError> {
-    let mut angles = Vec::with_capacity(3 * output.face_count());
-    for f in output.faces() {
-        for h in output.face_halfedges(f) {
-            angles.push(output.corner_angle(h).to_degrees());
-        }
-    }
-    let min_angle = angles.iter().copied().fold(f64::INFINITY, f64::min);
-    let mean_angle = angles.iter().sum::<f64>() / angles.len().max(1) as f64;
-    let share_below_30 =
-        angles.iter().filter(|&&a| a < 30.0).count() as f64 / angles.len().max(1) as f64;
-
-    let lengths = output.edge_lengths();
-    let n = lengths.len().max(1) as f64;
-    let edge_mean = lengths.iter().sum::<f64>() / n;
-    let variance = lengths.iter().map(|l| (l - edge_mean).powi(2)).sum::<f64>() / n;
-
     let on_output: Vec<Point3<f64>> = output
         .faces()
         .flat_map(|f| {
@@ -84,8 +68,33 @@ pub fn measure(input: &Mesh, output: &Mesh) -> Result<Quality, RemeshError> {
     let (max_a, mean_a) = max_mean(to_input.iter().map(|l| l.distance));
     let (max_b, mean_b) = max_mean(to_output.iter().map(|l| l.distance));
     Ok(Quality {
-        vertices: output.vertex_count(),
-        faces: output.face_count(),
+        hausdorff: max_a.max(max_b),
+        mean_distance: (mean_a + mean_b) / 2.0,
+        diagonal: input.bounding_box().diagonal(),
+        ..shape(output)
+    })
+}
+
+/// The angles and edge lengths of `mesh` alone ([`Quality`] with zero distances and the
+/// mesh's own diagonal): the "before" of a remeshing.
+pub fn shape(mesh: &Mesh) -> Quality {
+    let mut angles = Vec::with_capacity(3 * mesh.face_count());
+    for f in mesh.faces() {
+        for h in mesh.face_halfedges(f) {
+            angles.push(mesh.corner_angle(h).to_degrees());
+        }
+    }
+    let min_angle = angles.iter().copied().fold(f64::INFINITY, f64::min);
+    let mean_angle = angles.iter().sum::<f64>() / angles.len().max(1) as f64;
+    let share_below_30 =
+        angles.iter().filter(|&&a| a < 30.0).count() as f64 / angles.len().max(1) as f64;
+    let lengths = mesh.edge_lengths();
+    let n = lengths.len().max(1) as f64;
+    let edge_mean = lengths.iter().sum::<f64>() / n;
+    let variance = lengths.iter().map(|l| (l - edge_mean).powi(2)).sum::<f64>() / n;
+    Quality {
+        vertices: mesh.vertex_count(),
+        faces: mesh.face_count(),
         min_angle,
         mean_angle,
         share_below_30,
@@ -93,10 +102,10 @@ pub fn measure(input: &Mesh, output: &Mesh) -> Result<Quality, RemeshError> {
         edge_mean,
         edge_max: lengths.iter().copied().fold(0.0, f64::max),
         edge_spread: variance.sqrt() / edge_mean,
-        hausdorff: max_a.max(max_b),
-        mean_distance: (mean_a + mean_b) / 2.0,
-        diagonal: input.bounding_box().diagonal(),
-    })
+        hausdorff: 0.0,
+        mean_distance: 0.0,
+        diagonal: mesh.bounding_box().diagonal(),
+    }
 }
 
 fn max_mean(d: impl Iterator<Item = f64>) -> (f64, f64) {
