@@ -138,7 +138,7 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
     let output = dir.path().join("out.obj");
     write_soup(&input, &disk(3));
     write_soup(&sphere, &icosphere(2));
-    let cases: [(&[&str], &str); 11] = [
+    let cases: [(&[&str], &str); 13] = [
         (&["--edge-length", "0"], "edge-length"),
         (&["--edge-length", "-0.1"], "edge-length"),
         (&["--edge-length", "NaN"], "edge-length"),
@@ -160,6 +160,14 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
         (
             &["--method", "qc-angles", "--feature-angle", "200"],
             "--feature-angle",
+        ),
+        (
+            &["--method", "qc-angles", "--min-angle", "25"],
+            "--min-angle is a flag of --method param",
+        ),
+        (
+            &["--edge-length", "0.1", "--reference", "equiangular"],
+            "--reference is a flag of --method qc-angles",
         ),
         (&[], "--edge-length L or --vertices N"),
     ];

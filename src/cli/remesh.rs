@@ -157,6 +157,7 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
         ("--png", args.png.as_deref()),
         ("--report", args.report.as_deref()),
     ])?;
+    check_method_flags(args)?;
     match args.method {
         MethodArg::Param if args.edge_length.is_none() && args.vertices.is_none() => {
             bail!(
@@ -191,6 +192,47 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     finish(args, &report, quiet, || {
         print_summary(args, &result, &quality, seconds)
     })
+}
+
+/// Refuses, before any work, the flags of the other method (they would be ignored
+/// silently): a flag counts as given when its value differs from its default.
+fn check_method_flags(args: &RemeshArgs) -> anyhow::Result<()> {
+    let given = |set: bool, flag: &'static str| set.then_some(flag);
+    let (flags, method, other) = match args.method {
+        MethodArg::QcAngles => (
+            [
+                given(args.param != "auto", "--param"),
+                given(args.min_angle != 30.0, "--min-angle"),
+                given(args.size_field != SizeFieldArg::Uniform, "--size-field"),
+                given(args.max_vertices != 5_000_000, "--max-vertices"),
+            ]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>(),
+            "qc-angles",
+            "param",
+        ),
+        MethodArg::Param => (
+            [
+                given(args.reference != ReferenceArg::Optimized, "--reference"),
+                given(args.constraint != KeepArg::Normal, "--constraint"),
+                given(args.max_iters != 10, "--max-iters"),
+                given(args.tolerance != 1e-4, "--tolerance"),
+                given(args.feature_angle != 60.0, "--feature-angle"),
+                given(args.no_project, "--no-project"),
+                given(args.allow_flips, "--allow-flips"),
+            ]
+            .into_iter()
+            .flatten()
+            .collect(),
+            "param",
+            "qc-angles",
+        ),
+    };
+    if let Some(flag) = flags.first() {
+        bail!("{flag} is a flag of --method {other}; --method {method} does not read it");
+    }
+    Ok(())
 }
 
 /// `--method qc-angles` ([`beltrami_remesh::in_place`]).
