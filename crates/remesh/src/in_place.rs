@@ -26,7 +26,7 @@ use beltrami_core::{
     Constraint, Context, Goal, Map, OptionValue, Pin, Position, Problem, Solution, Solver,
     SolverError, Stop, Target,
 };
-use beltrami_mesh::{Mesh, Point3, Vector3, VertexId};
+use beltrami_mesh::{FaceId, Mesh, Point3, Vector3, VertexId};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::RemeshError;
@@ -254,35 +254,51 @@ fn settle(
 ) -> Result<Settled, RemeshError> {
     let mut positions = image.to_vec();
     if project_onto_input {
-        project(mesh, index, &mut positions)?;
+        project(mesh, index, &mut positions, mesh.vertices())?;
     }
     let mut pulled = 0;
     let mut flipped = flipped_faces(mesh, index, &positions)?;
     let target = positions.clone();
     let mut share = vec![1.0; mesh.vertex_count()];
-    for _ in 0..PULL_BACK_ROUNDS {
-        let bad: Vec<_> = mesh
+    let mut seen = vec![usize::MAX; mesh.face_count()];
+    for round in 0..PULL_BACK_ROUNDS {
+        let mut moved: Vec<VertexId> = mesh
             .faces()
             .filter(|f| flipped[f.idx()] && !was_flipped[f.idx()])
+            .flat_map(|f| mesh.face_vertices(f))
             .collect();
-        if bad.is_empty() {
+        if moved.is_empty() {
             break;
         }
-        for f in bad {
-            for v in mesh.face_vertices(f) {
-                let s = &mut share[v.idx()];
-                if *s == 1.0 {
-                    pulled += 1;
-                }
-                *s = if *s > 1.0 / 64.0 { *s / 2.0 } else { 0.0 };
-                let from = mesh.position(v);
-                positions[v.idx()] = from + (target[v.idx()] - from) * *s;
+        moved.sort_unstable();
+        moved.dedup();
+        for &v in &moved {
+            let s = &mut share[v.idx()];
+            if *s == 1.0 {
+                pulled += 1;
             }
+            *s = if *s > 1.0 / 64.0 { *s / 2.0 } else { 0.0 };
+            let from = mesh.position(v);
+            positions[v.idx()] = from + (target[v.idx()] - from) * *s;
         }
         if project_onto_input {
-            project(mesh, index, &mut positions)?;
+            project(mesh, index, &mut positions, moved.iter().copied())?;
         }
-        flipped = flipped_faces(mesh, index, &positions)?;
+        // Only the faces around a moved vertex can have changed.
+        let mut around = Vec::new();
+        for &v in &moved {
+            for h in mesh.outgoing_halfedges(v) {
+                if let Some(f) = mesh.face(h)
+                    && seen[f.idx()] != round
+                {
+                    seen[f.idx()] = round;
+                    around.push(f);
+                }
+            }
+        }
+        for (f, t) in around.iter().zip(turned(mesh, index, &positions, &around)?) {
+            flipped[f.idx()] = t;
+        }
     }
     Ok(Settled {
         positions,
@@ -295,14 +311,15 @@ fn settle(
 /// back at its input position after seven).
 const PULL_BACK_ROUNDS: usize = 40;
 
-/// Moves every vertex off the boundary to its closest point on `mesh`.
+/// Moves the vertices `moved` that are off the boundary to their closest points on
+/// `mesh`.
 fn project(
     mesh: &Mesh,
     index: &SurfaceIndex<'_>,
     positions: &mut [Point3<f64>],
+    moved: impl Iterator<Item = VertexId>,
 ) -> Result<(), RemeshError> {
-    let moved: Vec<usize> = mesh
-        .vertices()
+    let moved: Vec<usize> = moved
         .filter(|&v| !mesh.is_boundary_vertex(v))
         .map(|v| v.idx())
         .collect();
@@ -313,24 +330,26 @@ fn project(
     Ok(())
 }
 
-/// Per face of `mesh` at `positions`: whether it is turned against the surface of
-/// `index` ([`InPlace::flipped`]).
-fn flipped_faces(
+/// Per face of `faces` (of `mesh` at `positions`): whether it is turned against the
+/// surface of `index` ([`InPlace::flipped`]).
+fn turned(
     mesh: &Mesh,
     index: &SurfaceIndex<'_>,
     positions: &[Point3<f64>],
+    faces: &[FaceId],
 ) -> Result<Vec<bool>, RemeshError> {
     let corners = |f| mesh.face_vertices(f).map(|v: VertexId| positions[v.idx()]);
-    let centroids: Vec<Point3<f64>> = mesh
-        .faces()
-        .map(|f| {
+    let centroids: Vec<Point3<f64>> = faces
+        .iter()
+        .map(|&f| {
             let n = mesh.face_degree(f) as f64;
             Point3::from(corners(f).map(|p| p.coords).sum::<Vector3<f64>>() / n)
         })
         .collect();
-    mesh.faces()
+    faces
+        .iter()
         .zip(index.locate_all(&centroids)?)
-        .map(|(f, located)| {
+        .map(|(&f, located)| {
             let p: Vec<Point3<f64>> = corners(f).collect();
             let area: Vector3<f64> = (0..p.len())
                 .map(|k| p[k].coords.cross(&p[(k + 1) % p.len()].coords))
@@ -338,6 +357,15 @@ fn flipped_faces(
             Ok(area.dot(&index.normal(&located.point)?) <= 0.0)
         })
         .collect()
+}
+
+/// [`turned`] for every face.
+fn flipped_faces(
+    mesh: &Mesh,
+    index: &SurfaceIndex<'_>,
+    positions: &[Point3<f64>],
+) -> Result<Vec<bool>, RemeshError> {
+    turned(mesh, index, positions, &mesh.faces().collect::<Vec<_>>())
 }
 
 /// The vertices, off the boundary, of the edges whose two faces' normals differ by more
