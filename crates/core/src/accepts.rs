@@ -49,6 +49,18 @@ pub enum Topology {
 }
 
 impl Topology {
+    /// Every one-component topology: what a solver that maps any connected surface
+    /// lists in [`Accepts::topologies`].
+    pub const CONNECTED: &'static [Topology] = &[
+        Topology::Disk,
+        Topology::Annulus,
+        Topology::MultiplyConnected,
+        Topology::Sphere,
+        Topology::Torus,
+        Topology::HigherGenus,
+        Topology::BoundedHigherGenus,
+    ];
+
     /// The topology of `mesh`.
     pub fn of(mesh: &Mesh) -> Self {
         let components = mesh.components();

@@ -96,7 +96,8 @@ impl PointDerivatives {
     }
 }
 
-fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), FemError> {
+/// [`FemError::Length`] unless `got == expected`.
+pub(crate) fn check_len(what: &'static str, expected: usize, got: usize) -> Result<(), FemError> {
     if expected == got {
         Ok(())
     } else {

@@ -235,13 +235,7 @@ pub fn beltrami_operator(
     elements: &Elements,
     mu: &[Complex64],
 ) -> Result<SparseColMat<usize, Complex64>, FemError> {
-    if mu.len() != elements.face_count() {
-        return Err(FemError::Length {
-            what: "Beltrami coefficient",
-            expected: elements.face_count(),
-            got: mu.len(),
-        });
-    }
+    crate::beltrami::check_len("Beltrami coefficient", elements.face_count(), mu.len())?;
     let mut positions = Vec::with_capacity(elements.point_count() * 4);
     let mut values = Vec::with_capacity(elements.point_count() * 4);
     for (row, q) in elements.points().iter().enumerate() {

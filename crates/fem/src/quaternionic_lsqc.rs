@@ -28,21 +28,10 @@ use crate::{Elements, FemError};
 pub const ROWS_PER_POINT: usize = 4;
 
 /// The operator `x -> df^- - mu df^+` (module docs) of `elements` (built with
-/// `Frame::Face`) for the coefficients `mu` per face (`mu1 + i mu2`), on `vertex_count`
+/// `Frame::Face`) for coefficients `mu` per face (`mu1 + i mu2`), on `vertex_count`
 /// vertices: `4 Q` rows, `3 vertex_count` columns, followed by the rows of `extra`
-/// (e.g. [`NormalConstraint`]). One-shot; [`QuaternionicOperator`] keeps the pattern
-/// for repeated assemblies.
-pub fn quaternionic_operator(
-    elements: &Elements,
-    vertex_count: usize,
-    mu: &[Complex64],
-    extra: Option<&NormalConstraint>,
-) -> Result<SparseColMat<usize, f64>, FemError> {
-    QuaternionicOperator::new(elements, vertex_count, extra)?.assemble(elements, mu, extra)
-}
-
-/// The pattern of [`quaternionic_operator`], sorted once; each [`assemble`](Self::assemble)
-/// only recomputes the values for a new `mu`.
+/// (e.g. [`NormalConstraint`]). The pattern is sorted once; each
+/// [`assemble`](Self::assemble) only recomputes the values for a new `mu`.
 #[derive(Debug, Clone)]
 pub struct QuaternionicOperator {
     pattern: Pattern,
@@ -93,13 +82,7 @@ impl QuaternionicOperator {
         mu: &[Complex64],
         extra: Option<&NormalConstraint>,
     ) -> Result<SparseColMat<usize, f64>, FemError> {
-        if mu.len() != elements.face_count() {
-            return Err(FemError::Length {
-                what: "Beltrami coefficient",
-                expected: elements.face_count(),
-                got: mu.len(),
-            });
-        }
+        crate::beltrami::check_len("Beltrami coefficient", elements.face_count(), mu.len())?;
         let mut values = Vec::with_capacity(self.pattern.entry_count());
         for q in elements.points() {
             let normal = q.frame.normal;
@@ -135,13 +118,7 @@ pub fn quaternionic_residual(
     image: &[Point3<f64>],
     mu: &[Complex64],
 ) -> Result<Vec<f64>, FemError> {
-    if mu.len() != elements.face_count() {
-        return Err(FemError::Length {
-            what: "Beltrami coefficient",
-            expected: elements.face_count(),
-            got: mu.len(),
-        });
-    }
+    crate::beltrami::check_len("Beltrami coefficient", elements.face_count(), mu.len())?;
     let derivatives = crate::beltrami::spatial_derivatives(elements, image.len(), image)?;
     let mut r = Vec::with_capacity(ROWS_PER_POINT * elements.point_count());
     for (q, d) in elements.points().iter().zip(derivatives) {
@@ -197,7 +174,7 @@ impl NormalConstraint {
     }
 }
 
-/// The weight of every row of [`quaternionic_operator`]: the quadrature weight of its
+/// The weight of every row of [`QuaternionicOperator`]: the quadrature weight of its
 /// point, repeated for the four components.
 pub fn row_weights(elements: &Elements) -> Vec<f64> {
     elements
@@ -276,7 +253,7 @@ pub enum SpaceError {
 }
 
 /// The least-squares quasiconformal map into R^3 of a coefficient `mu` per face
-/// (Algorithm 1): [`quaternionic_operator`] on `elements`, held vertices, the optional
+/// (Algorithm 1): [`QuaternionicOperator`] on `elements`, held vertices, the optional
 /// normal penalty ([`NormalConstraint`]) and area equality ([`AreaConstraint`]). The
 /// symbolic factorization is built once; each [`solve`](Self::solve) refills the
 /// operator's values for a new `mu` (the QC iteration solves one per iteration).

@@ -65,15 +65,7 @@ pub const OPTIONS: &[OptionSpec] = &[
 /// What the flow accepts.
 pub const ACCEPTS: Accepts = Accepts {
     elements: &[Element::Triangle],
-    topologies: &[
-        Topology::Disk,
-        Topology::Annulus,
-        Topology::MultiplyConnected,
-        Topology::Sphere,
-        Topology::Torus,
-        Topology::HigherGenus,
-        Topology::BoundedHigherGenus,
-    ],
+    topologies: Topology::CONNECTED,
     targets: &[
         TargetKind::PlaneKeep,
         TargetKind::PlaneCircle,

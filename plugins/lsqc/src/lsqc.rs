@@ -39,15 +39,7 @@ const ACCEPTS: Accepts = Accepts {
     elements: &[Element::Triangle, Element::Quad],
     // Into the plane: disks (checked by `setup`, with the way out); into space: any
     // surface with held vertices.
-    topologies: &[
-        Topology::Disk,
-        Topology::Annulus,
-        Topology::MultiplyConnected,
-        Topology::Sphere,
-        Topology::Torus,
-        Topology::HigherGenus,
-        Topology::BoundedHigherGenus,
-    ],
+    topologies: Topology::CONNECTED,
     targets: &[
         TargetKind::PlaneKeep,
         TargetKind::PlaneGiven,

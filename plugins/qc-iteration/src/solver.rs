@@ -60,15 +60,7 @@ const OPTIONS: &[OptionSpec] = &[
 
 const ACCEPTS: Accepts = Accepts {
     elements: &[Element::Triangle, Element::Quad],
-    topologies: &[
-        Topology::Disk,
-        Topology::Annulus,
-        Topology::MultiplyConnected,
-        Topology::Sphere,
-        Topology::Torus,
-        Topology::HigherGenus,
-        Topology::BoundedHigherGenus,
-    ],
+    topologies: Topology::CONNECTED,
     targets: &[
         TargetKind::PlaneKeep,
         TargetKind::PlaneGiven,
@@ -128,9 +120,10 @@ impl Solver for QcIteration {
                     let zero = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
                     let operator = beltrami_operator(mesh, &elements, &zero)?;
                     let solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, options)?;
-                    let weights = elements.points().iter().map(|q| q.weight).collect();
+                    let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
                     Ok(Planar {
                         mesh,
+                        rhs: vec![Complex64::new(0.0, 0.0); weights.len()],
                         elements,
                         solver,
                         weights,

@@ -36,6 +36,8 @@ pub(crate) struct Planar<'m> {
     pub(crate) elements: Elements,
     pub(crate) solver: LeastSquaresSolver<Complex64>,
     pub(crate) weights: Vec<f64>,
+    /// The zero right-hand side (one entry per quadrature point).
+    pub(crate) rhs: Vec<Complex64>,
     pub(crate) map: Vec<Complex64>,
 }
 
@@ -46,10 +48,9 @@ impl Linearized for Planar<'_> {
 
     fn solve(&mut self, mu: &[Complex64]) -> Result<(), SolverError> {
         let operator = beltrami_operator(self.mesh, &self.elements, mu)?;
-        let zero = vec![Complex64::new(0.0, 0.0); self.weights.len()];
         self.map = self
             .solver
-            .solve(operator.as_ref(), Some(&self.weights), &zero)?;
+            .solve(operator.as_ref(), Some(&self.weights), &self.rhs)?;
         Ok(())
     }
 
