@@ -223,11 +223,21 @@ fn triangulate_chart(
             .map(|i| p.coords[i] * sizes[chart.to_original[v[i].idx()].idx()])
             .sum::<f64>()
     };
-    let inner: Vec<_> = chart
+    let mut inner: Vec<_> = chart
         .mesh
         .vertices()
         .filter(|&v| !chart.mesh.is_boundary_vertex(v))
         .map(|v| (uv[v.idx()], chart.mesh.position(v)))
+        .collect();
+    // In Morton order of their parameter points, each point location in the
+    // triangulation starts next to the previous one.
+    let planar_points: Vec<_> = inner
+        .iter()
+        .map(|(z, _)| beltrami_mesh::Point3::new(z.re, z.im, 0.0))
+        .collect();
+    inner = beltrami_spatial::morton::order(&planar_points)
+        .into_iter()
+        .map(|i| inner[i as usize])
         .collect();
     let tri = refine::triangulate(
         &domain,
@@ -272,7 +282,13 @@ fn triangulate_chart(
     }
     let surface = beltrami_spatial::SurfaceIndex::new(mesh)?;
     seam_flips::flip_for_angles(&mut faces, &positions, &sizes_out, &surface)?;
-    star_relaxation::relax_worst_stars(&faces, &mut positions, &mut on_source, &surface)?;
+    star_relaxation::relax_worst_stars(
+        &faces,
+        &mut positions,
+        &mut on_source,
+        &sizes_out,
+        &surface,
+    )?;
     seam_flips::flip_for_angles(&mut faces, &positions, &sizes_out, &surface)?;
     let soup = PolygonSoup::from_triangles(positions, &faces);
     let result = Mesh::from_soup(&soup).map_err(|error| RemeshError::Build {

@@ -49,14 +49,14 @@ use spade::{
 
 use crate::RemeshError;
 use crate::boundary::BoundarySamples;
-use crate::domain::Domain;
+use crate::domain::{Domain, cross};
 
 /// Longest lifted edge, relative to the asked length, that is not split.
 const ALPHA: f64 = 1.65;
 
 /// Largest distance, relative to the asked length, between an input vertex and the
 /// interpolated result over its parameter point, before the vertex is inserted.
-const DEVIATION: f64 = 0.2;
+pub(crate) const DEVIATION: f64 = 0.2;
 
 /// Size passes at most (each splits every face that is too large).
 const MAX_PASSES: usize = 40;
@@ -110,7 +110,11 @@ pub fn triangulate(
         pinned: Vec::new(),
     };
     for &z in &samples.points {
-        let (point, position) = domain.lift(z)?.ok_or(RemeshError::Overlap { solver })?;
+        // Consecutive samples of a loop are neighbours on the surface.
+        let hint = tri.on_chart.last().map(|p| p.face);
+        let (point, position) = domain
+            .lift(z, hint)?
+            .ok_or(RemeshError::Overlap { solver })?;
         tri.push(z, point, position, size(&point));
     }
     let sin_limit = min_angle.to_radians().sin();
@@ -140,7 +144,8 @@ pub fn triangulate(
             }
             let z = idx.map(|i| tri.uv[i]);
             let (c, r) = frontal_point(&z, &p, h);
-            let q = if c.is_finite() && domain.lift(c)?.is_some() {
+            let hint = Some(tri.on_chart[idx[0]].face);
+            let q = if c.is_finite() && domain.lift(c, hint)?.is_some() {
                 c
             } else {
                 let m = face.center();
@@ -164,33 +169,26 @@ pub fn triangulate(
         }
     }
 
-    let before = cdt.num_vertices();
-    cdt.refine(
-        RefinementParameters::<f64>::new()
-            .with_angle_limit(AngleLimit::from_deg(min_angle))
-            .keep_constraint_edges()
-            .exclude_outer_faces(true)
-            .with_max_additional_vertices(max_vertices.saturating_sub(before).max(1)),
-    );
-    for i in before..cdt.num_vertices() {
-        let p = cdt.vertex(FixedVertexHandle::from_index(i)).position();
-        let q = Complex64::new(p.x, p.y);
-        // spade's new vertices lie inside the domain (no constraint edge is split); a
-        // vertex on its boundary up to rounding lifts to the closest domain point.
-        let (point, position) = domain.lift_closest(q)?;
-        tri.push(q, point, position, size(&point));
-    }
-    if tri.uv.len() > max_vertices {
-        return Err(RemeshError::TooManyVertices {
-            limit: max_vertices,
-        });
-    }
+    refine_angles(&mut cdt, &mut tri, domain, size, min_angle, max_vertices)?;
 
     let boundary = samples.points.len();
     for _ in 0..SMOOTHING_ROUNDS {
         if context.is_cancelled() {
             return Err(RemeshError::Cancelled);
         }
+        tri.faces = faces_of(&cdt);
+        smooth(&mut tri, boundary, domain, size)?;
+        cdt = load(&tri.uv, &samples.edges, solver)?;
+    }
+    // The smoothing moves the neighbours of the feature vertices chosen during the size
+    // passes, so the interpolation between them can leave the input again: check anew,
+    // insert what deviates, restore the angles and smooth once more.
+    for _ in 0..FEATURE_ROUNDS {
+        let features = deviating(&cdt, &tri, inner);
+        if insert_all(&mut cdt, &mut tri, domain, size, features, true)? == 0 {
+            break;
+        }
+        refine_angles(&mut cdt, &mut tri, domain, size, min_angle, max_vertices)?;
         tri.faces = faces_of(&cdt);
         smooth(&mut tri, boundary, domain, size)?;
         cdt = load(&tri.uv, &samples.edges, solver)?;
@@ -202,6 +200,50 @@ pub fn triangulate(
         }
     }
     Ok(tri)
+}
+
+/// Rounds of the feature check after the smoothing at most (each inserts the input
+/// vertices that deviate, refines and smooths once).
+const FEATURE_ROUNDS: usize = 3;
+
+/// spade's refinement of `cdt` to the angle limit `min_angle` (degrees), constraint
+/// edges kept and outer faces excluded; its new vertices are lifted into `tri`.
+fn refine_angles(
+    cdt: &mut Cdt,
+    tri: &mut Triangulation,
+    domain: &Domain<'_>,
+    size: &impl Fn(&SurfacePoint) -> f64,
+    min_angle: f64,
+    max_vertices: usize,
+) -> Result<(), RemeshError> {
+    let before = cdt.num_vertices();
+    cdt.refine(
+        RefinementParameters::<f64>::new()
+            .with_angle_limit(AngleLimit::from_deg(min_angle))
+            .keep_constraint_edges()
+            .exclude_outer_faces(true)
+            .with_max_additional_vertices(max_vertices.saturating_sub(before).max(1)),
+    );
+    for i in before..cdt.num_vertices() {
+        let vertex = cdt.vertex(FixedVertexHandle::from_index(i));
+        let p = vertex.position();
+        let q = Complex64::new(p.x, p.y);
+        let hint = vertex
+            .out_edges()
+            .map(|e| e.to().fix().index())
+            .find(|&j| j < i)
+            .map(|j| tri.on_chart[j].face);
+        // spade's new vertices lie inside the domain (no constraint edge is split); a
+        // vertex on its boundary up to rounding lifts to the closest domain point.
+        let (point, position) = domain.lift_closest(q, hint)?;
+        tri.push(q, point, position, size(&point));
+    }
+    if tri.uv.len() > max_vertices {
+        return Err(RemeshError::TooManyVertices {
+            limit: max_vertices,
+        });
+    }
+    Ok(())
 }
 
 /// Sweeps of [`flip_for_angles`] at most.
@@ -274,7 +316,8 @@ pub(crate) const FLIP_DEVIATION: f64 = 0.05;
 /// midpoint of `ab` in the plane.
 fn chord_gap(tri: &Triangulation, domain: &Domain<'_>, a: u32, b: u32) -> Result<f64, RemeshError> {
     let (a, b) = (a as usize, b as usize);
-    let (_, on_surface) = domain.lift_closest((tri.uv[a] + tri.uv[b]) / 2.0)?;
+    let hint = Some(tri.on_chart[a].face);
+    let (_, on_surface) = domain.lift_closest((tri.uv[a] + tri.uv[b]) / 2.0, hint)?;
     let chord = (tri.position[a].coords + tri.position[b].coords) / 2.0;
     Ok((on_surface.coords - chord).norm())
 }
@@ -350,10 +393,10 @@ fn insert_all(
 ) -> Result<usize, RemeshError> {
     let mut inserted = 0;
     for (r, q) in points {
-        if too_close(cdt, q, r) {
+        let Some(near) = vertex_nearby(cdt, q, r) else {
             continue;
-        }
-        if let Some((point, position)) = domain.lift(q)?
+        };
+        if let Some((point, position)) = domain.lift(q, Some(tri.on_chart[near].face))?
             && let Ok(handle) = cdt.insert(Point2::new(q.re, q.im))
             && handle.index() == tri.uv.len()
         {
@@ -401,11 +444,6 @@ fn deviating(
     }
     out.sort_by(|a, b| b.0.total_cmp(&a.0));
     out.into_iter().map(|(_, r, q)| (r, q)).collect()
-}
-
-/// `Im(conj(a) b)`, twice the signed area of the triangle `0, a, b`.
-fn cross(a: Complex64, b: Complex64) -> f64 {
-    a.re * b.im - a.im * b.re
 }
 
 /// The constrained Delaunay triangulation of `points` with constraint edges `edges`
@@ -485,7 +523,7 @@ fn smooth(
             continue;
         }
         let q = sum[i] / weight[i];
-        if let Some((point, position)) = domain.lift(q)? {
+        if let Some((point, position)) = domain.lift(q, Some(tri.on_chart[i].face))? {
             tri.uv[i] = q;
             tri.on_chart[i] = point;
             tri.position[i] = position;
@@ -511,14 +549,17 @@ pub(crate) fn smallest_sine(p: &[Point3<f64>; 3]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// True if a vertex of the face containing `q` lies within `radius` of it (a point
-/// inserted earlier in the same pass, typically).
-fn too_close(cdt: &Cdt, q: Complex64, radius: f64) -> bool {
+/// A vertex of the face of `cdt` containing `q`, or `None` when one of them lies within
+/// `radius` of `q` (a point inserted earlier in the same pass, typically) or `q` is not
+/// inside a face.
+fn vertex_nearby(cdt: &Cdt, q: Complex64, radius: f64) -> Option<usize> {
     use spade::PositionInTriangulation as P;
     let near = |p: Point2<f64>| (Complex64::new(p.x, p.y) - q).norm() < radius;
     match cdt.locate(Point2::new(q.re, q.im)) {
-        P::OnFace(f) => cdt.face(f).vertices().iter().any(|v| near(v.position())),
-        P::OnVertex(_) | P::OnEdge(_) => true,
-        P::OutsideOfConvexHull(_) | P::NoTriangulation => true,
+        P::OnFace(f) => {
+            let vertices = cdt.face(f).vertices();
+            (!vertices.iter().any(|v| near(v.position()))).then(|| vertices[0].fix().index())
+        }
+        P::OnVertex(_) | P::OnEdge(_) | P::OutsideOfConvexHull(_) | P::NoTriangulation => None,
     }
 }

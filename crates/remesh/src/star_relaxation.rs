@@ -8,13 +8,17 @@
 //! not on the surface's boundary, tries the centroid of its neighbours projected onto
 //! the input (the closest point of the input surface, exact on it); the move is kept
 //! when it raises the smallest angle of the vertex's faces and turns none of them over
-//! (each new face normal has a positive dot product with the old one).
+//! (each new face normal has a positive dot product with the old one), and when every
+//! input vertex that the star held within the feature tolerance (`DEVIATION h`, see
+//! [`crate::refine`]) stays within it: a move must not cut off a crease that the
+//! refinement kept.
 
 use beltrami_mesh::{Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
+use beltrami_spatial::closest_point::closest_on_triangle;
 
 use crate::RemeshError;
-use crate::refine::smallest_sine;
+use crate::refine::{DEVIATION, smallest_sine};
 
 /// Smallest angle, in degrees, below which a face's vertices are moved. At 20 (the
 /// refinement's limit) the eight shared meshes of the pymeshlab comparison ended at
@@ -28,11 +32,13 @@ const SWEEPS: usize = 4;
 
 /// Relaxes the vertices of the faces `faces` (triangles, indices into `positions`)
 /// whose smallest angle is below [`ANGLE_LIMIT`] (module docs); `on_source` follows
-/// every move. Returns the moves made.
+/// every move; `sizes[v]` is the asked edge length at vertex `v`, which sets its feature
+/// tolerance. Boundary vertices stay. Returns the moves made.
 pub fn relax_worst_stars(
     faces: &[[u32; 3]],
     positions: &mut [Point3<f64>],
     on_source: &mut [SurfacePoint],
+    sizes: &[f64],
     surface: &SurfaceIndex<'_>,
 ) -> Result<usize, RemeshError> {
     let n = positions.len();
@@ -99,7 +105,17 @@ pub fn relax_worst_stars(
                     .iter()
                     .zip(&normals)
                     .all(|(&g, n)| normal(positions, g).dot(n) > 0.0);
-                if after > before * (1.0 + 1e-9) && keeps_turn {
+                if after > before * (1.0 + 1e-9)
+                    && keeps_turn
+                    && keeps_features(
+                        faces,
+                        &star[v],
+                        positions,
+                        (v, old),
+                        DEVIATION * sizes[v],
+                        surface,
+                    )?
+                {
                     on_source[v] = located.point;
                     moved += 1;
                 } else {
@@ -113,6 +129,47 @@ pub fn relax_worst_stars(
         }
     }
     Ok(moves)
+}
+
+/// Whether every input vertex near the star `star` of vertex `v` (faces `faces`, `v`
+/// now at `positions[v]`, before at `old`) that lay within `tolerance` of the star
+/// before still does.
+fn keeps_features(
+    faces: &[[u32; 3]],
+    star: &[usize],
+    positions: &[Point3<f64>],
+    (v, old): (usize, Point3<f64>),
+    tolerance: f64,
+    surface: &SurfaceIndex<'_>,
+) -> Result<bool, RemeshError> {
+    let corners = |g: usize, moved: bool| {
+        faces[g].map(|i| {
+            let i = i as usize;
+            if i == v && !moved { old } else { positions[i] }
+        })
+    };
+    let distance = |x: &Point3<f64>, moved: bool| {
+        star.iter()
+            .map(|&g| closest_on_triangle(x, &corners(g, moved)).distance())
+            .fold(f64::INFINITY, f64::min)
+    };
+    let reach = star
+        .iter()
+        .flat_map(|&g| corners(g, false).into_iter().chain(corners(g, true)))
+        .map(|p| (p - old).norm())
+        .fold(0.0, f64::max);
+    let input = surface.mesh();
+    let mut near: Vec<_> = surface
+        .faces_within(&old, reach + tolerance)?
+        .into_iter()
+        .flat_map(|f| input.face_vertices(f))
+        .collect();
+    near.sort_unstable();
+    near.dedup();
+    Ok(near.into_iter().all(|w| {
+        let x = input.position(w);
+        distance(&x, false) > tolerance || distance(&x, true) <= tolerance
+    }))
 }
 
 #[cfg(test)]
@@ -147,7 +204,8 @@ mod tests {
                 .fold(f64::INFINITY, f64::min)
         };
         assert!(smallest(&positions) < ANGLE_LIMIT.to_radians().sin());
-        let moves = relax_worst_stars(&faces, &mut positions, &mut on_source, &index).unwrap();
+        let moves =
+            relax_worst_stars(&faces, &mut positions, &mut on_source, &[0.5; 7], &index).unwrap();
         assert!(moves >= 1);
         // The centroid of the ring is the centre: equilateral faces again, on the plane.
         assert!((positions[6] - Point3::new(0.0, 0.0, 1.0)).norm() < 1e-12);

@@ -315,3 +315,35 @@ fn two_components_are_refused() {
         "{error}"
     );
 }
+
+#[test]
+fn every_input_vertex_of_a_rough_surface_stays_within_the_feature_tolerance() {
+    // Ripples of wavelength 0.07 and height up to 0.02 (0.4 h) on a flat boundary: a
+    // chord of length h = 0.05 cuts them off unless their vertices are inserted
+    // (refine.rs: an input vertex farther than 0.2 h from the interpolated result over
+    // its parameter point is inserted and held). The smoothing moves the neighbours of
+    // the inserted vertices, so the check must hold for the final mesh, not only where
+    // the size passes end.
+    let input = mesh(&mapped(
+        jittered_grid(48, 48, Cells::Triangles, 0.3, 11),
+        |p| {
+            let bump = 16.0 * p.x * (1.0 - p.x) * p.y * (1.0 - p.y);
+            let ripple = (90.0 * p.x + 1.3).sin() * (90.0 * p.y + 0.7).sin();
+            Point3::new(p.x, p.y, 0.02 * bump * ripple)
+        },
+    ));
+    let l = 0.05;
+    let result = run(&input, l);
+    let out = &result.remeshed.mesh;
+    let index = beltrami_spatial::SurfaceIndex::new(out).unwrap();
+    let worst = input
+        .vertices()
+        .filter(|&v| !input.is_boundary_vertex(v))
+        .map(|v| index.locate(&input.position(v)).unwrap().distance)
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= 0.2 * l * (1.0 + 1e-9),
+        "an input vertex is {worst} from the result, {} h",
+        worst / l
+    );
+}

@@ -55,6 +55,13 @@ pub enum SpatialError {
         found: usize,
     },
 
+    /// A search radius that is negative, NaN or infinite.
+    #[error("search radius {radius} is not a finite non-negative number")]
+    InvalidRadius {
+        /// The radius.
+        radius: f64,
+    },
+
     /// The mesh needs more kd-tree samples than a `u32` item index can address.
     #[error("the mesh is too large to index: {samples} samples exceed u32::MAX")]
     TooLarge {

@@ -317,6 +317,34 @@ impl<'m> SurfaceIndex<'m> {
         Ok(self.search(p, None, &mut Scratch::new()))
     }
 
+    /// Every face with a point within `radius` of `p`, in increasing id order, each once;
+    /// a few farther faces may be listed too. A face within `radius` has a sample whose
+    /// center is within `radius + R` and whose lower bound (module docs) is at most
+    /// `radius`, so the same tree query and bound as [`SurfaceIndex::locate`] find it.
+    /// Fails on a non-finite `p` or a radius that is negative or not finite.
+    pub fn faces_within(&self, p: &Point3<f64>, radius: f64) -> Result<Vec<FaceId>, SpatialError> {
+        check_point(p)?;
+        if !(radius.is_finite() && radius >= 0.0) {
+            return Err(SpatialError::InvalidRadius { radius });
+        }
+        let reach = (radius + self.max_radius) * (1.0 + 1e-12);
+        let pad = 16.0 * f64::EPSILON * p.coords.amax();
+        let mut faces = Vec::new();
+        self.tree
+            .query(&[p.x, p.y, p.z])
+            .within::<SquaredEuclidean<f64>>(reach * reach)
+            .unsorted()
+            .visit(|item| {
+                let sample = &self.samples[item.item as usize];
+                if sample.lower_bound(p, item.distance) <= radius * (1.0 + 1e-12) + pad {
+                    faces.push(sample.face);
+                }
+            });
+        faces.sort_unstable();
+        faces.dedup();
+        Ok(faces)
+    }
+
     /// The exact closest point of the mesh to `p`, with the search started from face
     /// `hint` (typically the face the point was on before it moved) instead of the face
     /// of the nearest sample: one kd-tree query instead of two, with a small radius when

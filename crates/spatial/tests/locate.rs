@@ -211,3 +211,41 @@ fn a_zero_area_face_is_handled() {
     assert!((moved.position - expected.position).norm() < 1e-12);
     moved.point.validate(&mesh).unwrap();
 }
+
+#[test]
+fn faces_within_a_radius_include_every_face_that_close() {
+    // Warped quads and triangles; radii from zero to a few face sizes.
+    let mesh = build(&torus(24, 12, 1.0, 0.4, Cells::Quads));
+    let index = SurfaceIndex::new(&mesh).unwrap();
+    let mut rng = Rng::new(5);
+    for (i, p) in queries(&mesh, &mut rng, 200, 0.2).iter().enumerate() {
+        let radius = [0.0, 0.05, 0.2, 0.6][i % 4];
+        let listed = index.faces_within(p, radius).unwrap();
+        assert!(listed.windows(2).all(|w| w[0] < w[1]), "sorted and unique");
+        let within: Vec<FaceId> = mesh
+            .faces()
+            .filter(|&f| closest_on_face(&mesh, f, p).distance() <= radius)
+            .collect();
+        for f in &within {
+            assert!(
+                listed.contains(f),
+                "face {f} within {radius} of {p} is missing"
+            );
+        }
+        // The lower bounds keep the list close to the true one.
+        assert!(
+            listed.len() <= 4 * within.len() + 8,
+            "{} listed for {}",
+            listed.len(),
+            within.len()
+        );
+    }
+    assert!(matches!(
+        index.faces_within(&Point3::origin(), f64::NAN),
+        Err(SpatialError::InvalidRadius { .. })
+    ));
+    assert!(matches!(
+        index.faces_within(&Point3::origin(), -1.0),
+        Err(SpatialError::InvalidRadius { .. })
+    ));
+}
