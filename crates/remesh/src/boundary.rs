@@ -13,6 +13,8 @@
 use std::collections::HashMap;
 
 use beltrami_mesh::{HalfedgeId, Mesh, VertexId};
+
+use crate::refine::DEVIATION;
 use num_complex::Complex64;
 
 /// A sample's identity on the surface, shared by all its copies on the boundary.
@@ -59,6 +61,12 @@ pub fn sample(
         .flat_map(|b| chart.loop_halfedges(b).map(edge_key))
         .collect();
     keys.sort_unstable();
+    // An edge of the surface's own boundary has one copy in the chart, a cut edge two.
+    let single: std::collections::HashSet<(u32, u32)> = keys
+        .chunk_by(|a, b| a == b)
+        .filter(|copies| copies.len() == 1)
+        .map(|copies| copies[0])
+        .collect();
     keys.dedup();
     let mut degree: HashMap<u32, usize> = HashMap::new();
     for &(a, b) in &keys {
@@ -92,16 +100,24 @@ pub fn sample(
             run.push(h);
             let last = i + 1 == hs.len();
             if last || is_node(chart.target(h)) {
-                sample_run(
-                    chart,
-                    uv,
-                    &original,
-                    &run,
-                    &spacing,
-                    &mut chains,
-                    &mut ids,
-                    &mut out,
-                );
+                let mut pieces = Vec::new();
+                if single.contains(&edge_key(run[0])) {
+                    split_at_corners(chart, &original, &run, &spacing, &mut pieces);
+                } else {
+                    pieces.push(run.clone());
+                }
+                for piece in &pieces {
+                    sample_run(
+                        chart,
+                        uv,
+                        &original,
+                        piece,
+                        &spacing,
+                        &mut chains,
+                        &mut ids,
+                        &mut out,
+                    );
+                }
                 run.clear();
             }
         }
@@ -111,6 +127,88 @@ pub fn sample(
     }
     out.vertex_count = ids.len();
     out
+}
+
+/// The lengths of the edges of `run`, their sum and the number of pieces the run is
+/// sampled with: its length over the mean spacing at its surface vertices (at least 1,
+/// or 3 for a run that closes on the surface).
+fn pieces_of(
+    chart: &Mesh,
+    original: &impl Fn(VertexId) -> VertexId,
+    run: &[HalfedgeId],
+    spacing: &impl Fn(VertexId) -> f64,
+) -> (Vec<f64>, f64, usize) {
+    let lengths: Vec<f64> = run
+        .iter()
+        .map(|&h| chart.halfedge_vector(h).norm())
+        .collect();
+    let total: f64 = lengths.iter().sum();
+    let closed = original(chart.origin(run[0])) == original(chart.target(run[run.len() - 1]));
+    let vertices = run
+        .iter()
+        .map(|&h| chart.origin(h))
+        .chain(std::iter::once(chart.target(run[run.len() - 1])));
+    let mean_spacing = vertices.map(|v| spacing(original(v))).sum::<f64>() / (run.len() + 1) as f64;
+    let n = (total / mean_spacing).round() as usize;
+    (lengths, total, n.max(if closed { 3 } else { 1 }))
+}
+
+/// Splits a run of the surface's own boundary at its vertices until every vertex lies
+/// within the feature tolerance (`DEVIATION h`, [`crate::refine`]) of the chord between
+/// the samples around it (Douglas-Peucker with equal-length samples): the boundary keeps
+/// its corners as the interior keeps its creases.
+fn split_at_corners(
+    chart: &Mesh,
+    original: &impl Fn(VertexId) -> VertexId,
+    run: &[HalfedgeId],
+    spacing: &impl Fn(VertexId) -> f64,
+    pieces: &mut Vec<Vec<HalfedgeId>>,
+) {
+    let (lengths, total, n) = pieces_of(chart, original, run, spacing);
+    let at = |s: f64| {
+        let mut before = 0.0;
+        for (k, &h) in run.iter().enumerate() {
+            if before + lengths[k] >= s || k + 1 == run.len() {
+                let t = if lengths[k] > 0.0 {
+                    ((s - before) / lengths[k]).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (a, b) = (
+                    chart.position(chart.origin(h)),
+                    chart.position(chart.target(h)),
+                );
+                return a + (b - a) * t;
+            }
+            before += lengths[k];
+        }
+        chart.position(chart.origin(run[0]))
+    };
+    let step = total / n as f64;
+    let mut worst = (0.0, 0);
+    let mut arc = 0.0;
+    for j in 1..run.len() {
+        arc += lengths[j - 1];
+        let k = ((arc / step).floor() as usize).min(n - 1);
+        let (a, b) = (at(k as f64 * step), at((k + 1) as f64 * step));
+        let p = chart.position(chart.origin(run[j]));
+        let ab = b - a;
+        let t = if ab.norm_squared() > 0.0 {
+            ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let gap = (p - (a + ab * t)).norm() / spacing(original(chart.origin(run[j])));
+        if gap > worst.0 {
+            worst = (gap, j);
+        }
+    }
+    if worst.0 > DEVIATION {
+        split_at_corners(chart, original, &run[..worst.1], spacing, pieces);
+        split_at_corners(chart, original, &run[worst.1..], spacing, pieces);
+    } else {
+        pieces.push(run.to_vec());
+    }
 }
 
 /// Adds the samples of one run (all but its last point, which starts the next run).
@@ -129,21 +227,11 @@ fn sample_run(
     sequence.push(original(chart.target(run[run.len() - 1])).0);
     let reversed: Vec<u32> = sequence.iter().rev().copied().collect();
     let forward = sequence <= reversed;
-    let closed = sequence[0] == sequence[sequence.len() - 1];
-    let lengths: Vec<f64> = run
-        .iter()
-        .map(|&h| chart.halfedge_vector(h).norm())
-        .collect();
-    let total: f64 = lengths.iter().sum();
+    let (lengths, total, pieces) = pieces_of(chart, original, run, spacing);
     let next_chain = chains.len();
     let (chain, n) = *chains
         .entry(if forward { sequence.clone() } else { reversed })
-        .or_insert_with(|| {
-            let mean_spacing =
-                sequence.iter().map(|&v| spacing(VertexId(v))).sum::<f64>() / sequence.len() as f64;
-            let n = (total / mean_spacing).round() as usize;
-            (next_chain, n.max(if closed { 3 } else { 1 }))
-        });
+        .or_insert((next_chain, pieces));
     let mut edge = 0;
     let mut before = 0.0;
     for k in 0..n {

@@ -12,6 +12,13 @@ pub enum Opening {
     /// Not at all: the surface is a disk, or the parameterizer maps its boundary loops
     /// as they are.
     Uncut,
+    /// Not at all, but parameterized with its holes closed: a genus-0 surface with
+    /// several boundary loops mapped by a parameterizer of disks, with every loop but
+    /// the longest closed by scaffold faces ([`crate::scaffold`]); `holes` loops closed.
+    Filled {
+        /// Number of loops closed for the parameterization.
+        holes: usize,
+    },
     /// Along the cut graph of [`beltrami_mesh::cut_to_disk`] (genus >= 1, or several
     /// boundary loops): `edges` mesh edges.
     CutGraph {
@@ -27,10 +34,11 @@ pub enum Opening {
 }
 
 impl Opening {
-    /// The stable name in reports: `uncut`, `cut-graph` or `slit`.
+    /// The stable name in reports: `uncut`, `filled`, `cut-graph` or `slit`.
     pub fn name(&self) -> &'static str {
         match self {
             Opening::Uncut => "uncut",
+            Opening::Filled { .. } => "filled",
             Opening::CutGraph { .. } => "cut-graph",
             Opening::Slit { .. } => "slit",
         }
@@ -51,9 +59,9 @@ pub struct Chart {
 }
 
 /// Opens `mesh` into a chart: a disk as it is; a closed genus-0 surface along a slit;
-/// a genus-0 surface with several boundary loops as it is when `keep_loops` (a
-/// circle-domain parameterizer), otherwise, like every surface of genus >= 1, along its
-/// cut graph.
+/// a genus-0 surface with several boundary loops as it is (when not `keep_loops`, its
+/// parameterization closes the holes: [`Opening::Filled`]); every surface of genus >= 1
+/// along its cut graph.
 pub fn open(mesh: &Mesh, keep_loops: bool) -> Result<Chart, RemeshError> {
     let components = mesh.components();
     if components.len() != 1 {
@@ -69,6 +77,14 @@ pub fn open(mesh: &Mesh, keep_loops: bool) -> Result<Chart, RemeshError> {
     };
     if c.is_disk() || (keep_loops && c.genus == 0 && c.boundary_loops > 1) {
         return Ok(uncut());
+    }
+    if c.genus == 0 && c.boundary_loops > 1 {
+        return Ok(Chart {
+            opening: Opening::Filled {
+                holes: c.boundary_loops - 1,
+            },
+            ..uncut()
+        });
     }
     if c.is_closed() && c.genus == 0 {
         let slit = slit_path(mesh);

@@ -52,6 +52,7 @@ pub mod param;
 pub mod quality;
 pub mod reference_angles;
 pub mod refine;
+pub mod scaffold;
 mod seam_flips;
 pub mod size;
 mod star_relaxation;
@@ -194,7 +195,14 @@ fn remesh_with(
     param::planar_target(solver)?;
     let chart = chart::open(mesh, param::keeps_loops(solver))?;
     timings.lap("chart");
-    let uv = param::parameterize(&chart.mesh, solver, context)?;
+    let uv = if let Opening::Filled { .. } = chart.opening {
+        let closed = scaffold::close_holes(&chart.mesh)?;
+        let mut uv = param::parameterize(&closed, solver, context)?;
+        uv.truncate(chart.mesh.vertex_count());
+        uv
+    } else {
+        param::parameterize(&chart.mesh, solver, context)?
+    };
     timings.lap("parameterize");
     let mut out = triangulate_chart(mesh, &chart, &uv, solver.name(), options, sizes, context)?;
     timings.laps.append(&mut out.timings);

@@ -48,16 +48,17 @@ pub fn keeps_loops(solver: &dyn Solver) -> bool {
     solver.accepts().targets.contains(&TargetKind::CircleDomain)
 }
 
-/// The parameterizer `auto` picks for `mesh` among the registered solvers: `qcmc` for a
-/// genus-0 surface with several boundary loops when registered, and `lscm` otherwise
-/// (on a disk as it is, on a closed genus-0 surface after a slit, on every other surface
-/// after a cut to a disk). `fallback` is the solver to retry with when the first
-/// choice's map folds or overlaps: `tutte`, whose convex boundary makes the map
-/// one-to-one (Tutte's theorem).
-pub fn auto<'r>(
-    registry: &'r Registry,
-    mesh: &Mesh,
-) -> Result<(&'r dyn Solver, Option<&'r dyn Solver>), RemeshError> {
+/// The parameterizers `auto` tries for `mesh`, in order: on a genus-0 surface with
+/// several boundary loops `lscm` of the surface with its holes closed (the chart stays
+/// uncut, [`crate::chart::Opening::Filled`]), then `qcmc` (its circle domain) when
+/// registered; on every other surface `lscm` (on a disk as it is, on a closed genus-0
+/// surface after a slit, otherwise after a cut to a disk); last `tutte`, whose convex
+/// boundary makes the map one-to-one (Tutte's theorem). The next one is tried when a
+/// map folds or overlaps. On the shared multiply connected meshes LSCM with closed holes
+/// gives as good a remesh as the circle domain in a third of the time (`mc4_face_a`),
+/// and a far better one where the circle domain nearly folds at a coarse hole
+/// (`mc8_peaks`, docs/remesh.md); `mc2_sophie`'s LSCM folds a face and goes to `qcmc`.
+pub fn auto<'r>(registry: &'r Registry, mesh: &Mesh) -> Result<Vec<&'r dyn Solver>, RemeshError> {
     let components = mesh.components();
     if components.len() != 1 {
         return Err(RemeshError::Components {
@@ -65,23 +66,20 @@ pub fn auto<'r>(
         });
     }
     let c = components[0];
-    let fallback = registry.get("tutte").ok();
-    if c.genus == 0
-        && c.boundary_loops > 1
-        && let Ok(qcmc) = registry.get("qcmc")
-    {
-        return Ok((qcmc, fallback));
-    }
     let lscm = registry.get("lscm").map_err(|error| RemeshError::Solve {
         solver: "auto",
         error,
     })?;
-    Ok((lscm, fallback))
+    let mut order = vec![lscm];
+    if c.genus == 0 && c.boundary_loops > 1 {
+        order.extend(registry.get("qcmc").ok());
+    }
+    order.extend(registry.get("tutte").ok());
+    Ok(order)
 }
 
 /// The parameterizers to try, in order, for the name `name`: `auto` gives [`auto`]'s
-/// choice and then its fallback (when it differs), any other name the registered solver
-/// of that name alone.
+/// order, any other name the registered solver of that name alone.
 pub fn chosen<'r>(
     registry: &'r Registry,
     mesh: &Mesh,
@@ -94,10 +92,7 @@ pub fn chosen<'r>(
         })?;
         return Ok(vec![solver]);
     }
-    let (first, fallback) = auto(registry, mesh)?;
-    Ok(std::iter::once(first)
-        .chain(fallback.filter(|f| f.name() != first.name()))
-        .collect())
+    auto(registry, mesh)
 }
 
 /// Maps `chart` into the plane with `solver` and checks that no face folds over

@@ -347,3 +347,31 @@ fn every_input_vertex_of_a_rough_surface_stays_within_the_feature_tolerance() {
         worst / l
     );
 }
+
+#[test]
+fn the_corners_of_a_boundary_are_kept() {
+    // A jittered square (its boundary stays on the square) at an edge length that
+    // divides none of its sides: equal-length samples along the whole loop would cut the
+    // corners off by up to 0.06, more than the feature tolerance 0.2 L.
+    let square = mesh(&jittered_grid(10, 10, Cells::Triangles, 0.3, 3));
+    let l = 0.13;
+    let out = run(&square, l).remeshed.mesh;
+    for corner in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+        let c = Point3::new(corner.0, corner.1, 0.0);
+        let nearest = out
+            .positions()
+            .iter()
+            .map(|p| (p - c).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            nearest < 1e-12,
+            "corner {corner:?}: nearest vertex at {nearest}"
+        );
+    }
+    let q = quality::measure(&square, &out).unwrap();
+    assert!(
+        q.hausdorff < 1e-12,
+        "a planar region: Hausdorff {}",
+        q.hausdorff
+    );
+}
