@@ -134,10 +134,10 @@ fn vertices_curvature_and_png_are_honoured() {
 fn bad_options_fail_with_the_option_named_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("disk.obj");
-    let sphere = dir.path().join("sphere.obj");
+    let torus_file = dir.path().join("torus.obj");
     let output = dir.path().join("out.obj");
     write_soup(&input, &disk(3));
-    write_soup(&sphere, &icosphere(2));
+    write_soup(&torus_file, &torus(24, 8, 1.0, 0.4, Cells::Triangles));
     let cases: [(&[&str], &str); 13] = [
         (&["--edge-length", "0"], "edge-length"),
         (&["--edge-length", "-0.1"], "edge-length"),
@@ -183,9 +183,10 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
         );
         assert!(!output.exists(), "{extra:?} wrote an output");
     }
+    // A spherical map serves closed genus-0 surfaces only.
     let out = beltrami(&[
         "remesh",
-        s(&sphere),
+        s(&torus_file),
         "--edge-length",
         "0.2",
         "--param",
@@ -195,7 +196,7 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
     ]);
     assert!(!out.status.success());
     assert!(
-        text(&out.stderr).contains("not into the plane"),
+        text(&out.stderr).contains("maps closed genus-0 surfaces onto the sphere"),
         "{}",
         text(&out.stderr)
     );

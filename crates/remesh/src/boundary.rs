@@ -43,12 +43,16 @@ pub struct BoundarySamples {
 
 /// Samples the boundary of `chart` (parameter positions `uv`, surface vertex of each
 /// chart vertex `to_original`) with pieces of about `spacing(v)` on the surface near
-/// surface vertex `v` (a chain takes the mean over its vertices).
+/// surface vertex `v` (a chain takes the mean over its vertices). With `keep_corners`,
+/// runs of the surface's own boundary (edges with one copy in the chart) are split at
+/// their corners ([`split_at_corners`]); a chart of part of a surface, whose boundary
+/// the surface goes on across, passes `false`.
 pub fn sample(
     chart: &Mesh,
     uv: &[Complex64],
     to_original: &[VertexId],
     spacing: impl Fn(VertexId) -> f64,
+    keep_corners: bool,
 ) -> BoundarySamples {
     let original = |v: VertexId| to_original[v.idx()];
     let edge_key = |h: HalfedgeId| {
@@ -101,7 +105,7 @@ pub fn sample(
             let last = i + 1 == hs.len();
             if last || is_node(chart.target(h)) {
                 let mut pieces = Vec::new();
-                if single.contains(&edge_key(run[0])) {
+                if keep_corners && single.contains(&edge_key(run[0])) {
                     split_at_corners(chart, &original, &run, &spacing, &mut pieces);
                 } else {
                     pieces.push(run.clone());

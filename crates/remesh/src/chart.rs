@@ -25,6 +25,10 @@ pub enum Opening {
         /// Number of cut edges.
         edges: usize,
     },
+    /// A closed genus-0 surface split into two disks along a loop of edges near the
+    /// equator of its spherical map, each mapped by the stereographic projection from the
+    /// opposite pole ([`crate::two_charts`]); the loop is sampled once for both.
+    TwoCharts,
     /// A closed genus-0 surface slit along the shortest path between two far apart
     /// vertices (a tree, so the surface minus the slit is a disk): `edges` mesh edges.
     Slit {
@@ -34,11 +38,12 @@ pub enum Opening {
 }
 
 impl Opening {
-    /// The stable name in reports: `uncut`, `filled`, `cut-graph` or `slit`.
+    /// The stable name in reports: `uncut`, `filled`, `two-charts`, `cut-graph` or `slit`.
     pub fn name(&self) -> &'static str {
         match self {
             Opening::Uncut => "uncut",
             Opening::Filled { .. } => "filled",
+            Opening::TwoCharts => "two-charts",
             Opening::CutGraph { .. } => "cut-graph",
             Opening::Slit { .. } => "slit",
         }

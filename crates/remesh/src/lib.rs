@@ -56,6 +56,7 @@ pub mod scaffold;
 mod seam_flips;
 pub mod size;
 mod star_relaxation;
+pub mod two_charts;
 
 use std::time::Instant;
 
@@ -192,6 +193,9 @@ fn remesh_with(
     context: &mut Context<'_>,
 ) -> Result<Remeshing, RemeshError> {
     let mut timings = Stopwatch::default();
+    if param::maps_onto_sphere(solver) {
+        return two_charts::remesh(mesh, solver, options, sizes, context);
+    }
     param::planar_target(solver)?;
     let chart = chart::open(mesh, param::keeps_loops(solver))?;
     timings.lap("chart");
@@ -210,9 +214,22 @@ fn remesh_with(
     Ok(out)
 }
 
+/// The remeshed surface built from `soup`, refused unless it has the topology of `mesh`.
+pub(crate) fn assemble(mesh: &Mesh, soup: &PolygonSoup) -> Result<Mesh, RemeshError> {
+    let result = Mesh::from_soup(soup).map_err(|error| RemeshError::Build {
+        what: "remeshed surface",
+        error,
+    })?;
+    let (expected, found) = (describe(mesh), describe(&result));
+    if expected != found {
+        return Err(RemeshError::TopologyChanged { expected, found });
+    }
+    Ok(result)
+}
+
 /// Triangulates the parameter domain of `chart` (positions `uv`), lifts it onto `mesh`
 /// and builds the result.
-fn triangulate_chart(
+pub(crate) fn triangulate_chart(
     mesh: &Mesh,
     chart: &chart::Chart,
     uv: &[num_complex::Complex64],
@@ -224,7 +241,14 @@ fn triangulate_chart(
     let mut timings = Stopwatch::default();
     let planar = domain::planar_mesh(&chart.mesh, uv)?;
     let domain = domain::Domain::new(&chart.mesh, &planar)?;
-    let samples = boundary::sample(&chart.mesh, uv, &chart.to_original, |v| sizes[v.idx()]);
+    let keep_corners = chart.opening != Opening::TwoCharts;
+    let samples = boundary::sample(
+        &chart.mesh,
+        uv,
+        &chart.to_original,
+        |v| sizes[v.idx()],
+        keep_corners,
+    );
     let size_at = |p: &SurfacePoint| {
         let (v, n) = chart.mesh.face_vertex_array(p.face);
         (0..n)
@@ -298,15 +322,7 @@ fn triangulate_chart(
         &surface,
     )?;
     seam_flips::flip_for_angles(&mut faces, &positions, &sizes_out, &surface)?;
-    let soup = PolygonSoup::from_triangles(positions, &faces);
-    let result = Mesh::from_soup(&soup).map_err(|error| RemeshError::Build {
-        what: "remeshed surface",
-        error,
-    })?;
-    let (expected, found) = (describe(mesh), describe(&result));
-    if expected != found {
-        return Err(RemeshError::TopologyChanged { expected, found });
-    }
+    let result = assemble(mesh, &PolygonSoup::from_triangles(positions, &faces))?;
     timings.lap("assemble");
     Ok(Remeshing {
         remeshed: Remeshed {

@@ -42,6 +42,13 @@ pub fn planar_target(solver: &dyn Solver) -> Result<Target<'static>, RemeshError
     })
 }
 
+/// True if `solver` maps onto the sphere and into no planar domain: a closed genus-0
+/// surface is then remeshed in two charts ([`crate::two_charts`]).
+pub fn maps_onto_sphere(solver: &dyn Solver) -> bool {
+    let targets = solver.accepts().targets;
+    targets.contains(&TargetKind::Sphere) && !PLANAR_TARGETS.iter().any(|k| targets.contains(k))
+}
+
 /// True if `solver` maps several boundary loops onto a circle domain, so that a
 /// multiply connected surface needs no cut.
 pub fn keeps_loops(solver: &dyn Solver) -> bool {
@@ -141,7 +148,7 @@ const UNTANGLE_ROUNDS: usize = 100;
 /// unfolds where the neighbourhood's boundary is star-shaped around it), a boundary one
 /// to the midpoint of its two boundary neighbours (straightening a folded boundary),
 /// until no face folds or the rounds run out; the caller checks what is left.
-fn untangle(chart: &Mesh, uv: &mut [Complex64]) {
+pub(crate) fn untangle(chart: &Mesh, uv: &mut [Complex64]) {
     for _ in 0..UNTANGLE_ROUNDS {
         let mut moving: Vec<_> = chart
             .faces()

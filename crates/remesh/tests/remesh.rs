@@ -188,17 +188,31 @@ fn a_torus_closes_up_along_its_seams() {
     let input = mesh(&torus(60, 24, 1.0, 0.35, Cells::Triangles));
     let l = 0.06;
     let result = run(&input, l);
+    let q = closes_up(&input, &result, l, "cut-graph", "genus 1 and no boundary");
+    assert!(q.min_angle > 15.0, "smallest angle {}", q.min_angle);
+}
+
+/// Checks that `result` (of `input` at edge length `l`) was opened by `opening`, has
+/// the topology `topology`, no duplicate vertex (its seams are closed) and a mean edge
+/// within 10% of `l`; returns its quality.
+fn closes_up(
+    input: &Mesh,
+    result: &Remeshing,
+    l: f64,
+    opening: &str,
+    topology: &str,
+) -> quality::Quality {
     let out = &result.remeshed.mesh;
-    assert_eq!(result.opening.name(), "cut-graph");
-    assert_eq!(describe(out), "genus 1 and no boundary");
+    assert_eq!(result.opening.name(), opening);
+    assert_eq!(describe(out), topology);
     assert!(!has_duplicate_vertex(out, 1e-3 * l));
-    let q = quality::measure(&input, out).unwrap();
+    let q = quality::measure(input, out).unwrap();
     assert!(
         (q.edge_mean / l - 1.0).abs() < 0.1,
         "mean edge {}",
         q.edge_mean
     );
-    assert!(q.min_angle > 15.0, "smallest angle {}", q.min_angle);
+    q
 }
 
 #[test]
@@ -265,24 +279,57 @@ fn bad_options_get_errors_naming_the_option() {
 }
 
 #[test]
-fn a_parameterizer_onto_the_sphere_is_refused() {
-    let input = mesh(&icosphere(2));
+fn a_sphere_remeshed_through_its_spherical_map_in_two_charts() {
+    // The icosphere's own vertices are its spherical map (up to the solver's Moebius
+    // normalization), so both charts are stereographic images of round caps: the result
+    // must close up along the shared loop, keep the sphere's shape to second order and
+    // the angle limit.
+    let input = mesh(&icosphere(5));
     let solvers: [&dyn Solver; 1] = [&Sphere];
-    let error = remesh(
+    let l = 0.08;
+    let result = remesh(
         &input,
+        &solvers,
+        &RemeshOptions::with_edge_length(l),
+        &mut Context::new(),
+    )
+    .expect("a closed genus-0 surface is remeshed through its spherical map");
+    let q = closes_up(&input, &result, l, "two-charts", "genus 0 and no boundary");
+    assert!(q.min_angle > 20.0, "smallest angle {}", q.min_angle);
+    let out = &result.remeshed.mesh;
+    let worst = out
+        .faces()
+        .map(|f| (out.face_centroid(f).coords.norm() - 1.0).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 0.5 * l * l,
+        "a face centroid {worst} off the sphere"
+    );
+    for v in out.vertices() {
+        let sp = result.remeshed.on_source[v.idx()];
+        let gap = (sp.position(&input) - out.position(v)).norm();
+        assert!(gap < 1e-12, "vertex {v} is {gap} from its surface point");
+    }
+    // Anything but a closed genus-0 surface is refused, naming its topology.
+    let torus_mesh = mesh(&torus(24, 8, 1.0, 0.4, Cells::Triangles));
+    let error = remesh(
+        &torus_mesh,
         &solvers,
         &RemeshOptions::with_edge_length(0.2),
         &mut Context::new(),
     )
     .unwrap_err();
-    assert!(matches!(
-        error,
-        RemeshError::Parameterizer {
-            solver: "sphere",
-            ..
-        }
-    ));
-    assert!(error.to_string().contains("not into the plane"), "{error}");
+    assert!(
+        matches!(
+            error,
+            RemeshError::Parameterizer {
+                solver: "sphere",
+                ..
+            }
+        ),
+        "{error}"
+    );
+    assert!(error.to_string().contains("genus 1"), "{error}");
 }
 
 #[test]
