@@ -221,6 +221,19 @@ def test_remesh_matches_the_command(cli, hemisphere, tmp_path):
     assert report["min_angle"] >= 20.0
 
 
+def test_remesh_through_the_spherical_map_matches_the_command(cli, tmp_path):
+    spot = MESHES / "spot.obj"
+    out, r = tmp_path / "out.obj", tmp_path / "r.json"
+    cli("remesh", spot, "--edge-length", "0.06", "--param", "sphere", "-o", out, "--report", r)
+    V, F = beltrami.read_mesh(spot)
+    V2, F2, report = beltrami.remesh(V, F, edge_length=0.06, param="sphere", info=True)
+    W, G = beltrami.read_mesh(out)
+    close(V2, W)
+    np.testing.assert_array_equal(F2, G)
+    assert report["opening"] == report_of(r)["opening"] == "two-charts"
+    assert report["topology"] == "genus 0 and no boundary"
+
+
 def test_remesh_in_place_matches_the_command(cli, tmp_path):
     spot = MESHES / "spot.obj"
     out, r = tmp_path / "out.obj", tmp_path / "r.json"
