@@ -138,8 +138,16 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
     let output = dir.path().join("out.obj");
     write_soup(&input, &disk(3));
     write_soup(&torus_file, &torus(24, 8, 1.0, 0.4, Cells::Triangles));
-    let cases: [(&[&str], &str); 13] = [
+    let cases: [(&[&str], &str); 15] = [
         (&["--edge-length", "0"], "edge-length"),
+        (
+            &["--edge-length", "0.1", "--feature-tolerance", "0"],
+            "feature-tolerance",
+        ),
+        (
+            &["--edge-length", "0.1", "--feature-tolerance", "NaN"],
+            "feature-tolerance",
+        ),
         (&["--edge-length", "-0.1"], "edge-length"),
         (&["--edge-length", "NaN"], "edge-length"),
         (&["--edge-length", "inf"], "edge-length"),

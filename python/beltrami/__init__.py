@@ -609,16 +609,27 @@ def remesh(
     min_angle: float = 30.0,
     size_field: str = "uniform",
     max_vertices: int = 5_000_000,
+    feature_tolerance: float = 0.2,
     info: bool = False,
 ) -> Any:
     """A new triangle mesh of the surface with the asked ``edge_length`` (or about
-    ``vertices`` vertices): parameterize (``param``: ``auto`` or a solver), triangulate
-    the parameter domain by constrained Delaunay refinement with angles of at least
-    ``min_angle`` degrees, lift back (docs/remesh.md). Returns ``(V2, F2)``.
+    ``vertices`` vertices): parameterize (``param``: ``auto``, a solver, or ``sphere``
+    for a closed genus-0 surface in two charts), triangulate the parameter domain by
+    constrained Delaunay refinement with angles of at least ``min_angle`` degrees, lift
+    back (docs/remesh.md); input vertices farther than ``feature_tolerance`` times the
+    edge length from the result are inserted (``inf``: none). Returns ``(V2, F2)``.
     ``beltrami remesh``."""
     V, F = _mesh(V, F)
     V2, F2, report = _native.remesh(
-        V, F, edge_length, vertices, param, float(min_angle), size_field, int(max_vertices)
+        V,
+        F,
+        edge_length,
+        vertices,
+        param,
+        float(min_angle),
+        size_field,
+        int(max_vertices),
+        float(feature_tolerance),
     )
     return (V2, F2, json.loads(report)) if info else (V2, F2)
 

@@ -31,7 +31,7 @@ fn mesh_arrays(mesh: &Mesh) -> PyResult<(Array2<f64>, Array2<i64>)> {
 /// `vertices` vertices), made through a parameterization (`beltrami remesh`): returns
 /// the positions, the triangles and the JSON report of `--report`.
 #[pyfunction]
-#[pyo3(signature = (v, f, edge_length=None, vertices=None, param="auto", min_angle=30.0, size_field="uniform", max_vertices=5_000_000))]
+#[pyo3(signature = (v, f, edge_length=None, vertices=None, param="auto", min_angle=30.0, size_field="uniform", max_vertices=5_000_000, feature_tolerance=beltrami_remesh::FEATURE_TOLERANCE))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -43,6 +43,7 @@ pub fn remesh<'py>(
     min_angle: f64,
     size_field: &str,
     max_vertices: usize,
+    feature_tolerance: f64,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, String)> {
     let resolution = match (edge_length, vertices) {
         (Some(l), None) => Resolution::EdgeLength(l),
@@ -69,6 +70,7 @@ pub fn remesh<'py>(
         min_angle,
         size_field,
         max_vertices,
+        feature_tolerance,
     };
     let remesh_error = |e: &beltrami_remesh::RemeshError| errors::from_error(Kind::Solver, e);
     options

@@ -142,6 +142,8 @@ def test_remesh_needs_a_resolution(disk):
         beltrami.remesh(*disk)
     with pytest.raises(beltrami.OptionError, match="min"):
         beltrami.remesh(*disk, edge_length=0.1, min_angle=50.0)
+    with pytest.raises(beltrami.OptionError, match="feature-tolerance"):
+        beltrami.remesh(*disk, edge_length=0.1, feature_tolerance=0.0)
 
 
 def test_cut_to_disk_refuses_a_closed_genus_0_mesh(closed):

@@ -96,9 +96,10 @@ pub struct RemeshArgs {
     #[arg(long = "allow-flips")]
     pub allow_flips: bool,
     /// The parameterizer, any registered solver that maps into the plane (`beltrami
-    /// solvers` lists them), or `auto`: lscm on a disk, on a closed genus-0 surface
-    /// slit open and on any other surface cut to a disk (qcmc for several boundary
-    /// loops when registered), with tutte when the map folds or overlaps.
+    /// solvers` lists them), `sphere` for a closed genus-0 surface (two stereographic
+    /// charts), or `auto`: lscm on a disk, on a closed genus-0 surface slit open, on a
+    /// genus-0 surface with several boundary loops with its holes closed (then qcmc),
+    /// on any other surface cut to a disk, with tutte when the map folds or overlaps.
     #[arg(long, value_name = "NAME", default_value = "auto")]
     pub param: String,
     /// The smallest angle refinement enforces, in degrees (at most 33.8).
@@ -115,6 +116,16 @@ pub struct RemeshArgs {
     /// The most vertices the result may have.
     #[arg(long = "max-vertices", value_name = "N", default_value_t = 5_000_000)]
     pub max_vertices: usize,
+    /// How far the result may pass an input vertex, as a fraction of the edge length,
+    /// before that vertex is inserted (creases and boundary corners kept); `inf` inserts
+    /// none (the asked length on rough input, at the price of the distance).
+    #[arg(
+        long = "feature-tolerance",
+        value_name = "T",
+        default_value_t = beltrami_remesh::FEATURE_TOLERANCE,
+        allow_hyphen_values = true
+    )]
+    pub feature_tolerance: f64,
     /// Output mesh (.obj, .gltf, .glb).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -146,6 +157,7 @@ impl RemeshArgs {
                 SizeFieldArg::Curvature => SizeField::Curvature,
             },
             max_vertices: self.max_vertices,
+            feature_tolerance: self.feature_tolerance,
         }
     }
 }
@@ -205,6 +217,10 @@ fn check_method_flags(args: &RemeshArgs) -> anyhow::Result<()> {
                 given(args.min_angle != 30.0, "--min-angle"),
                 given(args.size_field != SizeFieldArg::Uniform, "--size-field"),
                 given(args.max_vertices != 5_000_000, "--max-vertices"),
+                given(
+                    args.feature_tolerance != beltrami_remesh::FEATURE_TOLERANCE,
+                    "--feature-tolerance",
+                ),
             ]
             .into_iter()
             .flatten()

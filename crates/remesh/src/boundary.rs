@@ -14,7 +14,6 @@ use std::collections::HashMap;
 
 use beltrami_mesh::{HalfedgeId, Mesh, VertexId};
 
-use crate::refine::DEVIATION;
 use num_complex::Complex64;
 
 /// A sample's identity on the surface, shared by all its copies on the boundary.
@@ -43,16 +42,17 @@ pub struct BoundarySamples {
 
 /// Samples the boundary of `chart` (parameter positions `uv`, surface vertex of each
 /// chart vertex `to_original`) with pieces of about `spacing(v)` on the surface near
-/// surface vertex `v` (a chain takes the mean over its vertices). With `keep_corners`,
-/// runs of the surface's own boundary (edges with one copy in the chart) are split at
-/// their corners ([`split_at_corners`]); a chart of part of a surface, whose boundary
-/// the surface goes on across, passes `false`.
+/// surface vertex `v` (a chain takes the mean over its vertices). With a finite
+/// `corner_tolerance` (the feature tolerance relative to the spacing), runs of the
+/// surface's own boundary (edges with one copy in the chart) are split at their corners
+/// ([`split_at_corners`]); a chart of part of a surface, whose boundary the surface goes
+/// on across, passes `f64::INFINITY`.
 pub fn sample(
     chart: &Mesh,
     uv: &[Complex64],
     to_original: &[VertexId],
     spacing: impl Fn(VertexId) -> f64,
-    keep_corners: bool,
+    corner_tolerance: f64,
 ) -> BoundarySamples {
     let original = |v: VertexId| to_original[v.idx()];
     let edge_key = |h: HalfedgeId| {
@@ -105,8 +105,15 @@ pub fn sample(
             let last = i + 1 == hs.len();
             if last || is_node(chart.target(h)) {
                 let mut pieces = Vec::new();
-                if keep_corners && single.contains(&edge_key(run[0])) {
-                    split_at_corners(chart, &original, &run, &spacing, &mut pieces);
+                if corner_tolerance.is_finite() && single.contains(&edge_key(run[0])) {
+                    split_at_corners(
+                        chart,
+                        &original,
+                        &run,
+                        &spacing,
+                        corner_tolerance,
+                        &mut pieces,
+                    );
                 } else {
                     pieces.push(run.clone());
                 }
@@ -158,14 +165,15 @@ fn pieces_of(
 }
 
 /// Splits a run of the surface's own boundary at its vertices until every vertex lies
-/// within the feature tolerance (`DEVIATION h`, [`crate::refine`]) of the chord between
-/// the samples around it (Douglas-Peucker with equal-length samples): the boundary keeps
-/// its corners as the interior keeps its creases.
+/// within `tolerance` times the spacing of the chord between the samples around it
+/// (Douglas-Peucker with equal-length samples): the boundary keeps its corners as the
+/// interior keeps its creases.
 fn split_at_corners(
     chart: &Mesh,
     original: &impl Fn(VertexId) -> VertexId,
     run: &[HalfedgeId],
     spacing: &impl Fn(VertexId) -> f64,
+    tolerance: f64,
     pieces: &mut Vec<Vec<HalfedgeId>>,
 ) {
     let (lengths, total, n) = pieces_of(chart, original, run, spacing);
@@ -207,9 +215,9 @@ fn split_at_corners(
             worst = (gap, j);
         }
     }
-    if worst.0 > DEVIATION {
-        split_at_corners(chart, original, &run[..worst.1], spacing, pieces);
-        split_at_corners(chart, original, &run[worst.1..], spacing, pieces);
+    if worst.0 > tolerance {
+        split_at_corners(chart, original, &run[..worst.1], spacing, tolerance, pieces);
+        split_at_corners(chart, original, &run[worst.1..], spacing, tolerance, pieces);
     } else {
         pieces.push(run.to_vec());
     }

@@ -65,7 +65,7 @@ use beltrami_mesh::{Mesh, PolygonSoup, SurfacePoint};
 
 pub use chart::Opening;
 pub use error::RemeshError;
-pub use options::{MAX_MIN_ANGLE, RemeshOptions, Resolution, SizeField};
+pub use options::{FEATURE_TOLERANCE, MAX_MIN_ANGLE, RemeshOptions, Resolution, SizeField};
 pub use quality::Quality;
 
 /// A remeshed surface and how it was made.
@@ -241,13 +241,17 @@ pub(crate) fn triangulate_chart(
     let mut timings = Stopwatch::default();
     let planar = domain::planar_mesh(&chart.mesh, uv)?;
     let domain = domain::Domain::new(&chart.mesh, &planar)?;
-    let keep_corners = chart.opening != Opening::TwoCharts;
+    let corner_tolerance = if chart.opening == Opening::TwoCharts {
+        f64::INFINITY
+    } else {
+        options.feature_tolerance
+    };
     let samples = boundary::sample(
         &chart.mesh,
         uv,
         &chart.to_original,
         |v| sizes[v.idx()],
-        keep_corners,
+        corner_tolerance,
     );
     let size_at = |p: &SurfacePoint| {
         let (v, n) = chart.mesh.face_vertex_array(p.face);
@@ -278,6 +282,7 @@ pub(crate) fn triangulate_chart(
         &size_at,
         options.min_angle,
         options.max_vertices,
+        options.feature_tolerance,
         parameterizer,
         context,
     )?;
@@ -319,6 +324,7 @@ pub(crate) fn triangulate_chart(
         &mut positions,
         &mut on_source,
         &sizes_out,
+        options.feature_tolerance,
         &surface,
     )?;
     seam_flips::flip_for_angles(&mut faces, &positions, &sizes_out, &surface)?;

@@ -10,6 +10,10 @@ use crate::RemeshError;
 /// it may insert vertices forever.
 pub const MAX_MIN_ANGLE: f64 = 33.8;
 
+/// The default feature tolerance, relative to the asked edge length (see
+/// [`RemeshOptions::feature_tolerance`]).
+pub const FEATURE_TOLERANCE: f64 = 0.2;
+
 /// How long the edges of the result should be.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Resolution {
@@ -47,6 +51,13 @@ pub struct RemeshOptions {
     pub size_field: SizeField,
     /// The most vertices the result may have (a guard against a too small edge length).
     pub max_vertices: usize,
+    /// How far, relative to the asked edge length `h`, the result may pass an input
+    /// vertex before that vertex is inserted and held (a crease or spike thinner than
+    /// the edge length is kept instead of cut off; the boundary keeps its corners the
+    /// same way). Default [`FEATURE_TOLERANCE`]; smaller follows the input more closely
+    /// with more vertices, `f64::INFINITY` inserts none and keeps the asked length on
+    /// rough input at the price of the distance.
+    pub feature_tolerance: f64,
 }
 
 impl Default for RemeshOptions {
@@ -56,6 +67,7 @@ impl Default for RemeshOptions {
             min_angle: 30.0,
             size_field: SizeField::Uniform,
             max_vertices: 5_000_000,
+            feature_tolerance: FEATURE_TOLERANCE,
         }
     }
 }
@@ -92,6 +104,15 @@ impl RemeshOptions {
                 option: "min-angle",
                 message: format!(
                     "must lie in (0, {MAX_MIN_ANGLE}] degrees, got {a}: Delaunay refinement cannot guarantee a larger smallest angle"
+                ),
+            });
+        }
+        let t = self.feature_tolerance;
+        if t.is_nan() || t <= 0.0 {
+            return Err(RemeshError::InvalidOption {
+                option: "feature-tolerance",
+                message: format!(
+                    "must be > 0 (a fraction of the edge length, or inf for none), got {t}"
                 ),
             });
         }

@@ -15,7 +15,7 @@
 //!    the surface by `s`, the parameter edges come out `s` times shorter.
 //!    Then every vertex of the input whose distance to the piecewise linear
 //!    interpolation of the lifted triangulation at its parameter point exceeds
-//!    `DEVIATION h` is inserted itself (both surfaces are piecewise linear over the
+//!    `t h` (`t` the feature tolerance, default 0.2) is inserted itself (both surfaces are piecewise linear over the
 //!    parameter domain, so their distance is largest at a vertex of either or at a
 //!    crossing of their edges): a spike or crease thinner than the edge length is kept
 //!    instead of cut off, which bounds the Hausdorff distance. Such vertices are not
@@ -54,10 +54,6 @@ use crate::domain::{Domain, cross};
 /// Longest lifted edge, relative to the asked length, that is not split.
 const ALPHA: f64 = 1.65;
 
-/// Largest distance, relative to the asked length, between an input vertex and the
-/// interpolated result over its parameter point, before the vertex is inserted.
-pub(crate) const DEVIATION: f64 = 0.2;
-
 /// Size passes at most (each splits every face that is too large).
 const MAX_PASSES: usize = 40;
 
@@ -87,7 +83,9 @@ type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 /// Triangulates and refines the domain (module docs). `size(p)` is the asked edge
 /// length at surface point `p` of the chart; `min_angle` in degrees. `inner` lists the
-/// interior vertices of the chart as their parameter point and surface position.
+/// interior vertices of the chart as their parameter point and surface position;
+/// `tolerance` is the feature tolerance relative to the asked length (the module docs'
+/// `0.2`, [`crate::RemeshOptions::feature_tolerance`]).
 #[allow(clippy::too_many_arguments)]
 pub fn triangulate(
     domain: &Domain<'_>,
@@ -96,6 +94,7 @@ pub fn triangulate(
     size: &impl Fn(&SurfacePoint) -> f64,
     min_angle: f64,
     max_vertices: usize,
+    tolerance: f64,
     solver: &'static str,
     context: &mut Context<'_>,
 ) -> Result<Triangulation, RemeshError> {
@@ -156,7 +155,7 @@ pub fn triangulate(
         wanted.sort_by(|a, b| b.0.total_cmp(&a.0));
         let mut inserted = insert_all(&mut cdt, &mut tri, domain, size, wanted, false)?;
         if inserted == 0 {
-            let features = deviating(&cdt, &tri, inner);
+            let features = deviating(&cdt, &tri, inner, tolerance);
             inserted = insert_all(&mut cdt, &mut tri, domain, size, features, true)?;
         }
         if tri.uv.len() > max_vertices {
@@ -184,7 +183,7 @@ pub fn triangulate(
     // passes, so the interpolation between them can leave the input again: check anew,
     // insert what deviates, restore the angles and smooth once more.
     for _ in 0..FEATURE_ROUNDS {
-        let features = deviating(&cdt, &tri, inner);
+        let features = deviating(&cdt, &tri, inner, tolerance);
         if insert_all(&mut cdt, &mut tri, domain, size, features, true)? == 0 {
             break;
         }
@@ -408,13 +407,14 @@ fn insert_all(
     Ok(inserted)
 }
 
-/// Input vertices farther than `DEVIATION h` from the interpolated result at their
+/// Input vertices farther than `tolerance h` from the interpolated result at their
 /// parameter point (module docs), as (the radius of the closeness test of
 /// [`insert_all`], point), farthest first.
 fn deviating(
     cdt: &Cdt,
     tri: &Triangulation,
     inner: &[(Complex64, Point3<f64>)],
+    tolerance: f64,
 ) -> Vec<(f64, Complex64)> {
     use spade::PositionInTriangulation as P;
     let mut out: Vec<(f64, f64, Complex64)> = Vec::new();
@@ -435,7 +435,7 @@ fn deviating(
             + tri.position[idx[2]].coords * l2;
         let h = idx.iter().map(|&i| tri.size[i]).sum::<f64>() / 3.0;
         let deviation = (p.coords - interpolated).norm();
-        if deviation > DEVIATION * h {
+        if deviation > tolerance * h {
             let r = (0..3)
                 .map(|k| (z[k] - q).norm())
                 .fold(f64::INFINITY, f64::min);

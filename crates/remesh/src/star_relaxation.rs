@@ -9,16 +9,16 @@
 //! the input (the closest point of the input surface, exact on it); the move is kept
 //! when it raises the smallest angle of the vertex's faces and turns none of them over
 //! (each new face normal has a positive dot product with the old one), and when every
-//! input vertex that the star held within the feature tolerance (`DEVIATION h`, see
-//! [`crate::refine`]) stays within it: a move must not cut off a crease that the
-//! refinement kept.
+//! input vertex that the star held within the feature tolerance (`t h`, see
+//! [`crate::RemeshOptions::feature_tolerance`]) stays within it: a move must not cut off
+//! a crease that the refinement kept.
 
 use beltrami_mesh::{Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
 use beltrami_spatial::closest_point::closest_on_triangle;
 
 use crate::RemeshError;
-use crate::refine::{DEVIATION, smallest_sine};
+use crate::refine::smallest_sine;
 
 /// Smallest angle, in degrees, below which a face's vertices are moved. At 20 (the
 /// refinement's limit) the eight shared meshes of the pymeshlab comparison ended at
@@ -32,13 +32,15 @@ const SWEEPS: usize = 4;
 
 /// Relaxes the vertices of the faces `faces` (triangles, indices into `positions`)
 /// whose smallest angle is below [`ANGLE_LIMIT`] (module docs); `on_source` follows
-/// every move; `sizes[v]` is the asked edge length at vertex `v`, which sets its feature
-/// tolerance. Boundary vertices stay. Returns the moves made.
+/// every move; `sizes[v]` is the asked edge length at vertex `v`, and `tolerance` times
+/// it its feature tolerance (an infinite one guards nothing). Boundary vertices stay.
+/// Returns the moves made.
 pub fn relax_worst_stars(
     faces: &[[u32; 3]],
     positions: &mut [Point3<f64>],
     on_source: &mut [SurfacePoint],
     sizes: &[f64],
+    tolerance: f64,
     surface: &SurfaceIndex<'_>,
 ) -> Result<usize, RemeshError> {
     let n = positions.len();
@@ -112,7 +114,7 @@ pub fn relax_worst_stars(
                         &star[v],
                         positions,
                         (v, old),
-                        DEVIATION * sizes[v],
+                        tolerance * sizes[v],
                         surface,
                     )?
                 {
@@ -142,6 +144,9 @@ fn keeps_features(
     tolerance: f64,
     surface: &SurfaceIndex<'_>,
 ) -> Result<bool, RemeshError> {
+    if !tolerance.is_finite() {
+        return Ok(true);
+    }
     let corners = |g: usize, moved: bool| {
         faces[g].map(|i| {
             let i = i as usize;
@@ -204,8 +209,15 @@ mod tests {
                 .fold(f64::INFINITY, f64::min)
         };
         assert!(smallest(&positions) < ANGLE_LIMIT.to_radians().sin());
-        let moves =
-            relax_worst_stars(&faces, &mut positions, &mut on_source, &[0.5; 7], &index).unwrap();
+        let moves = relax_worst_stars(
+            &faces,
+            &mut positions,
+            &mut on_source,
+            &[0.5; 7],
+            0.2,
+            &index,
+        )
+        .unwrap();
         assert!(moves >= 1);
         // The centroid of the ring is the centre: equilateral faces again, on the plane.
         assert!((positions[6] - Point3::new(0.0, 0.0, 1.0)).norm() < 1e-12);

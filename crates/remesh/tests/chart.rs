@@ -62,7 +62,7 @@ fn both_copies_of_a_seam_point_share_one_vertex() {
         .iter()
         .map(|p| Complex64::new(p.x, p.y))
         .collect();
-    let samples = sample(&chart.mesh, &uv, &chart.to_original, |_| 0.1, true);
+    let samples = sample(&chart.mesh, &uv, &chart.to_original, |_| 0.1, 0.2);
     // Every seam point of a torus cut along a figure-eight is on two sides of the
     // square, except the crossing, which is its four corners.
     let mut uses = vec![0usize; samples.vertex_count];

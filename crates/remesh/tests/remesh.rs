@@ -276,6 +276,18 @@ fn bad_options_get_errors_naming_the_option() {
             other => panic!("{resolution:?}, {min_angle}: expected an option error, got {other:?}"),
         }
     }
+    for tolerance in [0.0, -0.2, f64::NAN] {
+        let options = RemeshOptions {
+            feature_tolerance: tolerance,
+            ..RemeshOptions::with_edge_length(0.1)
+        };
+        match remesh(&input, &solvers, &options, &mut Context::new()) {
+            Err(RemeshError::InvalidOption { option, .. }) => {
+                assert_eq!(option, "feature-tolerance")
+            }
+            other => panic!("tolerance {tolerance}: expected an option error, got {other:?}"),
+        }
+    }
 }
 
 #[test]
@@ -366,11 +378,11 @@ fn two_components_are_refused() {
 #[test]
 fn every_input_vertex_of_a_rough_surface_stays_within_the_feature_tolerance() {
     // Ripples of wavelength 0.07 and height up to 0.02 (0.4 h) on a flat boundary: a
-    // chord of length h = 0.05 cuts them off unless their vertices are inserted
-    // (refine.rs: an input vertex farther than 0.2 h from the interpolated result over
-    // its parameter point is inserted and held). The smoothing moves the neighbours of
-    // the inserted vertices, so the check must hold for the final mesh, not only where
-    // the size passes end.
+    // chord of length h = 0.05 cuts them off unless their vertices are inserted (an
+    // input vertex farther than t h from the interpolated result over its parameter
+    // point is inserted and held, t the feature tolerance, 0.2 by default). The
+    // smoothing moves the neighbours of the inserted vertices, so the check must hold
+    // for the final mesh, not only where the size passes end.
     let input = mesh(&mapped(
         jittered_grid(48, 48, Cells::Triangles, 0.3, 11),
         |p| {
@@ -380,18 +392,34 @@ fn every_input_vertex_of_a_rough_surface_stays_within_the_feature_tolerance() {
         },
     ));
     let l = 0.05;
-    let result = run(&input, l);
-    let out = &result.remeshed.mesh;
-    let index = beltrami_spatial::SurfaceIndex::new(out).unwrap();
-    let worst = input
-        .vertices()
-        .filter(|&v| !input.is_boundary_vertex(v))
-        .map(|v| index.locate(&input.position(v)).unwrap().distance)
-        .fold(0.0, f64::max);
+    let farthest = |tolerance: f64| {
+        let solvers: [&dyn Solver; 2] = [&Lscm, &Tutte];
+        let options = RemeshOptions {
+            feature_tolerance: tolerance,
+            ..RemeshOptions::with_edge_length(l)
+        };
+        let result = remesh(&input, &solvers, &options, &mut Context::new()).unwrap();
+        let out = &result.remeshed.mesh;
+        let index = beltrami_spatial::SurfaceIndex::new(out).unwrap();
+        input
+            .vertices()
+            .filter(|&v| !input.is_boundary_vertex(v))
+            .map(|v| index.locate(&input.position(v)).unwrap().distance)
+            .fold(0.0, f64::max)
+            / l
+    };
+    for tolerance in [0.2, 0.1] {
+        let worst = farthest(tolerance);
+        assert!(
+            worst <= tolerance * (1.0 + 1e-9),
+            "tolerance {tolerance}: an input vertex is {worst} h from the result"
+        );
+    }
+    // Without features the ripples are cut off.
+    let worst = farthest(f64::INFINITY);
     assert!(
-        worst <= 0.2 * l * (1.0 + 1e-9),
-        "an input vertex is {worst} from the result, {} h",
-        worst / l
+        worst > 0.2,
+        "no features: the farthest input vertex is {worst} h away"
     );
 }
 
