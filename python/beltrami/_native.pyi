@@ -40,6 +40,7 @@ def remesh(
     min_angle: float = 30.0,
     size_field: str = "uniform",
     max_vertices: int = 5000000,
+    feature_tolerance: float = 0.2,
 ) -> Tuple[Floats, Ints, str]: ...
 def remesh_in_place(
     v: Floats,

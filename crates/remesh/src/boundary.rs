@@ -177,32 +177,34 @@ fn split_at_corners(
     pieces: &mut Vec<Vec<HalfedgeId>>,
 ) {
     let (lengths, total, n) = pieces_of(chart, original, run, spacing);
-    let at = |s: f64| {
-        let mut before = 0.0;
-        for (k, &h) in run.iter().enumerate() {
-            if before + lengths[k] >= s || k + 1 == run.len() {
-                let t = if lengths[k] > 0.0 {
-                    ((s - before) / lengths[k]).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                let (a, b) = (
-                    chart.position(chart.origin(h)),
-                    chart.position(chart.target(h)),
-                );
-                return a + (b - a) * t;
-            }
-            before += lengths[k];
-        }
-        chart.position(chart.origin(run[0]))
-    };
     let step = total / n as f64;
+    // The samples, in one sweep along the run.
+    let mut samples = Vec::with_capacity(n + 1);
+    let (mut edge, mut before) = (0, 0.0);
+    for k in 0..=n {
+        let s = step * k as f64;
+        while edge + 1 < run.len() && before + lengths[edge] < s {
+            before += lengths[edge];
+            edge += 1;
+        }
+        let t = if lengths[edge] > 0.0 {
+            ((s - before) / lengths[edge]).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let h = run[edge];
+        let (a, b) = (
+            chart.position(chart.origin(h)),
+            chart.position(chart.target(h)),
+        );
+        samples.push(a + (b - a) * t);
+    }
     let mut worst = (0.0, 0);
     let mut arc = 0.0;
     for j in 1..run.len() {
         arc += lengths[j - 1];
         let k = ((arc / step).floor() as usize).min(n - 1);
-        let (a, b) = (at(k as f64 * step), at((k + 1) as f64 * step));
+        let (a, b) = (samples[k], samples[k + 1]);
         let p = chart.position(chart.origin(run[j]));
         let ab = b - a;
         let t = if ab.norm_squared() > 0.0 {

@@ -127,16 +127,27 @@ pub fn parameterize(
         })?
         .to_vec();
     let mut uv = uv;
-    untangle(chart, &mut uv);
-    let mut flipped = chart.faces().filter(|&f| signed_area(chart, &uv, f) <= 0.0);
-    if let Some(first) = flipped.next() {
-        return Err(RemeshError::Flipped {
-            solver: solver.name(),
+    one_to_one(chart, &mut uv, solver.name())?;
+    Ok(uv)
+}
+
+/// Repairs the few folded faces of the map `uv` of `chart` ([`untangle`]) and refuses
+/// it, naming `solver` and the first face, when some still fold.
+pub(crate) fn one_to_one(
+    chart: &Mesh,
+    uv: &mut [Complex64],
+    solver: &'static str,
+) -> Result<(), RemeshError> {
+    untangle(chart, uv);
+    let mut flipped = chart.faces().filter(|&f| signed_area(chart, uv, f) <= 0.0);
+    match flipped.next() {
+        Some(first) => Err(RemeshError::Flipped {
+            solver,
             flipped: 1 + flipped.count(),
             first,
-        });
+        }),
+        None => Ok(()),
     }
-    Ok(uv)
 }
 
 /// Rounds of [`untangle`] at most.
@@ -148,7 +159,7 @@ const UNTANGLE_ROUNDS: usize = 100;
 /// unfolds where the neighbourhood's boundary is star-shaped around it), a boundary one
 /// to the midpoint of its two boundary neighbours (straightening a folded boundary),
 /// until no face folds or the rounds run out; the caller checks what is left.
-pub(crate) fn untangle(chart: &Mesh, uv: &mut [Complex64]) {
+fn untangle(chart: &Mesh, uv: &mut [Complex64]) {
     for _ in 0..UNTANGLE_ROUNDS {
         let mut moving: Vec<_> = chart
             .faces()

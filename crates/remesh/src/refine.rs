@@ -15,9 +15,9 @@
 //!    the surface by `s`, the parameter edges come out `s` times shorter.
 //!    Then every vertex of the input whose distance to the piecewise linear
 //!    interpolation of the lifted triangulation at its parameter point exceeds
-//!    `t h` (`t` the feature tolerance, default 0.2) is inserted itself (both surfaces are piecewise linear over the
-//!    parameter domain, so their distance is largest at a vertex of either or at a
-//!    crossing of their edges): a spike or crease thinner than the edge length is kept
+//!    `t h` (`t` the feature tolerance, default 0.2) is inserted itself (both surfaces
+//!    are piecewise linear over the parameter domain, so their distance is largest at a
+//!    vertex of either or at a crossing of their edges): a spike or crease thinner than the edge length is kept
 //!    instead of cut off, which bounds the Hausdorff distance. Such vertices are not
 //!    moved by the smoothing.
 //! 3. spade's refinement with the angle limit, constraint edges kept (a seam must not be
@@ -170,14 +170,16 @@ pub fn triangulate(
 
     refine_angles(&mut cdt, &mut tri, domain, size, min_angle, max_vertices)?;
 
-    let boundary = samples.points.len();
-    for _ in 0..SMOOTHING_ROUNDS {
+    let smooth_round = |cdt: &Cdt, tri: &mut Triangulation| {
         if context.is_cancelled() {
             return Err(RemeshError::Cancelled);
         }
-        tri.faces = faces_of(&cdt);
-        smooth(&mut tri, boundary, domain, size)?;
-        cdt = load(&tri.uv, &samples.edges, solver)?;
+        tri.faces = faces_of(cdt);
+        smooth(tri, samples.points.len(), domain, size)?;
+        load(&tri.uv, &samples.edges, solver)
+    };
+    for _ in 0..SMOOTHING_ROUNDS {
+        cdt = smooth_round(&cdt, &mut tri)?;
     }
     // The smoothing moves the neighbours of the feature vertices chosen during the size
     // passes, so the interpolation between them can leave the input again: check anew,
@@ -188,9 +190,7 @@ pub fn triangulate(
             break;
         }
         refine_angles(&mut cdt, &mut tri, domain, size, min_angle, max_vertices)?;
-        tri.faces = faces_of(&cdt);
-        smooth(&mut tri, boundary, domain, size)?;
-        cdt = load(&tri.uv, &samples.edges, solver)?;
+        cdt = smooth_round(&cdt, &mut tri)?;
     }
     tri.faces = faces_of(&cdt);
     for _ in 0..FLIP_SWEEPS {

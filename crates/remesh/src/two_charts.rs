@@ -71,27 +71,32 @@ pub fn remesh(
         // chords; local Tutte steps repair it as for any parameterizer. The samples of
         // the shared loop stay where they were on the surface (the lift keeps an edge's
         // parameter), so the two disks still meet.
-        param::untangle(&half, &mut uv);
-        if let Some(first) = half
-            .faces()
-            .find(|&f| param::signed_area(&half, &uv, f) <= 0.0)
-        {
-            return Err(RemeshError::Flipped {
-                solver: solver.name(),
-                flipped: half
-                    .faces()
-                    .filter(|&f| param::signed_area(&half, &uv, f) <= 0.0)
-                    .count(),
-                first: FaceId(faces[first.idx()].0),
-            });
-        }
+        param::one_to_one(&half, &mut uv, solver.name()).map_err(|error| match error {
+            RemeshError::Flipped {
+                solver,
+                flipped,
+                first,
+            } => RemeshError::Flipped {
+                solver,
+                flipped,
+                first: faces[first.idx()],
+            },
+            other => other,
+        })?;
         let chart = Chart {
-            mesh: half.clone(),
+            mesh: half,
             to_original,
             opening: Opening::TwoCharts,
         };
-        let result =
-            crate::triangulate_chart(&half, &chart, &uv, solver.name(), options, sizes, context)?;
+        let result = crate::triangulate_chart(
+            &chart.mesh,
+            &chart,
+            &uv,
+            solver.name(),
+            options,
+            sizes,
+            context,
+        )?;
         halves.push((result, faces));
     }
     weld(mesh, halves)
