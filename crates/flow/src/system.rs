@@ -38,7 +38,7 @@
 
 use beltrami_core::SolverError;
 use beltrami_fem::assembly::Pattern;
-use beltrami_fem::solve::amd_order;
+use beltrami_fem::solve::fill_reducing_order;
 use beltrami_fem::{DofBuilder, DofMap, Elements, SolveOptions, SpdSolver};
 use beltrami_mesh::{FaceId, Point3, Vector3, VertexId};
 use faer::MatMut;
@@ -448,7 +448,8 @@ impl FlowSystem {
     }
 }
 
-/// An elimination order of the unknowns: AMD on the graph of the vertices (an edge per
+/// An elimination order of the unknowns: `fill_reducing_order` of the graph of the
+/// vertices (AMD, or nested dissection on large regular meshes; an edge per
 /// triangle side), the unknowns that move one vertex only with their vertex, the shared
 /// ones (offsets, coupled to a whole curve) last in increasing order. Ordering the
 /// vertex graph is about four times cheaper than the unknowns' graph, and keeps each
@@ -465,7 +466,7 @@ fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<Vec<usize>, S
         }
     }
     let graph = Pattern::new(nv, nv, &positions)?;
-    let vertices = amd_order(graph.symbolic().as_ref())?;
+    let vertices = fill_reducing_order(graph.symbolic().as_ref())?;
     let shared: Vec<bool> = (0..n)
         .map(|j| dofs.unknown_nodes(j).is_some_and(|nodes| nodes.count() > 1))
         .collect();

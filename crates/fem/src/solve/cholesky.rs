@@ -5,7 +5,7 @@
 //! on every call; iterative solvers refactor the same pattern every step, so this
 //! wrapper keeps both and calls the low-level `SymbolicCholesky::factorize_numeric_llt`.
 
-use super::SolveError;
+use super::{NESTED_DISSECTION_FROM, SolveError, fill_reducing_order};
 use crate::dof::Scalar;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -40,13 +40,23 @@ pub(super) struct Cholesky<T: Scalar> {
 }
 
 impl<T: Scalar> Cholesky<T> {
-    /// Symbolic analysis (AMD ordering, elimination tree, supernodes) of `pattern`
-    /// (square; only its lower triangle matters).
+    /// Symbolic analysis (fill-reducing order, elimination tree, supernodes) of
+    /// `pattern` (square; only its lower triangle matters). The order is
+    /// [`fill_reducing_order`]'s; below [`NESTED_DISSECTION_FROM`] rows that is AMD,
+    /// left to faer.
     pub(super) fn new(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         par: Par,
     ) -> Result<Self, SolveError> {
-        Self::with_ordering(pattern, None, par)
+        if pattern.nrows() < NESTED_DISSECTION_FROM {
+            return Self::with_ordering(pattern, None, par);
+        }
+        let forward = fill_reducing_order(pattern)?;
+        let mut inverse = vec![0; forward.len()];
+        for (k, &i) in forward.iter().enumerate() {
+            inverse[i] = k;
+        }
+        Self::with_ordering(pattern, Some((&forward, &inverse)), par)
     }
 
     /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row

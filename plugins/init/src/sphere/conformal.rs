@@ -64,7 +64,7 @@
 //! drifting along the Moebius group (each solve's discretization error is not invariant
 //! under it).
 
-use beltrami_fem::solve::amd_order;
+use beltrami_fem::solve::fill_reducing_order;
 use beltrami_fem::{EdgeWeights, SolveError, SolveOptions, SpdSolver};
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector3, VertexId};
 use faer::Mat;
@@ -74,7 +74,8 @@ use num_complex::Complex64;
 
 use super::inverse_stereographic;
 
-/// The approximate minimum degree elimination order of the vertex graph of `weights`
+/// The fill-reducing elimination order (`fill_reducing_order`) of the vertex graph of
+/// `weights`
 /// (the pattern of the cotangent Laplacian), shared by the three systems of the
 /// conformal start: eliminating a subset in the order of the whole keeps the fill low
 /// (the separators of the whole graph restricted to the subset).
@@ -89,7 +90,7 @@ pub(super) fn vertex_order(weights: &EdgeWeights) -> Result<Vec<usize>, SolveErr
     }
     let pattern = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
         .map_err(|_| SolveError::Faer(FaerError::IndexOverflow))?;
-    amd_order(pattern.symbolic())
+    fill_reducing_order(pattern.symbolic())
 }
 
 /// The discrete harmonic map of `mesh` with the vertices of face `removed` fixed at a
