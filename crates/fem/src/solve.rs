@@ -894,16 +894,27 @@ const AMD_STRUGGLES: f64 = 15.0;
 /// AMD ([`amd_order`]), unless the pattern has at least [`NESTED_DISSECTION_FROM`] rows
 /// and AMD's own operation count says its factor is expensive for the size
 /// (`flops >= 15 n^(3/2)`, the growth of a planar mesh's factor under a poor order):
-/// then [`nested_dissection_order`]. On large meshes with regular structure (generated
+/// then [`nested_dissection_order`], computed on a second thread meanwhile. On large
+/// meshes with regular structure (generated
 /// disks and grids, subdivided scans) that halves the operations of the numeric
 /// factorization; on scans at their original resolution AMD stays ahead.
 pub fn fill_reducing_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<Vec<usize>, SolveError> {
     let n = pattern.nrows();
-    let (order, flops) = amd_order_with_count(pattern)?;
-    if n >= NESTED_DISSECTION_FROM && flops >= AMD_STRUGGLES * (n as f64).powf(1.5) {
-        nested_dissection_order(pattern)
+    if n < NESTED_DISSECTION_FROM {
+        return amd_order(pattern);
+    }
+    // Both orders are computed at once (on a second core where there is one), so the
+    // choice costs the longer of the two instead of their sum.
+    let (amd, nested) = std::thread::scope(|scope| {
+        let nested = scope.spawn(|| nested_dissection_order(pattern));
+        (amd_order_with_count(pattern), nested.join())
+    });
+    let (order, flops) = amd?;
+    if flops >= AMD_STRUGGLES * (n as f64).powf(1.5) {
+        // A panic in the ordering thread is a bug; pass it on as one.
+        nested.unwrap_or_else(|panic| std::panic::resume_unwind(panic))
     } else {
         Ok(order)
     }

@@ -210,31 +210,67 @@ impl Dissection<'_> {
     /// sets run across the diameter instead of around one end, which suits elongated
     /// parts). The one with the fewest vertices after thinning is taken among those
     /// that leave neither side more than [`BALANCE`] of the part.
-    fn best_cut(&self, from_u: &Levels, from_v: &Levels, total: usize) -> Cut {
+    fn best_cut(&self, id: u32, from_u: &Levels, from_v: &Levels, total: usize) -> Cut {
         let depth_u = from_u.starts.len() - 2;
         let depth_v = from_v.starts.len() - 2;
         let keys = [Key::U, Key::V, Key::Difference(depth_v as u32)];
         let ranges = [depth_u + 1, depth_v + 1, depth_u + depth_v + 1];
-        // Per key: vertices per value, and per band start the band's vertices that
-        // keep a neighbour on each side (those thinning leaves in the separator).
+        let key_of = |w: usize| {
+            let (d_u, d_v) = (self.distance_u[w], self.distance_v[w]);
+            [d_u, d_v, d_u + depth_v as u32 - d_v]
+        };
+        // Vertices per key value, then the band starts that leave neither side empty
+        // nor larger than the limit.
         let mut counts: Vec<Vec<usize>> = ranges.iter().map(|&r| vec![0; r]).collect();
+        for &v in &from_u.queue {
+            for (count, k) in counts.iter_mut().zip(key_of(v)) {
+                count[k as usize] += 1;
+            }
+        }
+        let limit = (BALANCE * total as f64) as usize;
+        let balanced: Vec<Vec<bool>> = keys
+            .iter()
+            .zip(&counts)
+            .map(|(key, count)| {
+                let width = key.width();
+                let mut before = 0;
+                (0..count.len())
+                    .map(|start| {
+                        let band: usize =
+                            count[start..(start + width).min(count.len())].iter().sum();
+                        let after = total - before - band;
+                        let ok = before > 0 && after > 0 && before <= limit && after <= limit;
+                        before += count[start];
+                        ok
+                    })
+                    .collect()
+            })
+            .collect();
+        // Per balanced band start, the band's vertices that keep a neighbour on each
+        // side (those thinning leaves in the separator); only vertices in some
+        // balanced band are looked at.
         let mut kept: Vec<Vec<usize>> = ranges.iter().map(|&r| vec![0; r]).collect();
         for &v in &from_u.queue {
-            let key = |w: usize| {
-                let (d_u, d_v) = (self.distance_u[w], self.distance_v[w]);
-                [d_u, d_v, d_u + depth_v as u32 - d_v]
+            let own = key_of(v);
+            let in_band = |i: usize| {
+                let k = own[i] as usize;
+                (k.saturating_sub(keys[i].width() - 1)..=k).any(|start| balanced[i][start])
             };
-            let own = key(v);
+            if !(0..3).any(in_band) {
+                continue;
+            }
             let (mut low, mut high) = (own, own);
             for &w in self.graph.neighbours(v) {
-                for (i, k) in key(w).into_iter().enumerate() {
+                if self.part[w] != id {
+                    continue;
+                }
+                for (i, k) in key_of(w).into_iter().enumerate() {
                     low[i] = low[i].min(k);
                     high[i] = high[i].max(k);
                 }
             }
             for (i, key) in keys.iter().enumerate() {
                 let k = own[i] as usize;
-                counts[i][k] += 1;
                 let width = key.width();
                 let first = k.saturating_sub(width - 1);
                 for (start, kept) in kept[i][first..=k].iter_mut().enumerate() {
@@ -245,21 +281,10 @@ impl Dissection<'_> {
                 }
             }
         }
-        let limit = (BALANCE * total as f64) as usize;
         let mut best: Option<(Cut, usize)> = None;
         for (i, &key) in keys.iter().enumerate() {
-            let width = key.width();
-            let mut before = 0;
-            for start in 0..counts[i].len().saturating_sub(width) {
-                let band: usize = counts[i][start..start + width].iter().sum();
-                let after = total - before - band;
-                let size = kept[i][start];
-                if before > 0
-                    && after > 0
-                    && before <= limit
-                    && after <= limit
-                    && best.is_none_or(|(_, s)| size < s)
-                {
+            for (start, &size) in kept[i].iter().enumerate() {
+                if balanced[i][start] && best.is_none_or(|(_, s)| size < s) {
                     best = Some((
                         Cut {
                             key,
@@ -268,7 +293,6 @@ impl Dissection<'_> {
                         size,
                     ));
                 }
-                before += counts[i][start];
             }
         }
         best.map_or_else(
@@ -389,7 +413,7 @@ impl Dissection<'_> {
             std::mem::swap(&mut self.distance_u, &mut self.distance_v);
         }
         let total = levels.queue.len();
-        let cut = self.best_cut(&levels, &far, total);
+        let cut = self.best_cut(id, &levels, &far, total);
         let (a_id, b_id, s_id) = (self.fresh_part(), self.fresh_part(), self.fresh_part());
         let mut a = Vec::new();
         let mut b = Vec::new();

@@ -15,14 +15,13 @@
 //! Positions are read as `f64` (tobj's `use_f64` feature). Texture coordinates are kept
 //! per face corner when every face corner names one.
 
-use std::fmt::Write as _;
 use std::io::Write as _;
 use std::path::Path;
 
 use nalgebra::{Point3, Vector2};
 
 use super::{RawMesh, ReadError, VertexAttributes, WriteError};
-use crate::{Mesh, PolygonSoup};
+use crate::{FaceId, Mesh, PolygonSoup};
 
 /// Reads an OBJ file. See the module docs for what is kept.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
@@ -319,6 +318,7 @@ pub fn write(
     let slots = super::slots::OutputSlots::new(mesh);
     let position = slots.positions(mesh, attributes);
     let uv = attributes.uvs.map(|u| slots.scatter(u));
+    let faces: Vec<FaceId> = mesh.faces().collect();
     super::write_atomically(path, |w| {
         writeln!(
             w,
@@ -326,29 +326,131 @@ pub fn write(
             slots.len(),
             mesh.face_count()
         )?;
-        for p in &position {
-            writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
-        }
+        write_lines(w, position.len(), |i, line| {
+            let p = &position[i];
+            writeln!(line, "v {} {} {}", p.x, p.y, p.z)
+        })?;
         if let Some(uv) = &uv {
-            for t in uv {
-                writeln!(w, "vt {} {}", t.x, t.y)?;
-            }
+            write_lines(w, uv.len(), |i, line| {
+                writeln!(line, "vt {} {}", uv[i].x, uv[i].y)
+            })?;
         }
-        let mut line = String::new();
-        for f in mesh.faces() {
-            line.clear();
-            line.push('f');
-            for v in mesh.face_vertices(f) {
+        write_lines(w, faces.len(), |i, line| {
+            line.push(b'f');
+            for v in mesh.face_vertices(faces[i]) {
                 let k = slots.slot(v) + 1;
-                // Writing into a String cannot fail.
-                let _ = if uv.is_some() {
-                    write!(line, " {k}/{k}")
-                } else {
-                    write!(line, " {k}")
-                };
+                line.push(b' ');
+                push_decimal(line, k);
+                if uv.is_some() {
+                    line.push(b'/');
+                    push_decimal(line, k);
+                }
             }
-            writeln!(w, "{line}")?;
-        }
-        Ok(())
+            line.push(b'\n');
+            Ok(())
+        })
     })
+}
+
+/// Appends the decimal digits of `k` (the formatting machinery of `write!` costs more
+/// than the digits on face lines, a third of writing a large mesh).
+fn push_decimal(line: &mut Vec<u8>, mut k: usize) {
+    let mut digits = [0u8; 20];
+    let mut at = digits.len();
+    loop {
+        at -= 1;
+        digits[at] = b'0' + (k % 10) as u8;
+        k /= 10;
+        if k == 0 {
+            break;
+        }
+    }
+    line.extend_from_slice(&digits[at..]);
+}
+
+/// Lines formatted per block by one thread.
+const LINE_BLOCK: usize = 1 << 14;
+
+/// Writes `count` lines in order, line `i` appended to a buffer by `line(i, buffer)`.
+/// Formatting numbers is most of the cost of writing a large mesh (shortest round-trip
+/// decimals), so consecutive blocks of lines are formatted on the available cores at
+/// once and written in order; at most one block per core is held in memory.
+fn write_lines(
+    w: &mut impl std::io::Write,
+    count: usize,
+    line: impl Fn(usize, &mut Vec<u8>) -> std::io::Result<()> + Sync,
+) -> std::io::Result<()> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut buffers = vec![Vec::new(); threads.min(count.div_ceil(LINE_BLOCK)).max(1)];
+    let format = |buffer: &mut Vec<u8>, begin: usize| {
+        buffer.clear();
+        (begin..(begin + LINE_BLOCK).min(count)).try_for_each(|i| line(i, buffer))
+    };
+    let mut start = 0;
+    while start < count {
+        if let [buffer] = buffers.as_mut_slice() {
+            format(buffer, start)?;
+        } else {
+            std::thread::scope(|scope| {
+                let formatting: Vec<_> = buffers
+                    .iter_mut()
+                    .enumerate()
+                    .map(|(t, buffer)| {
+                        let begin = start + t * LINE_BLOCK;
+                        let format = &format;
+                        scope.spawn(move || -> std::io::Result<()> {
+                            buffer.clear();
+                            if begin < count {
+                                format(buffer, begin)?;
+                            }
+                            Ok(())
+                        })
+                    })
+                    .collect();
+                formatting.into_iter().try_for_each(|thread| {
+                    thread
+                        .join()
+                        .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                })
+            })?;
+        }
+        for buffer in &buffers {
+            w.write_all(buffer)?;
+        }
+        start += buffers.len() * LINE_BLOCK;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{LINE_BLOCK, push_decimal, write_lines};
+
+    #[test]
+    fn decimal_digits_match_display() {
+        for k in [0, 7, 10, 99, 100, 123_456_789, usize::MAX] {
+            let mut s = b"x".to_vec();
+            push_decimal(&mut s, k);
+            assert_eq!(s, format!("x{k}").into_bytes());
+        }
+    }
+
+    #[test]
+    fn lines_come_out_in_order_across_blocks() {
+        // More lines than one block per core, and a last block cut short.
+        let count = 5 * LINE_BLOCK + 17;
+        let mut out = Vec::new();
+        write_lines(&mut out, count, |i, line| {
+            push_decimal(line, i);
+            line.push(b'\n');
+            Ok(())
+        })
+        .unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<usize> = text.lines().map(|l| l.parse().unwrap()).collect();
+        assert_eq!(lines, (0..count).collect::<Vec<_>>());
+        let mut empty = Vec::new();
+        write_lines(&mut empty, 0, |_, _| unreachable!()).unwrap();
+        assert!(empty.is_empty());
+    }
 }
