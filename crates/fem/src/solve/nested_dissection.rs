@@ -36,7 +36,7 @@ const DONE: u32 = u32::MAX;
 /// The symmetric graph of a square pattern without its diagonal, as adjacency lists.
 struct Graph {
     start: Vec<usize>,
-    neighbours: Vec<usize>,
+    neighbours: Vec<u32>,
 }
 
 impl Graph {
@@ -44,7 +44,7 @@ impl Graph {
     /// `i != j`, read in either triangle, makes `i` and `j` neighbours; duplicates are
     /// harmless).
     fn of_pattern(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Self {
-        let mut degree = vec![0usize; n + 1];
+        let mut degree = vec![0usize; n];
         for j in 0..n {
             for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
                 if i != j {
@@ -53,21 +53,15 @@ impl Graph {
                 }
             }
         }
-        let mut start = Vec::with_capacity(n + 1);
-        let mut total = 0;
-        for d in &degree[..n] {
-            start.push(total);
-            total += d;
-        }
-        start.push(total);
+        let start = offsets(&degree);
         let mut fill = start.clone();
-        let mut neighbours = vec![0usize; total];
+        let mut neighbours = vec![0u32; start[n]];
         for j in 0..n {
             for &i in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
                 if i != j {
-                    neighbours[fill[i]] = j;
+                    neighbours[fill[i]] = j as u32;
                     fill[i] += 1;
-                    neighbours[fill[j]] = i;
+                    neighbours[fill[j]] = i as u32;
                     fill[j] += 1;
                 }
             }
@@ -75,9 +69,68 @@ impl Graph {
         Self { start, neighbours }
     }
 
-    fn neighbours(&self, v: usize) -> &[usize] {
-        &self.neighbours[self.start[v]..self.start[v + 1]]
+    /// The vertices in breadth-first order, component after component.
+    fn breadth_first_order(&self) -> Vec<usize> {
+        let n = self.start.len() - 1;
+        let mut seen = vec![false; n];
+        let mut order = Vec::with_capacity(n);
+        for root in 0..n {
+            if seen[root] {
+                continue;
+            }
+            seen[root] = true;
+            let mut head = order.len();
+            order.push(root);
+            while head < order.len() {
+                let v = order[head];
+                head += 1;
+                for w in self.neighbours(v) {
+                    if !seen[w] {
+                        seen[w] = true;
+                        order.push(w);
+                    }
+                }
+            }
+        }
+        order
     }
+
+    /// The same graph with vertex `order[k]` renumbered `k`.
+    fn renumbered(&self, order: &[usize]) -> Self {
+        let mut new_index = vec![0u32; order.len()];
+        for (k, &v) in order.iter().enumerate() {
+            new_index[v] = k as u32;
+        }
+        let degree: Vec<usize> = order.iter().map(|&v| self.degree(v)).collect();
+        let start = offsets(&degree);
+        let mut neighbours = Vec::with_capacity(self.neighbours.len());
+        for &v in order {
+            neighbours.extend(self.neighbours(v).map(|w| new_index[w]));
+        }
+        Self { start, neighbours }
+    }
+
+    fn neighbours(&self, v: usize) -> impl Iterator<Item = usize> + '_ {
+        self.neighbours[self.start[v]..self.start[v + 1]]
+            .iter()
+            .map(|&w| w as usize)
+    }
+
+    fn degree(&self, v: usize) -> usize {
+        self.start[v + 1] - self.start[v]
+    }
+}
+
+/// Prefix sums: where each vertex's list starts, and the total at the end.
+fn offsets(degree: &[usize]) -> Vec<usize> {
+    let mut start = Vec::with_capacity(degree.len() + 1);
+    let mut total = 0;
+    for d in degree {
+        start.push(total);
+        total += d;
+    }
+    start.push(total);
+    start
 }
 
 /// Which distance array a search fills.
@@ -189,7 +242,7 @@ impl Dissection<'_> {
             let v = levels.queue[head];
             head += 1;
             let l = distance[v];
-            for &w in self.graph.neighbours(v) {
+            for w in self.graph.neighbours(v) {
                 if self.part[w] == id {
                     self.part[w] = visiting;
                     distance[w] = l + 1;
@@ -260,7 +313,7 @@ impl Dissection<'_> {
                 continue;
             }
             let (mut low, mut high) = (own, own);
-            for &w in self.graph.neighbours(v) {
+            for w in self.graph.neighbours(v) {
                 if self.part[w] != id {
                     continue;
                 }
@@ -324,7 +377,7 @@ impl Dissection<'_> {
         let mut row_idx = Vec::new();
         col_ptr.push(0);
         for &v in &vertices {
-            for &w in self.graph.neighbours(v) {
+            for w in self.graph.neighbours(v) {
                 if self.part[w] == id {
                     row_idx.push(self.distance_u[w] as usize);
                 }
@@ -355,7 +408,7 @@ impl Dissection<'_> {
 
     /// Whether `v` has a neighbour in the part `id`.
     fn touches(&self, v: usize, id: u32) -> bool {
-        self.graph.neighbours(v).iter().any(|&w| self.part[w] == id)
+        self.graph.neighbours(v).any(|w| self.part[w] == id)
     }
 
     /// Gives every vertex of `vertices` the part `id`.
@@ -402,7 +455,7 @@ impl Dissection<'_> {
             let v = last
                 .iter()
                 .copied()
-                .min_by_key(|&v| self.graph.neighbours(v).len())
+                .min_by_key(|&v| self.graph.degree(v))
                 .unwrap_or(vertices[0]);
             self.search(v, id, &mut far, Distance::V);
             self.assign(&far.queue, id);
@@ -473,7 +526,14 @@ impl Dissection<'_> {
 /// `col_ptr` has `n + 1` entries and `row_idx[col_ptr[j]..col_ptr[j + 1]]` are the rows
 /// of column `j`, all below `n`.
 pub(super) fn nested_dissection(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Vec<usize> {
-    let graph = Graph::of_pattern(n, col_ptr, row_idx);
+    // Renumbered in breadth-first order, a part's vertices and their neighbours lie
+    // close together in memory, which the many searches of the dissection reward
+    // (measured: the order of the twice-subdivided hand in 1.6 s instead of 2.1 s, of
+    // the twice-subdivided bunny in 0.9 s instead of 1.9 s).
+    let pattern_graph = Graph::of_pattern(n, col_ptr, row_idx);
+    let original = pattern_graph.breadth_first_order();
+    let graph = pattern_graph.renumbered(&original);
+    drop(pattern_graph);
     let mut dissection = Dissection {
         graph: &graph,
         part: vec![0; n],
@@ -483,5 +543,5 @@ pub(super) fn nested_dissection(n: usize, col_ptr: &[usize], row_idx: &[usize]) 
         order: Vec::with_capacity(n),
     };
     dissection.dissect((0..n).collect(), 0);
-    dissection.order
+    dissection.order.into_iter().map(|k| original[k]).collect()
 }
