@@ -6,18 +6,21 @@
 //! themselves and to `S`, and the rule applied recursively to `A` and `B` (George 1973,
 //! "Nested dissection of a regular finite element mesh") bounds the factor of a planar
 //! mesh with `n` vertices by `O(n log n)` entries and `O(n^(3/2))` operations, the best
-//! possible order (Lipton, Rose, Tarjan 1979). Minimum-degree orders such as AMD reach
-//! similar counts on small meshes but fall behind as `n` grows, and they cost more to
-//! compute.
+//! possible order (Lipton, Rose, Tarjan 1979). Minimum-degree orders such as AMD are
+//! cheaper to compute and as good on many scanned meshes, but fall behind on large
+//! regular ones (`fill_reducing_order` chooses; figures in docs/benchmarks.md).
 //!
-//! Separators here are level sets of a breadth-first search from a pseudo-peripheral
-//! vertex (George and Liu 1978, "An automatic nested dissection algorithm for irregular
-//! finite element problems"): the edges of a breadth-first search join only equal or
-//! consecutive levels, so every level separates the levels before it from those after.
-//! Among the levels that leave neither side more than [`BALANCE`] of the vertices the
-//! smallest is taken, then thinned: a separator vertex with no neighbour on one side
-//! moves to the other. Parts of at most [`LEAF`] vertices are eliminated in the order
-//! of their last search, where a surface mesh's fill stays within a band.
+//! Separators come from breadth-first searches (George and Liu 1978, "An automatic
+//! nested dissection algorithm for irregular finite element problems"): the edges of a
+//! search join only equal or consecutive levels, so every level separates the levels
+//! before it from those after. Here two searches start from the ends `u`, `v` of a
+//! pseudo-diameter, and three kinds of band are candidates: a level of `d_u`, a level
+//! of `d_v`, and two consecutive values of `d_u - d_v` (which an edge changes by at
+//! most 2), whose level sets cross the part between `u` and `v` instead of circling
+//! one of them. Among the bands that leave neither side more than [`BALANCE`] of the
+//! part, the one with the fewest vertices after thinning is taken, and thinned: a band
+//! vertex with no neighbour on one side moves to the other. Parts of at most [`LEAF`]
+//! vertices are ordered by AMD.
 
 /// Largest part ordered by minimum degree instead of a further separator (256: the
 /// factors of the 1M-triangle disk and of the subdivided hand were within 3% of each
@@ -366,10 +369,9 @@ impl Dissection<'_> {
 
     /// Appends the minimum-degree order (faer's AMD) of the subgraph of part `id`.
     fn eliminate_leaf(&mut self, vertices: Vec<usize>, id: u32) {
-        use faer::dyn_stack::{MemBuffer, MemStack};
         use faer::sparse::SymbolicSparseColMatRef;
-        use faer::sparse::linalg::amd;
         let n = vertices.len();
+        // The distances are not needed any more in a leaf: they hold the local index.
         for (k, &v) in vertices.iter().enumerate() {
             self.distance_u[v] = k as u32;
         }
@@ -385,24 +387,14 @@ impl Dissection<'_> {
             col_ptr.push(row_idx.len());
         }
         let pattern = SymbolicSparseColMatRef::new_unsorted_checked(n, n, &col_ptr, None, &row_idx);
-        let (mut forward, mut inverse) = (vec![0usize; n], vec![0usize; n]);
-        let mut buffer =
-            MemBuffer::new(amd::order_maybe_unsorted_scratch::<usize>(n, row_idx.len()));
-        let ok = amd::order_maybe_unsorted(
-            &mut forward,
-            &mut inverse,
-            pattern,
-            Default::default(),
-            MemStack::new(&mut buffer),
-        )
-        .is_ok();
+        let order = super::amd_order(pattern);
         for &v in &vertices {
             self.part[v] = DONE;
         }
-        if ok {
-            self.order.extend(forward.iter().map(|&k| vertices[k]));
-        } else {
-            self.order.extend(vertices);
+        match order {
+            Ok(order) => self.order.extend(order.iter().map(|&k| vertices[k])),
+            // Only an allocation failure stops AMD: the part as it is, still an order.
+            Err(_) => self.order.extend(vertices),
         }
     }
 
