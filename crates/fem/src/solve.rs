@@ -698,13 +698,7 @@ impl<T: Scalar> SpdSolver<T> {
         let n = pattern.nrows();
         check_len("the column count of the pattern", n, pattern.ncols())?;
         check_len("the length of the order", n, order.len())?;
-        let mut inverse = vec![usize::MAX; n];
-        for (k, &i) in order.iter().enumerate() {
-            if i >= n || inverse[i] != usize::MAX {
-                return Err(SolveError::InvalidOrder { index: k });
-            }
-            inverse[i] = k;
-        }
+        let inverse = inverse_permutation(order)?;
         Ok(Self {
             pattern: pattern.to_owned()?,
             cholesky: Cholesky::with_ordering(pattern, Some((order, &inverse)), options.par())?,
@@ -878,6 +872,20 @@ impl<T: Scalar> SpdSolver<T> {
     }
 }
 
+/// `inverse[order[k]] = k`; [`SolveError::InvalidOrder`] names the first entry of `order`
+/// that is out of range or repeated.
+fn inverse_permutation(order: &[usize]) -> Result<Vec<usize>, SolveError> {
+    let n = order.len();
+    let mut inverse = vec![usize::MAX; n];
+    for (k, &i) in order.iter().enumerate() {
+        if i >= n || inverse[i] != usize::MAX {
+            return Err(SolveError::InvalidOrder { index: k });
+        }
+        inverse[i] = k;
+    }
+    Ok(inverse)
+}
+
 /// Unknown count from which [`fill_reducing_order`] considers nested dissection.
 pub const NESTED_DISSECTION_FROM: usize = 100_000;
 
@@ -895,9 +903,9 @@ const AMD_STRUGGLES: f64 = 15.0;
 /// and AMD's own operation count says its factor is expensive for the size
 /// (`flops >= 15 n^(3/2)`, the growth of a planar mesh's factor under a poor order):
 /// then [`nested_dissection_order`], computed on a second thread meanwhile. On large
-/// meshes with regular structure (generated
-/// disks and grids, subdivided scans) that halves the operations of the numeric
-/// factorization; on scans at their original resolution AMD stays ahead.
+/// meshes with regular structure (generated disks and grids, subdivided scans) that
+/// halves the operations of the numeric factorization; on scans at their original
+/// resolution AMD stays ahead.
 pub fn fill_reducing_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<Vec<usize>, SolveError> {

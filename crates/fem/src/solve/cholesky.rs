@@ -5,7 +5,7 @@
 //! on every call; iterative solvers refactor the same pattern every step, so this
 //! wrapper keeps both and calls the low-level `SymbolicCholesky::factorize_numeric_llt`.
 
-use super::{NESTED_DISSECTION_FROM, SolveError, fill_reducing_order};
+use super::{NESTED_DISSECTION_FROM, SolveError, fill_reducing_order, inverse_permutation};
 use crate::dof::Scalar;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -52,10 +52,7 @@ impl<T: Scalar> Cholesky<T> {
             return Self::with_ordering(pattern, None, par);
         }
         let forward = fill_reducing_order(pattern)?;
-        let mut inverse = vec![0; forward.len()];
-        for (k, &i) in forward.iter().enumerate() {
-            inverse[i] = k;
-        }
+        let inverse = inverse_permutation(&forward)?;
         Self::with_ordering(pattern, Some((&forward, &inverse)), par)
     }
 

@@ -163,6 +163,15 @@ enum Side {
 }
 
 impl Key {
+    /// The key's value at a vertex with distances `d_u`, `d_v`.
+    fn value(self, d_u: u32, d_v: u32) -> u32 {
+        match self {
+            Key::U => d_u,
+            Key::V => d_v,
+            Key::Difference(shift) => d_u + shift - d_v,
+        }
+    }
+
     /// How many consecutive values of the key a separator band takes: enough that no
     /// edge jumps over the band.
     fn width(self) -> usize {
@@ -182,11 +191,7 @@ struct Cut {
 
 impl Cut {
     fn side(&self, d_u: u32, d_v: u32) -> Side {
-        let key = match self.key {
-            Key::U => d_u,
-            Key::V => d_v,
-            Key::Difference(shift) => d_u + shift - d_v,
-        };
+        let key = self.key.value(d_u, d_v);
         if key < self.start {
             Side::A
         } else if key < self.start + self.key.width() as u32 {
@@ -216,6 +221,15 @@ struct Levels {
     queue: Vec<usize>,
     /// `queue[starts[l]..starts[l + 1]]` is level `l`.
     starts: Vec<usize>,
+}
+
+impl Levels {
+    fn with_capacity(vertices: usize) -> Self {
+        Self {
+            queue: Vec::with_capacity(vertices),
+            starts: Vec::new(),
+        }
+    }
 }
 
 impl Dissection<'_> {
@@ -271,10 +285,7 @@ impl Dissection<'_> {
         let depth_v = from_v.starts.len() - 2;
         let keys = [Key::U, Key::V, Key::Difference(depth_v as u32)];
         let ranges = [depth_u + 1, depth_v + 1, depth_u + depth_v + 1];
-        let key_of = |w: usize| {
-            let (d_u, d_v) = (self.distance_u[w], self.distance_v[w]);
-            [d_u, d_v, d_u + depth_v as u32 - d_v]
-        };
+        let key_of = |w: usize| keys.map(|key| key.value(self.distance_u[w], self.distance_v[w]));
         // Vertices per key value, then the band starts that leave neither side empty
         // nor larger than the limit.
         let mut counts: Vec<Vec<usize>> = ranges.iter().map(|&r| vec![0; r]).collect();
@@ -416,10 +427,7 @@ impl Dissection<'_> {
             self.eliminate_leaf(vertices, id);
             return;
         }
-        let mut levels = Levels {
-            queue: Vec::with_capacity(vertices.len()),
-            starts: Vec::new(),
-        };
+        let mut levels = Levels::with_capacity(vertices.len());
         self.search(vertices[0], id, &mut levels, Distance::U);
         if levels.queue.len() < vertices.len() {
             // The part is not connected: the component of `root` and the rest are
@@ -438,10 +446,7 @@ impl Dissection<'_> {
         self.assign(&levels.queue, id);
         // Pseudo-peripheral pair (u, v): v is a vertex of least degree in the last level
         // of the search from u; u moves to v while that search gets deeper.
-        let mut far = Levels {
-            queue: Vec::with_capacity(vertices.len()),
-            starts: Vec::new(),
-        };
+        let mut far = Levels::with_capacity(vertices.len());
         for _ in 0..SWEEPS {
             let last = &levels.queue[levels.starts[levels.starts.len() - 2]..];
             let v = last
@@ -495,7 +500,7 @@ impl Dissection<'_> {
         }
         if a.is_empty() || b.is_empty() {
             // A part that no level splits (a clique-like part): eliminate it as it is.
-            let all = levels.queue.clone();
+            let all = std::mem::take(&mut levels.queue);
             for &v in &all {
                 self.part[v] = DONE;
             }

@@ -318,7 +318,6 @@ pub fn write(
     let slots = super::slots::OutputSlots::new(mesh);
     let position = slots.positions(mesh, attributes);
     let uv = attributes.uvs.map(|u| slots.scatter(u));
-    let faces: Vec<FaceId> = mesh.faces().collect();
     super::write_atomically(path, |w| {
         writeln!(
             w,
@@ -335,9 +334,9 @@ pub fn write(
                 writeln!(line, "vt {} {}", uv[i].x, uv[i].y)
             })?;
         }
-        write_lines(w, faces.len(), |i, line| {
+        write_lines(w, mesh.face_count(), |i, line| {
             line.push(b'f');
-            for v in mesh.face_vertices(faces[i]) {
+            for v in mesh.face_vertices(FaceId::from_usize(i)) {
                 let k = slots.slot(v) + 1;
                 line.push(b' ');
                 push_decimal(line, k);
