@@ -9,7 +9,8 @@
 //! the point's tangent frame (P1: one point per triangle, Q1: four per quad).
 
 use beltrami_mesh::Mesh;
-use faer::sparse::SparseColMat;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use nalgebra::Vector2;
 use num_complex::Complex64;
 
 use crate::assembly::Pattern;
@@ -176,23 +177,52 @@ pub fn complex_derivatives(
     mesh: &Mesh,
     elements: &Elements,
 ) -> Result<ComplexDerivatives, FemError> {
-    let mut positions = Vec::with_capacity(elements.point_count() * 4);
-    let mut dz = Vec::with_capacity(elements.point_count() * 4);
-    let mut dzbar = Vec::with_capacity(elements.point_count() * 4);
-    for (row, q) in elements.points().iter().enumerate() {
-        for (k, v) in elements.nodes(q.face).iter().enumerate() {
-            positions.push((row, v.idx()));
-            let g = q.grad[k];
-            dz.push(Complex64::new(0.5 * g.x, -0.5 * g.y));
-            dzbar.push(Complex64::new(0.5 * g.x, 0.5 * g.y));
-        }
-    }
-    let pattern = Pattern::new(elements.point_count(), mesh.vertex_count(), &positions)?;
+    let dz = point_vertex_matrix(mesh, elements, |g, _| Complex64::new(0.5 * g.x, -0.5 * g.y))?;
+    let dzbar = point_vertex_matrix(mesh, elements, |g, _| Complex64::new(0.5 * g.x, 0.5 * g.y))?;
     Ok(ComplexDerivatives {
-        dz: pattern.assemble(&dz)?,
-        dzbar: pattern.assemble(&dzbar)?,
+        dz,
+        dzbar,
         weights: elements.points().iter().map(|q| q.weight).collect(),
     })
+}
+
+/// The `points x vertices` matrix with `value(grad N_k(q), q)` at row `q` and the column
+/// of node `k` of `q`'s face, for every quadrature point `q` and node `k`.
+///
+/// Built column by column in one counting pass: the points are visited in row order,
+/// so every column receives its rows already increasing and nothing is sorted. (A
+/// general triplet assembly keeps a position list, a copy of it and a permutation: three
+/// times the memory of the matrix, which at a million faces costs more than the
+/// arithmetic.) The nodes of a face are distinct vertices of a mesh, so no entry repeats.
+fn point_vertex_matrix(
+    mesh: &Mesh,
+    elements: &Elements,
+    value: impl Fn(Vector2<f64>, usize) -> Complex64,
+) -> Result<SparseColMat<usize, Complex64>, FemError> {
+    let (rows, cols) = (elements.point_count(), mesh.vertex_count());
+    let mut col_ptr = vec![0usize; cols + 1];
+    for q in elements.points() {
+        for v in elements.nodes(q.face) {
+            col_ptr[v.idx() + 1] += 1;
+        }
+    }
+    for c in 0..cols {
+        col_ptr[c + 1] += col_ptr[c];
+    }
+    let nnz = col_ptr[cols];
+    let mut next = col_ptr[..cols].to_vec();
+    let mut row_idx = vec![0usize; nnz];
+    let mut values = vec![Complex64::new(0.0, 0.0); nnz];
+    for (row, q) in elements.points().iter().enumerate() {
+        for (k, v) in elements.nodes(q.face).iter().enumerate() {
+            let slot = &mut next[v.idx()];
+            row_idx[*slot] = row;
+            values[*slot] = value(q.grad[k], row);
+            *slot += 1;
+        }
+    }
+    let symbolic = SymbolicSparseColMat::new_checked(rows, cols, col_ptr, None, row_idx);
+    Ok(SparseColMat::new(symbolic, values))
 }
 
 /// The real `2m x 2n` form of a complex `m x n` matrix: entry `a + i b` at `(r, c)`
@@ -236,17 +266,10 @@ pub fn beltrami_operator(
     mu: &[Complex64],
 ) -> Result<SparseColMat<usize, Complex64>, FemError> {
     crate::beltrami::check_len("Beltrami coefficient", elements.face_count(), mu.len())?;
-    let mut positions = Vec::with_capacity(elements.point_count() * 4);
-    let mut values = Vec::with_capacity(elements.point_count() * 4);
-    for (row, q) in elements.points().iter().enumerate() {
-        let m = mu[q.face.idx()];
-        for (k, v) in elements.nodes(q.face).iter().enumerate() {
-            let g = q.grad[k];
-            let dz = Complex64::new(0.5 * g.x, -0.5 * g.y);
-            let dzbar = Complex64::new(0.5 * g.x, 0.5 * g.y);
-            positions.push((row, v.idx()));
-            values.push(dzbar - m * dz);
-        }
-    }
-    Pattern::new(elements.point_count(), mesh.vertex_count(), &positions)?.assemble(&values)
+    let points = elements.points();
+    point_vertex_matrix(mesh, elements, |g, row| {
+        let dz = Complex64::new(0.5 * g.x, -0.5 * g.y);
+        let dzbar = Complex64::new(0.5 * g.x, 0.5 * g.y);
+        dzbar - mu[points[row].face.idx()] * dz
+    })
 }

@@ -909,22 +909,41 @@ const AMD_STRUGGLES: f64 = 15.0;
 pub fn fill_reducing_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<Vec<usize>, SolveError> {
+    fill_reducing_order_meanwhile(pattern, |_| ()).map(|(order, _)| order)
+}
+
+/// [`fill_reducing_order`], running `meanwhile` on the calling thread while the
+/// nested-dissection order is still being computed, once AMD has finished and chosen it:
+/// `meanwhile` gets AMD's count of the factor's entries (diagonal included) and its
+/// result is returned beside the order (`None` when AMD's order is taken).
+fn fill_reducing_order_meanwhile<R>(
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+    meanwhile: impl FnOnce(usize) -> R,
+) -> Result<(Vec<usize>, Option<R>), SolveError> {
     let n = pattern.nrows();
     if n < NESTED_DISSECTION_FROM {
-        return amd_order(pattern);
+        return Ok((amd_order(pattern)?, None));
     }
     // Both orders are computed at once (on a second core where there is one), so the
     // choice costs the longer of the two instead of their sum.
-    let (amd, nested) = std::thread::scope(|scope| {
+    let (amd, nested, extra) = std::thread::scope(|scope| {
         let nested = scope.spawn(|| nested_dissection_order(pattern));
-        (amd_order_with_count(pattern), nested.join())
+        let amd = amd_order_with_count(pattern);
+        let extra = match &amd {
+            Ok(count) if count.n_mult_subs_ldl >= AMD_STRUGGLES * (n as f64).powf(1.5) => {
+                Some(meanwhile(count.entries))
+            }
+            _ => None,
+        };
+        (amd, nested.join(), extra)
     });
-    let (order, flops) = amd?;
-    if flops >= AMD_STRUGGLES * (n as f64).powf(1.5) {
+    let amd = amd?;
+    if extra.is_some() {
         // A panic in the ordering thread is a bug; pass it on as one.
-        nested.unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        let order = nested.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+        Ok((order, extra))
     } else {
-        Ok(order)
+        Ok((amd.order, None))
     }
 }
 
@@ -946,14 +965,22 @@ pub fn nested_dissection_order(
 /// The approximate minimum degree order of the symmetric pattern `pattern + pattern^T`
 /// (faer's AMD): `order[k]` is the row to eliminate k-th.
 pub fn amd_order(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Vec<usize>, SolveError> {
-    amd_order_with_count(pattern).map(|(order, _)| order)
+    amd_order_with_count(pattern).map(|count| count.order)
 }
 
-/// [`amd_order`] with AMD's estimate of the multiply-subtract operations of the
-/// `L D L^T` factorization in that order.
+/// An AMD order and AMD's own counts for the factor in that order.
+struct AmdOrder {
+    order: Vec<usize>,
+    /// Multiply-subtract operations of the `L D L^T` factorization.
+    n_mult_subs_ldl: f64,
+    /// Entries of `L`, diagonal included.
+    entries: usize,
+}
+
+/// [`amd_order`] with AMD's estimates of the factor's cost and size in that order.
 fn amd_order_with_count(
     pattern: SymbolicSparseColMatRef<'_, usize>,
-) -> Result<(Vec<usize>, f64), SolveError> {
+) -> Result<AmdOrder, SolveError> {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::amd;
     let n = pattern.nrows();
@@ -969,7 +996,12 @@ fn amd_order_with_count(
         Default::default(),
         MemStack::new(&mut buffer),
     )?;
-    Ok((forward, count.n_mult_subs_ldl))
+    // AMD counts one division per entry below the diagonal.
+    Ok(AmdOrder {
+        order: forward,
+        n_mult_subs_ldl: count.n_mult_subs_ldl,
+        entries: n + count.n_div as usize,
+    })
 }
 
 /// `y = M x` for a Hermitian `M` given by its lower triangle (entries above the diagonal

@@ -137,22 +137,44 @@ fn fill_reducing_order_switches_only_on_large_regular_meshes() {
     );
 }
 
-#[test]
-fn solves_in_nested_dissection_order_match_amd_order() {
-    // The grid Laplacian plus a shift: the solution does not depend on the order.
-    let k = 120;
+/// The triangulated `k x k` grid's Laplacian plus `shift` times the identity (lower
+/// triangle), and a right-hand side.
+fn shifted_grid_laplacian(k: usize, shift: f64) -> (SparseColMat<usize, f64>, Vec<f64>) {
     let n = k * k;
-    let edges = triangulated_grid(k);
     let mut triplets: Vec<Triplet<usize, usize, f64>> = Vec::new();
     let mut degree = vec![0.0; n];
-    for &(a, b) in &edges {
+    for &(a, b) in &triangulated_grid(k) {
         triplets.push(Triplet::new(a.max(b), a.min(b), -1.0));
         degree[a] += 1.0;
         degree[b] += 1.0;
     }
-    triplets.extend((0..n).map(|i| Triplet::new(i, i, degree[i] + 0.01)));
+    triplets.extend((0..n).map(|i| Triplet::new(i, i, degree[i] + shift)));
     let m = SparseColMat::try_new_from_triplets(n, n, &triplets).unwrap();
-    let rhs: Vec<f64> = (0..n).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
+    let rhs = (0..n).map(|i| ((i * 7919) % 101) as f64 - 50.0).collect();
+    (m, rhs)
+}
+
+/// `max |M x - b|` over `max |b|` for `M` given by its lower triangle.
+fn relative_residual(m: &SparseColMat<usize, f64>, x: &[f64], b: &[f64]) -> f64 {
+    let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
+    for j in 0..m.ncols() {
+        for (i, &v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+            r[i] += v * x[j];
+            if i != j {
+                r[j] += v * x[i];
+            }
+        }
+    }
+    let scale = b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    r.iter().fold(0.0f64, |a, v| a.max(v.abs())) / scale
+}
+
+#[test]
+fn solves_in_nested_dissection_order_match_amd_order() {
+    // The solution does not depend on the order.
+    let k = 120;
+    let n = k * k;
+    let (m, rhs) = shifted_grid_laplacian(k, 0.01);
     let solve = |order: Vec<usize>| {
         let mut solver =
             SpdSolver::with_order(m.symbolic(), &order, SolveOptions::default()).unwrap();
@@ -165,4 +187,28 @@ fn solves_in_nested_dissection_order_match_amd_order() {
     let amd = solve(amd_order(m.symbolic()).unwrap());
     let scale = amd.norm_max();
     assert!((&nd - &amd).norm_max() < 1e-10 * scale);
+}
+
+#[test]
+fn a_large_solver_refactors_correctly_in_nested_dissection_order() {
+    // The 700 x 700 grid takes nested dissection (test above), whose factor is stored in
+    // the block touched while the dissection was computed. Two matrices with one pattern
+    // through one solver: both solutions satisfy their systems.
+    let k = 700;
+    let n = k * k;
+    for (round, shift) in [0.01, 1.0].into_iter().enumerate() {
+        let (m, rhs) = shifted_grid_laplacian(k, shift);
+        let mut solver = SpdSolver::new(m.symbolic(), SolveOptions::default()).unwrap();
+        for pass in 0..2 {
+            solver.factorize(m.as_ref()).unwrap();
+            let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
+            solver.solve_in_place(x.as_mut()).unwrap();
+            let x: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+            let residual = relative_residual(&m, &x, &rhs);
+            assert!(
+                residual < 1e-9,
+                "round {round}, pass {pass}: residual {residual:e}"
+            );
+        }
+    }
 }

@@ -28,7 +28,7 @@ use beltrami_core::{
     Target, TargetKind, Topology, topology,
 };
 use beltrami_fem::boundary::far_boundary_pair;
-use beltrami_fem::operators::{apply, complex_derivatives};
+use beltrami_fem::operators::{apply, beltrami_operator};
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::VertexId;
 use num_complex::Complex64;
@@ -102,33 +102,28 @@ impl Solver for Lscm {
                 input(pinned[1].0)
             ));
         }
-        let (elements, derivatives, mut solver) = context.stage("assembly", &mut report, || {
+        let (elements, dzbar, mut solver) = context.stage("assembly", &mut report, || {
             let elements = Elements::new(mesh, Frame::Face)?;
-            let derivatives = complex_derivatives(mesh, &elements)?;
+            // D_zbar is the Beltrami operator of mu = 0.
+            let conformal = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
+            let dzbar = beltrami_operator(mesh, &elements, &conformal)?;
             let mut constraints = DofConstraints::new();
             for &(v, z) in &pinned {
                 constraints.fix(v, z);
             }
             let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
-            let solver = LeastSquaresSolver::new(
-                derivatives.dzbar.symbolic(),
-                &dofs,
-                solve_options(settings),
-            )?;
-            Ok((elements, derivatives, solver))
+            let solver = LeastSquaresSolver::new(dzbar.symbolic(), &dofs, solve_options(settings))?;
+            Ok((elements, dzbar, solver))
         })?;
+        let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
         let map = context.stage("solve", &mut report, || {
-            let zero = vec![Complex64::new(0.0, 0.0); derivatives.dzbar.nrows()];
-            Ok(solver.solve(
-                derivatives.dzbar.as_ref(),
-                Some(&derivatives.weights),
-                &zero,
-            )?)
+            let zero = vec![Complex64::new(0.0, 0.0); dzbar.nrows()];
+            Ok(solver.solve(dzbar.as_ref(), Some(&weights), &zero)?)
         })?;
-        let residual = apply(&derivatives.dzbar, &map);
+        let residual = apply(&dzbar, &map);
         let energy = residual
             .iter()
-            .zip(&derivatives.weights)
+            .zip(&weights)
             .map(|(r, w)| w * r.norm_sqr())
             .sum();
         metrics.energy_history.push(energy);

@@ -5,7 +5,9 @@
 //! on every call; iterative solvers refactor the same pattern every step, so this
 //! wrapper keeps both and calls the low-level `SymbolicCholesky::factorize_numeric_llt`.
 
-use super::{NESTED_DISSECTION_FROM, SolveError, fill_reducing_order, inverse_permutation};
+use super::{
+    NESTED_DISSECTION_FROM, SolveError, fill_reducing_order_meanwhile, inverse_permutation,
+};
 use crate::dof::Scalar;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -42,8 +44,8 @@ pub(super) struct Cholesky<T: Scalar> {
 impl<T: Scalar> Cholesky<T> {
     /// Symbolic analysis (fill-reducing order, elimination tree, supernodes) of
     /// `pattern` (square; only its lower triangle matters). The order is
-    /// [`fill_reducing_order`]'s; below [`NESTED_DISSECTION_FROM`] rows that is AMD,
-    /// left to faer.
+    /// [`fill_reducing_order`](super::fill_reducing_order)'s; below
+    /// [`NESTED_DISSECTION_FROM`] rows that is AMD, left to faer.
     pub(super) fn new(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         par: Par,
@@ -51,9 +53,15 @@ impl<T: Scalar> Cholesky<T> {
         if pattern.nrows() < NESTED_DISSECTION_FROM {
             return Self::with_ordering(pattern, None, par);
         }
-        let forward = fill_reducing_order(pattern)?;
+        // The kernel clears every page a process touches for the first time, and the
+        // factor is the largest block of a solve. While the nested dissection is still
+        // being computed, this thread (done with AMD) touches a buffer of AMD's factor
+        // size; the factor reuses it when the dissection's factor fits, which it does
+        // where the dissection is taken for its smaller factor.
+        let (forward, spare) =
+            fill_reducing_order_meanwhile(pattern, |entries| touched_zeros::<T>(entries))?;
         let inverse = inverse_permutation(&forward)?;
-        Self::with_ordering(pattern, Some((&forward, &inverse)), par)
+        Self::build(pattern, Some((&forward, &inverse)), par, spare.flatten())
     }
 
     /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
@@ -62,6 +70,17 @@ impl<T: Scalar> Cholesky<T> {
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: Option<(&[usize], &[usize])>,
         par: Par,
+    ) -> Result<Self, SolveError> {
+        Self::build(pattern, order, par, None)
+    }
+
+    /// [`Cholesky::with_ordering`], the factor's values stored in `spare` when it is
+    /// long enough.
+    fn build(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: Option<(&[usize], &[usize])>,
+        par: Par,
+        spare: Option<Vec<T>>,
     ) -> Result<Self, SolveError> {
         let ordering = match order {
             Some((forward, inverse)) => {
@@ -73,8 +92,15 @@ impl<T: Scalar> Cholesky<T> {
             factorize_symbolic_cholesky(pattern, Side::Lower, ordering, Default::default())?;
         let n = symbolic.nrows();
         let req = Self::scratch(&symbolic, 1, par);
+        let values = match spare {
+            Some(mut values) if values.len() >= symbolic.len_val() => {
+                values.truncate(symbolic.len_val());
+                values
+            }
+            _ => vec![T::from_f64(0.0); symbolic.len_val()],
+        };
         Ok(Self {
-            values: vec![T::from_f64(0.0); symbolic.len_val()],
+            values,
             diagonal: vec![0.0; n],
             buffer: MemBuffer::try_new(req).map_err(|_| FaerError::OutOfMemory)?,
             buffer_columns: 1,
@@ -186,5 +212,59 @@ impl<T: Scalar> Cholesky<T> {
             MemStack::new(&mut self.buffer),
         );
         Ok(())
+    }
+}
+
+/// `len` zeros written one by one, so that every page of the block is touched now (a
+/// zero-filled allocation may be left to the kernel's lazy zero pages); `None` when the
+/// memory is not available, which only forgoes the early touch.
+fn touched_zeros<T: Scalar>(len: usize) -> Option<Vec<T>> {
+    let mut values = Vec::new();
+    values.try_reserve_exact(len).ok()?;
+    values.resize(len, T::from_f64(0.0));
+    Some(values)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::Mat;
+    use faer::sparse::{SparseColMat, Triplet};
+
+    /// The path graph's Laplacian plus the identity (lower triangle), `n x n`.
+    fn path_matrix(n: usize) -> SparseColMat<usize, f64> {
+        let mut triplets: Vec<_> = (0..n).map(|i| Triplet::new(i, i, 3.0)).collect();
+        triplets.extend((1..n).map(|i| Triplet::new(i, i - 1, -1.0)));
+        SparseColMat::try_new_from_triplets(n, n, &triplets).unwrap()
+    }
+
+    #[test]
+    fn a_spare_block_holds_the_factor_only_when_long_enough() {
+        let n = 50;
+        let m = path_matrix(n);
+        let expected = {
+            let mut fresh = Cholesky::<f64>::build(m.symbolic(), None, Par::Seq, None).unwrap();
+            fresh.factorize(m.as_ref(), 0.0).unwrap();
+            let mut x = Mat::from_fn(n, 1, |i, _| i as f64);
+            fresh.solve_in_place(x.as_mut()).unwrap();
+            x
+        };
+        let len = Cholesky::<f64>::build(m.symbolic(), None, Par::Seq, None)
+            .unwrap()
+            .values
+            .len();
+        // Whatever the spare holds (here not zeros), the factor is the same.
+        for spare_len in [len - 1, len, len + 7] {
+            let spare = vec![7.5; spare_len];
+            let spare_ptr = spare.as_ptr();
+            let mut cholesky =
+                Cholesky::<f64>::build(m.symbolic(), None, Par::Seq, Some(spare)).unwrap();
+            assert_eq!(cholesky.values.len(), len);
+            assert_eq!(cholesky.values.as_ptr() == spare_ptr, spare_len >= len);
+            cholesky.factorize(m.as_ref(), 0.0).unwrap();
+            let mut x = Mat::from_fn(n, 1, |i, _| i as f64);
+            cholesky.solve_in_place(x.as_mut()).unwrap();
+            assert!((&x - &expected).norm_max() < 1e-14);
+        }
     }
 }
