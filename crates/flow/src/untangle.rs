@@ -19,8 +19,11 @@
 //! projected back onto the target, and the move is kept if its star has fewer flipped
 //! faces than before; otherwise (or when the kernel is empty) the mean of its link's
 //! images, projected, is tried the same way: across a fold of the target, the tangent
-//! plane at one image says little about where the others are. A round visits the free vertices of every flipped face; a later
-//! round also their free neighbours, whose moves can open an empty kernel. Boundary,
+//! plane at one image says little about where the others are. A round visits the free
+//! vertices of every flipped face; a later round also their free neighbours, whose
+//! moves can open an empty kernel, and keeps moves that leave the star's count of flips
+//! unchanged too (a flip that passes to another face of the star can be removed there
+//! by the next vertex; the count of flips never grows, and the rounds are bounded). Boundary,
 //! curve and fixed vertices never move. The flow runs again afterwards to restore
 //! conformality, from a map with fewer flips, and keeps them at most as many.
 
@@ -209,7 +212,12 @@ pub fn untangle<G: TargetGeometry>(
                     faces[f] = image_face(elements, normals, image, FaceId(f as u32));
                 }
                 let after = star.iter().filter(|&&f| faces[f].flipped()).count();
-                if after < flips || (flips == 0 && after == 0) {
+                // From the second round a move that keeps the star's count is kept as
+                // well: across a fold narrower than the star, a flip only passes between
+                // two faces of one vertex, and the neighbour visited next can remove it
+                // from the other face (hemisphere onto the human face: 1 flip -> 0).
+                let sideways = round > 0 && after == flips;
+                if after < flips || sideways || (flips == 0 && after == 0) {
                     done.moves += 1;
                     break;
                 }
