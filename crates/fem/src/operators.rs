@@ -14,7 +14,7 @@ use nalgebra::Vector2;
 use num_complex::Complex64;
 
 use crate::assembly::Pattern;
-use crate::{Elements, FemError};
+use crate::{Elements, FemError, QuadraturePoint};
 
 /// Positions `(row, col)` of all element-matrix entries, face by face, `i` major.
 fn element_positions(elements: &Elements) -> Vec<(usize, usize)> {
@@ -177,8 +177,8 @@ pub fn complex_derivatives(
     mesh: &Mesh,
     elements: &Elements,
 ) -> Result<ComplexDerivatives, FemError> {
-    let dz = point_vertex_matrix(mesh, elements, |g, _| Complex64::new(0.5 * g.x, -0.5 * g.y))?;
-    let dzbar = point_vertex_matrix(mesh, elements, |g, _| Complex64::new(0.5 * g.x, 0.5 * g.y))?;
+    let dz = point_vertex_matrix(mesh, elements, |q, k| d_z(q.grad[k]))?;
+    let dzbar = point_vertex_matrix(mesh, elements, |q, k| d_zbar(q.grad[k]))?;
     Ok(ComplexDerivatives {
         dz,
         dzbar,
@@ -186,8 +186,18 @@ pub fn complex_derivatives(
     })
 }
 
-/// The `points x vertices` matrix with `value(grad N_k(q), q)` at row `q` and the column
-/// of node `k` of `q`'s face, for every quadrature point `q` and node `k`.
+/// `(d_x N - i d_y N) / 2` of a shape function with gradient `g`.
+fn d_z(g: Vector2<f64>) -> Complex64 {
+    Complex64::new(0.5 * g.x, -0.5 * g.y)
+}
+
+/// `(d_x N + i d_y N) / 2` of a shape function with gradient `g`.
+fn d_zbar(g: Vector2<f64>) -> Complex64 {
+    Complex64::new(0.5 * g.x, 0.5 * g.y)
+}
+
+/// The `points x vertices` matrix with `value(q, k)` at the row of quadrature point `q`
+/// and the column of node `k` of `q`'s face, for every point and node.
 ///
 /// Built column by column in one counting pass: the points are visited in row order,
 /// so every column receives its rows already increasing and nothing is sorted. (A
@@ -197,7 +207,7 @@ pub fn complex_derivatives(
 fn point_vertex_matrix(
     mesh: &Mesh,
     elements: &Elements,
-    value: impl Fn(Vector2<f64>, usize) -> Complex64,
+    value: impl Fn(&QuadraturePoint, usize) -> Complex64,
 ) -> Result<SparseColMat<usize, Complex64>, FemError> {
     let (rows, cols) = (elements.point_count(), mesh.vertex_count());
     let mut col_ptr = vec![0usize; cols + 1];
@@ -217,7 +227,7 @@ fn point_vertex_matrix(
         for (k, v) in elements.nodes(q.face).iter().enumerate() {
             let slot = &mut next[v.idx()];
             row_idx[*slot] = row;
-            values[*slot] = value(q.grad[k], row);
+            values[*slot] = value(q, k);
             *slot += 1;
         }
     }
@@ -266,10 +276,7 @@ pub fn beltrami_operator(
     mu: &[Complex64],
 ) -> Result<SparseColMat<usize, Complex64>, FemError> {
     crate::beltrami::check_len("Beltrami coefficient", elements.face_count(), mu.len())?;
-    let points = elements.points();
-    point_vertex_matrix(mesh, elements, |g, row| {
-        let dz = Complex64::new(0.5 * g.x, -0.5 * g.y);
-        let dzbar = Complex64::new(0.5 * g.x, 0.5 * g.y);
-        dzbar - mu[points[row].face.idx()] * dz
+    point_vertex_matrix(mesh, elements, |q, k| {
+        d_zbar(q.grad[k]) - mu[q.face.idx()] * d_z(q.grad[k])
     })
 }

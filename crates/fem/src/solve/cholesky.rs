@@ -58,8 +58,7 @@ impl<T: Scalar> Cholesky<T> {
         // being computed, this thread (done with AMD) touches a buffer of AMD's factor
         // size; the factor reuses it when the dissection's factor fits, which it does
         // where the dissection is taken for its smaller factor.
-        let (forward, spare) =
-            fill_reducing_order_meanwhile(pattern, |entries| touched_zeros::<T>(entries))?;
+        let (forward, spare) = fill_reducing_order_meanwhile(pattern, touched_zeros::<T>)?;
         let inverse = inverse_permutation(&forward)?;
         Self::build(pattern, Some((&forward, &inverse)), par, spare.flatten())
     }
