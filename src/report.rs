@@ -16,6 +16,7 @@
 //! | `initial_flipped`, `initial_mu_mean`, `initial_mu_max` | the same for the map an iterative solver started from |
 //! | `mu_error` | `{rms, l2_squared, sup, sup_face}`: \|mu - target\| for a prescribed `mu` ([`beltrami_fem::MuError`]; `sup_face` a face id) |
 //! | `k` | the dilatation of an extremal map |
+//! | `teichmueller_bound` | the least `sup \|mu\|` of any map homotopic to the result, when known (a registration between tori, from their conformal moduli) |
 //! | `factorizations`, `cg_iterations` | numeric factorizations, and conjugate-gradient iterations of steps that reused one |
 //! | `annulus_radius` | the free inner radius of an annulus target |
 //! | `energy_history`, `step_sizes` | per iteration |
@@ -74,6 +75,7 @@ pub fn solution_json(solution: &Solution) -> JsonMap<String, Value> {
             "rms": e.rms, "l2_squared": e.l2_squared, "sup": e.sup, "sup_face": e.sup_face.idx(),
         })),
         "k": m.k,
+        "teichmueller_bound": m.teichmueller_bound,
         "factorizations": m.factorizations,
         "cg_iterations": m.cg_iterations,
         "annulus_radius": x.annulus_radius.map(|a| a.radius),

@@ -7,7 +7,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use beltrami_mesh::io::{self, VertexAttributes};
-use beltrami_mesh::primitives::{self, Cells};
+use beltrami_mesh::primitives::{self, Cells, ModifiedTorus};
 use beltrami_mesh::{BuildOptions, Mesh, Point3};
 use beltrami_spatial::SurfaceIndex;
 
@@ -886,6 +886,98 @@ fn tori_of_revolution_of_different_moduli_respect_the_teichmueller_bound() {
         assert!(
             mean <= k + 0.05,
             "mean |mu| {mean} more than 0.05 above the bound {k}"
+        );
+        // The bound the report computes from the meshes' own moduli (harmonic forms on
+        // 1728 and 1800 vertices) is the analytic one to the discretization error.
+        let reported = r["teichmueller_bound"].as_f64().unwrap();
+        assert!(
+            (reported - k).abs() < 2e-3,
+            "reported bound {reported}, analytic {k}"
+        );
+        // The L2-smallest map may go below the bound on average (thin onto fat: 0.16)
+        // by concentrating its distortion; the L4 norm weighs the largest |mu| more and
+        // moves the map towards the extremal one, |mu| = k everywhere.
+        let (_, r4) = register(source, target, &["--max-iters", "60", "--p", "4"], 1.01);
+        let (mean4, max4) = (
+            r4["mu_mean"].as_f64().unwrap(),
+            r4["mu_max"].as_f64().unwrap(),
+        );
+        assert!(
+            (mean4 - k).abs() <= 0.05,
+            "L4: mean |mu| {mean4} more than 0.05 from the bound {k}"
+        );
+        assert!(
+            k <= max4 && max4 < max,
+            "L4: max |mu| {max4}, L2 {max}, bound {k}"
+        );
+    }
+}
+
+#[test]
+fn kitten_and_bob_are_paired_in_the_class_of_least_distortion() {
+    let Some(shared) = shared_meshes("kitten_and_bob_are_paired_in_the_class_of_least_distortion")
+    else {
+        return;
+    };
+    // Bob's loop a (the greedy basis's shortest) is conformally the long one: pairing it
+    // with the kitten's a has bound 0.593, and the kitten onto Bob kept 4 flips; the
+    // quarter turn has 0.098.
+    let (kitten, bob) = (shared.join("g1_kitten.obj"), shared.join("g1_bob.obj"));
+    for (source, target) in [(&kitten, &bob), (&bob, &kitten)] {
+        let (_, r) = register(source, target, &[], 0.6);
+        let bound = r["teichmueller_bound"].as_f64().unwrap();
+        let notes = r["notes"].to_string();
+        assert!(
+            notes.contains("pairing a with a and b with b would have 0.59"),
+            "{notes}"
+        );
+        let (mean, max) = (
+            r["mu_mean"].as_f64().unwrap(),
+            r["mu_max"].as_f64().unwrap(),
+        );
+        println!(
+            "{}: mean {mean:.4}, max {max:.4}, bound {bound:.4}",
+            s(source)
+        );
+        assert!((bound - 0.098).abs() < 2e-3, "bound {bound}");
+        // The L2-smallest map's mean may fall below the bound (on the sup) by
+        // concentrating its distortion; the bound itself is below the sup.
+        assert!(mean <= bound + 0.05, "mean {mean}, bound {bound}");
+        assert!(max >= bound && max < 0.9, "max {max}, bound {bound}");
+    }
+}
+
+#[test]
+fn modified_tori_stay_within_0_05_of_the_bound_the_report_computes() {
+    // Wong-Zhao's phi_1 and phi_2 have no closed-form modulus: the report's bound (from
+    // both meshes' harmonic 1-forms) is the reference. It is a lower bound for the sup
+    // of |mu| of every map homotopic to the result; the L2-smallest map's mean is near it.
+    let dir = tempfile::tempdir().unwrap();
+    let torus = |name: &str, kind: ModifiedTorus| {
+        let soup = primitives::modified_torus(kind, 40, 16);
+        write(dir.path(), name, &Mesh::from_soup(&soup).unwrap())
+    };
+    let (one, two) = (
+        torus("phi1.obj", ModifiedTorus::Phi1),
+        torus("phi2.obj", ModifiedTorus::Phi2),
+    );
+    for (source, target) in [(&one, &two), (&two, &one)] {
+        let (_, r) = register(source, target, &[], 1.0);
+        let bound = r["teichmueller_bound"].as_f64().unwrap();
+        let (mean, max) = (
+            r["mu_mean"].as_f64().unwrap(),
+            r["mu_max"].as_f64().unwrap(),
+        );
+        let _ = writeln!(
+            std::io::stderr(),
+            "{}: mean {mean:.4}, max {max:.4}, bound {bound:.4}",
+            s(source)
+        );
+        assert!(bound > 0.1 && bound < 0.2, "bound {bound}");
+        assert!(max >= bound, "max |mu| {max} below the bound {bound}");
+        assert!(
+            (mean - bound).abs() <= 0.05,
+            "mean |mu| {mean} more than 0.05 from the bound {bound}"
         );
     }
 }

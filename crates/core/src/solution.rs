@@ -71,6 +71,9 @@ pub struct Metrics {
     pub mu_error: Option<MuError>,
     /// The dilatation `k = |mu|` of an extremal (Teichmueller) map.
     pub k: Option<f64>,
+    /// The smallest `sup |mu|` of any map in the result's homotopy class, when known
+    /// (a registration between two tori: from their conformal moduli).
+    pub teichmueller_bound: Option<f64>,
     /// Iterations done (0 for direct solvers).
     pub iterations: usize,
     /// Energy or error after each iteration (direct solvers: the final energy, if any).

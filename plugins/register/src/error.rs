@@ -128,6 +128,14 @@ pub enum RegisterError {
         /// The mesh error.
         error: MeshError,
     },
+    /// The finite elements of a mesh could not be set up (a degenerate face).
+    #[error("finite elements of the {side}: {error}")]
+    Elements {
+        /// Which mesh.
+        side: Side,
+        /// The element error.
+        error: FemError,
+    },
     /// Point location failed.
     #[error("point location: {0}")]
     Spatial(#[from] SpatialError),

@@ -319,42 +319,6 @@ fn cross_ratio_map(points: [Vector3<f64>; 3]) -> Option<[[Complex64; 2]; 2]> {
     Some([[c1 * p1[1], -c1 * p1[0]], [c3 * p3[1], -c3 * p3[0]]])
 }
 
-/// An orientation-preserving symmetry of the torus `R^2 / Z^2` as seen on the square:
-/// `quarter_turns` rotations by 90 degrees about the centre `(1/2, 1/2)` (each maps the
-/// lattice to itself) followed by a translation by `shift`, the result wrapped into
-/// `[0, 1)^2`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct SquareMap {
-    /// Number of counter-clockwise quarter turns (0..4).
-    pub quarter_turns: u8,
-    /// The translation.
-    pub shift: Complex64,
-}
-
-impl SquareMap {
-    /// The rotation part alone, no wrap.
-    pub(crate) fn turn(&self, x: Complex64) -> Complex64 {
-        let center = Complex64::new(0.5, 0.5);
-        let mut d = x - center;
-        for _ in 0..self.quarter_turns {
-            d *= Complex64::i();
-        }
-        center + d
-    }
-
-    /// The image of a point of the square, wrapped into `[0, 1)^2`.
-    pub(crate) fn apply(&self, x: Complex64) -> Complex64 {
-        let y = self.turn(x) + self.shift;
-        Complex64::new(y.re.rem_euclid(1.0), y.im.rem_euclid(1.0))
-    }
-}
-
-/// The distance on the torus `R^2 / Z^2` between two points of the square.
-pub(crate) fn periodic_distance(a: Complex64, b: Complex64) -> f64 {
-    let d = a - b;
-    Complex64::new(d.re - d.re.round(), d.im - d.im.round()).norm()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

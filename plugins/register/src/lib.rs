@@ -41,6 +41,7 @@ mod consistency;
 mod disk;
 mod error;
 mod landmarks;
+mod modulus;
 mod param;
 mod polygon;
 mod projection;
@@ -48,6 +49,7 @@ mod routing;
 mod skeleton;
 mod solver;
 mod sphere;
+mod square_map;
 mod topology;
 mod torus;
 
@@ -57,6 +59,7 @@ use beltrami_spatial::SurfaceIndex;
 
 pub use error::{RegisterError, Side};
 pub use landmarks::{Landmark, LandmarkTarget};
+pub use modulus::{TorusPeriods, teichmueller_bound};
 pub use solver::Register;
 pub use topology::{Shape, Topology, check_topology};
 
@@ -80,6 +83,10 @@ pub struct InitialMap {
     /// against or orthogonal to it). No flips for a bijective map between well-shaped
     /// meshes.
     pub distortion: DistortionStats,
+    /// The smallest `sup |mu|` of any map homotopic to this one, when known: between
+    /// two tori, from their conformal moduli in the markings the map pairs
+    /// ([`teichmueller_bound`]).
+    pub teichmueller_bound: Option<f64>,
 }
 
 impl InitialMap {
@@ -111,10 +118,15 @@ pub fn initial_map(
     let target_index = SurfaceIndex::new(target)?;
     let marks = landmarks::resolve(source, target, &target_index, landmarks)?;
     let mut notes = Vec::new();
+    let mut teichmueller_bound = None;
     let (mut points, honoured) = match topology {
         Topology::Disk => disk::map(source, target, &marks, &mut notes)?,
         Topology::Sphere => sphere::map(source, target, &target_index, &marks, &mut notes)?,
-        Topology::Torus => torus::map(source, target, &marks, &mut notes)?,
+        Topology::Torus => {
+            let torus = torus::map(source, target, &marks, &mut notes)?;
+            teichmueller_bound = Some(torus.teichmueller_bound);
+            (torus.points, torus.honoured)
+        }
         Topology::MultiplyConnected | Topology::HigherGenus => {
             let cut = polygon::map(source, target, &target_index, &marks, &mut notes);
             if marks.is_empty() && target.boundary_loop_count() == 0 {
@@ -158,6 +170,7 @@ pub fn initial_map(
         topology,
         notes,
         distortion,
+        teichmueller_bound,
     })
 }
 

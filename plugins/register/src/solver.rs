@@ -208,6 +208,7 @@ impl Solver for Register {
         // Judged against the target's normals at the images (the rule of `beltrami
         // distortion --target` and of the flow), when the initial map was built.
         solution.metrics.initial_distortion = Some(initial.distortion);
+        solution.metrics.teichmueller_bound = initial.teichmueller_bound;
         if solution.metrics.flipped().unwrap_or(0) > 0
             && let Some(Map::OnMesh(points)) = solution.map().cloned()
         {

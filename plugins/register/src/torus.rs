@@ -40,11 +40,21 @@ use num_complex::Complex64;
 
 use crate::compose;
 use crate::error::{RegisterError, Side};
-use crate::landmarks::{Resolved, SpatialMatch, SquareMap, interpolate, periodic_distance};
-use crate::param::{domain_mesh, input_indices, planar_points, tutte};
+use crate::landmarks::{Resolved, SpatialMatch, interpolate};
+use crate::modulus::{TorusPeriods, periods, teichmueller_bound};
+use crate::param::{domain_mesh, input_indices, path_fractions, planar_points, tutte};
+use crate::square_map::{LatticeMap, SquareMap, periodic_distance};
 
 /// Translations per direction tried without landmarks.
 const SHIFTS: usize = 8;
+
+/// Homotopy classes tried without landmarks: lattice maps with entries of at most this
+/// size (module `square_map`).
+const CLASS_ENTRIES: i32 = 2;
+
+/// Classes whose Teichmueller bounds differ by less than this are told apart by the
+/// spatial match; pairing `a` with `a` is kept when it is that close to the least.
+const CLASS_TIE: f64 = 0.01;
 
 /// Source vertices used to score the translations at most.
 const SCORE_SAMPLES: usize = 512;
@@ -53,20 +63,30 @@ const SCORE_SAMPLES: usize = 512;
 const HONOURED: f64 = 1e-9;
 
 /// A torus cut into its square.
-struct Square {
-    cut: CutMesh,
+pub(crate) struct Square {
+    pub(crate) cut: CutMesh,
     /// Parameter of every cut-mesh vertex in `[0, 1]^2`.
-    param: Vec<Complex64>,
+    pub(crate) param: Vec<Complex64>,
 }
 
-/// The source's images on the target and the landmarks honoured exactly (indices into
-/// `marks`).
+/// The initial map between two tori.
+pub(crate) struct TorusMap {
+    /// The source's images on the target.
+    pub(crate) points: Vec<SurfacePoint>,
+    /// The landmarks honoured exactly (indices into `marks`).
+    pub(crate) honoured: Vec<usize>,
+    /// The Teichmueller bound of the map's homotopy class (module `modulus`).
+    pub(crate) teichmueller_bound: f64,
+}
+
+/// The source's images on the target, the landmarks honoured exactly and the
+/// Teichmueller bound of the map's homotopy class.
 pub(crate) fn map(
     source: &Mesh,
     target: &Mesh,
     marks: &[Resolved],
     notes: &mut Vec<String>,
-) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
+) -> Result<TorusMap, RegisterError> {
     let source_square = square(source, Side::Source, notes)?;
     let target_square = square(target, Side::Target, notes)?;
     let domain = domain_mesh(
@@ -75,12 +95,31 @@ pub(crate) fn map(
         Side::Target,
     )?;
     let s_param = &source_square.param[..source.vertex_count()];
+    let source_periods = periods(
+        source,
+        &source_square.cut,
+        &source_square.param,
+        Side::Source,
+    )?;
+    let target_periods = periods(
+        target,
+        &target_square.cut,
+        &target_square.param,
+        Side::Target,
+    )?;
+    let tau = source_periods.tau();
 
     let (map, honoured) = if marks.is_empty() {
-        let map = best_by_space(source, target, &domain, s_param)?;
+        let (candidates, identity) = least_distortion_classes(tau, &target_periods);
+        let map = best_by_space(source, target, &domain, s_param, &candidates)?;
         notes.push(format!(
-            "torus: no landmark; a paired with a, b with b, {} and translation ({:.3}, {:.3}) of the square chosen by a rough spatial match",
-            if map.quarter_turns == 0 { "no turn" } else { "half turn" },
+            "torus: no landmark; {} (the homotopy class of least Teichmueller bound{}), translation ({:.3}, {:.3}) of the square chosen by a rough spatial match",
+            map.linear.describe(),
+            if candidates.contains(&LatticeMap::IDENTITY) {
+                String::new()
+            } else {
+                format!("; pairing a with a and b with b would have {identity:.4}")
+            },
             map.shift.re,
             map.shift.im
         ));
@@ -99,7 +138,7 @@ pub(crate) fn map(
         let mut best: Option<(f64, SquareMap)> = None;
         for &quarter_turns in turns {
             let mut map = SquareMap {
-                quarter_turns,
+                linear: LatticeMap::quarter_turns(quarter_turns),
                 shift: Complex64::new(0.0, 0.0),
             };
             map.shift = t[0] - map.turn(s[0]);
@@ -120,17 +159,12 @@ pub(crate) fn map(
             .filter(|&k| periodic_distance(map.apply(s[k]), t[k]) <= HONOURED)
             .collect();
         notes.push(format!(
-            "torus: {} quarter turns and translation ({:.4}, {:.4}) of the square from the landmarks ({} of {} honoured exactly{})",
-            map.quarter_turns,
+            "torus: {} and translation ({:.4}, {:.4}) of the square from the landmarks ({} of {} honoured exactly)",
+            map.linear.describe(),
             map.shift.re,
             map.shift.im,
             honoured.len(),
             marks.len(),
-            if map.quarter_turns % 2 == 1 {
-                "; the source's a goes to the target's b"
-            } else {
-                ""
-            }
         ));
         (map, honoured)
     };
@@ -141,11 +175,49 @@ pub(crate) fn map(
             "torus: the farthest source image was {gap:.3e} outside the target's square and was moved onto it"
         ));
     }
-    Ok((points, honoured))
+    let tau_target = target_periods.tau_in(&map.linear);
+    let bound = teichmueller_bound(tau, tau_target);
+    notes.push(format!(
+        "torus: conformal moduli (periods of a over b) {:.5}{:+.5}i (source) and {:.5}{:+.5}i (target, in the loops the map pairs with the source's): every map in this homotopy class has sup |mu| >= {bound:.5} (Teichmueller bound)",
+        tau.re, tau.im, tau_target.re, tau_target.im
+    ));
+    Ok(TorusMap {
+        points,
+        honoured,
+        teichmueller_bound: bound,
+    })
+}
+
+/// The homotopy classes a map without landmarks chooses from, and the Teichmueller
+/// bound of pairing `a` with `a`: the classes (lattice maps with entries up to
+/// `CLASS_ENTRIES`) whose bound is within `CLASS_TIE` of the least, or the identity and
+/// its half turn when the identity is among them (the loops' own pairing is kept when it
+/// costs nothing).
+fn least_distortion_classes(tau: Complex64, target: &TorusPeriods) -> (Vec<LatticeMap>, f64) {
+    let bound_of = |linear: &LatticeMap| teichmueller_bound(tau, target.tau_in(linear));
+    let classes: Vec<(f64, LatticeMap)> = LatticeMap::all_within(CLASS_ENTRIES)
+        .map(|linear| (bound_of(&linear), linear))
+        .collect();
+    let least = classes.iter().map(|c| c.0).fold(f64::INFINITY, f64::min);
+    let identity = bound_of(&LatticeMap::IDENTITY);
+    let candidates = if identity <= least + CLASS_TIE {
+        vec![LatticeMap::IDENTITY, LatticeMap::quarter_turns(2)]
+    } else {
+        classes
+            .iter()
+            .filter(|c| c.0 <= least + CLASS_TIE)
+            .map(|c| c.1)
+            .collect()
+    };
+    (candidates, identity)
 }
 
 /// Cuts `mesh` and maps it onto the unit square (module docs), noting the loops.
-fn square(mesh: &Mesh, side: Side, notes: &mut Vec<String>) -> Result<Square, RegisterError> {
+pub(crate) fn square(
+    mesh: &Mesh,
+    side: Side,
+    notes: &mut Vec<String>,
+) -> Result<Square, RegisterError> {
     let cut = cut_to_disk(mesh).map_err(|error| RegisterError::Cut { side, error })?;
     let sides = cut
         .torus_sides
@@ -205,36 +277,14 @@ fn square(mesh: &Mesh, side: Side, notes: &mut Vec<String>) -> Result<Square, Re
     Ok(Square { cut, param })
 }
 
-/// Arc-length fractions along an open path, 0 at its first and 1 at its last vertex.
-fn path_fractions(mesh: &Mesh, path: &[VertexId]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(path.len());
-    let mut total = 0.0;
-    out.push(0.0);
-    for w in path.windows(2) {
-        total += (mesh.position(w[1]) - mesh.position(w[0])).norm();
-        out.push(total);
-    }
-    let n = path.len().saturating_sub(1).max(1) as f64;
-    for (k, x) in out.iter_mut().enumerate() {
-        *x = if total > 0.0 {
-            *x / total
-        } else {
-            k as f64 / n
-        };
-    }
-    if let Some(last) = out.last_mut() {
-        *last = 1.0;
-    }
-    out
-}
-
-/// The half turn and translation (of `SHIFTS^2`) whose images best match the source in
-/// space (module docs).
+/// The linear part (of `candidates`) and translation (of `SHIFTS^2`) whose images best
+/// match the source in space (module docs).
 fn best_by_space(
     source: &Mesh,
     target: &Mesh,
     domain: &Mesh,
     s_param: &[Complex64],
+    candidates: &[LatticeMap],
 ) -> Result<SquareMap, RegisterError> {
     let spatial = SpatialMatch::new(source, target);
     let step = source.vertex_count().div_ceil(SCORE_SAMPLES).max(1);
@@ -247,15 +297,15 @@ fn best_by_space(
     let mut best = (
         f64::INFINITY,
         SquareMap {
-            quarter_turns: 0,
+            linear: LatticeMap::IDENTITY,
             shift: Complex64::new(0.0, 0.0),
         },
     );
-    for quarter_turns in [0, 2] {
+    for &linear in candidates {
         for i in 0..SHIFTS {
             for j in 0..SHIFTS {
                 let map = SquareMap {
-                    quarter_turns,
+                    linear,
                     shift: Complex64::new(i as f64, j as f64) / SHIFTS as f64,
                 };
                 let images: Vec<Point3<f64>> = samples
@@ -278,4 +328,58 @@ fn best_by_space(
         }
     }
     Ok(best.1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn periods_of(tau: Complex64) -> TorusPeriods {
+        TorusPeriods {
+            a: tau,
+            b: Complex64::new(1.0, 0.0),
+        }
+    }
+
+    #[test]
+    fn equal_moduli_keep_the_loops_own_pairing() {
+        let tau = Complex64::new(0.01, 0.46);
+        let (classes, identity) = least_distortion_classes(tau, &periods_of(tau));
+        assert_eq!(
+            classes,
+            [LatticeMap::IDENTITY, LatticeMap::quarter_turns(2)]
+        );
+        assert!(identity < 1e-15);
+    }
+
+    #[test]
+    fn a_target_whose_loop_a_is_conformally_long_is_turned() {
+        // The kitten (tau = 0.458 i) onto Bob, whose shortest loop is the conformally
+        // long one (tau = 1.794 i): pairing a with a has bound 0.593; a quarter turn
+        // compares 0.458 i with -1 / 1.794 i = 0.557 i, bound 0.098.
+        let (classes, identity) = least_distortion_classes(
+            Complex64::new(0.0, 0.458),
+            &periods_of(Complex64::new(0.0, 1.794)),
+        );
+        assert!((identity - 0.5932).abs() < 1e-3, "{identity}");
+        assert_eq!(classes.len(), 2, "{classes:?}");
+        assert!(classes.contains(&LatticeMap::quarter_turns(1)));
+        assert!(classes.contains(&LatticeMap::quarter_turns(3)));
+    }
+
+    #[test]
+    fn a_sheared_target_is_sheared_back() {
+        // The same torus read in the loops a + b and b: the class a -> a - b undoes it.
+        let tau = Complex64::new(0.1, 1.3);
+        let sheared = periods_of(tau + 1.0);
+        let (classes, identity) = least_distortion_classes(tau, &sheared);
+        assert!(identity > 0.3, "{identity}");
+        assert!(
+            classes.contains(&LatticeMap([[1, -1], [0, 1]])),
+            "{classes:?}"
+        );
+        for linear in &classes {
+            assert!(teichmueller_bound(tau, sheared.tau_in(linear)) < 1e-12);
+        }
+    }
 }
