@@ -21,17 +21,27 @@
 //! mesh's square, glued periodically, is a homeomorphism of the torus onto
 //! `R^2 / Z^2` taking `a` to the first and `b` to the second lattice direction.
 //!
-//! The homotopy class of the composed map is then fixed by pairing the source's `a`
-//! with the target's `a` (shortest with shortest) and `b` with `b`; both squares run in
-//! the same rotational sense, so the map preserves orientation. The remaining freedom is
-//! an orientation-preserving symmetry of the square ([`SquareMap`]): a quarter turn
-//! count and a translation. Without landmarks it is the half turn (0 or 2, which keep
-//! the pairing) and one of 8 x 8 translations that best match the two meshes in space
-//! (sum of squared distances, over up to 512 source vertices, between a vertex moved by
-//! the rough spatial match and its image); with one landmark no turn and the translation
-//! that takes the landmark onto its target; with more, the quarter turn (any of four,
-//! so a landmark set may pair `a` with the target's `b`) with the smallest periodic
-//! distances of the other landmarks to their targets.
+//! The composed map is `z -> L z + s (mod 1)` on the squares ([`SquareMap`]), with `L` an
+//! integer matrix of determinant 1 (module `square_map`): `L` fixes the homotopy class
+//! (which target loops the source's `a` and `b` go to), and both squares run in the same
+//! rotational sense, so the map preserves orientation.
+//!
+//! - Without landmarks, the class is the one of least Teichmueller bound (module
+//!   `modulus`: the conformal moduli of both meshes, every `L` with entries up to 2),
+//!   so that the flow starts in the class where the least distorted map lives. When
+//!   pairing `a` with `a` and `b` with `b` is within 0.01 of the least it is kept (with
+//!   its half turn); otherwise every class within 0.01 of the least is a candidate. The
+//!   candidate and one of 8 x 8 translations that best match the two meshes in space
+//!   (sum of squared distances, over up to 512 source vertices, between a vertex moved
+//!   by the rough spatial match and its image) are taken. Two meshes of one surface
+//!   have a class of bound near 0; a shortest loop that is conformally the long way
+//!   round (the kitten's `a` against Bob's) is paired with the other mesh's other loop.
+//! - With one landmark: `L` the identity and the translation that takes the landmark
+//!   onto its target; with more, the quarter turn (any of four, so a landmark set may
+//!   pair `a` with the target's `b`) with the smallest periodic distances of the other
+//!   landmarks to their targets.
+//!
+//! The notes give the pairing, both moduli and the bound of the class taken.
 
 use beltrami_fem::BoundaryMap;
 use beltrami_mesh::{CutMesh, Mesh, Point3, SurfacePoint, VertexId, cut_to_disk};
