@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use beltrami_mesh::io::{self, VertexAttributes};
 use beltrami_mesh::primitives::{self, Cells, ModifiedTorus};
-use beltrami_mesh::{BuildOptions, Mesh, Point3};
+use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup};
 use beltrami_spatial::SurfaceIndex;
 
 mod common;
@@ -385,17 +385,63 @@ fn distortion_against_the_target_agrees_across_folds_of_the_target() {
 
 #[test]
 fn a_registration_with_flips_fails_naming_them_unless_allowed() {
-    let Some(shared) = shared_meshes("a_registration_with_flips_fails_naming_them_unless_allowed")
-    else {
-        return;
-    };
-    // Without landmarks the 4-boundary faces keep one flipped face on a boundary edge.
-    // The promise is a bijection at exit 0; a flip that remains is an error naming the
-    // faces, and the map is written only with --allow-flips.
-    let (source, target) = (shared.join("mc4_face_a.obj"), shared.join("mc4_face_b.obj"));
+    // A square grid whose four corner cells are split so that every corner is an ear
+    // (a face with two boundary edges), onto a subdivided triangle: boundary vertices
+    // slide along the target's boundary, and an ear is flat unless a corner of the
+    // target lies strictly inside its two edges. Four ears and three corners: at least
+    // one ear is flat in every map, whatever the flow does. The promise is a bijection
+    // at exit 0, so this is an error naming the faces and why, and the map is written
+    // only with --allow-flips.
+    let n = 8u32;
+    let grid = primitives::grid(n as usize, n as usize, Cells::Triangles);
+    let id = |i: u32, j: u32| i + (n + 1) * j;
+    let mut source = PolygonSoup::new(grid.positions);
+    for j in 0..n {
+        for i in 0..n {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i, j) == (0, 0) || (i, j) == (n - 1, n - 1) {
+                source.push_face(&[a, b, d]);
+                source.push_face(&[b, c, d]);
+            } else {
+                source.push_face(&[a, b, c]);
+                source.push_face(&[a, c, d]);
+            }
+        }
+    }
+    let m = 10u32;
+    let mut ids = Vec::new();
+    let mut positions = Vec::new();
+    for j in 0..=m {
+        let row: Vec<u32> = (0..=m - j)
+            .map(|i| {
+                positions.push(Point3::new(
+                    (f64::from(i) + 0.5 * f64::from(j)) / f64::from(m),
+                    f64::from(j) * 3f64.sqrt() / 2.0 / f64::from(m),
+                    0.0,
+                ));
+                (positions.len() - 1) as u32
+            })
+            .collect();
+        ids.push(row);
+    }
+    let mut triangle = PolygonSoup::new(positions);
+    for j in 0..m as usize {
+        for i in 0..(m as usize - j) {
+            triangle.push_face(&[ids[j][i], ids[j][i + 1], ids[j + 1][i]]);
+            if i + 1 < m as usize - j {
+                triangle.push_face(&[ids[j][i + 1], ids[j + 1][i + 1], ids[j + 1][i]]);
+            }
+        }
+    }
     let dir = tempfile::tempdir().unwrap();
+    let source = write(dir.path(), "ears.obj", &Mesh::from_soup(&source).unwrap());
+    let target = write(
+        dir.path(),
+        "triangle.obj",
+        &Mesh::from_soup(&triangle).unwrap(),
+    );
     let (out, report) = (dir.path().join("out.obj"), dir.path().join("report.json"));
-    let args = |extra: &'static [&'static str]| {
+    let args = |extra: &[&'static str]| {
         let mut args = vec![
             "register".to_string(),
             s(&source).to_string(),
@@ -410,13 +456,11 @@ fn a_registration_with_flips_fails_naming_them_unless_allowed() {
     };
     let strict: Vec<String> = args(&[]);
     let run = beltrami(&strict.iter().map(String::as_str).collect::<Vec<_>>());
-    if run.status.success() {
-        assert_eq!(json(&report)["flipped"], 0, "exit 0 promises no flip");
-        return;
-    }
+    assert!(!run.status.success(), "four ears onto three corners");
     let message = text(&run.stderr);
     assert!(message.contains("flipped on the target"), "{message}");
     assert!(message.contains("input indices"), "{message}");
+    assert!(message.contains("are ears"), "{message}");
     assert!(message.contains("--allow-flips"), "{message}");
     assert_eq!(
         message.matches("flipped on the target").count(),
@@ -424,6 +468,7 @@ fn a_registration_with_flips_fails_naming_them_unless_allowed() {
         "{message}"
     );
     assert!(!out.exists(), "a failed registration writes no map");
+    assert!(!report.exists(), "a failed registration writes no report");
     let allowed: Vec<String> = args(&["--allow-flips"]);
     let run = beltrami(&allowed.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(run.status.success(), "{}", text(&run.stderr));
@@ -432,6 +477,23 @@ fn a_registration_with_flips_fails_naming_them_unless_allowed() {
     let notes = r["notes"].to_string();
     assert!(notes.contains("kept as asked"), "{notes}");
     assert!(out.exists());
+}
+
+#[test]
+fn the_four_boundary_faces_without_landmarks() {
+    let Some(shared) = shared_meshes("the_four_boundary_faces_without_landmarks") else {
+        return;
+    };
+    // The flow from the initial map (4 flips) left one flip on a boundary edge; the
+    // initial map untangled first, then flowed, has none.
+    let (source, target) = (shared.join("mc4_face_a.obj"), shared.join("mc4_face_b.obj"));
+    let (_, r) = register(&source, &target, &[], 0.8);
+    let notes = r["notes"].to_string();
+    assert!(
+        notes.contains("untangled first, 0: kept the second"),
+        "{notes}"
+    );
+    assert!(r["mu_max"].as_f64().unwrap() < 0.95, "{r}");
 }
 
 #[test]

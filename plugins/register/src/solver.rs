@@ -87,7 +87,21 @@ fn judge_flips(
         .filter(|&&(_, angle)| angle > FOLD_DEGREES)
         .count();
     let widest = flipped.iter().map(|&(_, a)| a).fold(0.0, f64::max);
-    let why = if folds > 0 {
+    let ears = flipped
+        .iter()
+        .filter(|&&(f, _)| {
+            source
+                .face_halfedges(f)
+                .filter(|&h| source.face(source.twin(h)).is_none())
+                .count()
+                >= 2
+        })
+        .count();
+    let why = if ears > 0 {
+        format!(
+            "{ears} of them are ears (faces with two boundary edges): their three corners slide along the target's boundary, and an ear whose corners lie on one straight stretch of it is flat; split the ears (or give the target's boundary a corner for each)"
+        )
+    } else if folds > 0 {
         format!(
             "{folds} of them have corners on target faces whose normals differ by more than {FOLD_DEGREES} degrees (up to {widest:.0}): the target folds within one source face there, finer than the source resolves"
         )
