@@ -44,6 +44,9 @@ pub struct ImageFace {
     pub local: [Vector2<f64>; 3],
     /// Whether the fem kernel finds the image flipped or degenerate (module docs).
     flipped: bool,
+    /// `n . N_T / |N_T|`: 1 where the image triangle lies in the target's tangent
+    /// plane, near 0 where it stands edge-on to it.
+    facing: f64,
 }
 
 impl ImageFace {
@@ -57,7 +60,23 @@ impl ImageFace {
     pub fn flipped(&self) -> bool {
         self.flipped
     }
+
+    /// Whether the image triangle stands nearly edge-on to the target's tangent plane
+    /// (`n . N_T / |N_T| < EDGE_ON`): seen from the target's normal it is a sliver about
+    /// to fold, whatever its own `|mu|`; a step of any size may flip it.
+    pub fn edge_on(&self) -> bool {
+        self.facing < EDGE_ON
+    }
+
+    /// Marks the face flipped (so that [`crate::untangle`] moves its vertices).
+    pub(crate) fn mark_flipped(&mut self) {
+        self.flipped = true;
+    }
 }
+
+/// The cosine between an image triangle and the target's tangent plane below which the
+/// triangle counts as edge-on ([`ImageFace::edge_on`]): about 84 degrees.
+pub const EDGE_ON: f64 = 0.1;
 
 /// The vertices of P1 face `f` of `elements`.
 pub(crate) fn triangle(elements: &Elements, f: FaceId) -> [VertexId; 3] {
@@ -111,6 +130,11 @@ pub fn image_face(
             Vector2::new(e2.dot(&r), e2.dot(&s)),
         ],
         flipped: image_derivatives(&fx, &fy, &reference).jacobian() <= 0.0,
+        facing: if reference.norm_squared() > 0.0 {
+            n.dot(&reference.normalize())
+        } else {
+            1.0
+        },
     }
 }
 

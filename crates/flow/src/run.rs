@@ -254,6 +254,20 @@ pub fn solve(
     )
 }
 
+/// Whether `new` ends with a lower error than `old`, without a flip, and with its
+/// largest `|mu|` below the barrier's start or not above `old`'s.
+fn lower_without_new_near_folds<G>(
+    new: &FlowRun<G>,
+    old: &FlowRun<G>,
+    objective: &Objective,
+) -> bool {
+    let last = |run: &FlowRun<G>| run.energy_history.last().copied().unwrap_or(f64::INFINITY);
+    let largest = |run: &FlowRun<G>| run.faces.iter().map(|f| f.mu().norm()).fold(0.0, f64::max);
+    !new.faces.iter().any(ImageFace::flipped)
+        && last(new) < last(old)
+        && largest(new) <= largest(old).max(objective.barrier_start)
+}
+
 /// The image faces of `image` on a target mesh (normals interpolated at the images).
 fn mesh_image_faces(
     elements: &Elements,
@@ -266,8 +280,8 @@ fn mesh_image_faces(
     faces
 }
 
-/// Untangles the flipped faces of `image` ([`untangle`], `faces` its image faces) and
-/// notes what it did, naming the map as `which`.
+/// Untangles the faces of `image` marked flipped ([`untangle`], `faces` its image
+/// faces) and notes what it did, naming them by `which` ("flipped", ...).
 fn untangle_noted(
     which: &str,
     elements: &Elements,
@@ -287,13 +301,8 @@ fn untangle_noted(
         faces,
         UNTANGLE_ROUNDS,
     );
-    let which = if which.is_empty() {
-        String::new()
-    } else {
-        format!("{which} ")
-    };
     report.notes.push(format!(
-        "untangled {which}{} flipped faces to {} by moving {} vertices into the kernels of their stars",
+        "untangled {}{which} faces to {} by moving {} vertices into the kernels of their stars",
         done.before, done.after, done.moves
     ));
     done
@@ -375,7 +384,7 @@ impl Runner<'_, '_> {
         if untangle_first {
             let mut faces = mesh_image_faces(elements, geometry, &image);
             untangle_noted(
-                "the initial map's",
+                " of the initial map's flipped",
                 elements,
                 geometry,
                 roles,
@@ -393,13 +402,55 @@ impl Runner<'_, '_> {
             (report, metrics),
         )?;
         for _ in 0..UNTANGLE_RESTARTS {
-            if !run.faces.iter().any(ImageFace::flipped) || context.is_cancelled() {
+            let flipped = run.faces.iter().any(ImageFace::flipped);
+            let edge_on = run.faces.iter().filter(|f| f.edge_on()).count();
+            let stalled = matches!(run.stop, Stop::Stalled);
+            if context.is_cancelled() || !(flipped || (stalled && edge_on > 0)) {
                 break;
             }
             let mut image = run.image.clone();
             let mut faces = run.faces.clone();
+            if !flipped {
+                // A flow stalled without flips: a face edge-on to the target flips under
+                // a step of any size along the flow; untangled like a flip, its vertices
+                // go into the kernels of their stars in the tangent plane, and the flow
+                // goes on from there when that ends lower without a new near-fold.
+                for face in faces.iter_mut().filter(|f| f.edge_on()) {
+                    face.mark_flipped();
+                }
+                let mut relaxed = image.clone();
+                let done = untangle_noted(
+                    " edge-on (where the flow stalled)",
+                    elements,
+                    geometry,
+                    roles,
+                    &mut relaxed,
+                    &mut faces,
+                    report,
+                );
+                if done.after > 0 {
+                    break;
+                }
+                let again = self.run(
+                    geometry.clone(),
+                    roles.to_vec(),
+                    relaxed,
+                    scale,
+                    context,
+                    (report, metrics),
+                )?;
+                if !lower_without_new_near_folds(&again, &run, self.objective) {
+                    report.notes.push(
+                        "the flow from the relaxed map did not end lower: kept the stalled one"
+                            .into(),
+                    );
+                    break;
+                }
+                run = again;
+                continue;
+            }
             let done = untangle_noted(
-                "", elements, geometry, roles, &mut image, &mut faces, report,
+                " flipped", elements, geometry, roles, &mut image, &mut faces, report,
             );
             if done.after >= done.before {
                 break;
