@@ -305,7 +305,10 @@ fn a_flow_blocked_by_a_face_edge_on_to_the_target_goes_on() {
     assert!(run.status.success(), "{}", text(&run.stderr));
     let (_, r) = register(&shared.join("g1_kitten.obj"), &target, &[], 0.5);
     let notes = r["notes"].to_string();
-    assert!(notes.contains("edge-on (where the flow stalled)"), "{notes}");
+    assert!(
+        notes.contains("edge-on (where the flow stalled)"),
+        "{notes}"
+    );
     let mean = r["mu_mean"].as_f64().unwrap();
     assert!(mean < 0.075, "mean |mu| {mean}");
 }

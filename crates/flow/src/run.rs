@@ -421,59 +421,37 @@ impl Runner<'_, '_> {
         )?;
         for _ in 0..UNTANGLE_RESTARTS {
             let flipped = run.faces.iter().any(ImageFace::flipped);
-            let edge_on = run.faces.iter().filter(|f| f.edge_on()).count();
-            let stalled = matches!(run.stop, Stop::Stalled) && still_falling(&run.energy_history);
-            if context.is_cancelled() || !(flipped || (stalled && edge_on > 0)) {
+            // A flow stalled without flips while its error still fell: a face edge-on to
+            // the target flips under a step of any size along the flow. Untangled like a
+            // flip, its vertices go into the kernels of their stars in the tangent
+            // plane, and the flow goes on from there when that ends lower without a new
+            // near-fold.
+            let blocked = !flipped
+                && matches!(run.stop, Stop::Stalled)
+                && still_falling(&run.energy_history)
+                && run.faces.iter().any(ImageFace::edge_on);
+            if context.is_cancelled() || !(flipped || blocked) {
                 break;
             }
             let mut image = run.image.clone();
             let mut faces = run.faces.clone();
-            if !flipped {
-                // A flow stalled without flips: a face edge-on to the target flips under
-                // a step of any size along the flow; untangled like a flip, its vertices
-                // go into the kernels of their stars in the tangent plane, and the flow
-                // goes on from there when that ends lower without a new near-fold.
+            if blocked {
                 for face in faces.iter_mut().filter(|f| f.edge_on()) {
                     face.mark_flipped();
                 }
-                let mut relaxed = image.clone();
-                let done = untangle_noted(
-                    " edge-on (where the flow stalled)",
-                    elements,
-                    geometry,
-                    roles,
-                    &mut relaxed,
-                    &mut faces,
-                    report,
-                );
-                if done.after > 0 {
-                    break;
-                }
-                let again = self.run(
-                    geometry.clone(),
-                    roles.to_vec(),
-                    relaxed,
-                    scale,
-                    context,
-                    (report, metrics),
-                )?;
-                if !lower_without_new_near_folds(&again, &run, self.objective) {
-                    report.notes.push(
-                        "the flow from the relaxed map did not end lower: kept the stalled one"
-                            .into(),
-                    );
-                    break;
-                }
-                run = again;
-                continue;
             }
+            let which = if blocked {
+                " edge-on (where the flow stalled)"
+            } else {
+                " flipped"
+            };
             let done = untangle_noted(
-                " flipped", elements, geometry, roles, &mut image, &mut faces, report,
+                which, elements, geometry, roles, &mut image, &mut faces, report,
             );
-            if done.after >= done.before {
+            if done.after >= done.before || (blocked && done.after > 0) {
                 break;
             }
-            run = self.run(
+            let again = self.run(
                 geometry.clone(),
                 roles.to_vec(),
                 image,
@@ -481,6 +459,13 @@ impl Runner<'_, '_> {
                 context,
                 (report, metrics),
             )?;
+            if blocked && !lower_without_new_near_folds(&again, &run, self.objective) {
+                report.notes.push(
+                    "the flow from the relaxed map did not end lower: kept the stalled one".into(),
+                );
+                break;
+            }
+            run = again;
         }
         Ok(run)
     }
