@@ -290,27 +290,22 @@ fn kitten_onto_the_modified_tori() {
 }
 
 #[test]
-fn a_flow_blocked_by_a_face_edge_on_to_the_target_goes_on() {
-    let Some(shared) = shared_meshes("a_flow_blocked_by_a_face_edge_on_to_the_target_goes_on")
-    else {
+fn a_face_edge_on_to_the_target_does_not_block_the_flow() {
+    let Some(shared) = shared_meshes("a_face_edge_on_to_the_target_does_not_block_the_flow") else {
         return;
     };
-    // The kitten onto phi_2 (L2) stalled after 9 steps at mean |mu| 0.083, the error
-    // still falling: one image face stood edge-on to the target (its own |mu| 0.8, but
-    // a step of any size along the flow flipped it). Its vertices moved into their
-    // stars' kernels, the flow goes on to a lower mean.
+    // The kitten onto phi_2 (L2) stalled after 9 steps at mean |mu| 0.083 when the flow
+    // measured every face in its own plane: one image face stood edge-on to the target
+    // (own |mu| 0.8, but a step of any size flipped it). Measured in a frame that turns
+    // to the target's tangent plane as a face tilts, its |mu| rises towards 1 before it
+    // folds, the barrier holds it, and the flow goes on (mean 0.026 measured).
     let dir = tempfile::tempdir().unwrap();
     let target = dir.path().join("phi2.obj");
     let run = beltrami(&["generate", "torus2", "--level", "1", "-o", s(&target)]);
     assert!(run.status.success(), "{}", text(&run.stderr));
     let (_, r) = register(&shared.join("g1_kitten.obj"), &target, &[], 0.5);
-    let notes = r["notes"].to_string();
-    assert!(
-        notes.contains("edge-on (where the flow stalled)"),
-        "{notes}"
-    );
     let mean = r["mu_mean"].as_f64().unwrap();
-    assert!(mean < 0.075, "mean |mu| {mean}");
+    assert!(mean < 0.04, "mean |mu| {mean}");
 }
 
 #[test]

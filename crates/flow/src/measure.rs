@@ -6,11 +6,18 @@
 //! reference normal is `N_T = sum_k n(Y_k)`, the target's normals at its vertices'
 //! images summed (for a target mesh the rule of
 //! `beltrami_spatial::SurfaceIndex::face_reference_normals`). The image frame is
-//! `(r, s, n)`: `r` along `Y_1 - Y_0`, `n` the triangle's unit normal turned to the side
-//! of `N_T` by the fem rule ([`beltrami_fem::beltrami::oriented_normal`]: against it, or
-//! orthogonal to it, `n` is minus the triangle's normal), `s = n x r` (Wong-Zhao 2014,
-//! Appendix: "local isometric coordinates (r, s) on each image face"). With
-//! `f_x = sum_k Y_k d_x N_k` and `f_y = sum_k Y_k d_y N_k` in R^3,
+//! `(r, s, n)`: `r` along `Y_1 - Y_0` projected onto the plane normal to `n`, `s = n x r`
+//! (Wong-Zhao 2014, Appendix: "local isometric coordinates (r, s) on each image
+//! face"), and `n` the triangle's unit normal turned to the side of `N_T` by the fem
+//! rule ([`beltrami_fem::beltrami::oriented_normal`]) while the triangle faces the
+//! target (`n . N_T / |N_T| >= 0.4`), turning smoothly to `N_T / |N_T|` as it tilts
+//! (reached at 0.1, about 84 degrees). In its own plane a triangle standing edge-on to
+//! the target keeps a healthy `|mu|` and jumps to a flip under a step of any size (the
+//! flow stalls there); seen in the target's tangent plane it thins to a segment, its
+//! `|mu|` rising continuously through 1 where it folds, which the barrier holds off.
+//! The reported `mu` is the fem kernel's, in the triangle's own plane
+//! ([`ImageFace::own_mu`]). With `f_x = sum_k Y_k d_x N_k` and `f_y = sum_k Y_k d_y N_k`
+//! in R^3,
 //!
 //! ```text
 //! F_x = f_x . r + i f_x . s,   F_y = f_y . r + i f_y . s,
@@ -44,15 +51,25 @@ pub struct ImageFace {
     pub local: [Vector2<f64>; 3],
     /// Whether the fem kernel finds the image flipped or degenerate (module docs).
     flipped: bool,
+    /// `mu` measured in the image triangle's own plane (the fem kernel's, which
+    /// `beltrami distortion` reports).
+    own_mu: Complex64,
     /// `n . N_T / |N_T|`: 1 where the image triangle lies in the target's tangent
     /// plane, near 0 where it stands edge-on to it.
     facing: f64,
 }
 
 impl ImageFace {
-    /// `mu = f_zbar / f_z`.
+    /// `mu = f_zbar / f_z`, in the target's tangent plane (module docs).
     pub fn mu(&self) -> Complex64 {
         self.derivatives.mu()
+    }
+
+    /// `mu` in the image triangle's own plane: what the fem kernel measures and
+    /// reports (equal to [`ImageFace::mu`] where the triangle lies in the tangent plane;
+    /// smaller in modulus where it is tilted out of it).
+    pub fn own_mu(&self) -> Complex64 {
+        self.own_mu
     }
 
     /// Whether the image is flipped or degenerate: the Jacobian of the fem kernel
@@ -97,14 +114,25 @@ pub fn image_face(
     let [a, b, c] = nodes.map(|v| image[v.idx()]);
     let (e1, e2) = (b - a, c - a);
     let reference: Vector3<f64> = nodes.iter().map(|v| normals[v.idx()]).sum();
-    let n = oriented_normal(&e1, &e2, &reference).unwrap_or_else(|| {
-        // A degenerate image triangle: any plane will do for the frame.
-        if reference.norm_squared() > 0.0 {
-            reference.normalize()
-        } else {
-            normals[nodes[0].idx()]
+    let own = oriented_normal(&e1, &e2, &reference);
+    // The frame: the triangle's own plane where it faces the target (the measure of
+    // the fem kernel), turning to the target's tangent plane (the plane of N_T) as the
+    // triangle tilts towards edge-on, so that `mu` passes continuously through
+    // |mu| = 1 where the image turns edge-on to the target and flips.
+    let unit_reference = (reference.norm_squared() > 0.0).then(|| reference.normalize());
+    let n = match (own, unit_reference) {
+        (Some(own), Some(unit)) => {
+            let w = tilt_weight(own.dot(&unit));
+            if w == 0.0 {
+                own
+            } else {
+                (own * (1.0 - w) + unit * w).normalize()
+            }
         }
-    });
+        (Some(own), None) => own,
+        (None, Some(unit)) => unit,
+        (None, None) => normals[nodes[0].idx()],
+    };
     let r = {
         let t = e1 - n * n.dot(&e1);
         if t.norm_squared() > 0.0 {
@@ -120,6 +148,7 @@ pub fn image_face(
         fy += image[v.idx()].coords * q.grad[k].y;
     }
     let along = |v: &Vector3<f64>| Complex64::new(v.dot(&r), v.dot(&s));
+    let kernel = image_derivatives(&fx, &fy, &reference);
     ImageFace {
         derivatives: PointDerivatives::from_xy(along(&fx), along(&fy)),
         r,
@@ -129,14 +158,30 @@ pub fn image_face(
             Vector2::new(e1.dot(&r), e1.dot(&s)),
             Vector2::new(e2.dot(&r), e2.dot(&s)),
         ],
-        flipped: image_derivatives(&fx, &fy, &reference).jacobian() <= 0.0,
-        facing: if reference.norm_squared() > 0.0 {
-            n.dot(&reference.normalize())
-        } else {
-            1.0
+        flipped: kernel.jacobian() <= 0.0,
+        own_mu: kernel.mu(),
+        facing: match (own, unit_reference) {
+            (Some(own), Some(unit)) => own.dot(&unit),
+            _ => 1.0,
         },
     }
 }
+
+/// The share of the target's tangent plane in the frame of a face whose own normal
+/// has cosine `facing` with the target's: 0 from [`TILT_START`] up, 1 at
+/// [`TILT_FULL`] and below, a smooth step between.
+fn tilt_weight(facing: f64) -> f64 {
+    let x = ((TILT_START - facing) / (TILT_START - TILT_FULL)).clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
+/// Faces whose own normal has at least this cosine with the target's are measured in
+/// their own plane ([`image_face`]).
+const TILT_START: f64 = 0.4;
+
+/// Faces whose own normal has at most this cosine with the target's are measured in
+/// the target's tangent plane.
+const TILT_FULL: f64 = 0.1;
 
 /// Every image face of the map `image` ([`image_face`]), into `out` (cleared first).
 pub fn image_faces(
@@ -319,5 +364,58 @@ mod tests {
             ..objective
         };
         assert_eq!(prescribed.barrier_weight(0.95), 0.0);
+    }
+
+    #[test]
+    fn a_face_tilting_through_edge_on_passes_continuously_through_a_fold() {
+        // The unit right triangle, its image turned about its first edge (the x axis)
+        // by theta, the target's normals all z: the image keeps its shape (own |mu| 0),
+        // but seen from the normal it thins to a segment at 90 degrees and folds over
+        // beyond. The flow's |mu| must rise continuously through 1 there, with the flip
+        // (the own-plane measure jumps from 0 to infinity).
+        use beltrami_fem::Frame;
+        use beltrami_mesh::{Mesh, PolygonSoup};
+        let corners = [
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.0),
+        ];
+        let mesh =
+            Mesh::from_soup(&PolygonSoup::from_triangles(corners.to_vec(), &[[0, 1, 2]])).unwrap();
+        let elements = Elements::new(&mesh, Frame::Face).unwrap();
+        let normals = vec![Vector3::z(); 3];
+        let mut previous: Option<f64> = None;
+        for tenths in 0..=1200 {
+            let degrees = f64::from(tenths) / 10.0;
+            let theta = degrees.to_radians();
+            let image = [
+                corners[0],
+                corners[1],
+                Point3::new(0.0, theta.cos(), theta.sin()),
+            ];
+            let face = image_face(&elements, &normals, &image, FaceId(0));
+            let m = face.mu().norm();
+            assert_eq!(face.flipped(), degrees > 90.0, "{degrees} degrees");
+            if degrees < 90.0 {
+                assert!(face.own_mu().norm() < 1e-12, "{degrees} degrees");
+                assert!(m < 1.0, "{degrees} degrees: |mu| {m}");
+            }
+            if degrees > 90.0 {
+                assert!(m > 1.0, "{degrees} degrees: |mu| {m}");
+            }
+            let facing = theta.cos().abs();
+            if (facing - EDGE_ON).abs() > 1e-9 {
+                assert_eq!(face.edge_on(), facing < EDGE_ON, "{degrees} degrees");
+            }
+            // Through the fold in small steps; beyond it (a flip, which the flow never
+            // takes) |mu| goes on rising towards the reflection's infinity.
+            if let Some(p) = previous {
+                assert!(m >= p - 1e-12, "{degrees} degrees: {p} -> {m}");
+                if degrees <= 95.0 {
+                    assert!(m - p < 0.02, "{degrees} degrees: {p} -> {m}");
+                }
+            }
+            previous = Some(m);
+        }
     }
 }

@@ -255,12 +255,13 @@ pub fn solve(
 }
 
 /// Whether the error fell by at least [`STILL_FALLING`] of itself over the last
-/// [`FALLING_STEPS`] steps: a flow stopped while still falling was blocked (by a face
-/// edge-on to the target); one that had flattened out was done.
+/// [`FALLING_STEPS`] steps, or the flow stopped within them: a flow stopped while still
+/// falling, or at once, was blocked (by a face edge-on to the target); one that had
+/// flattened out was done.
 fn still_falling(history: &[f64]) -> bool {
     let n = history.len();
-    n > FALLING_STEPS
-        && history[n - 1 - FALLING_STEPS] - history[n - 1]
+    n <= FALLING_STEPS
+        || history[n - 1 - FALLING_STEPS] - history[n - 1]
             >= STILL_FALLING * history[n - 1 - FALLING_STEPS]
 }
 
@@ -280,7 +281,12 @@ fn lower_without_new_near_folds<G>(
     objective: &Objective,
 ) -> bool {
     let last = |run: &FlowRun<G>| run.energy_history.last().copied().unwrap_or(f64::INFINITY);
-    let largest = |run: &FlowRun<G>| run.faces.iter().map(|f| f.mu().norm()).fold(0.0, f64::max);
+    let largest = |run: &FlowRun<G>| {
+        run.faces
+            .iter()
+            .map(|f| f.own_mu().norm())
+            .fold(0.0, f64::max)
+    };
     !new.faces.iter().any(ImageFace::flipped)
         && last(new) < last(old)
         && largest(new) <= largest(old).max(objective.barrier_start)
@@ -575,7 +581,7 @@ impl Runner<'_, '_> {
 impl<G> FlowRun<G> {
     /// The map, the per-face `mu` and flip flags.
     fn finish(self, planar: bool) -> (Map, Vec<Complex64>, Vec<bool>) {
-        let mu = self.faces.iter().map(|f| f.mu()).collect();
+        let mu = self.faces.iter().map(|f| f.own_mu()).collect();
         let flipped = self.faces.iter().map(|f| f.flipped()).collect();
         let map = if planar {
             Map::Planar(
