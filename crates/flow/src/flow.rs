@@ -124,6 +124,11 @@ pub struct FlowRun<G> {
 }
 
 impl<G> FlowRun<G> {
+    /// `E` after the last accepted step (before the first when none was).
+    pub fn final_energy(&self) -> f64 {
+        self.energy_history.last().copied().unwrap_or(f64::INFINITY)
+    }
+
     /// Accepted steps.
     pub fn iterations(&self) -> usize {
         self.step_sizes.len()

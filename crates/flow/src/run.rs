@@ -159,43 +159,39 @@ pub fn solve(
             &roles,
             initial.clone(),
             scale,
-            false,
+            None,
             context,
             (&mut report, &mut metrics),
         )?;
         let left = |run: &FlowRun<MeshTarget<'_>>| run.faces.iter().filter(|f| f.flipped()).count();
-        let initial_flips = || {
-            mesh_image_faces(&elements, &geometry, &initial)
-                .iter()
-                .any(ImageFace::flipped)
-        };
-        if left(&run) > 0 && !context.is_cancelled() && initial_flips() {
+        let first = left(&run);
+        if first > 0 && !context.is_cancelled() {
             // The flow takes no step that flips a face, so from a map without flips it
             // keeps none: flips of the initial map untangled first may leave none where
             // the flow from the flipped start dragged a flipped face's neighbours the
             // wrong way (a fixed landmark among its corners). Not the default: from the
             // flipped start the flow lowers |mu| further on most pairs.
-            let first = left(&run);
-            let again = runner.run_on_mesh(
-                &geometry,
-                &roles,
-                initial,
-                scale,
-                true,
-                context,
-                (&mut report, &mut metrics),
-            )?;
-            let second = left(&again);
-            let energy = |run: &FlowRun<MeshTarget<'_>>| {
-                run.energy_history.last().copied().unwrap_or(f64::INFINITY)
-            };
-            let better = second < first || (second == first && energy(&again) < energy(&run));
-            report.notes.push(format!(
-                "the flow from the initial map left {first} flipped faces; from the initial map untangled first, {second}: kept the {}",
-                if better { "second" } else { "first" }
-            ));
-            if better {
-                run = again;
+            let faces = mesh_image_faces(&elements, &geometry, &initial);
+            if faces.iter().any(ImageFace::flipped) {
+                let again = runner.run_on_mesh(
+                    &geometry,
+                    &roles,
+                    initial,
+                    scale,
+                    Some(faces),
+                    context,
+                    (&mut report, &mut metrics),
+                )?;
+                let second = left(&again);
+                let better = second < first
+                    || (second == first && again.final_energy() < run.final_energy());
+                report.notes.push(format!(
+                    "the flow from the initial map left {first} flipped faces; from the initial map untangled first, {second}: kept the {}",
+                    if better { "second" } else { "first" }
+                ));
+                if better {
+                    run = again;
+                }
             }
         }
         let points = geometry.locate_all(&run.image)?;
@@ -280,7 +276,6 @@ fn lower_without_new_near_folds<G>(
     old: &FlowRun<G>,
     objective: &Objective,
 ) -> bool {
-    let last = |run: &FlowRun<G>| run.energy_history.last().copied().unwrap_or(f64::INFINITY);
     let largest = |run: &FlowRun<G>| {
         run.faces
             .iter()
@@ -288,7 +283,7 @@ fn lower_without_new_near_folds<G>(
             .fold(0.0, f64::max)
     };
     !new.faces.iter().any(ImageFace::flipped)
-        && last(new) < last(old)
+        && new.final_energy() < old.final_energy()
         && largest(new) <= largest(old).max(objective.barrier_start)
 }
 
@@ -391,8 +386,8 @@ struct Runner<'a, 'p> {
 
 impl Runner<'_, '_> {
     /// Runs the flow on a target mesh from `image`, untangling its flips (the image's
-    /// before the flow when `untangle_first`) and flowing again while the untangling
-    /// removes some ([`UNTANGLE_RESTARTS`] times at most).
+    /// before the flow when `untangle_first` gives its image faces) and flowing again
+    /// while the untangling removes some ([`UNTANGLE_RESTARTS`] times at most).
     #[allow(clippy::too_many_arguments)]
     fn run_on_mesh<'t>(
         &self,
@@ -400,13 +395,23 @@ impl Runner<'_, '_> {
         roles: &[Role],
         mut image: Vec<Point3<f64>>,
         scale: f64,
-        untangle_first: bool,
+        untangle_first: Option<Vec<ImageFace>>,
         context: &mut Context<'_>,
         (report, metrics): (&mut Report, &mut Metrics),
     ) -> Result<FlowRun<MeshTarget<'t>>, SolverError> {
         let elements = self.elements;
-        if untangle_first {
-            let mut faces = mesh_image_faces(elements, geometry, &image);
+        let flow =
+            |image, context: &mut Context<'_>, report: &mut Report, metrics: &mut Metrics| {
+                self.run(
+                    geometry.clone(),
+                    roles.to_vec(),
+                    image,
+                    scale,
+                    context,
+                    (report, metrics),
+                )
+            };
+        if let Some(mut faces) = untangle_first {
             untangle_noted(
                 " of the initial map's flipped",
                 elements,
@@ -417,14 +422,7 @@ impl Runner<'_, '_> {
                 report,
             );
         }
-        let mut run = self.run(
-            geometry.clone(),
-            roles.to_vec(),
-            image,
-            scale,
-            context,
-            (report, metrics),
-        )?;
+        let mut run = flow(image, context, report, metrics)?;
         for _ in 0..UNTANGLE_RESTARTS {
             let flipped = run.faces.iter().any(ImageFace::flipped);
             // A flow stalled without flips while its error still fell: a face edge-on to
@@ -457,14 +455,7 @@ impl Runner<'_, '_> {
             if done.after >= done.before || (blocked && done.after > 0) {
                 break;
             }
-            let again = self.run(
-                geometry.clone(),
-                roles.to_vec(),
-                image,
-                scale,
-                context,
-                (report, metrics),
-            )?;
+            let again = flow(image, context, report, metrics)?;
             if blocked && !lower_without_new_near_folds(&again, &run, self.objective) {
                 report.notes.push(
                     "the flow from the relaxed map did not end lower: kept the stalled one".into(),
