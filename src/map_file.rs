@@ -134,12 +134,14 @@ pub fn vertex_mu(mesh: &Mesh, field: &BeltramiField) -> Result<Vec<f64>, MapFile
 
 /// Writes the map of `solution` (a map of `mesh`'s vertices) to `path` (`.obj`,
 /// `.gltf` or `.glb`) as described in the module docs; `target` is the target mesh of a
-/// map onto one.
+/// map onto one. An OBJ file takes the text of the lines that do not depend on the map
+/// from `sections` where they fit ([`io::obj::write_with_sections`]).
 pub fn write(
     path: &Path,
     mesh: &Mesh,
     solution: &Solution,
     target: Option<&Mesh>,
+    sections: Option<&io::obj::MeshSections>,
 ) -> Result<(), MapFileError> {
     let format = Format::from_path(path).ok_or_else(|| WriteError::UnknownFormat {
         path: path.to_path_buf(),
@@ -160,7 +162,10 @@ pub fn write(
         Image::Uv(uv) => attributes.uvs = Some(uv),
         Image::Positions(p) => attributes.positions = Some(p),
     }
-    io::write(path, mesh, &attributes)?;
+    match format {
+        Format::Obj => io::obj::write_with_sections(path, mesh, &attributes, sections)?,
+        Format::Gltf | Format::Glb => io::write(path, mesh, &attributes)?,
+    }
     Ok(())
 }
 
@@ -195,7 +200,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
 
         let obj = dir.path().join("map.obj");
-        write(&obj, &mesh, &solution, None).unwrap();
+        write(&obj, &mesh, &solution, None, None).unwrap();
         let back = read(&obj);
         assert_eq!(back.mesh.positions(), mesh.positions());
         let uv = back.vertex_uvs().unwrap();
@@ -204,7 +209,7 @@ mod tests {
         }
 
         let glb = dir.path().join("map.glb");
-        write(&glb, &mesh, &solution, None).unwrap();
+        write(&glb, &mesh, &solution, None, None).unwrap();
         let back = read(&glb);
         for (p, q) in back.mesh.positions().iter().zip(mesh.positions()) {
             assert!((p - q).norm() < 1e-6);
@@ -271,11 +276,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let obj = dir.path().join("on_target.obj");
 
-        let err = write(&obj, &source, &solution, None).unwrap_err();
+        let err = write(&obj, &source, &solution, None, None).unwrap_err();
         assert!(matches!(err, MapFileError::NoTarget), "{err}");
         assert!(!obj.exists());
 
-        write(&obj, &source, &solution, Some(&target)).unwrap();
+        write(&obj, &source, &solution, Some(&target), None).unwrap();
         let back = read(&obj);
         assert!(back.vertex_uvs().is_none());
         for (v, (p, q)) in back.mesh.positions().iter().zip(&points).enumerate() {
@@ -287,7 +292,7 @@ mod tests {
         let glb = dir.path().join("bad.glb");
         points[7].coords = [0.7, 0.7, -0.4, 0.0];
         let bad = Solution::from_map(Map::OnMesh(points), Report::new("test"));
-        let err = write(&glb, &source, &bad, Some(&target)).unwrap_err();
+        let err = write(&glb, &source, &bad, Some(&target), None).unwrap_err();
         assert!(
             matches!(err, MapFileError::OffTarget { vertex: 7, .. }),
             "{err}"
@@ -304,7 +309,7 @@ mod tests {
         );
         let dir = tempfile::tempdir().unwrap();
         let glb = dir.path().join("spatial.glb");
-        write(&glb, &source, &solution, None).unwrap();
+        write(&glb, &source, &solution, None, None).unwrap();
         let back = read(&glb);
         for (p, q) in back.mesh.positions().iter().zip(target.positions()) {
             assert!((p - q).norm() < 1e-6);
@@ -321,7 +326,7 @@ mod tests {
             Map::Planar(vec![Complex64::new(0.0, 0.0); 3]),
             Report::new("test"),
         );
-        let err = write(&obj, &source, &short, None).unwrap_err();
+        let err = write(&obj, &source, &short, None, None).unwrap_err();
         assert!(
             matches!(
                 err,
@@ -340,7 +345,7 @@ mod tests {
             ..short
         };
         assert!(matches!(
-            write(&obj, &source, &remeshed, None),
+            write(&obj, &source, &remeshed, None, None),
             Err(MapFileError::NoMap)
         ));
         let ply = dir.path().join("out.ply");
@@ -349,14 +354,14 @@ mod tests {
             Report::new("test"),
         );
         assert!(matches!(
-            write(&ply, &source, &spatial, None),
+            write(&ply, &source, &spatial, None, None),
             Err(MapFileError::Write(WriteError::UnknownFormat { .. }))
         ));
         let mut nan = target.positions().to_vec();
         nan[2].x = f64::NAN;
         let nan = Solution::from_map(Map::Spatial(nan), Report::new("test"));
         assert!(matches!(
-            write(&obj, &source, &nan, None),
+            write(&obj, &source, &nan, None, None),
             Err(MapFileError::Write(WriteError::NonFinite { vertex: 2, .. }))
         ));
         assert!(!obj.exists() && !ply.exists());

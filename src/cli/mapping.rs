@@ -10,6 +10,7 @@ use beltrami::report;
 use beltrami_core::{Context, OptionValue, Options, Pin, Problem, Progress, Solution, Solver};
 use beltrami_fem::ReferenceNormal;
 use beltrami_mesh::Mesh;
+use beltrami_mesh::io::obj::MeshSections;
 use beltrami_mesh::io::{self, Format};
 use beltrami_render::{Layout, Scene, Style, check_png_path};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -225,6 +226,50 @@ pub fn solve(
     };
     bar.finish();
     Ok((solution?, start.elapsed().as_secs_f64()))
+}
+
+/// [`solve`], formatting meanwhile the parts of an OBJ output that do not depend on the
+/// map (its `v` and `f` lines, [`MeshSections`]) on a background thread of the lowest
+/// priority, so that they take only the time the solver leaves a core idle (most
+/// solvers factor and step on one core). `with_uvs`: whether the map is expected to be
+/// planar (written as `vt` lines); a wrong guess costs only the early formatting.
+/// Nothing is formatted ahead for other output formats.
+pub fn solve_formatting_output(
+    solver: &dyn Solver,
+    problem: &Problem<'_>,
+    progress: ProgressStyleArg,
+    output: &Path,
+    with_uvs: bool,
+) -> anyhow::Result<(Solution, f64, Option<MeshSections>)> {
+    if Format::from_path(output) != Some(Format::Obj) {
+        return solve(solver, problem, progress)
+            .map(|(solution, seconds)| (solution, seconds, None));
+    }
+    let mesh = problem.source;
+    std::thread::scope(|scope| {
+        let sections = scope.spawn(move || {
+            lower_this_threads_priority();
+            MeshSections::format(mesh, with_uvs)
+        });
+        let solved = solve(solver, problem, progress);
+        // A panic while formatting is a bug; pass it on as one.
+        let sections = sections
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        solved.map(|(solution, seconds)| (solution, seconds, Some(sections)))
+    })
+}
+
+/// Gives the calling thread the lowest scheduling priority (nice 19; on Linux the nice
+/// value is per thread), best effort: only speed depends on it.
+fn lower_this_threads_priority() {
+    #[cfg(target_os = "linux")]
+    // SAFETY: gettid and setpriority take no pointers; setpriority on the caller's own
+    // thread id changes only that thread's nice value.
+    unsafe {
+        let tid = libc::syscall(libc::SYS_gettid);
+        libc::setpriority(libc::PRIO_PROCESS, tid as libc::id_t, 19);
+    }
 }
 
 /// Parses `--png`: a path ending in `.png`, so that a wrong name fails before the solve.

@@ -120,8 +120,14 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
             .map(Constraint::Pin),
     );
 
-    let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    map_file::write(&args.output, mesh, &solution, None)?;
+    let (solution, seconds, sections) = mapping::solve_formatting_output(
+        solver,
+        &problem,
+        args.common.progress(quiet),
+        &args.output,
+        problem.target.is_planar(),
+    )?;
+    map_file::write(&args.output, mesh, &solution, None, sections.as_ref())?;
     mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     let mut circles = super::qc::circles(mesh, &solution, &mut report);

@@ -351,7 +351,13 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         &args.common,
     );
 
-    let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
+    let (solution, seconds, sections) = mapping::solve_formatting_output(
+        solver,
+        &problem,
+        args.common.progress(quiet),
+        &args.output,
+        problem.target.is_planar(),
+    )?;
     let error = solution.metrics.mu_error;
     if let (Some(Map::Spatial(_)), false) = (
         solution.map(),
@@ -359,7 +365,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     ) {
         bail!("{} gave points in space for a planar target", solver.name());
     }
-    map_file::write(&args.output, mesh, &solution, None)?;
+    map_file::write(&args.output, mesh, &solution, None, sections.as_ref())?;
     if let Some(path) = &args.qd {
         write_quadratic_differential(path, mesh, &solution)?;
     }

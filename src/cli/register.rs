@@ -110,7 +110,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    map_file::write(&args.output, source, &solution, Some(target))?;
+    map_file::write(&args.output, source, &solution, Some(target), None)?;
     if let Some(path) = &args.correspondence {
         let Some(Map::OnMesh(points)) = solution.map() else {
             bail!("the register solver did not give points on the target mesh");

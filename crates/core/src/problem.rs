@@ -60,6 +60,17 @@ pub enum Target<'a> {
     Surface,
 }
 
+impl Target<'_> {
+    /// Whether maps onto this target are planar (a point of the complex plane per
+    /// vertex): the plane, the disk, annuli and circle domains.
+    pub fn is_planar(&self) -> bool {
+        matches!(
+            self,
+            Target::Plane(_) | Target::Disk | Target::Annulus { .. } | Target::CircleDomain
+        )
+    }
+}
+
 /// What the map should achieve.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Goal {

@@ -20,6 +20,7 @@ use std::path::Path;
 
 use nalgebra::{Point3, Vector2};
 
+use super::slots::OutputSlots;
 use super::{RawMesh, ReadError, VertexAttributes, WriteError};
 use crate::{FaceId, Mesh, PolygonSoup};
 
@@ -314,41 +315,121 @@ pub fn write(
     mesh: &Mesh,
     attributes: &VertexAttributes<'_>,
 ) -> Result<(), WriteError> {
+    write_with_sections(path, mesh, attributes, None)
+}
+
+/// [`write`], taking the text of the sections that do not depend on the map from
+/// `sections` when they fit `attributes` (formatted earlier by
+/// [`MeshSections::format`] for the same mesh: the `v` lines when `attributes` keeps the
+/// mesh's own positions, the `f` lines when the texture-coordinate indices agree);
+/// what does not fit is formatted here. The file is the same byte for byte either way.
+pub fn write_with_sections(
+    path: &Path,
+    mesh: &Mesh,
+    attributes: &VertexAttributes<'_>,
+    sections: Option<&MeshSections>,
+) -> Result<(), WriteError> {
     attributes.check(mesh)?;
-    let slots = super::slots::OutputSlots::new(mesh);
-    let position = slots.positions(mesh, attributes);
+    let slots = OutputSlots::new(mesh);
+    let with_uvs = attributes.uvs.is_some();
+    let ready = sections.filter(|s| s.faces_len == mesh.face_count() && s.slots == slots.len());
+    let vertices = ready.filter(|_| attributes.positions.is_none());
+    let faces = ready.filter(|s| s.with_uvs == with_uvs);
+    let position = match vertices {
+        Some(_) => Vec::new(),
+        None => slots.positions(mesh, attributes),
+    };
     let uv = attributes.uvs.map(|u| slots.scatter(u));
     super::write_atomically(path, |w| {
-        writeln!(
-            w,
-            "# beltrami: {} vertices, {} faces",
-            slots.len(),
-            mesh.face_count()
-        )?;
-        write_lines(w, position.len(), |i, line| {
-            let p = &position[i];
-            writeln!(line, "v {} {} {}", p.x, p.y, p.z)
-        })?;
+        writeln!(w, "{}", header(&slots, mesh))?;
+        match vertices {
+            Some(sections) => w.write_all(&sections.vertices)?,
+            None => write_lines(w, position.len(), |i, line| vertex_line(&position[i], line))?,
+        }
         if let Some(uv) = &uv {
             write_lines(w, uv.len(), |i, line| {
                 writeln!(line, "vt {} {}", uv[i].x, uv[i].y)
             })?;
         }
-        write_lines(w, mesh.face_count(), |i, line| {
-            line.push(b'f');
-            for v in mesh.face_vertices(FaceId::from_usize(i)) {
-                let k = slots.slot(v) + 1;
-                line.push(b' ');
-                push_decimal(line, k);
-                if uv.is_some() {
-                    line.push(b'/');
-                    push_decimal(line, k);
-                }
-            }
-            line.push(b'\n');
-            Ok(())
-        })
+        match faces {
+            Some(sections) => w.write_all(&sections.faces),
+            None => write_lines(w, mesh.face_count(), |i, line| {
+                face_line(mesh, &slots, with_uvs, i, line);
+                Ok(())
+            }),
+        }
     })
+}
+
+/// The text of the `v` and `f` lines of a mesh's OBJ file, formatted before the map to
+/// write with it is known (a solver runs meanwhile, mostly on one core), so that writing
+/// the map then only formats its `vt` lines. Holds about 60 bytes per vertex and 30 per
+/// face.
+#[derive(Debug, Clone)]
+pub struct MeshSections {
+    /// Whether the `f` lines name texture coordinates (`f a/a b/b c/c`).
+    with_uvs: bool,
+    /// The mesh's face count and the file's vertex count, to recognize the mesh.
+    faces_len: usize,
+    slots: usize,
+    /// `v` lines of the mesh's own positions.
+    vertices: Vec<u8>,
+    /// `f` lines.
+    faces: Vec<u8>,
+}
+
+impl MeshSections {
+    /// Formats the `v` lines of `mesh`'s positions and its `f` lines, with
+    /// texture-coordinate indices when `with_uvs`, on the calling thread.
+    pub fn format(mesh: &Mesh, with_uvs: bool) -> Self {
+        let slots = OutputSlots::new(mesh);
+        let position = slots.positions(mesh, &VertexAttributes::default());
+        let mut vertices = Vec::new();
+        for p in &position {
+            // Writing into a vector cannot fail.
+            let _ = vertex_line(p, &mut vertices);
+        }
+        let mut faces = Vec::new();
+        for i in 0..mesh.face_count() {
+            face_line(mesh, &slots, with_uvs, i, &mut faces);
+        }
+        Self {
+            with_uvs,
+            faces_len: mesh.face_count(),
+            slots: slots.len(),
+            vertices,
+            faces,
+        }
+    }
+}
+
+/// The first line of every written file (without its line break).
+fn header(slots: &OutputSlots, mesh: &Mesh) -> String {
+    format!(
+        "# beltrami: {} vertices, {} faces",
+        slots.len(),
+        mesh.face_count()
+    )
+}
+
+/// Appends the `v` line of `p`.
+fn vertex_line(p: &Point3<f64>, line: &mut Vec<u8>) -> std::io::Result<()> {
+    writeln!(line, "v {} {} {}", p.x, p.y, p.z)
+}
+
+/// Appends the `f` line of face `i`, each corner `k` or `k/k` (the vertex's slot + 1).
+fn face_line(mesh: &Mesh, slots: &OutputSlots, with_uvs: bool, i: usize, line: &mut Vec<u8>) {
+    line.push(b'f');
+    for v in mesh.face_vertices(FaceId::from_usize(i)) {
+        let k = slots.slot(v) + 1;
+        line.push(b' ');
+        push_decimal(line, k);
+        if with_uvs {
+            line.push(b'/');
+            push_decimal(line, k);
+        }
+    }
+    line.push(b'\n');
 }
 
 /// Appends the decimal digits of `k` (the formatting machinery of `write!` costs more
@@ -423,7 +504,60 @@ fn write_lines(
 
 #[cfg(test)]
 mod tests {
-    use super::{LINE_BLOCK, push_decimal, write_lines};
+    use super::{LINE_BLOCK, MeshSections, push_decimal, write, write_lines, write_with_sections};
+    use crate::Mesh;
+    use crate::io::VertexAttributes;
+    use crate::primitives::{Cells, grid};
+    use nalgebra::{Point3, Vector2};
+
+    #[test]
+    fn sections_formatted_ahead_give_the_same_file_and_are_ignored_where_they_do_not_fit() {
+        let dir = tempfile::tempdir().unwrap();
+        let mesh = Mesh::from_soup(&grid(7, 5, Cells::Triangles)).unwrap();
+        let other = Mesh::from_soup(&grid(3, 3, Cells::Quads)).unwrap();
+        let uvs: Vec<Vector2<f64>> = mesh
+            .positions()
+            .iter()
+            .map(|p| Vector2::new(0.3 * p.x + 0.1, p.y / 3.0))
+            .collect();
+        let moved: Vec<Point3<f64>> = mesh
+            .positions()
+            .iter()
+            .map(|p| Point3::new(p.y, -p.x, 0.25 + p.x * p.y))
+            .collect();
+        let with_uvs = VertexAttributes {
+            uvs: Some(&uvs),
+            ..Default::default()
+        };
+        let with_positions = VertexAttributes {
+            positions: Some(&moved),
+            ..Default::default()
+        };
+        let plain = VertexAttributes::default();
+        let read = |name: &str| std::fs::read(dir.path().join(name)).unwrap();
+        for (attributes, tag) in [
+            (&with_uvs, "uv"),
+            (&with_positions, "xyz"),
+            (&plain, "plain"),
+        ] {
+            write(&dir.path().join(format!("{tag}.obj")), &mesh, attributes).unwrap();
+            let expected = read(&format!("{tag}.obj"));
+            // Sections of either kind, and sections of another mesh: same bytes.
+            let kinds = [
+                MeshSections::format(&mesh, true),
+                MeshSections::format(&mesh, false),
+                MeshSections::format(&other, true),
+            ];
+            for (k, sections) in kinds.iter().enumerate() {
+                let name = format!("{tag}-{k}.obj");
+                write_with_sections(&dir.path().join(&name), &mesh, attributes, Some(sections))
+                    .unwrap();
+                assert_eq!(read(&name), expected, "{name}");
+            }
+        }
+        let text = String::from_utf8(read("uv.obj")).unwrap();
+        assert!(text.contains("\nvt 0.1 0\n") && text.contains("\nf 1/1 2/2 "));
+    }
 
     #[test]
     fn decimal_digits_match_display() {
