@@ -41,6 +41,7 @@ mod cholesky;
 mod nested_dissection;
 mod normal;
 mod saddle;
+mod two_domains;
 
 pub use saddle::{SaddlePointSolution, SaddlePointSolver, solve_saddle_point};
 
@@ -909,25 +910,39 @@ const AMD_STRUGGLES: f64 = 15.0;
 pub fn fill_reducing_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<Vec<usize>, SolveError> {
-    fill_reducing_order_meanwhile(pattern, |_| ()).map(|(order, _)| order)
+    fill_reducing_order_meanwhile(pattern, |_| ()).map(|ordered| ordered.order)
+}
+
+/// An elimination order as [`fill_reducing_order`] chooses it.
+struct Ordered<R> {
+    /// `order[k]` is the row eliminated `k`-th.
+    order: Vec<usize>,
+    /// The first split of a nested-dissection order ([`nested_dissection::Dissected`]).
+    halves: Option<[usize; 2]>,
+    /// What `meanwhile` returned, when nested dissection was taken.
+    meanwhile: Option<R>,
 }
 
 /// [`fill_reducing_order`], running `meanwhile` on the calling thread while the
 /// nested-dissection order is still being computed, once AMD has finished and chosen it:
-/// `meanwhile` gets AMD's count of the factor's entries (diagonal included) and its
-/// result is returned beside the order (`None` when AMD's order is taken).
+/// `meanwhile` gets AMD's count of the factor's entries (diagonal included).
 fn fill_reducing_order_meanwhile<R>(
     pattern: SymbolicSparseColMatRef<'_, usize>,
     meanwhile: impl FnOnce(usize) -> R,
-) -> Result<(Vec<usize>, Option<R>), SolveError> {
+) -> Result<Ordered<R>, SolveError> {
     let n = pattern.nrows();
+    let amd_only = |order| Ordered {
+        order,
+        halves: None,
+        meanwhile: None,
+    };
     if n < NESTED_DISSECTION_FROM {
-        return Ok((amd_order(pattern)?, None));
+        return Ok(amd_only(amd_order(pattern)?));
     }
     // Both orders are computed at once (on a second core where there is one), so the
     // choice costs the longer of the two instead of their sum.
     let (amd, nested, extra) = std::thread::scope(|scope| {
-        let nested = scope.spawn(|| nested_dissection_order(pattern));
+        let nested = scope.spawn(|| dissected(pattern));
         let amd = amd_order_with_count(pattern);
         let extra = match &amd {
             Ok(count) if count.n_mult_subs_ldl >= AMD_STRUGGLES * (n as f64).powf(1.5) => {
@@ -940,10 +955,14 @@ fn fill_reducing_order_meanwhile<R>(
     let amd = amd?;
     if extra.is_some() {
         // A panic in the ordering thread is a bug; pass it on as one.
-        let order = nested.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
-        Ok((order, extra))
+        let nested = nested.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+        Ok(Ordered {
+            order: nested.order,
+            halves: nested.halves,
+            meanwhile: extra,
+        })
     } else {
-        Ok((amd.order, None))
+        Ok(amd_only(amd.order))
     }
 }
 
@@ -953,6 +972,13 @@ fn fill_reducing_order_meanwhile<R>(
 pub fn nested_dissection_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<Vec<usize>, SolveError> {
+    dissected(pattern).map(|d| d.order)
+}
+
+/// [`nested_dissection_order`] with its first split.
+fn dissected(
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+) -> Result<nested_dissection::Dissected, SolveError> {
     let n = pattern.nrows();
     check_len("the column count of the pattern", n, pattern.ncols())?;
     Ok(nested_dissection::nested_dissection(

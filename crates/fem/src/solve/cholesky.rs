@@ -5,6 +5,7 @@
 //! on every call; iterative solvers refactor the same pattern every step, so this
 //! wrapper keeps both and calls the low-level `SymbolicCholesky::factorize_numeric_llt`.
 
+use super::two_domains::TwoDomains;
 use super::{
     NESTED_DISSECTION_FROM, SolveError, fill_reducing_order_meanwhile, inverse_permutation,
 };
@@ -17,7 +18,7 @@ use faer::sparse::linalg::cholesky::{
     LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par, Side};
+use faer::{Conj, Mat, MatMut, Par, Side};
 
 /// Why a numeric factorization failed. Indices are rows of the matrix as given (the
 /// fill-reducing permutation undone).
@@ -29,8 +30,95 @@ pub(super) enum FactorFailure {
     SmallPivot { index: usize, ratio: f64 },
 }
 
-/// `A = P^T L L^H P` of a Hermitian matrix whose lower triangle is read.
-pub(super) struct Cholesky<T: Scalar> {
+/// `A = P^T L L^H P` of a Hermitian matrix whose lower triangle is read: one sparse
+/// factorization of the whole matrix, or, for large matrices ordered by nested
+/// dissection, two factorizations at once ([`TwoDomains`]).
+pub(super) enum Cholesky<T: Scalar> {
+    Whole(Box<Factor<T>>),
+    Halves(Box<TwoDomains<T>>),
+}
+
+impl<T: Scalar> Cholesky<T> {
+    /// Symbolic analysis (fill-reducing order, elimination tree, supernodes) of
+    /// `pattern` (square; only its lower triangle matters). The order is
+    /// [`fill_reducing_order`](super::fill_reducing_order)'s; below
+    /// [`NESTED_DISSECTION_FROM`] rows that is AMD, left to faer. A nested-dissection
+    /// order is factored in its two halves at once ([`TwoDomains`]) when its first split
+    /// has a separator and both halves.
+    pub(super) fn new(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        par: Par,
+    ) -> Result<Self, SolveError> {
+        if pattern.nrows() < NESTED_DISSECTION_FROM {
+            return Self::with_ordering(pattern, None, par);
+        }
+        // The kernel clears every page a process touches for the first time, and the
+        // factor is the largest block of a solve. While the nested dissection is still
+        // being computed, this thread (done with AMD) touches two blocks of half AMD's
+        // factor size; each half's factor reuses one when it fits, which it does where
+        // the dissection is taken for its smaller factor.
+        let ordered = fill_reducing_order_meanwhile(pattern, |entries| {
+            [
+                touched_zeros::<T>(entries / 2),
+                touched_zeros::<T>(entries / 2),
+            ]
+        })?;
+        let [spare_a, spare_b] = ordered.meanwhile.unwrap_or([None, None]);
+        if let Some(halves) = ordered.halves {
+            let spares = [spare_a, spare_b];
+            if let Some(two) = TwoDomains::new(pattern, &ordered.order, halves, spares)? {
+                return Ok(Self::Halves(Box::new(two)));
+            }
+            let inverse = inverse_permutation(&ordered.order)?;
+            let order = Some((&ordered.order[..], &inverse[..]));
+            return Ok(Self::Whole(Box::new(Factor::build(
+                pattern, order, par, None,
+            )?)));
+        }
+        let inverse = inverse_permutation(&ordered.order)?;
+        let order = Some((&ordered.order[..], &inverse[..]));
+        Ok(Self::Whole(Box::new(Factor::build(
+            pattern, order, par, spare_a,
+        )?)))
+    }
+
+    /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
+    /// eliminated k-th) instead of AMD, when given, factored as a whole.
+    pub(super) fn with_ordering(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: Option<(&[usize], &[usize])>,
+        par: Par,
+    ) -> Result<Self, SolveError> {
+        Ok(Self::Whole(Box::new(Factor::build(
+            pattern, order, par, None,
+        )?)))
+    }
+
+    /// Numeric factorization of `matrix` (the pattern given at construction, lower
+    /// triangle read) and the pivot test of [`Factor::factorize`].
+    pub(super) fn factorize(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, T>,
+        tolerance: f64,
+    ) -> Result<(), FactorFailure> {
+        match self {
+            Self::Whole(factor) => factor.factorize(matrix, tolerance),
+            Self::Halves(two) => two.factorize(matrix, tolerance),
+        }
+    }
+
+    /// Solves `A X = B` in place with the last successful factorization.
+    pub(super) fn solve_in_place(&mut self, rhs: MatMut<'_, T>) -> Result<(), SolveError> {
+        match self {
+            Self::Whole(factor) => factor.solve_in_place(rhs),
+            Self::Halves(two) => two.solve_in_place(rhs),
+        }
+    }
+}
+
+/// One sparse `L L^H` factorization of a whole matrix (faer's simplicial or supernodal
+/// kernel, as its symbolic analysis chooses).
+pub(super) struct Factor<T: Scalar> {
     symbolic: SymbolicCholesky<usize>,
     values: Vec<T>,
     /// Diagonal of the last matrix factored, in its own order.
@@ -41,41 +129,11 @@ pub(super) struct Cholesky<T: Scalar> {
     par: Par,
 }
 
-impl<T: Scalar> Cholesky<T> {
-    /// Symbolic analysis (fill-reducing order, elimination tree, supernodes) of
-    /// `pattern` (square; only its lower triangle matters). The order is
-    /// [`fill_reducing_order`](super::fill_reducing_order)'s; below
-    /// [`NESTED_DISSECTION_FROM`] rows that is AMD, left to faer.
-    pub(super) fn new(
-        pattern: SymbolicSparseColMatRef<'_, usize>,
-        par: Par,
-    ) -> Result<Self, SolveError> {
-        if pattern.nrows() < NESTED_DISSECTION_FROM {
-            return Self::with_ordering(pattern, None, par);
-        }
-        // The kernel clears every page a process touches for the first time, and the
-        // factor is the largest block of a solve. While the nested dissection is still
-        // being computed, this thread (done with AMD) touches a buffer of AMD's factor
-        // size; the factor reuses it when the dissection's factor fits, which it does
-        // where the dissection is taken for its smaller factor.
-        let (forward, spare) = fill_reducing_order_meanwhile(pattern, touched_zeros::<T>)?;
-        let inverse = inverse_permutation(&forward)?;
-        Self::build(pattern, Some((&forward, &inverse)), par, spare.flatten())
-    }
-
-    /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
-    /// eliminated k-th) instead of AMD, when given.
-    pub(super) fn with_ordering(
-        pattern: SymbolicSparseColMatRef<'_, usize>,
-        order: Option<(&[usize], &[usize])>,
-        par: Par,
-    ) -> Result<Self, SolveError> {
-        Self::build(pattern, order, par, None)
-    }
-
-    /// [`Cholesky::with_ordering`], the factor's values stored in `spare` when it is
-    /// long enough.
-    fn build(
+impl<T: Scalar> Factor<T> {
+    /// Symbolic analysis of `pattern` in the elimination order `order` (forward and
+    /// inverse arrays; AMD's when `None`), the factor's values stored in `spare` when it
+    /// is long enough.
+    pub(super) fn build(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: Option<(&[usize], &[usize])>,
         par: Par,
@@ -214,6 +272,54 @@ impl<T: Scalar> Cholesky<T> {
     }
 }
 
+impl<T: Scalar> Factor<T> {
+    /// `order[k]` is the row of the matrix eliminated `k`-th.
+    pub(super) fn eliminated(&self, k: usize) -> usize {
+        match self.symbolic.perm() {
+            Some(perm) => perm.arrays().0[k],
+            None => k,
+        }
+    }
+
+    /// The last `s` rows and columns of `L` in elimination order, as a dense
+    /// lower-triangular `s x s` matrix (zeros above the diagonal). With the matrix
+    /// `[A B^H; B C]`, `B` and `C` of `s` rows, this is the Cholesky factor of the Schur
+    /// complement `C - B A^-1 B^H`.
+    pub(super) fn trailing_factor(&self, s: usize) -> Mat<T> {
+        let n = self.diagonal.len();
+        let first = n - s;
+        let mut l = Mat::<T>::zeros(s, s);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(sym) => {
+                for j in first..n {
+                    for p in sym.col_ptr()[j]..sym.col_ptr()[j + 1] {
+                        l[(sym.row_idx()[p] - first, j - first)] = self.values[p];
+                    }
+                }
+            }
+            SymbolicCholeskyRaw::Supernodal(sym) => {
+                let factor = SupernodalLltRef::new(sym, &self.values);
+                for si in 0..sym.n_supernodes() {
+                    let node = factor.supernode(si);
+                    let (start, block) = (node.start(), node.val());
+                    let width = block.ncols();
+                    // Rows of the block: the supernode's own columns, then its pattern.
+                    for c in first.saturating_sub(start)..width {
+                        let j = start + c - first;
+                        for r in c..width {
+                            l[(start + r - first, j)] = block[(r, c)];
+                        }
+                        for (q, &i) in node.pattern().iter().enumerate() {
+                            l[(i - first, j)] = block[(width + q, c)];
+                        }
+                    }
+                }
+            }
+        }
+        l
+    }
+}
+
 /// `len` zeros written one by one, so that every page of the block is touched now (a
 /// zero-filled allocation may be left to the kernel's lazy zero pages); `None` when the
 /// memory is not available, which only forgoes the early touch.
@@ -242,13 +348,13 @@ mod tests {
         let n = 50;
         let m = path_matrix(n);
         let expected = {
-            let mut fresh = Cholesky::<f64>::build(m.symbolic(), None, Par::Seq, None).unwrap();
+            let mut fresh = Factor::<f64>::build(m.symbolic(), None, Par::Seq, None).unwrap();
             fresh.factorize(m.as_ref(), 0.0).unwrap();
             let mut x = Mat::from_fn(n, 1, |i, _| i as f64);
             fresh.solve_in_place(x.as_mut()).unwrap();
             x
         };
-        let len = Cholesky::<f64>::build(m.symbolic(), None, Par::Seq, None)
+        let len = Factor::<f64>::build(m.symbolic(), None, Par::Seq, None)
             .unwrap()
             .values
             .len();
@@ -257,7 +363,7 @@ mod tests {
             let spare = vec![7.5; spare_len];
             let spare_ptr = spare.as_ptr();
             let mut cholesky =
-                Cholesky::<f64>::build(m.symbolic(), None, Par::Seq, Some(spare)).unwrap();
+                Factor::<f64>::build(m.symbolic(), None, Par::Seq, Some(spare)).unwrap();
             assert_eq!(cholesky.values.len(), len);
             assert_eq!(cholesky.values.as_ptr() == spare_ptr, spare_len >= len);
             cholesky.factorize(m.as_ref(), 0.0).unwrap();

@@ -30,6 +30,10 @@ const LEAF: usize = 256;
 /// Largest share of a part's vertices one side of its separator may hold.
 const BALANCE: f64 = 0.6;
 
+/// [`BALANCE`] of the first split, whose two sides are factored at once on two cores
+/// (`two_domains`): the factorization waits for the larger side.
+const FIRST_BALANCE: f64 = 0.52;
+
 /// Breadth-first sweeps spent looking for a pseudo-peripheral vertex.
 const SWEEPS: usize = 4;
 
@@ -213,6 +217,8 @@ struct Dissection<'g> {
     distance_v: Vec<u32>,
     next_part: u32,
     order: Vec<usize>,
+    /// The sizes of the two sides of the first split (see [`Dissected::halves`]).
+    halves: Option<[usize; 2]>,
 }
 
 /// A breadth-first search inside one part: the vertices reached in search order and
@@ -279,8 +285,15 @@ impl Dissection<'_> {
     /// at most 2, so those two values separate the smaller from the larger; its level
     /// sets run across the diameter instead of around one end, which suits elongated
     /// parts). The one with the fewest vertices after thinning is taken among those
-    /// that leave neither side more than [`BALANCE`] of the part.
-    fn best_cut(&self, id: u32, from_u: &Levels, from_v: &Levels, total: usize) -> Cut {
+    /// that leave neither side more than `balance` of the part.
+    fn best_cut(
+        &self,
+        id: u32,
+        from_u: &Levels,
+        from_v: &Levels,
+        total: usize,
+        balance: f64,
+    ) -> Cut {
         let depth_u = from_u.starts.len() - 2;
         let depth_v = from_v.starts.len() - 2;
         let keys = [Key::U, Key::V, Key::Difference(depth_v as u32)];
@@ -294,7 +307,7 @@ impl Dissection<'_> {
                 count[k as usize] += 1;
             }
         }
-        let limit = (BALANCE * total as f64) as usize;
+        let limit = (balance * total as f64) as usize;
         let balanced: Vec<Vec<bool>> = keys
             .iter()
             .zip(&counts)
@@ -439,6 +452,7 @@ impl Dissection<'_> {
                 .into_iter()
                 .filter(|&v| self.part[v] == id)
                 .collect();
+            self.halves.get_or_insert([component.len(), rest.len()]);
             self.dissect(component, component_id);
             self.dissect(rest, id);
             return;
@@ -463,7 +477,12 @@ impl Dissection<'_> {
             std::mem::swap(&mut self.distance_u, &mut self.distance_v);
         }
         let total = levels.queue.len();
-        let cut = self.best_cut(id, &levels, &far, total);
+        let balance = if self.halves.is_none() {
+            FIRST_BALANCE
+        } else {
+            BALANCE
+        };
+        let cut = self.best_cut(id, &levels, &far, total, balance);
         let (a_id, b_id, s_id) = (self.fresh_part(), self.fresh_part(), self.fresh_part());
         let mut a = Vec::new();
         let mut b = Vec::new();
@@ -510,19 +529,30 @@ impl Dissection<'_> {
         for &s in &separator {
             self.part[s] = DONE;
         }
+        self.halves.get_or_insert([a.len(), b.len()]);
         self.dissect(a, a_id);
         self.dissect(b, b_id);
         self.order.extend(separator);
     }
 }
 
-/// The nested-dissection elimination order of a square pattern (module docs): `order[k]`
-/// is the row eliminated `k`-th. Only the off-diagonal entries matter, read from either
-/// triangle.
+/// A nested-dissection order and its first split.
+pub(super) struct Dissected {
+    /// `order[k]` is the row eliminated `k`-th.
+    pub(super) order: Vec<usize>,
+    /// `[a, b]` when the first split divides the rows into two sides with no entry
+    /// between them: `order[..a]` orders one side, `order[a..a + b]` the other, and the
+    /// rest (possibly nothing, between two components) is their separator. `None` when
+    /// nothing was split (a part of at most [`LEAF`] rows, or one no level splits).
+    pub(super) halves: Option<[usize; 2]>,
+}
+
+/// The nested-dissection elimination order of a square pattern (module docs). Only the
+/// off-diagonal entries matter, read from either triangle.
 ///
 /// `col_ptr` has `n + 1` entries and `row_idx[col_ptr[j]..col_ptr[j + 1]]` are the rows
 /// of column `j`, all below `n`.
-pub(super) fn nested_dissection(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Vec<usize> {
+pub(super) fn nested_dissection(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Dissected {
     // Renumbered in breadth-first order, a part's vertices and their neighbours lie
     // close together in memory, which the many searches of the dissection reward
     // (measured: the order of the twice-subdivided hand in 1.6 s instead of 2.1 s, of
@@ -538,7 +568,11 @@ pub(super) fn nested_dissection(n: usize, col_ptr: &[usize], row_idx: &[usize]) 
         distance_v: vec![0; n],
         next_part: 0,
         order: Vec::with_capacity(n),
+        halves: None,
     };
     dissection.dissect((0..n).collect(), 0);
-    dissection.order.into_iter().map(|k| original[k]).collect()
+    Dissected {
+        order: dissection.order.into_iter().map(|k| original[k]).collect(),
+        halves: dissection.halves,
+    }
 }

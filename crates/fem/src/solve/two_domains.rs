@@ -1,0 +1,551 @@
+//! A sparse Cholesky factorization on two cores: one level of domain decomposition
+//! (substructuring) over the first split of a nested-dissection order.
+//!
+//! # The formulas
+//!
+//! The separator `S` splits the unknowns into sides `A` and `B` that share no entry:
+//!
+//! ```text
+//!       [ M_AA   0     M_AS ]
+//!   M = [ 0      M_BB  M_BS ]
+//!       [ M_SA   M_SB  M_SS ]
+//! ```
+//!
+//! The principal submatrices `M_A = [M_AA M_AS; M_SA M_SS]` and `M_B` (the same with
+//! `B`) are Hermitian positive definite whenever `M` is, and are factored at once, one
+//! per core, each eliminating its side before `S` (faer's sparse kernel does not
+//! factor independent subtrees at once). The last `|S|` columns of the factor of `M_A`
+//! are the Cholesky factor `L_A` of the side's Schur complement
+//!
+//! ```text
+//! T_A = L_A L_A^H = M_SS - M_SA M_AA^-1 M_AS        (likewise T_B),
+//! ```
+//!
+//! so the Schur complement of `M` onto `S` is `T_A + T_B - M_SS`, factored dense. A solve
+//! `M x = b` takes two solves with each side's factor, the sides at once:
+//!
+//! 1. `M_A [u; v_A] = [b_A; 0]` gives `v_A = -T_A^-1 g_A` with `g_A = M_SA M_AA^-1 b_A`,
+//!    so `g_A = -T_A v_A` (likewise `g_B`);
+//! 2. `(T_A + T_B - M_SS) x_S = b_S - g_A - g_B`;
+//! 3. `M_A [x_A; v] = [b_A; T_A x_S + g_A]` has `v = x_S`, so its first block row
+//!    `M_AA x_A = b_A - M_AS x_S` gives `x_A` (likewise `x_B`).
+//!
+//! The separator's dense work (its elimination in both sides, `T_A` and `T_B`, the
+//! factorization of their sum) costs a few times `|S|^3 / 3`, small against the sides
+//! when `S` is a nested dissection's top separator (about `sqrt(n)` rows of a planar
+//! mesh).
+
+use super::SolveError;
+use super::cholesky::{Factor, FactorFailure};
+use super::inverse_permutation;
+use crate::dof::Scalar;
+use faer::linalg::cholesky::llt::factor::LltError;
+use faer::linalg::matmul::matmul;
+use faer::linalg::matmul::triangular::{self, BlockStructure};
+use faer::linalg::solvers::{Llt, Solve};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
+
+/// The two sides' factorizations and the separator's dense Schur complement (module
+/// docs).
+pub(super) struct TwoDomains<T: Scalar> {
+    n: usize,
+    sides: [SideFactor<T>; 2],
+    /// The rows of `S` (numbering of `M`), in elimination order: the separator's
+    /// numbering.
+    separator: Vec<usize>,
+    /// The stored entries of `M_SS` read from the lower triangle of `M`: position among
+    /// the values of `M`, row and column in the separator's numbering.
+    separator_entries: Vec<(usize, usize, usize)>,
+    /// The factorization of `T_A + T_B - M_SS`, after a successful `factorize`.
+    schur: Option<Llt<T>>,
+}
+
+/// One side's submatrix `M_A`, numbered by increasing row of `M` (so that the lower
+/// triangle of `M` stays the lower triangle), and its factorization.
+struct SideFactor<T: Scalar> {
+    /// The row of `M` of each local row (the side's and the separator's, increasing).
+    rows: Vec<usize>,
+    /// The local row of each separator row, in the separator's numbering; these are
+    /// the last rows eliminated, in that order.
+    separator_local: Vec<usize>,
+    /// The local rows of the side itself.
+    own_local: Vec<usize>,
+    pattern: SymbolicSparseColMat<usize>,
+    /// For each stored value of `M_A`, its position among the values of `M`.
+    source: Vec<usize>,
+    values: Vec<T>,
+    factor: Factor<T>,
+    /// `T_A = L_A L_A^H` (`|S| x |S|`, both triangles, separator numbering), after a
+    /// successful factorization.
+    schur_part: Mat<T>,
+}
+
+/// Which side a row of `M` is on, [`SEPARATOR`] for the separator.
+const SEPARATOR: u8 = 2;
+
+impl<T: Scalar> TwoDomains<T> {
+    /// Symbolic phase for `pattern` (lower triangle read) in the nested-dissection order
+    /// `order` whose first split has sides of `halves[0]` and `halves[1]` rows, the rest
+    /// being their separator; `spares` are blocks the sides' factors may be stored in
+    /// (see [`Factor::build`]). `None` when the split does not separate (an entry
+    /// joins the two sides), a side is empty, or a side's factorization would not
+    /// eliminate the separator last: the caller then factors the whole.
+    pub(super) fn new(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: &[usize],
+        halves: [usize; 2],
+        spares: [Option<Vec<T>>; 2],
+    ) -> Result<Option<Self>, SolveError> {
+        let n = pattern.nrows();
+        let [a, b] = halves;
+        if a == 0 || b == 0 || a + b > n || order.len() != n {
+            return Ok(None);
+        }
+        let mut side_of = vec![SEPARATOR; n];
+        order[..a].iter().for_each(|&i| side_of[i] = 0);
+        order[a..a + b].iter().for_each(|&i| side_of[i] = 1);
+        let separator = order[a + b..].to_vec();
+        let mut separator_index = vec![usize::MAX; n];
+        for (k, &i) in separator.iter().enumerate() {
+            separator_index[i] = k;
+        }
+        let mut separator_entries = Vec::new();
+        for &j in &separator {
+            for p in pattern.col_range(j) {
+                let i = pattern.row_idx()[p];
+                if i >= j && side_of[i] == SEPARATOR {
+                    separator_entries.push((p, separator_index[i], separator_index[j]));
+                }
+            }
+        }
+        let [spare_a, spare_b] = spares;
+        let by_side =
+            |side, spare| SideFactor::new(pattern, order, &side_of, side, &separator_index, spare);
+        let (Some(side_a), Some(side_b)) = (by_side(0, spare_a)?, by_side(1, spare_b)?) else {
+            return Ok(None);
+        };
+        Ok(Some(Self {
+            n,
+            sides: [side_a, side_b],
+            separator,
+            separator_entries,
+            schur: None,
+        }))
+    }
+
+    /// Numeric factorization of `matrix` (the pattern given to [`new`](Self::new)): the
+    /// two sides at once, then the separator's Schur complement. The pivot test is
+    /// [`Factor::factorize`]'s, the separator's pivots taken from the dense factor;
+    /// failures name rows of `matrix`.
+    pub(super) fn factorize(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, T>,
+        tolerance: f64,
+    ) -> Result<(), FactorFailure> {
+        self.schur = None;
+        let values = matrix.val();
+        let [side_a, side_b] = &mut self.sides;
+        let (a, b) = both(
+            || side_a.factorize(values, tolerance),
+            || side_b.factorize(values, tolerance),
+        );
+        a?;
+        b?;
+        let s = self.separator.len();
+        let mut schur = &self.sides[0].schur_part + &self.sides[1].schur_part;
+        let mut diagonal = vec![0.0; s];
+        for &(p, r, c) in &self.separator_entries {
+            let v = values[p];
+            schur[(r, c)] -= v;
+            if r == c {
+                diagonal[r] = faer::traits::ComplexField::real_part_impl(&v);
+            } else {
+                schur[(c, r)] -= v.conjugate();
+            }
+        }
+        let llt = Llt::new(schur.as_ref(), Side::Lower).map_err(|error| match error {
+            LltError::NonPositivePivot { index } => FactorFailure::NonPositivePivot {
+                index: self.separator[index.min(s.saturating_sub(1))],
+            },
+        })?;
+        let l = llt.L();
+        let worst = (0..s)
+            .map(|k| (k, l[(k, k)].norm_sqr() / diagonal[k]))
+            .min_by(|x, y| x.1.total_cmp(&y.1));
+        if let Some((k, ratio)) = worst
+            && ratio < tolerance
+        {
+            return Err(FactorFailure::SmallPivot {
+                index: self.separator[k],
+                ratio,
+            });
+        }
+        self.schur = Some(llt);
+        Ok(())
+    }
+
+    /// Solves `M X = B` in place with the last successful factorization (module docs,
+    /// steps 1-3).
+    pub(super) fn solve_in_place(&mut self, mut rhs: MatMut<'_, T>) -> Result<(), SolveError> {
+        let schur = self.schur.as_ref().ok_or(SolveError::NotFactored)?;
+        if rhs.nrows() != self.n {
+            return Err(SolveError::Length {
+                what: "the rows of the right-hand side",
+                expected: self.n,
+                got: rhs.nrows(),
+            });
+        }
+        let (s, k) = (self.separator.len(), rhs.ncols());
+        let b = rhs.as_ref();
+        let zero = Mat::<T>::zeros(s, k);
+        let [side_a, side_b] = &mut self.sides;
+        // Step 1: g = -T v with M_A [u; v] = [b_A; 0].
+        let (w_a, w_b) = both(
+            || side_a.solve_side(b, zero.as_ref()),
+            || side_b.solve_side(b, zero.as_ref()),
+        );
+        let g_a = -side_a.schur_times(side_a.separator_part(&w_a?).as_ref());
+        let g_b = -side_b.schur_times(side_b.separator_part(&w_b?).as_ref());
+        // Step 2: the separator.
+        let mut x_s = Mat::<T>::from_fn(s, k, |r, c| b[(self.separator[r], c)]);
+        x_s -= &g_a;
+        x_s -= &g_b;
+        schur.solve_in_place(x_s.as_mut());
+        // Step 3: each side under the separator value T x_S + g.
+        let d_a = side_a.schur_times(x_s.as_ref()) + &g_a;
+        let d_b = side_b.schur_times(x_s.as_ref()) + &g_b;
+        let (x_a, x_b) = both(
+            || side_a.solve_side(b, d_a.as_ref()),
+            || side_b.solve_side(b, d_b.as_ref()),
+        );
+        let (x_a, x_b) = (x_a?, x_b?);
+        for (side, x) in [(&*side_a, &x_a), (&*side_b, &x_b)] {
+            for &l in &side.own_local {
+                let i = side.rows[l];
+                for c in 0..k {
+                    rhs[(i, c)] = x[(l, c)];
+                }
+            }
+        }
+        for (r, &i) in self.separator.iter().enumerate() {
+            for c in 0..k {
+                rhs[(i, c)] = x_s[(r, c)];
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Runs `a` on this thread and `b` on another, at once.
+fn both<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send) -> (A, B) {
+    std::thread::scope(|scope| {
+        let b = scope.spawn(b);
+        let a = a();
+        // A panic on the other thread is a bug; pass it on as one.
+        (a, b.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+    })
+}
+
+impl<T: Scalar> SideFactor<T> {
+    /// The submatrix of side `side` (`0` or `1`) and the separator, and its symbolic
+    /// factorization in `order` restricted to it (one thread); `None` when an entry of
+    /// `pattern` joins the two sides or the factorization would not eliminate the
+    /// separator last, in its own order.
+    fn new(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: &[usize],
+        side_of: &[u8],
+        side: u8,
+        separator_index: &[usize],
+        spare: Option<Vec<T>>,
+    ) -> Result<Option<Self>, SolveError> {
+        let other = 1 - side;
+        let n = pattern.nrows();
+        let rows: Vec<usize> = (0..n).filter(|&i| side_of[i] != other).collect();
+        let mut local = vec![usize::MAX; n];
+        for (l, &i) in rows.iter().enumerate() {
+            local[i] = l;
+        }
+        let mut col_ptr = Vec::with_capacity(rows.len() + 1);
+        let mut row_idx = Vec::new();
+        let mut source = Vec::new();
+        col_ptr.push(0);
+        for &j in &rows {
+            for p in pattern.col_range(j) {
+                let i = pattern.row_idx()[p];
+                if side_of[i] == other {
+                    if side_of[j] == side {
+                        return Ok(None);
+                    }
+                    // An entry of the other side's block of a separator column.
+                    continue;
+                }
+                row_idx.push(local[i]);
+                source.push(p);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let m = rows.len();
+        let sub = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
+        // The global order lists this side's rows, then the separator's.
+        let forward: Vec<usize> = order
+            .iter()
+            .filter(|&&i| side_of[i] != other)
+            .map(|&i| local[i])
+            .collect();
+        let inverse = inverse_permutation(&forward)?;
+        let factor = Factor::build(sub.as_ref(), Some((&forward, &inverse)), Par::Seq, spare)?;
+        let mut own_local = Vec::new();
+        let mut separator_local = Vec::new();
+        for (l, &i) in rows.iter().enumerate() {
+            if side_of[i] == side {
+                own_local.push(l);
+            } else {
+                separator_local.push((separator_index[i], l));
+            }
+        }
+        separator_local.sort_unstable();
+        let separator_local: Vec<usize> = separator_local.into_iter().map(|(_, l)| l).collect();
+        let first = m - separator_local.len();
+        if separator_local
+            .iter()
+            .enumerate()
+            .any(|(r, &l)| factor.eliminated(first + r) != l)
+        {
+            return Ok(None);
+        }
+        let s = separator_local.len();
+        Ok(Some(Self {
+            rows,
+            separator_local,
+            own_local,
+            values: vec![T::from_f64(0.0); source.len()],
+            pattern: sub,
+            source,
+            factor,
+            schur_part: Mat::zeros(s, s),
+        }))
+    }
+
+    /// Factors `M_A` from the values of `M`, then forms `T_A = L_A L_A^H` from the
+    /// factor's last `|S|` columns (the separator, in its own order).
+    fn factorize(&mut self, values: &[T], tolerance: f64) -> Result<(), FactorFailure> {
+        for (v, &p) in self.values.iter_mut().zip(&self.source) {
+            *v = values[p];
+        }
+        let matrix = SparseColMatRef::new(self.pattern.as_ref(), &self.values);
+        let rows = &self.rows;
+        self.factor
+            .factorize(matrix, tolerance)
+            .map_err(|failure| match failure {
+                FactorFailure::NonPositivePivot { index } => {
+                    FactorFailure::NonPositivePivot { index: rows[index] }
+                }
+                FactorFailure::SmallPivot { index, ratio } => FactorFailure::SmallPivot {
+                    index: rows[index],
+                    ratio,
+                },
+            })?;
+        let l = self.factor.trailing_factor(self.separator_local.len());
+        // Only the lower triangle of the product is computed (half the work), then
+        // mirrored: T_A is Hermitian.
+        triangular::matmul(
+            self.schur_part.as_mut(),
+            BlockStructure::TriangularLower,
+            Accum::Replace,
+            l.as_ref(),
+            BlockStructure::TriangularLower,
+            l.adjoint(),
+            BlockStructure::TriangularUpper,
+            T::from_f64(1.0),
+            Par::Seq,
+        );
+        let t = &mut self.schur_part;
+        for c in 1..t.ncols() {
+            for r in 0..c {
+                t[(r, c)] = t[(c, r)].conjugate();
+            }
+        }
+        Ok(())
+    }
+
+    /// The local solution of `M_A [u; v] = [b_A; d]`, `b` the right-hand side of `M`
+    /// and `d` the separator's (separator numbering).
+    fn solve_side(&mut self, b: MatRef<'_, T>, d: MatRef<'_, T>) -> Result<Mat<T>, SolveError> {
+        let mut w = Mat::<T>::from_fn(self.rows.len(), b.ncols(), |l, c| b[(self.rows[l], c)]);
+        for (r, &l) in self.separator_local.iter().enumerate() {
+            for c in 0..b.ncols() {
+                w[(l, c)] = d[(r, c)];
+            }
+        }
+        self.factor.solve_in_place(w.as_mut())?;
+        Ok(w)
+    }
+
+    /// The separator rows of a local vector, in the separator's numbering.
+    fn separator_part(&self, w: &Mat<T>) -> Mat<T> {
+        Mat::from_fn(self.separator_local.len(), w.ncols(), |r, c| {
+            w[(self.separator_local[r], c)]
+        })
+    }
+
+    /// `T_A v` for a separator vector `v`.
+    fn schur_times(&self, v: MatRef<'_, T>) -> Mat<T> {
+        let mut out = Mat::<T>::zeros(self.separator_local.len(), v.ncols());
+        matmul(
+            out.as_mut(),
+            Accum::Replace,
+            self.schur_part.as_ref(),
+            v,
+            T::from_f64(1.0),
+            Par::Seq,
+        );
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solve::dissected;
+    use faer::sparse::{SparseColMat, Triplet};
+    use num_complex::Complex64;
+
+    /// The lower triangle of a Hermitian matrix on the `k x k` triangulated grid:
+    /// `-w_e` on each edge `e` (complex, `|w_e| <= 1`, pointing in varied directions),
+    /// `shift + sum |w_e|` on the diagonal, so positive definite for `shift > 0` and
+    /// singular (the constant vector's rotations aside) for `shift = 0` with real
+    /// weights. `components` copies side by side without an edge between them.
+    fn grid(
+        k: usize,
+        shift: f64,
+        complex: bool,
+        components: usize,
+    ) -> SparseColMat<usize, Complex64> {
+        let per = k * k;
+        let n = per * components;
+        let mut diagonal = vec![shift; n];
+        let mut triplets = Vec::new();
+        let mut seed = 1u64;
+        for c in 0..components {
+            let id = |i: usize, j: usize| c * per + i + k * j;
+            for j in 0..k {
+                for i in 0..k {
+                    for (di, dj) in [(1, 0), (0, 1), (1, 1)] {
+                        if i + di < k && j + dj < k {
+                            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+                            let t = (seed >> 33) as f64 / (1u64 << 31) as f64;
+                            let w = if complex {
+                                Complex64::from_polar(0.5 + 0.5 * t, 6.0 * t)
+                            } else {
+                                Complex64::new(0.5 + 0.5 * t, 0.0)
+                            };
+                            let (a, b) = (id(i, j), id(i + di, j + dj));
+                            diagonal[a] += w.norm();
+                            diagonal[b] += w.norm();
+                            triplets.push(Triplet::new(b, a, -w));
+                        }
+                    }
+                }
+            }
+        }
+        triplets.extend((0..n).map(|i| Triplet::new(i, i, Complex64::new(diagonal[i], 0.0))));
+        SparseColMat::try_new_from_triplets(n, n, &triplets).unwrap()
+    }
+
+    /// The two-domain factorization of `m` in its nested-dissection order.
+    fn split(m: &SparseColMat<usize, Complex64>) -> TwoDomains<Complex64> {
+        let dissection = dissected(m.symbolic()).unwrap();
+        let halves = dissection.halves.expect("a split");
+        TwoDomains::new(m.symbolic(), &dissection.order, halves, [None, None])
+            .unwrap()
+            .expect("the split separates")
+    }
+
+    /// `max |M x - b| / max |b|` with `M` given by its lower triangle.
+    fn residual(m: &SparseColMat<usize, Complex64>, x: &Mat<Complex64>, b: &Mat<Complex64>) -> f64 {
+        let mut worst: f64 = 0.0;
+        for c in 0..b.ncols() {
+            let mut r: Vec<Complex64> = (0..b.nrows()).map(|i| -b[(i, c)]).collect();
+            for j in 0..m.ncols() {
+                for (i, v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+                    r[i] += v * x[(j, c)];
+                    if i != j {
+                        r[j] += v.conj() * x[(i, c)];
+                    }
+                }
+            }
+            worst = r.iter().map(|z| z.norm()).fold(worst, f64::max);
+        }
+        worst / b.norm_max()
+    }
+
+    #[test]
+    fn the_two_sides_and_the_separator_solve_a_hermitian_system() {
+        let m = grid(40, 0.05, true, 1);
+        let mut two = split(&m);
+        let (n, s) = (m.nrows(), two.separator.len());
+        let [a, b] = [two.sides[0].own_local.len(), two.sides[1].own_local.len()];
+        assert!(
+            s > 0 && s < 120 && a + b + s == n,
+            "sides {a}, {b}, separator {s}"
+        );
+        let rhs = Mat::from_fn(n, 3, |i, c| {
+            Complex64::new((i * (c + 1)) as f64 % 7.0, c as f64 - 1.0)
+        });
+        // Twice, as iterative solvers refactor one pattern.
+        for _ in 0..2 {
+            two.factorize(m.as_ref(), 1e-12).unwrap();
+            let mut x = rhs.clone();
+            two.solve_in_place(x.as_mut()).unwrap();
+            let r = residual(&m, &x, &rhs);
+            assert!(r < 1e-12, "residual {r:e}");
+        }
+    }
+
+    #[test]
+    fn two_components_are_solved_without_a_separator() {
+        let m = grid(12, 0.5, false, 2);
+        let mut two = split(&m);
+        assert!(two.separator.is_empty());
+        two.factorize(m.as_ref(), 1e-12).unwrap();
+        let rhs = Mat::from_fn(m.nrows(), 1, |i, _| Complex64::new(1.0 + i as f64, -2.0));
+        let mut x = rhs.clone();
+        two.solve_in_place(x.as_mut()).unwrap();
+        assert!(residual(&m, &x, &rhs) < 1e-12);
+    }
+
+    #[test]
+    fn a_singular_matrix_fails_at_a_row_of_the_matrix() {
+        // Real weights and no shift: the constant vector is in the kernel.
+        let m = grid(30, 0.0, false, 1);
+        let mut two = split(&m);
+        let mut x = Mat::<Complex64>::zeros(m.nrows(), 1);
+        assert!(matches!(
+            two.solve_in_place(x.as_mut()),
+            Err(SolveError::NotFactored)
+        ));
+        match two.factorize(m.as_ref(), 1e-10) {
+            Err(FactorFailure::SmallPivot { index, ratio }) => {
+                assert!(index < m.nrows() && ratio < 1e-10, "{index} {ratio:e}");
+            }
+            Err(FactorFailure::NonPositivePivot { index }) => assert!(index < m.nrows()),
+            Ok(()) => panic!("a singular matrix passed the pivot test"),
+        }
+        assert!(matches!(
+            two.solve_in_place(x.as_mut()),
+            Err(SolveError::NotFactored)
+        ));
+    }
+
+    #[test]
+    fn a_split_with_an_entry_between_the_sides_is_declined() {
+        let m = grid(20, 0.5, false, 1);
+        // Rows in plain order cut after the first row of the grid: rows 0 and 20 are
+        // joined by an edge, but 0 is on one side and 20 on the other.
+        let order: Vec<usize> = (0..m.nrows()).collect();
+        let two = TwoDomains::<Complex64>::new(m.symbolic(), &order, [20, 20], [None, None]);
+        assert!(two.unwrap().is_none());
+    }
+}
