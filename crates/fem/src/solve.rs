@@ -43,6 +43,7 @@ mod normal;
 mod saddle;
 mod two_domains;
 
+pub use normal::normal_pattern_of_cells;
 pub use saddle::{SaddlePointSolution, SaddlePointSolver, solve_saddle_point};
 
 use crate::dof::{DofMap, Scalar};
@@ -308,13 +309,43 @@ impl<T: Scalar> LeastSquaresSolver<T> {
         dofs: &DofMap<T>,
         options: SolveOptions,
     ) -> Result<Self, SolveError> {
+        Self::build(a_pattern, dofs, options, PlannedOrder::new)
+    }
+
+    /// [`new`](Self::new) in the order `order()` returns, called once the scatter maps
+    /// are built: a [`PlannedOrder`] of a pattern with the graph of the normal
+    /// equations (one row per reduced unknown, an entry wherever a row of `A` couples
+    /// two unknowns: [`normal_pattern_of_cells`](normal::normal_pattern_of_cells)), typically computed on another thread
+    /// while the caller assembled `A`. Any order of the right size gives the same
+    /// solutions; one of another graph only factors slower.
+    ///
+    /// Errors as [`new`](Self::new), and [`SolveError::Length`] when the order is not
+    /// of `dofs.reduced_len()` unknowns.
+    pub fn with_order(
+        a_pattern: SymbolicSparseColMatRef<'_, usize>,
+        dofs: &DofMap<T>,
+        options: SolveOptions,
+        order: impl FnOnce() -> Result<PlannedOrder<T>, SolveError>,
+    ) -> Result<Self, SolveError> {
+        Self::build(a_pattern, dofs, options, |_| order())
+    }
+
+    /// The symbolic phase, the order of the normal equations' pattern given by `order`.
+    fn build(
+        a_pattern: SymbolicSparseColMatRef<'_, usize>,
+        dofs: &DofMap<T>,
+        options: SolveOptions,
+        order: impl FnOnce(SymbolicSparseColMatRef<'_, usize>) -> Result<PlannedOrder<T>, SolveError>,
+    ) -> Result<Self, SolveError> {
         check_len("the column count of A", dofs.full_len(), a_pattern.ncols())?;
         let m = a_pattern.nrows();
         let n = dofs.reduced_len();
         let a_pattern = a_pattern.to_owned()?;
         let normal = NormalEquations::new(a_pattern.as_ref(), dofs)?;
+        let planned = order(normal.pattern())?;
+        check_len("the length of the order", n, planned.len())?;
         let cholesky = if n > 0 {
-            Some(Cholesky::new(normal.pattern(), options.par())?)
+            Some(Cholesky::planned(normal.pattern(), planned, options.par())?)
         } else {
             None
         };
@@ -963,6 +994,64 @@ fn fill_reducing_order_meanwhile<R>(
         })
     } else {
         Ok(amd_only(amd.order))
+    }
+}
+
+/// The elimination order [`LeastSquaresSolver`] and [`SpdSolver`] use for a pattern
+/// ([`fill_reducing_order`]), computed on its own, so that a caller can compute it on
+/// another thread while it assembles the matrices ([`LeastSquaresSolver::with_order`]):
+/// on a large mesh the order takes about as long as assembling.
+///
+/// Below [`NESTED_DISSECTION_FROM`] rows nothing is computed (faer's symbolic analysis
+/// computes the AMD order itself). From there, while the nested dissection is still
+/// being computed, the thread done with AMD touches two blocks of half AMD's factor
+/// size: the kernel clears every page a process touches for the first time, the factor
+/// is the largest block of a solve, and each side's factor ([`two_domains`]) reuses a
+/// block when it fits, which it does where the dissection is taken for its smaller
+/// factor.
+pub struct PlannedOrder<T: Scalar> {
+    n: usize,
+    ordered: Option<Ordered<[Option<Vec<T>>; 2]>>,
+}
+
+impl<T: Scalar> fmt::Debug for PlannedOrder<T> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("PlannedOrder")
+            .field("n", &self.n)
+            .field(
+                "nested_dissection",
+                &self.ordered.as_ref().map(|o| o.halves),
+            )
+            .finish_non_exhaustive()
+    }
+}
+
+impl<T: Scalar> PlannedOrder<T> {
+    /// The order of the square pattern `pattern` (only its lower triangle matters).
+    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, SolveError> {
+        let n = pattern.nrows();
+        check_len("the column count of the pattern", n, pattern.ncols())?;
+        let ordered = if n < NESTED_DISSECTION_FROM {
+            None
+        } else {
+            Some(fill_reducing_order_meanwhile(pattern, |entries| {
+                [
+                    cholesky::touched_zeros::<T>(entries / 2),
+                    cholesky::touched_zeros::<T>(entries / 2),
+                ]
+            })?)
+        };
+        Ok(Self { n, ordered })
+    }
+
+    /// The number of unknowns ordered.
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    /// True when there are no unknowns.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
     }
 }
 

@@ -29,6 +29,7 @@ use beltrami_core::{
 };
 use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::operators::{apply, beltrami_operator};
+use beltrami_fem::solve::{PlannedOrder, normal_pattern_of_cells};
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::VertexId;
 use num_complex::Complex64;
@@ -103,17 +104,36 @@ impl Solver for Lscm {
             ));
         }
         let (elements, dzbar, mut solver) = context.stage("assembly", &mut report, || {
-            let elements = Elements::new(mesh, Frame::Face)?;
-            // D_zbar is the Beltrami operator of mu = 0.
-            let conformal = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
-            let dzbar = beltrami_operator(mesh, &elements, &conformal)?;
             let mut constraints = DofConstraints::new();
             for &(v, z) in &pinned {
                 constraints.fix(v, z);
             }
             let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
-            let solver = LeastSquaresSolver::new(dzbar.symbolic(), &dofs, solve_options(settings))?;
-            Ok((elements, dzbar, solver))
+            // The elimination order needs only the mesh's connectivity: it is computed
+            // on another thread while the elements and D_zbar are assembled (on a large
+            // mesh the two take about as long).
+            std::thread::scope(|scope| {
+                let order = scope.spawn(|| {
+                    let faces = mesh.faces().map(|f| mesh.face_vertices(f));
+                    PlannedOrder::new(normal_pattern_of_cells(faces, &dofs)?.as_ref())
+                });
+                let elements = Elements::new(mesh, Frame::Face)?;
+                // D_zbar is the Beltrami operator of mu = 0.
+                let conformal = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
+                let dzbar = beltrami_operator(mesh, &elements, &conformal)?;
+                let solver = LeastSquaresSolver::with_order(
+                    dzbar.symbolic(),
+                    &dofs,
+                    solve_options(settings),
+                    // A panic in the ordering thread is a bug; pass it on as one.
+                    || {
+                        order
+                            .join()
+                            .unwrap_or_else(|p| std::panic::resume_unwind(p))
+                    },
+                )?;
+                Ok((elements, dzbar, solver))
+            })
         })?;
         let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
         let map = context.stage("solve", &mut report, || {

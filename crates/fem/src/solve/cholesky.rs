@@ -6,9 +6,7 @@
 //! wrapper keeps both and calls the low-level `SymbolicCholesky::factorize_numeric_llt`.
 
 use super::two_domains::TwoDomains;
-use super::{
-    NESTED_DISSECTION_FROM, SolveError, fill_reducing_order_meanwhile, inverse_permutation,
-};
+use super::{PlannedOrder, SolveError, inverse_permutation};
 use crate::dof::Scalar;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -41,45 +39,39 @@ pub(super) enum Cholesky<T: Scalar> {
 impl<T: Scalar> Cholesky<T> {
     /// Symbolic analysis (fill-reducing order, elimination tree, supernodes) of
     /// `pattern` (square; only its lower triangle matters). The order is
-    /// [`fill_reducing_order`](super::fill_reducing_order)'s; below
-    /// [`NESTED_DISSECTION_FROM`] rows that is AMD, left to faer. A nested-dissection
-    /// order is factored in its two halves at once ([`TwoDomains`]) when its first split
-    /// has a separator and both halves.
+    /// [`PlannedOrder::new`]'s; below [`NESTED_DISSECTION_FROM`](super::NESTED_DISSECTION_FROM)
+    /// rows that is AMD, left to faer. A nested-dissection order is factored in its two
+    /// sides at once ([`TwoDomains`]) when its first split has two sides.
     pub(super) fn new(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         par: Par,
     ) -> Result<Self, SolveError> {
-        if pattern.nrows() < NESTED_DISSECTION_FROM {
+        Self::planned(pattern, PlannedOrder::new(pattern)?, par)
+    }
+
+    /// [`Cholesky::new`] in an order computed beforehand for `pattern`.
+    pub(super) fn planned(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        planned: PlannedOrder<T>,
+        par: Par,
+    ) -> Result<Self, SolveError> {
+        let Some(ordered) = planned.ordered else {
             return Self::with_ordering(pattern, None, par);
-        }
-        // The kernel clears every page a process touches for the first time, and the
-        // factor is the largest block of a solve. While the nested dissection is still
-        // being computed, this thread (done with AMD) touches two blocks of half AMD's
-        // factor size; each half's factor reuses one when it fits, which it does where
-        // the dissection is taken for its smaller factor.
-        let ordered = fill_reducing_order_meanwhile(pattern, |entries| {
-            [
-                touched_zeros::<T>(entries / 2),
-                touched_zeros::<T>(entries / 2),
-            ]
-        })?;
+        };
         let [spare_a, spare_b] = ordered.meanwhile.unwrap_or([None, None]);
-        if let Some(halves) = ordered.halves {
-            let spares = [spare_a, spare_b];
-            if let Some(two) = TwoDomains::new(pattern, &ordered.order, halves, spares)? {
-                return Ok(Self::Halves(Box::new(two)));
-            }
-            let inverse = inverse_permutation(&ordered.order)?;
-            let order = Some((&ordered.order[..], &inverse[..]));
-            return Ok(Self::Whole(Box::new(Factor::build(
-                pattern, order, par, None,
-            )?)));
-        }
         let inverse = inverse_permutation(&ordered.order)?;
         let order = Some((&ordered.order[..], &inverse[..]));
-        Ok(Self::Whole(Box::new(Factor::build(
-            pattern, order, par, spare_a,
-        )?)))
+        let Some(halves) = ordered.halves else {
+            return Ok(Self::Whole(Box::new(Factor::build(
+                pattern, order, par, spare_a,
+            )?)));
+        };
+        match TwoDomains::new(pattern, &ordered.order, halves, [spare_a, spare_b])? {
+            Some(two) => Ok(Self::Halves(Box::new(two))),
+            None => Ok(Self::Whole(Box::new(Factor::build(
+                pattern, order, par, None,
+            )?))),
+        }
     }
 
     /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
@@ -323,7 +315,7 @@ impl<T: Scalar> Factor<T> {
 /// `len` zeros written one by one, so that every page of the block is touched now (a
 /// zero-filled allocation may be left to the kernel's lazy zero pages); `None` when the
 /// memory is not available, which only forgoes the early touch.
-fn touched_zeros<T: Scalar>(len: usize) -> Option<Vec<T>> {
+pub(super) fn touched_zeros<T: Scalar>(len: usize) -> Option<Vec<T>> {
     let mut values = Vec::new();
     values.try_reserve_exact(len).ok()?;
     values.resize(len, T::from_f64(0.0));

@@ -61,6 +61,7 @@
 
 use super::SolveError;
 use crate::dof::{DofMap, Scalar};
+use beltrami_mesh::VertexId;
 use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 /// An index of the scatter maps.
@@ -287,6 +288,73 @@ impl<T: Scalar> NormalEquations<T> {
             AnyMaps::Wide(maps) => maps.assemble(k, a, weights, residual, out),
         }
     }
+}
+
+/// The lower triangle (diagonal included, each column's rows increasing) of the pattern
+/// of the normal equations `K^H A^H W A K` of a matrix `A` whose rows each couple the
+/// nodes of one cell (the quadrature points of a face couple all its vertices), built
+/// without `A`: an entry `(c, d)`, `c >= d`, wherever reduced unknowns `c` and `d` are
+/// unknowns of nodes of one cell (a node's unknowns are those of its terms in `dofs`;
+/// a fixed node has none). Cheap enough to compute, with the order of the pattern, on
+/// another thread while `A` is assembled ([`super::LeastSquaresSolver::with_order`]).
+///
+/// Errors: [`SolveError::Length`] for a node beyond `dofs`' nodes.
+pub fn normal_pattern_of_cells<T: Scalar, C: IntoIterator<Item = VertexId>>(
+    cells: impl IntoIterator<Item = C>,
+    dofs: &DofMap<T>,
+) -> Result<SymbolicSparseColMat<usize>, SolveError> {
+    let n = dofs.reduced_len();
+    let mut unknowns = Vec::new();
+    // (column, row) of every coupling, duplicates included.
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for cell in cells {
+        unknowns.clear();
+        for node in cell {
+            let terms = dofs.terms(node).map_err(|_| SolveError::Length {
+                what: "the node index of a cell",
+                expected: dofs.n_nodes(),
+                got: node.idx(),
+            })?;
+            unknowns.extend(terms.filter_map(|t| dofs.term(t).map(|term| term.dof)));
+        }
+        for (p, &c) in unknowns.iter().enumerate() {
+            for &d in &unknowns[..=p] {
+                pairs.push((c.min(d), c.max(d)));
+            }
+        }
+    }
+    // Counting sort by column, then each column's rows sorted and deduplicated.
+    let mut col_ptr = vec![0usize; n + 1];
+    for &(col, _) in &pairs {
+        col_ptr[col + 1] += 1;
+    }
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    let mut next = col_ptr[..n].to_vec();
+    let mut rows = vec![0usize; pairs.len()];
+    for &(col, row) in &pairs {
+        rows[next[col]] = row;
+        next[col] += 1;
+    }
+    drop(pairs);
+    let mut row_idx = Vec::with_capacity(rows.len());
+    let mut out_ptr = Vec::with_capacity(n + 1);
+    out_ptr.push(0);
+    for j in 0..n {
+        let column = &mut rows[col_ptr[j]..col_ptr[j + 1]];
+        column.sort_unstable();
+        let start = row_idx.len();
+        for &i in column.iter() {
+            if row_idx.len() == start || row_idx.last() != Some(&i) {
+                row_idx.push(i);
+            }
+        }
+        out_ptr.push(row_idx.len());
+    }
+    Ok(SymbolicSparseColMat::new_checked(
+        n, n, out_ptr, None, row_idx,
+    ))
 }
 
 /// The pattern of `K` row by row: the columns of row `l` are `col[ptr[l]..ptr[l + 1]]`.
@@ -649,6 +717,14 @@ mod tests {
                 assert!((*g - *e).norm_sqr().sqrt() <= 1e-14 * scale);
             }
         }
+        // The pattern from the cells alone is the normal equations' own.
+        let cells = elements.map(|e| e.map(|v| VertexId(v as u32)));
+        let from_cells = normal_pattern_of_cells(cells, dofs).unwrap();
+        let normal = NormalEquations::new(a.symbolic(), dofs).unwrap();
+        assert_eq!(from_cells.col_ptr(), normal.pattern().col_ptr());
+        assert_eq!(from_cells.row_idx(), normal.pattern().row_idx());
+        let beyond = normal_pattern_of_cells([[VertexId(1), VertexId(8)]], dofs);
+        assert!(matches!(beyond, Err(SolveError::Length { got: 8, .. })));
     }
 
     fn constraints() -> DofConstraints {
