@@ -31,7 +31,7 @@ use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::operators::{apply, beltrami_operator};
 use beltrami_fem::solve::{PlannedOrder, normal_pattern_of_cells};
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
-use beltrami_mesh::VertexId;
+use beltrami_mesh::{FaceId, VertexId};
 use num_complex::Complex64;
 
 use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
@@ -114,7 +114,8 @@ impl Solver for Lscm {
             // mesh the two take about as long).
             std::thread::scope(|scope| {
                 let order = scope.spawn(|| {
-                    let faces = mesh.faces().map(|f| mesh.face_vertices(f));
+                    let faces =
+                        (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
                     PlannedOrder::new(normal_pattern_of_cells(faces, &dofs)?.as_ref())
                 });
                 let elements = Elements::new(mesh, Frame::Face)?;

@@ -300,61 +300,66 @@ impl<T: Scalar> NormalEquations<T> {
 ///
 /// Errors: [`SolveError::Length`] for a node beyond `dofs`' nodes.
 pub fn normal_pattern_of_cells<T: Scalar, C: IntoIterator<Item = VertexId>>(
-    cells: impl IntoIterator<Item = C>,
+    cells: impl Iterator<Item = C> + Clone,
     dofs: &DofMap<T>,
 ) -> Result<SymbolicSparseColMat<usize>, SolveError> {
     let n = dofs.reduced_len();
     let mut unknowns = Vec::new();
-    // (column, row) of every coupling, duplicates included.
-    let mut pairs: Vec<(usize, usize)> = Vec::new();
-    for cell in cells {
-        unknowns.clear();
-        for node in cell {
-            let terms = dofs.terms(node).map_err(|_| SolveError::Length {
-                what: "the node index of a cell",
-                expected: dofs.n_nodes(),
-                got: node.idx(),
-            })?;
-            unknowns.extend(terms.filter_map(|t| dofs.term(t).map(|term| term.dof)));
-        }
-        for (p, &c) in unknowns.iter().enumerate() {
-            for &d in &unknowns[..=p] {
-                pairs.push((c.min(d), c.max(d)));
+    // Each cell's couplings `(c, d)`, `c >= d`, go to column `d`: counted in a first
+    // pass over the cells, written in a second (no list of pairs is kept), then each
+    // column's rows are sorted and deduplicated in place.
+    let mut visit = |cells: &mut dyn Iterator<Item = C>,
+                     each: &mut dyn FnMut(usize, usize)|
+     -> Result<(), SolveError> {
+        for cell in cells {
+            unknowns.clear();
+            for node in cell {
+                let terms = dofs.terms(node).map_err(|_| SolveError::Length {
+                    what: "the node index of a cell",
+                    expected: dofs.n_nodes(),
+                    got: node.idx(),
+                })?;
+                unknowns.extend(terms.filter_map(|t| dofs.term(t).map(|term| term.dof)));
+            }
+            for (p, &c) in unknowns.iter().enumerate() {
+                for &d in &unknowns[..=p] {
+                    each(c.min(d), c.max(d));
+                }
             }
         }
-    }
-    // Counting sort by column, then each column's rows sorted and deduplicated.
+        Ok(())
+    };
     let mut col_ptr = vec![0usize; n + 1];
-    for &(col, _) in &pairs {
-        col_ptr[col + 1] += 1;
-    }
+    visit(&mut cells.clone(), &mut |col, _| col_ptr[col + 1] += 1)?;
     for j in 0..n {
         col_ptr[j + 1] += col_ptr[j];
     }
     let mut next = col_ptr[..n].to_vec();
-    let mut rows = vec![0usize; pairs.len()];
-    for &(col, row) in &pairs {
+    let mut rows = vec![0usize; col_ptr[n]];
+    visit(&mut cells.clone(), &mut |col, row| {
         rows[next[col]] = row;
         next[col] += 1;
-    }
-    drop(pairs);
-    let mut row_idx = Vec::with_capacity(rows.len());
-    let mut out_ptr = Vec::with_capacity(n + 1);
-    out_ptr.push(0);
+    })?;
+    drop(next);
+    // A column's distinct rows are written from its new start, which never passes its
+    // old one.
+    let mut end = 0;
     for j in 0..n {
-        let column = &mut rows[col_ptr[j]..col_ptr[j + 1]];
-        column.sort_unstable();
-        let start = row_idx.len();
-        for &i in column.iter() {
-            if row_idx.len() == start || row_idx.last() != Some(&i) {
-                row_idx.push(i);
+        let column = col_ptr[j]..col_ptr[j + 1];
+        rows[column.clone()].sort_unstable();
+        col_ptr[j] = end;
+        let start = end;
+        for k in column {
+            let i = rows[k];
+            if end == start || rows[end - 1] != i {
+                rows[end] = i;
+                end += 1;
             }
         }
-        out_ptr.push(row_idx.len());
     }
-    Ok(SymbolicSparseColMat::new_checked(
-        n, n, out_ptr, None, row_idx,
-    ))
+    col_ptr[n] = end;
+    rows.truncate(end);
+    Ok(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows))
 }
 
 /// The pattern of `K` row by row: the columns of row `l` are `col[ptr[l]..ptr[l + 1]]`.
@@ -719,11 +724,11 @@ mod tests {
         }
         // The pattern from the cells alone is the normal equations' own.
         let cells = elements.map(|e| e.map(|v| VertexId(v as u32)));
-        let from_cells = normal_pattern_of_cells(cells, dofs).unwrap();
+        let from_cells = normal_pattern_of_cells(cells.iter().copied(), dofs).unwrap();
         let normal = NormalEquations::new(a.symbolic(), dofs).unwrap();
         assert_eq!(from_cells.col_ptr(), normal.pattern().col_ptr());
         assert_eq!(from_cells.row_idx(), normal.pattern().row_idx());
-        let beyond = normal_pattern_of_cells([[VertexId(1), VertexId(8)]], dofs);
+        let beyond = normal_pattern_of_cells([[VertexId(1), VertexId(8)]].into_iter(), dofs);
         assert!(matches!(beyond, Err(SolveError::Length { got: 8, .. })));
     }
 
