@@ -231,16 +231,17 @@ pub fn solve(
 /// [`solve`], formatting meanwhile the parts of an OBJ output that do not depend on the
 /// map (its `v` and `f` lines, [`MeshSections`]) on a background thread of the lowest
 /// priority, so that they take only the time the solver leaves a core idle (most
-/// solvers factor and step on one core). `with_uvs`: whether the map is expected to be
-/// planar (written as `vt` lines); a wrong guess costs only the early formatting.
+/// solvers factor and step on one core). The `f` lines name texture coordinates when the
+/// target is planar ([`beltrami_core::Target::is_planar`]: the map is written as `vt`
+/// lines); were the map of another kind, only the early formatting would be lost.
 /// Nothing is formatted ahead for other output formats.
 pub fn solve_formatting_output(
     solver: &dyn Solver,
     problem: &Problem<'_>,
     progress: ProgressStyleArg,
     output: &Path,
-    with_uvs: bool,
 ) -> anyhow::Result<(Solution, f64, Option<MeshSections>)> {
+    let with_uvs = problem.target.is_planar();
     if Format::from_path(output) != Some(Format::Obj) {
         return solve(solver, problem, progress)
             .map(|(solution, seconds)| (solution, seconds, None));

@@ -125,7 +125,6 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
         &problem,
         args.common.progress(quiet),
         &args.output,
-        problem.target.is_planar(),
     )?;
     map_file::write(&args.output, mesh, &solution, None, sections.as_ref())?;
     mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;

@@ -356,7 +356,6 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         &problem,
         args.common.progress(quiet),
         &args.output,
-        problem.target.is_planar(),
     )?;
     let error = solution.metrics.mu_error;
     if let (Some(Map::Spatial(_)), false) = (
