@@ -29,7 +29,14 @@
 //!    starting below the cap of [`FlowOptions::max_move`]) for which (while a landmark
 //!    is still pulled towards its goal, only the first condition)
 //!    `Y' = P(Y + t V)` (each vertex projected back onto the target by its role) has no
-//!    more flipped faces than `Y` and a smaller `E`.
+//!    more flipped faces than `Y` and a smaller `E`. When no `t` qualifies and
+//!    [`FlowOptions::untangle_trials`] is set, the search runs again with each trial's
+//!    new flips untangled first ([`crate::untangle`], a vertex of a flipped face trying
+//!    first its place before the step, then its star's kernel): a face near a fold
+//!    whose source triangle is a sliver (`g0_bunny_closed` has four, height/length
+//!    1e-4) has a `mu` so sensitive to its corners that the linearized flow folds it at
+//!    every step size, and the step search stalled (bunny onto spot at mean `|mu|`
+//!    0.330); putting back the few vertices that fold it keeps the rest of the step.
 //! 4. Stop when the largest vertex update `t max_i |V_i|` is below the tolerance, or no
 //!    step above it decreases `E`, or (conformal goals, whose `E` has the near-fold
 //!    barrier) `E` fell by less than [`FLAT_DECREASE`] of itself over the last
@@ -48,6 +55,10 @@ use crate::extension::HarmonicExtension;
 use crate::measure::{ImageFace, Objective, image_faces, triangle};
 use crate::system::{Flow, FlowSystem};
 use crate::target::{Role, TargetGeometry};
+use crate::untangle::untangle;
+
+/// Rounds of the untangling of a trial step's flips (item 3).
+const REPAIR_ROUNDS: usize = 4;
 
 /// Smallest `|mu|` used in the `L^p` reweighting (`p > 2`), so that faces that are
 /// already conformal keep a positive weight.
@@ -94,6 +105,9 @@ pub struct FlowOptions {
     /// The smallest step size tried; below it a step is lost in rounding (`2^-50` by
     /// default).
     pub min_step: f64,
+    /// Whether a step search that finds no step size runs again with each trial's new
+    /// flips untangled first (item 3 of the module docs).
+    pub untangle_trials: bool,
 }
 
 /// The result of [`run`].
@@ -287,35 +301,59 @@ pub fn run<G: TargetGeometry>(
         let clock = Instant::now();
         let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
         target.prepare_step(&image)?;
-        let mut t = if largest > options.max_move {
+        let first = if largest > options.max_move {
             options.max_move / largest
         } else {
             1.0
         };
-        let accepted = loop {
-            if t * largest < options.tolerance || t < options.min_step {
-                break None;
+        // The plain search, then (item 3) the search that untangles a trial's flips.
+        let mut accepted = None;
+        for repair in [false, true] {
+            if repair && !options.untangle_trials {
+                break;
             }
-            let moved = step(
-                &target,
-                &step_roles,
-                &image,
-                &flow,
-                t,
-                extension.as_mut(),
-                &mut delta,
-                &mut trial,
-                &mut trial_normals,
-            )?;
-            image_faces(elements, &trial_normals, &trial, &mut trial_faces);
-            let (e, flips) = objective.evaluate(&trial_faces);
-            if flips <= flipped && (pulling || e < energy) {
-                break Some((moved, e, flips));
+            let mut t = first;
+            accepted = loop {
+                if t * largest < options.tolerance || t < options.min_step {
+                    break None;
+                }
+                let moved = step(
+                    &target,
+                    &step_roles,
+                    &image,
+                    &flow,
+                    t,
+                    extension.as_mut(),
+                    &mut delta,
+                    &mut trial,
+                    &mut trial_normals,
+                )?;
+                image_faces(elements, &trial_normals, &trial, &mut trial_faces);
+                let (mut e, mut flips) = objective.evaluate(&trial_faces);
+                if repair && flips > flipped {
+                    untangle(
+                        elements,
+                        &moved,
+                        system.roles(),
+                        &mut trial,
+                        &mut trial_normals,
+                        &mut trial_faces,
+                        REPAIR_ROUNDS,
+                        Some(&image),
+                    );
+                    (e, flips) = objective.evaluate(&trial_faces);
+                }
+                if flips <= flipped && (pulling || e < energy) {
+                    break Some((moved, e, flips, t));
+                }
+                t *= 0.5;
+            };
+            if accepted.is_some() {
+                break;
             }
-            t *= 0.5;
-        };
+        }
         step_seconds += clock.elapsed().as_secs_f64();
-        let Some((moved, e, flips)) = accepted else {
+        let Some((moved, e, flips, t)) = accepted else {
             stop = if largest < options.tolerance {
                 Stop::Converged
             } else {

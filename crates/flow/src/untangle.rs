@@ -109,7 +109,10 @@ fn centroid(polygon: &[Vector2<f64>]) -> Option<Vector2<f64>> {
 }
 
 /// Moves free vertices of flipped faces into the kernels of their stars (module docs),
-/// for at most `rounds` rounds; `faces` and `normals` are updated with `image`.
+/// for at most `rounds` rounds; `faces` and `normals` are updated with `image`. With
+/// `previous` (the images before a trial step of the flow), a vertex first tries its
+/// previous image: the least move that can unfold a face the step folded.
+#[allow(clippy::too_many_arguments)]
 pub fn untangle<G: TargetGeometry>(
     elements: &Elements,
     target: &G,
@@ -118,6 +121,7 @@ pub fn untangle<G: TargetGeometry>(
     normals: &mut [Vector3<f64>],
     faces: &mut [ImageFace],
     rounds: usize,
+    previous: Option<&[Point3<f64>]>,
 ) -> Untangled {
     let triangles: Vec<[usize; 3]> = (0..elements.face_count())
         .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
@@ -187,9 +191,10 @@ pub fn untangle<G: TargetGeometry>(
                     break;
                 }
             }
-            // Candidates: the kernel's centroid in the tangent plane at the image, then
-            // the mean of the link's images (across a fold of the target the tangent
-            // plane at one corner says little about the others).
+            // Candidates: the previous image (when given), the kernel's centroid in the
+            // tangent plane at the image, then the mean of the link's images (across a
+            // fold of the target the tangent plane at one corner says little about the
+            // others).
             let kernel = centroid(&polygon).map(|p| origin + u * p.x + w * p.y);
             let mut link = Vector3::zeros();
             let mut links = 0usize;
@@ -202,7 +207,8 @@ pub fn untangle<G: TargetGeometry>(
                 }
             }
             let mean = (links > 0).then(|| Point3::from(link / links as f64));
-            for candidate in [kernel, mean].into_iter().flatten() {
+            let back = previous.and_then(|p| p.get(v).copied());
+            for candidate in [back, kernel, mean].into_iter().flatten() {
                 let moved = target.project(Role::Free, &candidate);
                 let (old_normal, old_faces): (Vector3<f64>, Vec<ImageFace>) =
                     (normals[v], star.iter().map(|&f| faces[f]).collect());

@@ -56,6 +56,7 @@ fn a_vertex_dragged_across_its_neighbour_comes_back_into_its_star() {
             &mut normals,
             &mut faces,
             8,
+            None,
         );
         assert_eq!(done.before, before);
         assert_eq!(done.after, 0, "c = {c}: {done:?}");
@@ -77,6 +78,55 @@ fn a_vertex_dragged_across_its_neighbour_comes_back_into_its_star() {
         assert!(
             (p.x - home.x).abs() < 0.25 && (p.y - home.y).abs() < 0.25,
             "c = {c}: {p} vs {home}"
+        );
+    }
+}
+
+#[test]
+fn a_vertex_a_step_folded_goes_back_to_its_place_before_the_step() {
+    // The step search of the flow untangles a trial step's flips with the images before
+    // the step: the vertex that folded its star goes back exactly where it was (the
+    // least move), not to its star's kernel centroid, and nothing else moves.
+    let (mesh, _) = lifted(8, 0.5);
+    let elements = Elements::new(&mesh, Frame::Face).unwrap();
+    let index = SurfaceIndex::new(&mesh).unwrap();
+    let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh));
+    let before_step: Vec<Point3<f64>> = mesh.positions().to_vec();
+    let mut image = before_step.clone();
+    let dragged = 4 + 9 * 4;
+    // Only the dragged vertex may move.
+    let roles: Vec<Role> = (0..image.len())
+        .map(|v| {
+            if v == dragged {
+                Role::Free
+            } else {
+                Role::Fixed
+            }
+        })
+        .collect();
+    // Off the grid point, so that the kernel's centroid is not the previous place.
+    image[dragged] = target.project(Role::Free, &Point3::new(0.8, 0.52, 0.0));
+    let mut normals: Vec<Vector3<f64>> = image.iter().map(|p| target.normal(p)).collect();
+    let mut faces = Vec::new();
+    image_faces(&elements, &normals, &image, &mut faces);
+    let done = untangle(
+        &elements,
+        &target,
+        &roles,
+        &mut image,
+        &mut normals,
+        &mut faces,
+        4,
+        Some(&before_step),
+    );
+    assert_eq!(done.after, 0, "{done:?}");
+    assert_eq!(done.moves, 1, "{done:?}");
+    for v in 0..image.len() {
+        assert!(
+            (image[v] - before_step[v]).norm() < 1e-12,
+            "vertex {v}: {} vs {}",
+            image[v],
+            before_step[v]
         );
     }
 }
