@@ -315,7 +315,7 @@ impl<T: Scalar> LeastSquaresSolver<T> {
     /// [`new`](Self::new) in the order `order()` returns, called once the scatter maps
     /// are built: a [`PlannedOrder`] of a pattern with the graph of the normal
     /// equations (one row per reduced unknown, an entry wherever a row of `A` couples
-    /// two unknowns: [`normal_pattern_of_cells`](normal::normal_pattern_of_cells)), typically computed on another thread
+    /// two unknowns: [`normal_pattern_of_cells`]), typically computed on another thread
     /// while the caller assembled `A`. Any order of the right size gives the same
     /// solutions; one of another graph only factors slower.
     ///
@@ -1006,9 +1006,9 @@ fn fill_reducing_order_meanwhile<R>(
 /// computes the AMD order itself). From there, while the nested dissection is still
 /// being computed, the thread done with AMD touches two blocks of half AMD's factor
 /// size: the kernel clears every page a process touches for the first time, the factor
-/// is the largest block of a solve, and each side's factor ([`two_domains`]) reuses a
-/// block when it fits, which it does where the dissection is taken for its smaller
-/// factor.
+/// is the largest block of a solve, and each side's factor of the two-domain
+/// factorization reuses a block when it fits, which it does where the dissection is
+/// taken for its smaller factor.
 pub struct PlannedOrder<T: Scalar> {
     n: usize,
     ordered: Option<Ordered<[Option<Vec<T>>; 2]>>,

@@ -318,7 +318,7 @@ pub fn write(
     write_with_sections(path, mesh, attributes, None)
 }
 
-/// [`write`], taking the text of the sections that do not depend on the map from
+/// [`write()`], taking the text of the sections that do not depend on the map from
 /// `sections` when they fit `attributes` (formatted earlier by
 /// [`MeshSections::format`] for the same mesh: the `v` lines when `attributes` keeps the
 /// mesh's own positions, the `f` lines when the texture-coordinate indices agree);
