@@ -2,7 +2,7 @@
 //! faces; moving it back into the kernel removes them, and nothing else moves.
 
 use beltrami_fem::{Elements, Frame};
-use beltrami_flow_engine::measure::image_faces;
+use beltrami_flow_engine::measure::{ImageFace, image_faces};
 use beltrami_flow_engine::mesh_target::{MeshTarget, TargetCurve};
 use beltrami_flow_engine::target::{Role, TargetGeometry};
 use beltrami_flow_engine::untangle::untangle;
@@ -31,6 +31,23 @@ fn lifted(n: usize, c: f64) -> (Mesh, Vec<Role>) {
     (mesh, roles)
 }
 
+/// The vertex at grid point (4, 4) of [`lifted`]`(8, _)`.
+const DRAGGED: usize = 4 + 9 * 4;
+
+/// Drags [`DRAGGED`] past its neighbour (6, 4) (off the grid points, so that its star's
+/// kernel centroid is not its place) and returns the images' normals and faces.
+fn drag(
+    target: &MeshTarget<'_>,
+    elements: &Elements,
+    image: &mut [Point3<f64>],
+) -> (Vec<Vector3<f64>>, Vec<ImageFace>) {
+    image[DRAGGED] = target.project(Role::Free, &Point3::new(0.8, 0.52, 0.0));
+    let normals: Vec<Vector3<f64>> = image.iter().map(|p| target.normal(p)).collect();
+    let mut faces = Vec::new();
+    image_faces(elements, &normals, image, &mut faces);
+    (normals, faces)
+}
+
 #[test]
 fn a_vertex_dragged_across_its_neighbour_comes_back_into_its_star() {
     for c in [0.0, 0.5] {
@@ -40,11 +57,8 @@ fn a_vertex_dragged_across_its_neighbour_comes_back_into_its_star() {
         let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh));
         // The identity map, with vertex (4, 4) dragged past its neighbour (6, 4).
         let mut image: Vec<Point3<f64>> = mesh.positions().to_vec();
-        let dragged = 4 + 9 * 4;
-        image[dragged] = target.project(Role::Free, &Point3::new(0.8, 0.52, 0.0));
-        let mut normals: Vec<Vector3<f64>> = image.iter().map(|p| target.normal(p)).collect();
-        let mut faces = Vec::new();
-        image_faces(&elements, &normals, &image, &mut faces);
+        let dragged = DRAGGED;
+        let (mut normals, mut faces) = drag(&target, &elements, &mut image);
         let before = faces.iter().filter(|f| f.flipped()).count();
         assert!(before >= 2, "the drag flips faces: {before}");
         let original = image.clone();
@@ -93,7 +107,7 @@ fn a_vertex_a_step_folded_goes_back_to_its_place_before_the_step() {
     let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh));
     let before_step: Vec<Point3<f64>> = mesh.positions().to_vec();
     let mut image = before_step.clone();
-    let dragged = 4 + 9 * 4;
+    let dragged = DRAGGED;
     // Only the dragged vertex may move.
     let roles: Vec<Role> = (0..image.len())
         .map(|v| {
@@ -104,11 +118,7 @@ fn a_vertex_a_step_folded_goes_back_to_its_place_before_the_step() {
             }
         })
         .collect();
-    // Off the grid point, so that the kernel's centroid is not the previous place.
-    image[dragged] = target.project(Role::Free, &Point3::new(0.8, 0.52, 0.0));
-    let mut normals: Vec<Vector3<f64>> = image.iter().map(|p| target.normal(p)).collect();
-    let mut faces = Vec::new();
-    image_faces(&elements, &normals, &image, &mut faces);
+    let (mut normals, mut faces) = drag(&target, &elements, &mut image);
     let done = untangle(
         &elements,
         &target,

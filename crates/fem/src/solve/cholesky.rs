@@ -58,20 +58,20 @@ impl<T: Scalar> Cholesky<T> {
         let Some(ordered) = planned.ordered else {
             return Self::with_ordering(pattern, None, par);
         };
-        let [spare_a, spare_b] = ordered.meanwhile.unwrap_or([None, None]);
+        // The inverse also checks that the order is a permutation before either path.
         let inverse = inverse_permutation(&ordered.order)?;
-        let order = Some((&ordered.order[..], &inverse[..]));
-        let Some(halves) = ordered.halves else {
-            return Ok(Self::Whole(Box::new(Factor::build(
-                pattern, order, par, spare_a,
-            )?)));
-        };
-        match TwoDomains::new(pattern, &ordered.order, halves, [spare_a, spare_b])? {
-            Some(two) => Ok(Self::Halves(Box::new(two))),
-            None => Ok(Self::Whole(Box::new(Factor::build(
-                pattern, order, par, None,
-            )?))),
+        let mut spares = ordered.meanwhile.unwrap_or_default();
+        if let Some(halves) = ordered.halves
+            && let Some(two) =
+                TwoDomains::new(pattern, &ordered.order, halves, std::mem::take(&mut spares))?
+        {
+            return Ok(Self::Halves(Box::new(two)));
         }
+        let [spare, _] = spares;
+        let order = Some((&ordered.order[..], &inverse[..]));
+        Ok(Self::Whole(Box::new(Factor::build(
+            pattern, order, par, spare,
+        )?)))
     }
 
     /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
