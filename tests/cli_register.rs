@@ -525,6 +525,13 @@ fn a_registration_with_flips_fails_naming_them_unless_allowed() {
     assert!(r["flipped"].as_u64().unwrap() > 0, "{r}");
     let notes = r["notes"].to_string();
     assert!(notes.contains("kept as asked"), "{notes}");
+    // The initial map has flips; untangled first it still ends with flips, so the flow
+    // from the initial map as it was is tried too, and the notes say which was kept.
+    assert!(r["initial_flipped"].as_u64().unwrap() > 0, "{r}");
+    assert!(
+        notes.contains("untangled first left 3 flipped faces; from the initial map as it was, 3: kept the first"),
+        "{notes}"
+    );
     assert!(out.exists());
 }
 
@@ -534,14 +541,15 @@ fn the_four_boundary_faces_without_landmarks() {
         return;
     };
     // The flow from the initial map (4 flips) left one flip on a boundary edge; the
-    // initial map untangled first, then flowed, has none.
+    // initial map untangled first, then flowed, has none, and no other start is tried.
     let (source, target) = (shared.join("mc4_face_a.obj"), shared.join("mc4_face_b.obj"));
     let (_, r) = register(&source, &target, &[], 0.8);
     let notes = r["notes"].to_string();
     assert!(
-        notes.contains("untangled first, 0: kept the second"),
+        notes.contains("untangled 4 of the initial map's flipped faces to 0"),
         "{notes}"
     );
+    assert!(!notes.contains("as it was"), "{notes}");
     assert!(r["mu_max"].as_f64().unwrap() < 0.95, "{r}");
 }
 
