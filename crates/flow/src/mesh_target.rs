@@ -5,63 +5,50 @@
 //! along it, as a polyline of target vertices.
 
 use std::cell::RefCell;
+use std::sync::Arc;
 
 use beltrami_core::SolverError;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3, VertexId};
-use beltrami_spatial::closest_point::closest_on_segment;
 use beltrami_spatial::frame::interpolated_normal;
-use beltrami_spatial::{BoundaryMode, MoveOptions, SurfaceIndex};
+use beltrami_spatial::{BoundaryMode, MoveOptions, PolylineIndex, SurfaceIndex};
 
 use crate::target::{Role, TargetGeometry};
 
-/// A polyline of target vertices a chain of source vertices slides along.
-#[derive(Debug, Clone, PartialEq)]
+/// A polyline of target vertices a chain of source vertices slides along, indexed for
+/// exact closest points ([`PolylineIndex`]; shared by the clones of a target, one per
+/// trial step).
+#[derive(Debug, Clone)]
 pub struct TargetCurve {
-    /// Its points, in order.
-    pub points: Vec<Point3<f64>>,
-    /// Whether the last point connects back to the first (a boundary loop).
-    pub closed: bool,
+    index: Arc<PolylineIndex>,
 }
 
 impl TargetCurve {
     /// The curve through target vertices `vertices`.
-    pub fn through(mesh: &Mesh, vertices: &[VertexId], closed: bool) -> Self {
-        Self {
-            points: vertices.iter().map(|&v| mesh.position(v)).collect(),
-            closed,
-        }
+    pub fn through(mesh: &Mesh, vertices: &[VertexId], closed: bool) -> Result<Self, SolverError> {
+        let points = vertices.iter().map(|&v| mesh.position(v)).collect();
+        let index = PolylineIndex::new(points, closed).map_err(spatial_error)?;
+        Ok(Self {
+            index: Arc::new(index),
+        })
     }
 
     /// Every boundary loop of `mesh`, in `boundary_loop_list` order.
-    pub fn boundary_loops(mesh: &Mesh) -> Vec<Self> {
+    pub fn boundary_loops(mesh: &Mesh) -> Result<Vec<Self>, SolverError> {
         mesh.boundary_loop_list()
             .iter()
             .map(|l| Self::through(mesh, &l.vertices, true))
             .collect()
     }
 
-    fn segments(&self) -> impl Iterator<Item = (Point3<f64>, Point3<f64>)> + '_ {
-        let n = self.points.len();
-        let count = if self.closed { n } else { n.saturating_sub(1) };
-        (0..count).map(move |k| (self.points[k], self.points[(k + 1) % n]))
-    }
-
-    /// The closest point of the curve to `p` and the unit direction of its segment.
+    /// The closest point of the curve to `p` and the unit direction of its segment (the
+    /// curve's first point and the x axis when it has no segment of positive length).
     pub fn closest(&self, p: &Point3<f64>) -> (Point3<f64>, Vector3<f64>) {
-        let mut best: Option<(f64, Point3<f64>, Vector3<f64>)> = None;
-        for (a, b) in self.segments() {
-            let d = b - a;
-            if d.norm_squared() == 0.0 {
-                continue;
-            }
-            let c = closest_on_segment(p, &a, &b);
-            if best.is_none_or(|(dist, _, _)| c.distance_squared < dist) {
-                best = Some((c.distance_squared, c.position, d.normalize()));
-            }
-        }
-        match best {
-            Some((_, q, t)) => (q, t),
-            None => (self.points.first().copied().unwrap_or(*p), Vector3::x()),
+        match self.index.closest(p) {
+            Some(on) => (on.position, on.direction),
+            None => (
+                self.index.points().first().copied().unwrap_or(*p),
+                Vector3::x(),
+            ),
         }
     }
 

@@ -257,7 +257,7 @@ pub(crate) fn mesh_roles(
     pins: &[VertexId],
 ) -> Result<(Vec<TargetCurve>, Vec<Role>), SolverError> {
     let mesh = problem.source;
-    let mut curves = TargetCurve::boundary_loops(target);
+    let mut curves = TargetCurve::boundary_loops(target)?;
     let mut roles = vec![Role::Free; mesh.vertex_count()];
     for l in mesh.boundary_loop_list() {
         let nearest = (0..curves.len()).min_by(|&a, &b| {
@@ -275,7 +275,7 @@ pub(crate) fn mesh_roles(
     }
     for curve in problem.constraints.curves() {
         let c = curves.len();
-        curves.push(TargetCurve::through(target, &curve.target, false));
+        curves.push(TargetCurve::through(target, &curve.target, false)?);
         let n = curve.source.len();
         for (k, &v) in curve.source.iter().enumerate() {
             roles[v.idx()] = if k == 0 || k + 1 == n {

@@ -54,7 +54,7 @@ fn a_vertex_dragged_across_its_neighbour_comes_back_into_its_star() {
         let (mesh, roles) = lifted(8, c);
         let elements = Elements::new(&mesh, Frame::Face).unwrap();
         let index = SurfaceIndex::new(&mesh).unwrap();
-        let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh));
+        let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh).unwrap());
         // The identity map, with vertex (4, 4) dragged past its neighbour (6, 4).
         let mut image: Vec<Point3<f64>> = mesh.positions().to_vec();
         let dragged = DRAGGED;
@@ -104,7 +104,7 @@ fn a_vertex_a_step_folded_goes_back_to_its_place_before_the_step() {
     let (mesh, _) = lifted(8, 0.5);
     let elements = Elements::new(&mesh, Frame::Face).unwrap();
     let index = SurfaceIndex::new(&mesh).unwrap();
-    let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh));
+    let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh).unwrap());
     let before_step: Vec<Point3<f64>> = mesh.positions().to_vec();
     let mut image = before_step.clone();
     let dragged = DRAGGED;

@@ -63,7 +63,7 @@ const BUCKET: usize = 16;
 
 /// The kd-tree of sample centers: kiddo's immutable layout (Eytzinger stems, arena
 /// leaves) with leaves of [`BUCKET`] items, items being sample indices.
-type Tree = KdTree<f64, u32, Eytzinger, VecOfArenas<f64, u32, 3, BUCKET>, 3, BUCKET>;
+pub(crate) type Tree = KdTree<f64, u32, Eytzinger, VecOfArenas<f64, u32, 3, BUCKET>, 3, BUCKET>;
 
 /// Reusable traversal storage of the kd-tree queries (one per batch, so that a query
 /// does not set up its stack anew).

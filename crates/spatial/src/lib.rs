@@ -12,6 +12,9 @@
 //!   Morton order and take per-point face hints for warm starts.
 //! - [`closest_point`]: exact closest points on segments, triangles (all Voronoi regions,
 //!   robust for slivers and degenerate triangles) and bilinear quads.
+//! - [`PolylineIndex`] ([`polyline`]): exact closest points on a polyline (a boundary
+//!   loop or a feature curve the flow slides vertices along), by a kd-tree of pieces of
+//!   its segments.
 //! - [`frame`]: the tangent frame at a surface point from interpolated vertex normals.
 //! - [`motion`]: moving a surface point by a tangent displacement, by walking along the
 //!   surface (unfolding across edges, straightest continuation through vertices,
@@ -75,9 +78,11 @@ pub mod frame;
 pub mod index;
 pub mod morton;
 pub mod motion;
+pub mod polyline;
 
 pub use beltrami_mesh::SurfacePoint;
 pub use error::SpatialError;
 pub use frame::TangentFrame;
 pub use index::{Located, SurfaceIndex};
 pub use motion::{BoundaryMode, MoveMethod, MoveOptions, MoveOutcome, MoveSummary, Moved};
+pub use polyline::{OnPolyline, PolylineIndex};
