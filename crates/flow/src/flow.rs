@@ -108,6 +108,10 @@ pub struct FlowOptions {
     /// Whether a step search that finds no step size runs again with each trial's new
     /// flips untangled first (item 3 of the module docs).
     pub untangle_trials: bool,
+    /// Threads of the loops over faces of each trial step (the image faces; a target
+    /// mesh's own batch queries follow its index's threads). The results are the same
+    /// for any number.
+    pub threads: usize,
 }
 
 /// The result of [`run`].
@@ -257,7 +261,7 @@ pub fn run<G: TargetGeometry>(
     let mut normals = Vec::new();
     target.project_all(system.roles(), None, &mut image, &mut normals)?;
     let mut faces = Vec::with_capacity(elements.face_count());
-    image_faces(elements, &normals, &image, &mut faces);
+    image_faces(elements, &normals, &image, &mut faces, options.threads);
     let (mut energy, mut flipped) = objective.evaluate(&faces);
     let mut energy_history = vec![energy];
     let (mut step_sizes, mut updates) = (Vec::new(), Vec::new());
@@ -328,7 +332,13 @@ pub fn run<G: TargetGeometry>(
                     &mut trial,
                     &mut trial_normals,
                 )?;
-                image_faces(elements, &trial_normals, &trial, &mut trial_faces);
+                image_faces(
+                    elements,
+                    &trial_normals,
+                    &trial,
+                    &mut trial_faces,
+                    options.threads,
+                );
                 let (mut e, mut flips) = objective.evaluate(&trial_faces);
                 if repair && flips > flipped {
                     untangle(

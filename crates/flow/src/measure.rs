@@ -35,6 +35,7 @@
 
 use beltrami_fem::Elements;
 use beltrami_fem::beltrami::{PointDerivatives, image_derivatives, oriented_normal};
+use beltrami_mesh::parallel::map_chunks_mut;
 use beltrami_mesh::{FaceId, Point3, Vector2, Vector3, VertexId};
 use num_complex::Complex64;
 
@@ -183,17 +184,27 @@ const TILT_START: f64 = 0.4;
 /// the target's tangent plane.
 const TILT_FULL: f64 = 0.1;
 
-/// Every image face of the map `image` ([`image_face`]), into `out` (cleared first).
+/// Every image face of the map `image` ([`image_face`]), into `out` (replaced), on
+/// `threads` threads ([`beltrami_mesh::parallel`]; the faces are the same for any
+/// number).
 pub fn image_faces(
     elements: &Elements,
     normals: &[Vector3<f64>],
     image: &[Point3<f64>],
     out: &mut Vec<ImageFace>,
+    threads: usize,
 ) {
     out.clear();
-    out.extend(
-        (0..elements.face_count()).map(|f| image_face(elements, normals, image, FaceId(f as u32))),
-    );
+    if elements.face_count() == 0 {
+        return;
+    }
+    let first = image_face(elements, normals, image, FaceId(0));
+    out.resize(elements.face_count(), first);
+    map_chunks_mut(out, threads, |offset, chunk| {
+        for (k, face) in chunk.iter_mut().enumerate() {
+            *face = image_face(elements, normals, image, FaceId::from_usize(offset + k));
+        }
+    });
 }
 
 /// Where the near-fold barrier of [`Objective`] acts and how it weighs faces.

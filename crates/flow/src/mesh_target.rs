@@ -8,6 +8,7 @@ use std::cell::RefCell;
 use std::sync::Arc;
 
 use beltrami_core::SolverError;
+use beltrami_mesh::parallel::map_chunks_mut;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3, VertexId};
 use beltrami_spatial::frame::interpolated_normal;
 use beltrami_spatial::{BoundaryMode, MoveOptions, PolylineIndex, SurfaceIndex};
@@ -189,19 +190,28 @@ impl TargetGeometry for MeshTarget<'_> {
             }
             None => self.locate_all(points)?,
         };
+        let (mesh, curves) = (self.mesh(), &self.curves);
+        let (vertex_normals, threads) = (self.index.vertex_normals(), self.index.threads());
         normals.clear();
-        for ((p, s), &role) in points.iter_mut().zip(&surface).zip(roles) {
-            normals.push(interpolated_normal(
-                self.mesh(),
-                self.index.vertex_normals(),
-                s,
-            ));
-            match role {
-                Role::Free => *p = s.position(self.mesh()),
-                Role::Curve(c) => *p = self.curves[c].closest(p).0,
-                Role::Fixed => {}
+        normals.resize(points.len(), Vector3::zeros());
+        map_chunks_mut(normals, threads, |offset, chunk| {
+            for (normal, s) in chunk.iter_mut().zip(&surface[offset..]) {
+                *normal = interpolated_normal(mesh, vertex_normals, s);
             }
-        }
+        });
+        map_chunks_mut(points, threads, |offset, chunk| {
+            for ((p, s), &role) in chunk
+                .iter_mut()
+                .zip(&surface[offset..])
+                .zip(&roles[offset..])
+            {
+                match role {
+                    Role::Free => *p = s.position(mesh),
+                    Role::Curve(c) => *p = curves[c].closest(p).0,
+                    Role::Fixed => {}
+                }
+            }
+        });
         Ok(())
     }
 }

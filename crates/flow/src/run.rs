@@ -59,6 +59,15 @@ pub const OPTIONS: &[OptionSpec] = &[
         },
         help: "the smallest step size tried (2^-50: below it a step is lost in rounding)",
     },
+    OptionSpec {
+        name: "step-threads",
+        kind: OptionKind::Int {
+            default: 0,
+            min: 0,
+            max: 256,
+        },
+        help: "threads that move, project and measure each trial step (0: one per core; the map is the same for any number)",
+    },
     THREADS,
 ];
 
@@ -120,6 +129,10 @@ pub fn solve(
         )));
     }
     let threads = settings.int("threads");
+    let step_threads = match settings.int("step-threads") {
+        0 => beltrami_mesh::parallel::available_threads(),
+        n => n,
+    };
     let barrier = match problem.target {
         Target::Sphere | Target::Mesh(_) => Barrier::AREA_WEIGHTED,
         _ => Barrier::PLANAR,
@@ -137,6 +150,7 @@ pub fn solve(
         settings,
         options,
         untangle_trials: false,
+        step_threads,
     };
     let input = |v: VertexId| mesh.vertex_map().to_input(v);
     let pins = pins(problem, &initial);
@@ -150,7 +164,9 @@ pub fn solve(
     }
     if let Target::Mesh(target) = &problem.target {
         let index = context.stage("target index", &mut report, || {
-            SurfaceIndex::new(target).map_err(|e| invalid(format!("the target mesh: {e}")))
+            SurfaceIndex::new(target)
+                .map(|index| index.with_threads(step_threads))
+                .map_err(|e| invalid(format!("the target mesh: {e}")))
         })?;
         let (curves, roles) = mesh_roles(problem, target, &initial, &pins)?;
         let geometry = MeshTarget::new(&index, curves);
@@ -296,7 +312,7 @@ fn mesh_image_faces(
 ) -> Vec<ImageFace> {
     let normals: Vec<_> = image.iter().map(|p| geometry.normal(p)).collect();
     let mut faces = Vec::with_capacity(elements.face_count());
-    image_faces(elements, &normals, image, &mut faces);
+    image_faces(elements, &normals, image, &mut faces, 1);
     faces
 }
 
@@ -387,6 +403,8 @@ struct Runner<'a, 'p> {
     options: SolveOptions,
     /// [`FlowOptions::untangle_trials`] of the runs.
     untangle_trials: bool,
+    /// [`FlowOptions::threads`] of the runs (option `step-threads`, 0 resolved).
+    step_threads: usize,
 }
 
 impl Runner<'_, '_> {
@@ -518,6 +536,7 @@ impl Runner<'_, '_> {
             },
             min_step: settings.float("min-step"),
             untangle_trials: self.untangle_trials,
+            threads: self.step_threads,
         };
         let run = report.time("flow", || {
         flow::run(

@@ -587,7 +587,7 @@ mod tests {
         // its prescribed flow.
         let normals = vec![Vector3::z(); image.len()];
         let mut faces = Vec::new();
-        image_faces(&elements, &normals, &image, &mut faces);
+        image_faces(&elements, &normals, &image, &mut faces, 1);
         let weights = vec![1.0; faces.len()];
         let rho = vec![Complex64::new(0.2, 0.0); faces.len()];
         let pulled = Vector3::new(0.0, 0.01, 0.0);

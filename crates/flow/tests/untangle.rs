@@ -44,7 +44,7 @@ fn drag(
     image[DRAGGED] = target.project(Role::Free, &Point3::new(0.8, 0.52, 0.0));
     let normals: Vec<Vector3<f64>> = image.iter().map(|p| target.normal(p)).collect();
     let mut faces = Vec::new();
-    image_faces(elements, &normals, image, &mut faces);
+    image_faces(elements, &normals, image, &mut faces, 1);
     (normals, faces)
 }
 
@@ -75,7 +75,7 @@ fn a_vertex_dragged_across_its_neighbour_comes_back_into_its_star() {
         assert_eq!(done.before, before);
         assert_eq!(done.after, 0, "c = {c}: {done:?}");
         let mut check = Vec::new();
-        image_faces(&elements, &normals, &image, &mut check);
+        image_faces(&elements, &normals, &image, &mut check, 2);
         assert_eq!(check.iter().filter(|f| f.flipped()).count(), 0);
         // The boundary never moves, and the untangled point lies on the target.
         for v in mesh.vertices() {

@@ -38,6 +38,7 @@ mod geometry;
 mod ids;
 pub mod io;
 mod mesh;
+pub mod parallel;
 pub mod primitives;
 mod soup;
 pub mod subdivision;

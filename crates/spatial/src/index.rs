@@ -121,6 +121,8 @@ pub struct SurfaceIndex<'m> {
     /// each face, contiguous.
     corners: Vec<Point3<f64>>,
     vertex_normals: Vec<Vector3<f64>>,
+    /// Threads of the batch queries ([`SurfaceIndex::with_threads`]).
+    threads: usize,
 }
 
 impl std::fmt::Debug for SurfaceIndex<'_> {
@@ -287,7 +289,27 @@ impl<'m> SurfaceIndex<'m> {
                 .flat_map(|f| mesh.face_vertices(f).map(|v| mesh.position(v)))
                 .collect(),
             vertex_normals: mesh.vertex_normals(),
+            threads: 1,
         })
+    }
+
+    /// The index with its batch queries ([`SurfaceIndex::locate_all`],
+    /// [`SurfaceIndex::locate_all_near`], [`SurfaceIndex::move_all`]) spread over
+    /// `threads` threads (0: one per core; 1, the default: the calling thread only).
+    /// Each point's result is the same for any number of threads: the searches are exact
+    /// and the walks independent.
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = if threads == 0 {
+            beltrami_mesh::parallel::available_threads()
+        } else {
+            threads
+        };
+        self
+    }
+
+    /// Threads of the batch queries.
+    pub fn threads(&self) -> usize {
+        self.threads
     }
 
     /// The indexed mesh.
@@ -406,8 +428,27 @@ impl<'m> SurfaceIndex<'m> {
     fn batch(
         &self,
         points: &[Point3<f64>],
-        start: impl Fn(usize, Option<FaceId>) -> Option<FaceId>,
+        start: impl Fn(usize, Option<FaceId>) -> Option<FaceId> + Sync,
     ) -> Vec<Located> {
+        let order = crate::morton::order(points);
+        // Each thread takes a stretch of the Morton order, its points near each other.
+        let stretches = beltrami_mesh::parallel::map_ranges(order.len(), self.threads, |range| {
+            let mut scratch = Scratch::new();
+            let mut previous: Option<(usize, FaceId)> = None;
+            order[range]
+                .iter()
+                .map(|&i| {
+                    let i = i as usize;
+                    let p = &points[i];
+                    let near = previous
+                        .filter(|&(j, _)| (points[j] - p).norm() <= self.max_radius)
+                        .map(|(_, face)| face);
+                    let located = self.search(p, start(i, near), &mut scratch);
+                    previous = Some((i, located.point.face));
+                    located
+                })
+                .collect::<Vec<_>>()
+        });
         let unset = Located {
             point: SurfacePoint {
                 face: FaceId(0),
@@ -417,17 +458,8 @@ impl<'m> SurfaceIndex<'m> {
             distance: f64::INFINITY,
         };
         let mut out = vec![unset; points.len()];
-        let mut scratch = Scratch::new();
-        let mut previous: Option<(usize, FaceId)> = None;
-        for i in crate::morton::order(points) {
-            let i = i as usize;
-            let p = &points[i];
-            let near = previous
-                .filter(|&(j, _)| (points[j] - p).norm() <= self.max_radius)
-                .map(|(_, face)| face);
-            let located = self.search(p, start(i, near), &mut scratch);
-            previous = Some((i, located.point.face));
-            out[i] = located;
+        for (&i, located) in order.iter().zip(stretches.into_iter().flatten()) {
+            out[i as usize] = located;
         }
         out
     }

@@ -888,18 +888,37 @@ impl SurfaceIndex<'_> {
                 .map_err(|e| SpatialError::from(e).in_batch(i))?;
             check_displacement(d).map_err(|e| e.in_batch(i))?;
         }
-        let mut summary = MoveSummary::default();
-        for (i, (p, d)) in points.iter_mut().zip(displacements).enumerate() {
-            let moved = self.move_point(p, d, options).map_err(|e| e.in_batch(i))?;
-            *p = moved.point;
-            summary.faces_crossed += moved.faces_crossed;
-            match moved.outcome {
-                MoveOutcome::Arrived => summary.arrived += 1,
-                MoveOutcome::StoppedAtBoundary => summary.stopped_at_boundary += 1,
-                MoveOutcome::SlidAlongBoundary => summary.slid_along_boundary += 1,
-                MoveOutcome::Projected => summary.projected += 1,
-            }
-        }
-        Ok(summary)
+        let parts =
+            beltrami_mesh::parallel::map_chunks_mut(points, self.threads(), |offset, chunk| {
+                let mut summary = MoveSummary::default();
+                for (i, p) in chunk.iter_mut().enumerate() {
+                    let d = &displacements[offset + i];
+                    let moved = self
+                        .move_point(p, d, options)
+                        .map_err(|e| e.in_batch(offset + i))?;
+                    *p = moved.point;
+                    summary.faces_crossed += moved.faces_crossed;
+                    match moved.outcome {
+                        MoveOutcome::Arrived => summary.arrived += 1,
+                        MoveOutcome::StoppedAtBoundary => summary.stopped_at_boundary += 1,
+                        MoveOutcome::SlidAlongBoundary => summary.slid_along_boundary += 1,
+                        MoveOutcome::Projected => summary.projected += 1,
+                    }
+                }
+                Ok::<_, SpatialError>(summary)
+            });
+        // The first failure in point order, as a sequential loop would report it.
+        parts
+            .into_iter()
+            .try_fold(MoveSummary::default(), |total, part| {
+                let part = part?;
+                Ok(MoveSummary {
+                    arrived: total.arrived + part.arrived,
+                    stopped_at_boundary: total.stopped_at_boundary + part.stopped_at_boundary,
+                    slid_along_boundary: total.slid_along_boundary + part.slid_along_boundary,
+                    projected: total.projected + part.projected,
+                    faces_crossed: total.faces_crossed + part.faces_crossed,
+                })
+            })
     }
 }

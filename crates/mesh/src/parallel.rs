@@ -1,0 +1,164 @@
+//! Data-parallel loops over mesh elements on scoped threads.
+//!
+//! The work is cut into consecutive chunks of at least [`MIN_CHUNK`] items (below that,
+//! starting a thread costs more than it saves), about [`CHUNKS_PER_THREAD`] per thread;
+//! the calling thread and `threads - 1` scoped threads take the next chunk in turn until
+//! none is left, so that chunks of costly items (long walks in one region of a surface)
+//! do not leave a thread waiting. The results come back in chunk order. Loops whose
+//! items are independent (a closest-point search or a walk per point, a Jacobian per
+//! face) give the same results for any number of threads.
+
+use std::ops::Range;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The fewest items worth a chunk of their own.
+pub const MIN_CHUNK: usize = 2048;
+
+/// Chunks per thread: enough for the turns to even out uneven chunks.
+pub const CHUNKS_PER_THREAD: usize = 8;
+
+/// The cores of this machine (1 when unknown): what a `threads` option of 0 means.
+pub fn available_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// The consecutive ranges of `0..len` the loops hand out for `threads` threads: one for
+/// a single thread, else about [`CHUNKS_PER_THREAD`] per thread of at least
+/// [`MIN_CHUNK`] items (at least one range), of equal sizes up to one.
+pub fn chunk_ranges(len: usize, threads: usize) -> Vec<Range<usize>> {
+    let count = if threads <= 1 {
+        1
+    } else {
+        (threads * CHUNKS_PER_THREAD).min(len / MIN_CHUNK).max(1)
+    };
+    (0..count)
+        .map(|k| k * len / count..(k + 1) * len / count)
+        .collect()
+}
+
+/// Runs `work` on every item of `chunks` (in turns, on the calling thread and
+/// `threads - 1` scoped threads) and returns the results in the order of `chunks`.
+fn in_turns<C: Send, R: Send>(
+    chunks: Vec<C>,
+    threads: usize,
+    work: impl Fn(C) -> R + Sync,
+) -> Vec<R> {
+    let count = chunks.len();
+    if count <= 1 || threads <= 1 {
+        return chunks.into_iter().map(work).collect();
+    }
+    let chunks: Vec<Mutex<Option<C>>> = chunks.into_iter().map(|c| Mutex::new(Some(c))).collect();
+    let next = AtomicUsize::new(0);
+    let turns = || {
+        let mut done = Vec::new();
+        loop {
+            let k = next.fetch_add(1, Ordering::Relaxed);
+            let Some(slot) = chunks.get(k) else {
+                break done;
+            };
+            let chunk = slot
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .take();
+            if let Some(chunk) = chunk {
+                done.push((k, work(chunk)));
+            }
+        }
+    };
+    let mut done = std::thread::scope(|scope| {
+        let others: Vec<_> = (1..threads.min(count))
+            .map(|_| scope.spawn(&turns))
+            .collect();
+        let mut done = turns();
+        for thread in others {
+            done.extend(
+                thread
+                    .join()
+                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+            );
+        }
+        done
+    });
+    done.sort_unstable_by_key(|&(k, _)| k);
+    done.into_iter().map(|(_, r)| r).collect()
+}
+
+/// `work(range)` over the [`chunk_ranges`] of `0..len`, results in range order.
+pub fn map_ranges<R: Send>(
+    len: usize,
+    threads: usize,
+    work: impl Fn(Range<usize>) -> R + Sync,
+) -> Vec<R> {
+    in_turns(chunk_ranges(len, threads), threads, work)
+}
+
+/// `work(offset, chunk)` over the chunks of `items` at the [`chunk_ranges`] (`offset`
+/// the index of the chunk's first item), results in chunk order.
+pub fn map_chunks_mut<T: Send, R: Send>(
+    items: &mut [T],
+    threads: usize,
+    work: impl Fn(usize, &mut [T]) -> R + Sync,
+) -> Vec<R> {
+    let ranges = chunk_ranges(items.len(), threads);
+    let mut chunks = Vec::with_capacity(ranges.len());
+    let mut rest = items;
+    for r in &ranges {
+        let (chunk, tail) = rest.split_at_mut(r.len());
+        chunks.push((r.start, chunk));
+        rest = tail;
+    }
+    in_turns(chunks, threads, |(offset, chunk)| work(offset, chunk))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_cover_the_items_in_order_with_enough_items_each() {
+        for (len, threads, count) in [
+            (0, 4, 1),
+            (10, 4, 1),
+            (MIN_CHUNK * 2 - 1, 4, 1),
+            (MIN_CHUNK * 2, 4, 2),
+            (MIN_CHUNK * 100 + 3, 3, 3 * CHUNKS_PER_THREAD),
+            (MIN_CHUNK * 100, 1, 1),
+        ] {
+            let ranges = chunk_ranges(len, threads);
+            assert_eq!(ranges.len(), count, "{len} items, {threads} threads");
+            assert_eq!(ranges[0].start, 0);
+            assert_eq!(ranges.last().unwrap().end, len);
+            for pair in ranges.windows(2) {
+                assert_eq!(pair[0].end, pair[1].start);
+            }
+            if count > 1 {
+                assert!(ranges.iter().all(|r| r.len() >= MIN_CHUNK));
+            }
+        }
+    }
+
+    #[test]
+    fn chunks_see_their_offsets_and_results_come_back_in_order() {
+        let len = MIN_CHUNK * 40 + 5;
+        let mut items = vec![0usize; len];
+        let parts = map_chunks_mut(&mut items, 2, |offset, chunk| {
+            if offset == 0 {
+                // The first chunk finishes last.
+                std::thread::sleep(std::time::Duration::from_millis(50));
+            }
+            for (i, x) in chunk.iter_mut().enumerate() {
+                *x = offset + i;
+            }
+            (offset, chunk.len())
+        });
+        assert_eq!(items, (0..len).collect::<Vec<_>>());
+        assert_eq!(parts.len(), 2 * CHUNKS_PER_THREAD);
+        assert_eq!(parts[0].0, 0);
+        assert!(parts.windows(2).all(|p| p[0].0 + p[0].1 == p[1].0));
+        assert_eq!(parts.last().map(|p| p.0 + p.1), Some(len));
+        let ranges = map_ranges(len, 2, |r| r);
+        assert_eq!(ranges, chunk_ranges(len, 2));
+        assert_eq!(map_ranges(0, 2, |r| r.len()), vec![0]);
+    }
+}
