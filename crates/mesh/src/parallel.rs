@@ -68,7 +68,7 @@ fn in_turns<C: Send, R: Send>(
     };
     let mut done = std::thread::scope(|scope| {
         let others: Vec<_> = (1..threads.min(count))
-            .map(|_| scope.spawn(&turns))
+            .map(|_| scope.spawn(turns))
             .collect();
         let mut done = turns();
         for thread in others {
