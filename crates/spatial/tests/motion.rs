@@ -565,3 +565,52 @@ fn bad_moves_are_typed_errors_and_batches_are_all_or_nothing() {
         "batch",
     );
 }
+
+#[test]
+fn batches_on_several_threads_give_each_point_the_same_answer() {
+    // A torus of 64 x 128 x 2 faces and 20,000 points: enough for several chunks per
+    // thread (beltrami_mesh::parallel::MIN_CHUNK).
+    let mesh = build(&torus(128, 64, 3.0, 1.0, Cells::Triangles));
+    let one = SurfaceIndex::new(&mesh).unwrap();
+    let mut rng = Rng::new(11);
+    let points: Vec<Point3<f64>> = (0..20_000)
+        .map(|_| {
+            Point3::new(
+                8.0 * rng.unit() - 4.0,
+                8.0 * rng.unit() - 4.0,
+                2.0 * rng.unit() - 1.0,
+            )
+        })
+        .collect();
+    let located = one.locate_all(&points).unwrap();
+    let hints: Vec<FaceId> = located.iter().map(|l| l.point.face).collect();
+    let steps: Vec<Vector3<f64>> = (0..points.len())
+        .map(|_| Vector3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5))
+        .collect();
+    let mut walked_one: Vec<SurfacePoint> = located.iter().map(|l| l.point).collect();
+    let summary_one = one
+        .move_all(&mut walked_one, &steps, &walk(BoundaryMode::Stop))
+        .unwrap();
+    for threads in [2, 3, 0] {
+        let many = SurfaceIndex::new(&mesh).unwrap().with_threads(threads);
+        assert!(many.threads() >= 1);
+        assert_eq!(many.locate_all(&points).unwrap(), located);
+        assert_eq!(many.locate_all_near(&points, &hints).unwrap(), located);
+        let mut walked: Vec<SurfacePoint> = located.iter().map(|l| l.point).collect();
+        let summary = many
+            .move_all(&mut walked, &steps, &walk(BoundaryMode::Stop))
+            .unwrap();
+        assert_eq!(walked, walked_one, "{threads} threads");
+        assert_eq!(summary, summary_one);
+    }
+    // A failure names the first bad point in point order, whatever the threads.
+    let mut bad = steps.clone();
+    bad[15_000] = Vector3::new(f64::NAN, 0.0, 0.0);
+    bad[17_000] = Vector3::new(f64::NAN, 0.0, 0.0);
+    let many = SurfaceIndex::new(&mesh).unwrap().with_threads(2);
+    let mut walked: Vec<SurfacePoint> = located.iter().map(|l| l.point).collect();
+    let error = many
+        .move_all(&mut walked, &bad, &walk(BoundaryMode::Stop))
+        .unwrap_err();
+    assert!(error.to_string().contains("15000"), "{error}");
+}
