@@ -184,9 +184,9 @@ const TILT_START: f64 = 0.4;
 /// the target's tangent plane.
 const TILT_FULL: f64 = 0.1;
 
-/// Every image face of the map `image` ([`image_face`]), into `out` (replaced), on
-/// `threads` threads ([`beltrami_mesh::parallel`]; the faces are the same for any
-/// number).
+/// Every image face of the map `image` ([`image_face`]), into `out` (resized to the face
+/// count, every entry overwritten), on `threads` threads ([`beltrami_mesh::parallel`];
+/// the faces are the same for any number).
 pub fn image_faces(
     elements: &Elements,
     normals: &[Vector3<f64>],
@@ -194,12 +194,17 @@ pub fn image_faces(
     out: &mut Vec<ImageFace>,
     threads: usize,
 ) {
-    out.clear();
-    if elements.face_count() == 0 {
+    let n = elements.face_count();
+    out.truncate(n);
+    if n == 0 {
         return;
     }
-    let first = image_face(elements, normals, image, FaceId(0));
-    out.resize(elements.face_count(), first);
+    // Every face is overwritten below: a vector kept from the last trial step (the
+    // flow's case) is not filled first.
+    if out.len() < n {
+        let first = image_face(elements, normals, image, FaceId(0));
+        out.resize(n, first);
+    }
     map_chunks_mut(out, threads, |offset, chunk| {
         for (k, face) in chunk.iter_mut().enumerate() {
             *face = image_face(elements, normals, image, FaceId::from_usize(offset + k));
