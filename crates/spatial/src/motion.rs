@@ -161,6 +161,21 @@ pub struct MoveSummary {
     pub faces_crossed: usize,
 }
 
+impl std::ops::Add for MoveSummary {
+    type Output = Self;
+
+    /// The counts of two batches together.
+    fn add(self, other: Self) -> Self {
+        Self {
+            arrived: self.arrived + other.arrived,
+            stopped_at_boundary: self.stopped_at_boundary + other.stopped_at_boundary,
+            slid_along_boundary: self.slid_along_boundary + other.slid_along_boundary,
+            projected: self.projected + other.projected,
+            faces_crossed: self.faces_crossed + other.faces_crossed,
+        }
+    }
+}
+
 /// One triangle of the walk: a triangle face, or half of a quad split along `p0 p2`
 /// (half 0 is `(p0, p1, p2)`, half 1 is `(p0, p2, p3)`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -910,15 +925,6 @@ impl SurfaceIndex<'_> {
         // The first failure in point order, as a sequential loop would report it.
         parts
             .into_iter()
-            .try_fold(MoveSummary::default(), |total, part| {
-                let part = part?;
-                Ok(MoveSummary {
-                    arrived: total.arrived + part.arrived,
-                    stopped_at_boundary: total.stopped_at_boundary + part.stopped_at_boundary,
-                    slid_along_boundary: total.slid_along_boundary + part.slid_along_boundary,
-                    projected: total.projected + part.projected,
-                    faces_crossed: total.faces_crossed + part.faces_crossed,
-                })
-            })
+            .try_fold(MoveSummary::default(), |total, part| Ok(total + part?))
     }
 }

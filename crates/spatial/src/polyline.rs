@@ -44,7 +44,6 @@ pub struct OnPolyline {
 /// A polyline with a kd-tree for exact closest-point queries (module docs).
 pub struct PolylineIndex {
     points: Vec<Point3<f64>>,
-    closed: bool,
     /// `None` when every segment has zero length.
     tree: Option<Tree>,
     /// The segment of each piece, in the tree's item order.
@@ -57,7 +56,6 @@ impl std::fmt::Debug for PolylineIndex {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("PolylineIndex")
             .field("points", &self.points.len())
-            .field("closed", &self.closed)
             .field("pieces", &self.pieces.len())
             .finish_non_exhaustive()
     }
@@ -65,58 +63,44 @@ impl std::fmt::Debug for PolylineIndex {
 
 impl PolylineIndex {
     /// The index of the polyline through `points`, closed (the last point joined to the
-    /// first) when `closed`. Fails with [`SpatialError::TooLarge`] beyond `u32` pieces.
+    /// first) when `closed`. Fails with [`SpatialError::TooLarge`] beyond `u32` segments
+    /// or pieces.
     pub fn new(points: Vec<Point3<f64>>, closed: bool) -> Result<Self, SpatialError> {
         let n = points.len();
         let count = if closed { n } else { n.saturating_sub(1) };
-        let segment = |s: usize| (points[s], points[(s + 1) % n]);
-        let mut lengths: Vec<f64> = (0..count)
-            .map(|s| {
-                let (a, b) = segment(s);
-                (b - a).norm()
-            })
-            .filter(|&l| l > 0.0)
+        let lengths: Vec<f64> = (0..count)
+            .map(|s| (points[(s + 1) % n] - points[s]).norm())
             .collect();
+        let mut positive: Vec<f64> = lengths.iter().copied().filter(|&l| l > 0.0).collect();
         let (mut centers, mut pieces, mut reach) = (Vec::new(), Vec::new(), 0.0f64);
-        if !lengths.is_empty() {
-            let middle = lengths.len() / 2;
-            let (_, &mut median, _) = lengths.select_nth_unstable_by(middle, f64::total_cmp);
+        if !positive.is_empty() {
+            let middle = positive.len() / 2;
+            let (_, &mut median, _) = positive.select_nth_unstable_by(middle, f64::total_cmp);
             let h = 2.0 * median;
-            for s in 0..count {
-                let (a, b) = segment(s);
-                let l = (b - a).norm();
-                if l == 0.0 {
-                    continue;
-                }
+            for (s, &l) in lengths.iter().enumerate().filter(|(_, l)| **l > 0.0) {
+                let (a, b) = (points[s], points[(s + 1) % n]);
                 let k = (l / h).ceil().clamp(1.0, MAX_PIECES as f64);
                 reach = reach.max(0.5 * l / k);
                 for i in 0..k as usize {
-                    let t = (i as f64 + 0.5) / k;
-                    let m = a + (b - a) * t;
+                    let m = a + (b - a) * ((i as f64 + 0.5) / k);
                     centers.push([m.x, m.y, m.z]);
-                    pieces.push(u32::try_from(s).map_err(|_| SpatialError::TooLarge {
-                        samples: centers.len(),
-                    })?);
+                    pieces.push(s as u32);
                 }
             }
         }
-        if u32::try_from(centers.len()).is_err() {
-            return Err(SpatialError::TooLarge {
-                samples: centers.len(),
-            });
+        let too_large = SpatialError::TooLarge {
+            samples: centers.len(),
+        };
+        if u32::try_from(count.max(centers.len())).is_err() {
+            return Err(too_large);
         }
         let tree = if centers.is_empty() {
             None
         } else {
-            Some(
-                Tree::new_from_slice(&centers).map_err(|_| SpatialError::TooLarge {
-                    samples: centers.len(),
-                })?,
-            )
+            Some(Tree::new_from_slice(&centers).map_err(|_| too_large)?)
         };
         Ok(Self {
             points,
-            closed,
             tree,
             pieces,
             reach,
@@ -126,11 +110,6 @@ impl PolylineIndex {
     /// The polyline's points.
     pub fn points(&self) -> &[Point3<f64>] {
         &self.points
-    }
-
-    /// Whether the last point is joined to the first.
-    pub fn is_closed(&self) -> bool {
-        self.closed
     }
 
     /// The ends of segment `s`.
