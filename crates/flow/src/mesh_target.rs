@@ -69,7 +69,8 @@ pub struct MeshTarget<'a> {
     curves: Vec<TargetCurve>,
     /// The face each source vertex was last located in: the start of the next search.
     hints: RefCell<Vec<FaceId>>,
-    /// The surface points of the images a step starts from ([`TargetGeometry::prepare_step`]).
+    /// The surface points of the images a step starts from ([`TargetGeometry::prepare_step`]);
+    /// after [`TargetGeometry::project_all`], those of the points it projected.
     start: RefCell<Vec<SurfacePoint>>,
 }
 
@@ -140,9 +141,36 @@ impl TargetGeometry for MeshTarget<'_> {
         self.curves[curve].closest(p).1
     }
 
+    /// Keeps the surface points of the last [`TargetGeometry::project_all`] where they
+    /// are still where `from` says (the accepted step's walk ended there: every free
+    /// vertex), and locates only the others (curve vertices, which sit on their
+    /// polyline instead, and vertices moved since, by an untangling).
     fn prepare_step(&self, from: &[Point3<f64>]) -> Result<(), SolverError> {
-        let located = self.locate_all(from)?;
-        *self.start.borrow_mut() = located;
+        let mesh = self.mesh();
+        let mut start = self.start.borrow_mut();
+        if start.len() != from.len() {
+            *start = self.locate_all(from)?;
+            return Ok(());
+        }
+        let stale: Vec<usize> = (0..from.len())
+            .filter(|&i| start[i].position(mesh) != from[i])
+            .collect();
+        if stale.is_empty() {
+            return Ok(());
+        }
+        let points: Vec<Point3<f64>> = stale.iter().map(|&i| from[i]).collect();
+        let hints: Vec<FaceId> = stale.iter().map(|&i| start[i].face).collect();
+        let located = self
+            .index
+            .locate_all_near(&points, &hints)
+            .map_err(spatial_error)?;
+        let mut all_hints = self.hints.borrow_mut();
+        for (&i, l) in stale.iter().zip(located) {
+            start[i] = l.point;
+            if let Some(h) = all_hints.get_mut(i) {
+                *h = l.point.face;
+            }
+        }
         Ok(())
     }
 
@@ -190,6 +218,9 @@ impl TargetGeometry for MeshTarget<'_> {
             }
             None => self.locate_all(points)?,
         };
+        *self.start.borrow_mut() = surface;
+        let kept = self.start.borrow();
+        let surface: &[SurfacePoint] = &kept;
         let (mesh, curves) = (self.mesh(), &self.curves);
         let (vertex_normals, threads) = (self.index.vertex_normals(), self.index.threads());
         normals.clear();
@@ -213,5 +244,72 @@ impl TargetGeometry for MeshTarget<'_> {
             }
         });
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use beltrami_mesh::primitives::{Cells, grid};
+
+    use super::*;
+
+    /// The unit-square grid lifted onto `z = (x^2 + y^2) / 2`, its boundary vertices on
+    /// curve 0.
+    fn paraboloid(n: usize) -> (Mesh, Vec<Role>) {
+        let mut soup = grid(n, n, Cells::Triangles);
+        for p in &mut soup.positions {
+            p.z = 0.5 * (p.x * p.x + p.y * p.y);
+        }
+        let mesh = Mesh::from_soup(&soup).expect("a grid is a valid mesh");
+        let roles = mesh
+            .vertices()
+            .map(|v| {
+                if mesh.is_boundary_vertex(v) {
+                    Role::Curve(0)
+                } else {
+                    Role::Free
+                }
+            })
+            .collect();
+        (mesh, roles)
+    }
+
+    #[test]
+    fn a_step_starts_from_the_points_the_accepted_walk_reached_or_from_fresh_ones() {
+        let (mesh, roles) = paraboloid(12);
+        let index = SurfaceIndex::new(&mesh).unwrap();
+        let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh).unwrap());
+        let mut image: Vec<Point3<f64>> = mesh.positions().to_vec();
+        let mut normals = Vec::new();
+        target
+            .project_all(&roles, None, &mut image, &mut normals)
+            .unwrap();
+        target.prepare_step(&image).unwrap();
+        // A trial step: every point pushed along a smooth field, walked on the surface.
+        let mut moved_image: Vec<Point3<f64>> = image
+            .iter()
+            .map(|p| p + Vector3::new(0.03 * p.y, -0.02 * p.x, 0.0))
+            .collect();
+        let moved = target.clone();
+        moved
+            .project_all(&roles, Some(&image), &mut moved_image, &mut normals)
+            .unwrap();
+        // An untangling moves one interior vertex after the walk.
+        let displaced = 5 + 13 * 6;
+        assert_eq!(roles[displaced], Role::Free);
+        moved_image[displaced] = moved.project(Role::Free, &Point3::new(0.37, 0.61, 0.0));
+        moved.prepare_step(&moved_image).unwrap();
+        let start = moved.start.borrow();
+        let fresh = index.locate_all(&moved_image).unwrap();
+        for (i, (s, l)) in start.iter().zip(&fresh).enumerate() {
+            s.validate(&mesh).unwrap();
+            let (kept, located) = (s.position(&mesh), l.point.position(&mesh));
+            assert!(
+                (kept - moved_image[i]).norm() < 1e-12 && (kept - located).norm() < 1e-12,
+                "vertex {i} ({:?}) starts at {kept} instead of {}",
+                roles[i],
+                moved_image[i]
+            );
+        }
     }
 }
