@@ -320,7 +320,7 @@ pub fn run<G: TargetGeometry>(
     target.project_all(system.roles(), None, &mut image, &mut normals)?;
     let mut faces = Vec::with_capacity(elements.face_count());
     image_faces(elements, &normals, &image, &mut faces, options.threads);
-    let (mut energy, mut flipped) = objective.evaluate(&faces);
+    let (mut energy, mut flipped) = objective.evaluate(&faces, options.threads);
     let mut energy_history = vec![energy];
     let (mut step_sizes, mut updates) = (Vec::new(), Vec::new());
     let (mut weights, mut rho) = (Vec::new(), Vec::new());
@@ -410,7 +410,7 @@ pub fn run<G: TargetGeometry>(
                     &mut trial_faces,
                     options.threads,
                 );
-                let (mut e, mut flips) = objective.evaluate(&trial_faces);
+                let (mut e, mut flips) = objective.evaluate(&trial_faces, options.threads);
                 if repair && flips > flipped {
                     untangle(
                         elements,
@@ -422,7 +422,7 @@ pub fn run<G: TargetGeometry>(
                         REPAIR_ROUNDS,
                         Some(&image),
                     );
-                    (e, flips) = objective.evaluate(&trial_faces);
+                    (e, flips) = objective.evaluate(&trial_faces, options.threads);
                 }
                 if flips <= flipped && (pulling || e < energy) {
                     break Some((moved, e, flips, t));

@@ -93,6 +93,23 @@ pub fn map_ranges<R: Send>(
     in_turns(chunk_ranges(len, threads), threads, work)
 }
 
+/// `work(range)` over consecutive ranges of `block` items (the last may be shorter) of
+/// `0..len`, results in range order. The ranges do not depend on `threads`, so a
+/// reduction that combines the results in order (a sum of floating-point terms) gives
+/// the same value for any number of threads.
+pub fn map_blocks<R: Send>(
+    len: usize,
+    block: usize,
+    threads: usize,
+    work: impl Fn(Range<usize>) -> R + Sync,
+) -> Vec<R> {
+    let block = block.max(1);
+    let ranges = (0..len.div_ceil(block))
+        .map(|k| k * block..((k + 1) * block).min(len))
+        .collect();
+    in_turns(ranges, threads, work)
+}
+
 /// `work(offset, chunk)` over the chunks of `items` at the [`chunk_ranges`] (`offset`
 /// the index of the chunk's first item), results in chunk order.
 pub fn map_chunks_mut<T: Send, R: Send>(
@@ -136,6 +153,24 @@ mod tests {
                 assert!(ranges.iter().all(|r| r.len() >= MIN_CHUNK));
             }
         }
+    }
+
+    #[test]
+    fn blocks_are_the_same_for_any_number_of_threads() {
+        let sum = |threads| {
+            map_blocks(10_007, 1000, threads, |r| {
+                r.map(|i| 1.0 / (1.0 + i as f64)).sum::<f64>()
+            })
+        };
+        let one = sum(1);
+        assert_eq!(one.len(), 11);
+        for threads in [2, 3, 8] {
+            assert_eq!(sum(threads), one);
+        }
+        let lengths = map_blocks(10_007, 1000, 2, |r| r.len());
+        assert_eq!(lengths[..10], [1000; 10]);
+        assert_eq!(lengths[10], 7);
+        assert!(map_blocks(0, 1000, 2, |r| r.len()).is_empty());
     }
 
     #[test]
