@@ -121,18 +121,20 @@ pub fn image_face(
     // triangle tilts towards edge-on, so that `mu` passes continuously through
     // |mu| = 1 where the image turns edge-on to the target and flips.
     let unit_reference = (reference.norm_squared() > 0.0).then(|| reference.normalize());
-    let n = match (own, unit_reference) {
+    // Whether the frame is the triangle's own plane (oriented by the reference), as the
+    // fem kernel's is.
+    let (n, own_plane) = match (own, unit_reference) {
         (Some(own), Some(unit)) => {
             let w = tilt_weight(own.dot(&unit));
             if w == 0.0 {
-                own
+                (own, true)
             } else {
-                (own * (1.0 - w) + unit * w).normalize()
+                ((own * (1.0 - w) + unit * w).normalize(), false)
             }
         }
-        (Some(own), None) => own,
-        (None, Some(unit)) => unit,
-        (None, None) => normals[nodes[0].idx()],
+        (Some(own), None) => (own, true),
+        (None, Some(unit)) => (unit, false),
+        (None, None) => (normals[nodes[0].idx()], false),
     };
     let r = {
         let t = e1 - n * n.dot(&e1);
@@ -149,9 +151,16 @@ pub fn image_face(
         fy += image[v.idx()].coords * q.grad[k].y;
     }
     let along = |v: &Vector3<f64>| Complex64::new(v.dot(&r), v.dot(&s));
-    let kernel = image_derivatives(&fx, &fy, &reference);
+    let derivatives = PointDerivatives::from_xy(along(&fx), along(&fy));
+    // In the own plane the kernel's frame differs from (r, s) by a rotation, which
+    // leaves mu and the Jacobian as they are: measure once.
+    let kernel = if own_plane {
+        derivatives
+    } else {
+        image_derivatives(&fx, &fy, &reference)
+    };
     ImageFace {
-        derivatives: PointDerivatives::from_xy(along(&fx), along(&fy)),
+        derivatives,
         r,
         s,
         local: [
@@ -442,5 +451,61 @@ mod tests {
             }
             previous = Some(m);
         }
+    }
+
+    #[test]
+    fn faces_measured_in_their_own_plane_agree_with_the_fem_kernel() {
+        use beltrami_fem::Frame;
+        use beltrami_mesh::{Mesh, PolygonSoup};
+        let corners = [
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.2, 0.0),
+            Point3::new(0.3, 0.9, 0.0),
+        ];
+        let mesh =
+            Mesh::from_soup(&PolygonSoup::from_triangles(corners.to_vec(), &[[0, 1, 2]])).unwrap();
+        let elements = Elements::new(&mesh, Frame::Face).unwrap();
+        let q = &elements.face_points(FaceId(0))[0];
+        // A fixed pseudo-random sequence in [-1, 1).
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        };
+        let (mut own_plane, mut tilted, mut flipped) = (0, 0, 0);
+        for _ in 0..2000 {
+            let image: Vec<Point3<f64>> = (0..3)
+                .map(|_| Point3::new(next(), next(), next()))
+                .collect();
+            let normals: Vec<Vector3<f64>> = (0..3)
+                .map(|_| Vector3::new(next(), next(), 0.3 + next()).normalize())
+                .collect();
+            let face = image_face(&elements, &normals, &image, FaceId(0));
+            let (mut fx, mut fy) = (Vector3::zeros(), Vector3::zeros());
+            for (k, p) in image.iter().enumerate() {
+                fx += p.coords * q.grad[k].x;
+                fy += p.coords * q.grad[k].y;
+            }
+            let reference: Vector3<f64> = normals.iter().sum();
+            let kernel = image_derivatives(&fx, &fy, &reference);
+            let scale = kernel.mu().norm().max(1.0);
+            assert!(
+                (face.own_mu() - kernel.mu()).norm() <= 1e-10 * scale,
+                "{image:?}: {} against {}",
+                face.own_mu(),
+                kernel.mu()
+            );
+            assert_eq!(face.flipped(), kernel.jacobian() <= 0.0, "{image:?}");
+            if face.facing >= TILT_START {
+                own_plane += 1;
+            } else {
+                tilted += 1;
+            }
+            flipped += usize::from(face.flipped());
+        }
+        // Both frames and both orientations were met.
+        assert!(own_plane > 200 && tilted > 200 && flipped > 200 && flipped < 1800);
     }
 }
