@@ -10,13 +10,10 @@
 //! weights and a maximum principle: interior corrections are averages of boundary ones).
 //! The Laplacian never changes, so it is factored once.
 //!
-//! Only the free vertices within [`BAND_RINGS`] rings of edges of a boundary vertex are
-//! unknowns; the correction is zero beyond them (their Laplacian rows keep every edge,
-//! so the band's inner edge is a zero Dirichlet condition). The correction is what keeps
-//! a boundary vertex's interior neighbours from crossing it, a matter of the first
-//! rings; solving over the whole interior cost one sparse solve with three right-hand
-//! sides per trial step, a third of the steps' time on `mc4_face_a` onto `mc4_face_b`
-//! remeshed to 100K faces.
+//! The unknowns can be limited to the free vertices within a number of rings of edges
+//! of a boundary vertex ([`crate::target::TargetGeometry::correction_rings`]); the
+//! correction is zero beyond them (their Laplacian rows keep every edge, so the band's
+//! inner edge is a zero Dirichlet condition).
 
 use beltrami_core::SolverError;
 use beltrami_fem::assembly::Pattern;
@@ -25,10 +22,6 @@ use beltrami_mesh::Vector3;
 use faer::Mat;
 
 use crate::target::Role;
-
-/// The rings of free vertices around the boundary vertices over which the correction is
-/// spread (module docs).
-pub const BAND_RINGS: usize = 8;
 
 /// The factored interior Laplacian and the couplings to the boundary.
 pub struct HarmonicExtension {
@@ -49,17 +42,22 @@ impl std::fmt::Debug for HarmonicExtension {
 }
 
 impl HarmonicExtension {
-    /// The extension for triangles `faces` with vertex `roles`, or `None` when no vertex
-    /// lies on a boundary curve (nothing to extend).
+    /// The extension for triangles `faces` with vertex `roles` over the free vertices
+    /// within `rings` rings of edges of a boundary vertex (`None`: every free vertex), or
+    /// `None` when no vertex lies on a boundary curve (nothing to extend).
     pub fn new(
         faces: &[[usize; 3]],
         roles: &[Role],
+        rings: Option<usize>,
         options: SolveOptions,
     ) -> Result<Option<Self>, SolverError> {
         if !roles.iter().any(|r| matches!(r, Role::Curve(_))) {
             return Ok(None);
         }
-        let within = band(faces, roles, BAND_RINGS);
+        let within = match rings {
+            Some(rings) => band(faces, roles, rings),
+            None => vec![true; roles.len()],
+        };
         let mut index = vec![None; roles.len()];
         let mut n = 0;
         for (v, role) in roles.iter().enumerate() {
@@ -205,9 +203,16 @@ mod tests {
         (faces, roles)
     }
 
-    fn extend(n: usize, shift: Vector3<f64>) -> (Vec<Role>, Vec<Vector3<f64>>) {
+    /// The band of [`extend`]'s tests.
+    const RINGS: usize = 8;
+
+    fn extend(
+        n: usize,
+        rings: Option<usize>,
+        shift: Vector3<f64>,
+    ) -> (Vec<Role>, Vec<Vector3<f64>>) {
         let (faces, roles) = square(n);
-        let mut extension = HarmonicExtension::new(&faces, &roles, SolveOptions::default())
+        let mut extension = HarmonicExtension::new(&faces, &roles, rings, SolveOptions::default())
             .unwrap()
             .unwrap();
         let delta: Vec<Vector3<f64>> = roles
@@ -227,12 +232,15 @@ mod tests {
 
     #[test]
     fn a_shift_of_the_whole_boundary_shifts_an_interior_within_the_band() {
-        // 12 x 12 cells: every vertex is within 6 rings of the boundary.
+        // 12 x 12 cells: every vertex is within 6 rings of the boundary; 40 x 40 with the
+        // whole interior.
         let shift = Vector3::new(0.3, -0.2, 0.1);
-        let (roles, moved) = extend(12, shift);
-        for (v, m) in moved.iter().enumerate() {
-            if roles[v] == Role::Free {
-                assert!((m - shift).norm() < 1e-12, "vertex {v} moved by {m}");
+        for (n, rings) in [(12, Some(RINGS)), (40, None)] {
+            let (roles, moved) = extend(n, rings, shift);
+            for (v, m) in moved.iter().enumerate() {
+                if roles[v] == Role::Free {
+                    assert!((m - shift).norm() < 1e-12, "vertex {v} moved by {m}");
+                }
             }
         }
     }
@@ -241,19 +249,19 @@ mod tests {
     fn beyond_the_band_nothing_moves_and_within_it_the_shift_fades() {
         let n = 40;
         let shift = Vector3::new(1.0, 0.0, 0.0);
-        let (_, moved) = extend(n, shift);
+        let (_, moved) = extend(n, Some(RINGS), shift);
         // Along the middle row, from the left boundary inwards.
         let row = n / 2;
         let along: Vec<f64> = (0..=n).map(|i| moved[row * (n + 1) + i].x).collect();
         // (`along[0]` is the boundary vertex itself, which `apply` leaves alone.)
-        let fading = &along[1..=BAND_RINGS];
+        let fading = &along[1..=RINGS];
         assert!(fading.iter().all(|&x| x > 0.0), "{along:?}");
         assert!(fading.windows(2).all(|w| w[1] < w[0]), "{along:?}");
         assert!(
             along[1] > 0.5,
             "the first ring follows the boundary: {along:?}"
         );
-        let beyond = &along[BAND_RINGS + 1..=n / 2];
+        let beyond = &along[RINGS + 1..=n / 2];
         assert!(beyond.iter().all(|&x| x == 0.0), "{along:?}");
     }
 }

@@ -311,7 +311,12 @@ pub fn run<G: TargetGeometry>(
         .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
         .collect();
     let mut extension = if target.curved() {
-        HarmonicExtension::new(&triangles, system.roles(), options.solve)?
+        HarmonicExtension::new(
+            &triangles,
+            system.roles(),
+            target.correction_rings(),
+            options.solve,
+        )?
     } else {
         None
     };

@@ -15,6 +15,13 @@ use beltrami_spatial::{BoundaryMode, MoveOptions, PolylineIndex, SurfaceIndex};
 
 use crate::target::{Role, TargetGeometry};
 
+/// The rings of free vertices next to the boundary over which the projection correction
+/// of a step is spread on a target mesh ([`TargetGeometry::correction_rings`]): on
+/// `mc4_face_a` onto `mc4_face_b` remeshed to 100K faces, solving over the whole
+/// interior took a third of the step search (5.1 s of 13 s), over 8 rings 0.5 s, with
+/// the same result.
+pub const CORRECTION_RINGS: usize = 8;
+
 /// A polyline of target vertices a chain of source vertices slides along, indexed for
 /// exact closest points ([`PolylineIndex`]; shared by the clones of a target, one per
 /// trial step).
@@ -176,6 +183,13 @@ impl TargetGeometry for MeshTarget<'_> {
 
     fn curve_count(&self) -> usize {
         self.curves.len()
+    }
+
+    /// [`CORRECTION_RINGS`]: the curves are polylines, so a vertex moved along its
+    /// segment's tangent stays on the curve, and only those that pass a corner are pulled
+    /// back; the correction is sparse and local.
+    fn correction_rings(&self) -> Option<usize> {
+        Some(CORRECTION_RINGS)
     }
 
     fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64> {

@@ -57,6 +57,15 @@ pub trait TargetGeometry: Clone {
         true
     }
 
+    /// How far from its curves a [`curved`](TargetGeometry::curved) target's
+    /// projection correction is spread ([`crate::extension`]): over the whole interior
+    /// (`None`, the default: a smooth curve such as a circle pulls every boundary vertex
+    /// a stepped tangent moves, and the interior must follow as a whole), or over that
+    /// many rings of edges next to the boundary.
+    fn correction_rings(&self) -> Option<usize> {
+        None
+    }
+
     /// The point of the target (for [`Role::Free`]) or of its curve (for
     /// [`Role::Curve`]) nearest to `p`; [`Role::Fixed`] points are returned unchanged.
     fn project(&self, role: Role, p: &Point3<f64>) -> Point3<f64>;
