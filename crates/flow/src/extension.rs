@@ -22,6 +22,7 @@ use beltrami_mesh::Vector3;
 use faer::Mat;
 
 use crate::target::Role;
+use crate::untangle::Stars;
 
 /// The factored interior Laplacian and the couplings to the boundary.
 pub struct HarmonicExtension {
@@ -136,36 +137,18 @@ impl HarmonicExtension {
 
 /// Whether each vertex is within `rings` edges of a boundary-curve vertex.
 fn band(faces: &[[usize; 3]], roles: &[Role], rings: usize) -> Vec<bool> {
-    let n = roles.len();
-    let mut start = vec![0usize; n + 1];
-    for face in faces {
-        for &v in face {
-            start[v + 1] += 2;
-        }
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut next = start.clone();
-    let mut neighbours = vec![0usize; start[n]];
-    for face in faces {
-        for k in 0..3 {
-            let (a, b) = (face[k], face[(k + 1) % 3]);
-            for (from, to) in [(a, b), (b, a)] {
-                neighbours[next[from]] = to;
-                next[from] += 1;
-            }
-        }
-    }
+    let stars = Stars::new(faces, roles.len());
     let mut inside: Vec<bool> = roles.iter().map(|r| matches!(r, Role::Curve(_))).collect();
-    let mut front: Vec<usize> = (0..n).filter(|&v| inside[v]).collect();
+    let mut front: Vec<usize> = (0..roles.len()).filter(|&v| inside[v]).collect();
     for _ in 0..rings {
         let mut reached = Vec::new();
         for &v in &front {
-            for &w in &neighbours[start[v]..start[v + 1]] {
-                if !inside[w] {
-                    inside[w] = true;
-                    reached.push(w);
+            for &f in stars.of(v) {
+                for &w in &faces[f] {
+                    if !inside[w] {
+                        inside[w] = true;
+                        reached.push(w);
+                    }
                 }
             }
         }

@@ -45,13 +45,13 @@ pub struct Untangled {
 }
 
 /// The faces around each vertex (compressed rows).
-struct Stars {
+pub(crate) struct Stars {
     start: Vec<usize>,
     faces: Vec<usize>,
 }
 
 impl Stars {
-    fn new(triangles: &[[usize; 3]], vertices: usize) -> Self {
+    pub(crate) fn new(triangles: &[[usize; 3]], vertices: usize) -> Self {
         let mut start = vec![0; vertices + 1];
         for t in triangles {
             for &v in t {
@@ -72,7 +72,7 @@ impl Stars {
         Self { start, faces }
     }
 
-    fn of(&self, v: usize) -> &[usize] {
+    pub(crate) fn of(&self, v: usize) -> &[usize] {
         &self.faces[self.start[v]..self.start[v + 1]]
     }
 }
