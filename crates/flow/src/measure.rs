@@ -352,16 +352,11 @@ impl Objective {
             let mut flipped = 0;
             for f in range {
                 let face = &faces[f];
-                // `|mu - sigma|^2` without `hypot`: most faces need no square root.
-                let d2 = (face.mu() - self.sigma(f)).norm_sqr();
-                let e = if self.p == 2.0 {
-                    d2
-                } else {
-                    d2.powf(0.5 * self.p)
-                };
+                let d = (face.mu() - self.sigma(f)).norm();
+                let e = if self.p == 2.0 { d * d } else { d.powf(self.p) };
                 energy += self.areas[f] * e;
-                if self.has_barrier() && d2 > self.barrier_start * self.barrier_start {
-                    energy += self.barrier_area(f) * barrier(d2.sqrt(), self.barrier_start);
+                if self.has_barrier() {
+                    energy += self.barrier_area(f) * barrier(d, self.barrier_start);
                 }
                 flipped += usize::from(face.flipped());
             }
