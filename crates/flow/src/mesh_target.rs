@@ -212,7 +212,8 @@ impl TargetGeometry for MeshTarget<'_> {
             // (its cost grows with the faces crossed, where locating a point far off the
             // surface searches a ball as large as that distance).
             Some(from) => {
-                let mut start = self.start.borrow().clone();
+                // Taken, not copied: the walk's end replaces it below.
+                let mut start = std::mem::take(&mut *self.start.borrow_mut());
                 if start.len() != from.len() {
                     start = self.locate_all(from)?;
                 }
