@@ -2,7 +2,8 @@
 //! them.
 
 use beltrami_fem::solve::{
-    NESTED_DISSECTION_FROM, amd_order, fill_reducing_order, nested_dissection_order,
+    NESTED_DISSECTION_FROM, amd_order, fill_reducing_order, first_split_order,
+    nested_dissection_order,
 };
 use beltrami_fem::{SolveOptions, SpdSolver};
 use faer::perm::PermRef;
@@ -211,4 +212,79 @@ fn a_large_solver_refactors_correctly_in_nested_dissection_order() {
             );
         }
     }
+}
+
+#[test]
+fn the_first_split_separates_two_balanced_sides_ordered_by_amd() {
+    let k = 150;
+    let n = k * k;
+    let edges = triangulated_grid(k);
+    let grid = pattern(n, &edges);
+    let split = first_split_order(grid.as_ref()).unwrap();
+    assert_permutation(&split.order, n);
+    let [a, b] = split.sides.expect("a grid splits");
+    let s = n - a - b;
+    // Balanced to 52% (the nested dissection's first split), a separator of about one
+    // grid line.
+    assert!(a.max(b) as f64 <= 0.52 * n as f64, "sides {a}, {b}");
+    assert!(s > 0 && s <= 2 * k, "separator {s}");
+    let mut side = vec![2u8; n];
+    split.order[..a].iter().for_each(|&i| side[i] = 0);
+    split.order[a..a + b].iter().for_each(|&i| side[i] = 1);
+    for &(p, q) in &edges {
+        assert!(
+            side[p] == 2 || side[q] == 2 || side[p] == side[q],
+            "edge {p}-{q} joins the sides"
+        );
+    }
+    // Inside the sides AMD, not further separators: the factor stays within a few
+    // percent of AMD's on the whole grid (a full nested dissection of this small grid
+    // has more).
+    let amd = factor_entries(&grid, &amd_order(grid.as_ref()).unwrap());
+    let entries = factor_entries(&grid, &split.order);
+    assert!(
+        (entries as f64) < 1.1 * amd as f64,
+        "{entries} against AMD's {amd}"
+    );
+}
+
+#[test]
+fn a_split_solver_matches_the_whole_factorization() {
+    let k = 150;
+    let n = k * k;
+    let (m, rhs) = shifted_grid_laplacian(k, 0.01);
+    let split = first_split_order(m.symbolic()).unwrap();
+    let mut two =
+        SpdSolver::with_split_order(m.symbolic(), &split, SolveOptions::default()).unwrap();
+    assert!(two.is_split());
+    let mut whole =
+        SpdSolver::with_order(m.symbolic(), &split.order, SolveOptions::default()).unwrap();
+    assert!(!whole.is_split());
+    let columns = Mat::from_fn(n, 2, |i, c| rhs[i] * (1.0 + c as f64) - c as f64);
+    let mut solutions = Vec::new();
+    for solver in [&mut two, &mut whole] {
+        // Twice, as the flow refactors one pattern.
+        for _ in 0..2 {
+            solver.factorize(m.as_ref()).unwrap();
+        }
+        let mut x = columns.clone();
+        solver.solve_in_place(x.as_mut()).unwrap();
+        solutions.push(x);
+    }
+    for c in 0..2 {
+        let x: Vec<f64> = (0..n).map(|i| solutions[0][(i, c)]).collect();
+        let b: Vec<f64> = (0..n).map(|i| columns[(i, c)]).collect();
+        let residual = relative_residual(&m, &x, &b);
+        assert!(residual < 1e-12, "column {c}: residual {residual:e}");
+    }
+    let scale = solutions[1].norm_max();
+    assert!((&solutions[0] - &solutions[1]).norm_max() < 1e-10 * scale);
+    // A split with no second side is factored whole.
+    let one_side = beltrami_fem::solve::SplitOrder {
+        order: split.order.clone(),
+        sides: Some([n, 0]),
+    };
+    let solver =
+        SpdSolver::<f64>::with_split_order(m.symbolic(), &one_side, SolveOptions::default());
+    assert!(!solver.unwrap().is_split());
 }

@@ -38,7 +38,7 @@
 
 use beltrami_core::SolverError;
 use beltrami_fem::assembly::Pattern;
-use beltrami_fem::solve::fill_reducing_order;
+use beltrami_fem::solve::{SplitOrder, fill_reducing_order, first_split_order};
 use beltrami_fem::{DofBuilder, DofMap, Elements, SolveError, SolveOptions, SpdSolver};
 use beltrami_mesh::{FaceId, Point3, Vector3, VertexId};
 use faer::MatMut;
@@ -240,7 +240,7 @@ impl FlowSystem {
         let diagonal = slots.split_off(faces_end);
         let matrix = pattern.assemble(&vec![0.0; positions.len()])?;
         let order = block_order(&faces, &dofs)?;
-        let solver = SpdSolver::with_order(pattern.symbolic().as_ref(), &order, options)?;
+        let solver = SpdSolver::with_split_order(pattern.symbolic().as_ref(), &order, options)?;
         Ok(Self {
             roles,
             flow: vec![0.0; dofs.full_len()],
@@ -467,13 +467,20 @@ impl FlowSystem {
     }
 }
 
-/// An elimination order of the unknowns: `fill_reducing_order` of the graph of the
-/// vertices (AMD, or nested dissection on large regular meshes; an edge per
-/// triangle side), the unknowns that move one vertex only with their vertex, the shared
+/// Vertex count from which the flow's normal equations are factored in two sides at
+/// once ([`first_split_order`]); below it one thread factors the whole.
+const TWO_SIDES_FROM: usize = 20_000;
+
+/// An elimination order of the unknowns built on the graph of the vertices (an edge per
+/// triangle side): the unknowns that move one vertex only with their vertex, the shared
 /// ones (offsets, coupled to a whole curve) last in increasing order. Ordering the
 /// vertex graph is about four times cheaper than the unknowns' graph, and keeps each
 /// vertex's pair in one supernode.
-fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<Vec<usize>, SolverError> {
+///
+/// From [`TWO_SIDES_FROM`] vertices the vertex order is [`first_split_order`]'s and its
+/// two sides carry over to the unknowns (the shared ones join the separator); below, it
+/// is [`fill_reducing_order`]'s, one whole.
+fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<SplitOrder, SolverError> {
     let nv = dofs.n_nodes();
     let n = dofs.reduced_len();
     let mut positions = Vec::with_capacity(nv + 3 * faces.len());
@@ -485,20 +492,37 @@ fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<Vec<usize>, S
         }
     }
     let graph = Pattern::new(nv, nv, &positions)?;
-    let vertices = fill_reducing_order(graph.symbolic().as_ref())?;
+    let vertices = if nv >= TWO_SIDES_FROM {
+        first_split_order(graph.symbolic().as_ref())?
+    } else {
+        SplitOrder {
+            order: fill_reducing_order(graph.symbolic().as_ref())?,
+            sides: None,
+        }
+    };
     let shared: Vec<bool> = (0..n)
         .map(|j| dofs.unknown_nodes(j).is_some_and(|nodes| nodes.count() > 1))
         .collect();
+    let [a, b] = vertices.sides.unwrap_or([nv, 0]);
     let mut order = Vec::with_capacity(n);
-    for v in vertices {
-        for (_, t) in dofs.node_terms(VertexId::from_usize(v))? {
-            if !shared[t.dof] {
-                order.push(t.dof);
+    let mut ends = [0; 2];
+    for (part, range) in [0..a, a..a + b, a + b..nv].into_iter().enumerate() {
+        for &v in &vertices.order[range] {
+            for (_, t) in dofs.node_terms(VertexId::from_usize(v))? {
+                if !shared[t.dof] {
+                    order.push(t.dof);
+                }
             }
+        }
+        if let Some(end) = ends.get_mut(part) {
+            *end = order.len();
         }
     }
     order.extend((0..n).filter(|&j| shared[j]));
-    Ok(order)
+    Ok(SplitOrder {
+        order,
+        sides: vertices.sides.map(|_| [ends[0], ends[1] - ends[0]]),
+    })
 }
 
 /// A vector of R^3 (three components) as the complex number of its components along

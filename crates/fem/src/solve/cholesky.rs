@@ -15,6 +15,7 @@ use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
 use faer::sparse::linalg::cholesky::{
     LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
 };
+use faer::sparse::linalg::triangular_solve;
 use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, MatMut, Par, Side};
 
@@ -72,6 +73,25 @@ impl<T: Scalar> Cholesky<T> {
         Ok(Self::Whole(Box::new(Factor::build(
             pattern, order, par, spare,
         )?)))
+    }
+
+    /// [`Cholesky::new`] in the order `order` (a permutation of the rows) whose first
+    /// `sides[0]` and next `sides[1]` rows are two sides no entry joins, the rest their
+    /// separator: factored in the two sides at once ([`TwoDomains`]) where that works,
+    /// else as a whole in `order`.
+    pub(super) fn split(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: &[usize],
+        sides: Option<[usize; 2]>,
+        par: Par,
+    ) -> Result<Self, SolveError> {
+        let inverse = inverse_permutation(order)?;
+        if let Some(sides) = sides
+            && let Some(two) = TwoDomains::new(pattern, order, sides, [None, None])?
+        {
+            return Ok(Self::Halves(Box::new(two)));
+        }
+        Self::with_ordering(pattern, Some((order, &inverse)), par)
     }
 
     /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
@@ -248,12 +268,7 @@ impl<T: Scalar> Factor<T> {
 
     /// Solves `A X = B` in place with the last successful factorization.
     pub(super) fn solve_in_place(&mut self, rhs: MatMut<'_, T>) -> Result<(), SolveError> {
-        if rhs.ncols() > self.buffer_columns {
-            // Grows only for more right-hand sides than ever before.
-            self.buffer = MemBuffer::try_new(Self::scratch(&self.symbolic, rhs.ncols(), self.par))
-                .map_err(|_| FaerError::OutOfMemory)?;
-            self.buffer_columns = rhs.ncols();
-        }
+        self.reserve_columns(rhs.ncols())?;
         LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             rhs,
@@ -265,6 +280,76 @@ impl<T: Scalar> Factor<T> {
 }
 
 impl<T: Scalar> Factor<T> {
+    /// Makes the buffer hold the scratch of solves with `columns` right-hand sides.
+    fn reserve_columns(&mut self, columns: usize) -> Result<(), SolveError> {
+        if columns > self.buffer_columns {
+            // Grows only for more right-hand sides than ever before.
+            self.buffer = MemBuffer::try_new(Self::scratch(&self.symbolic, columns, self.par))
+                .map_err(|_| FaerError::OutOfMemory)?;
+            self.buffer_columns = columns;
+        }
+        Ok(())
+    }
+
+    /// `Y = L^-1 Y` in place, the rows of `Y` in elimination order (row `k` the one
+    /// eliminated `k`-th, [`Factor::eliminated`]): the forward half of a solve, without
+    /// the permutation.
+    pub(super) fn lower_solve_in_place(&mut self, rhs: MatMut<'_, T>) -> Result<(), SolveError> {
+        self.reserve_columns(rhs.ncols())?;
+        let stack = MemStack::new(&mut self.buffer);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(sym) => {
+                let l = SparseColMatRef::new(sym.factor(), &self.values);
+                triangular_solve::solve_lower_triangular_in_place(l, Conj::No, rhs, self.par);
+            }
+            SymbolicCholeskyRaw::Supernodal(sym) => {
+                SupernodalLltRef::new(sym, &self.values).l_solve_with_conj(
+                    Conj::No,
+                    rhs,
+                    self.par,
+                    stack,
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// `Y = L^-H Y` in place, the rows of `Y` in elimination order: the backward half
+    /// of a solve, without the permutation.
+    pub(super) fn lower_adjoint_solve_in_place(
+        &mut self,
+        rhs: MatMut<'_, T>,
+    ) -> Result<(), SolveError> {
+        self.reserve_columns(rhs.ncols())?;
+        let stack = MemStack::new(&mut self.buffer);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(sym) => {
+                let l = SparseColMatRef::new(sym.factor(), &self.values);
+                triangular_solve::solve_lower_triangular_transpose_in_place(
+                    l,
+                    Conj::Yes,
+                    rhs,
+                    self.par,
+                );
+            }
+            SymbolicCholeskyRaw::Supernodal(sym) => {
+                SupernodalLltRef::new(sym, &self.values).l_transpose_solve_with_conj(
+                    Conj::Yes,
+                    rhs,
+                    self.par,
+                    stack,
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether faer chose its supernodal kernel (else the simplicial one).
+    #[cfg(test)]
+    pub(super) fn is_supernodal(&self) -> bool {
+        matches!(self.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_))
+    }
+
     /// `order[k]` is the row of the matrix eliminated `k`-th.
     pub(super) fn eliminated(&self, k: usize) -> usize {
         match self.symbolic.perm() {

@@ -219,6 +219,18 @@ struct Dissection<'g> {
     order: Vec<usize>,
     /// The sizes of the two sides of the first split (see [`Dissected::halves`]).
     halves: Option<[usize; 2]>,
+    depth: Depth,
+}
+
+/// How far a dissection splits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Depth {
+    /// Separators in every part down to parts of at most [`LEAF`] vertices.
+    Full,
+    /// The first separator only; each of its sides ordered by AMD as a whole (the
+    /// two-domain factorization of a scanned mesh: AMD keeps its advantage inside the
+    /// sides, and the sides are factored at once).
+    FirstSplit,
 }
 
 /// A breadth-first search inside one part: the vertices reached in search order and
@@ -436,7 +448,7 @@ impl Dissection<'_> {
 
     /// Appends the elimination order of the part `id`, whose vertices are `vertices`.
     fn dissect(&mut self, vertices: Vec<usize>, id: u32) {
-        if vertices.len() <= LEAF {
+        if vertices.len() <= LEAF || (self.depth == Depth::FirstSplit && self.halves.is_some()) {
             self.eliminate_leaf(vertices, id);
             return;
         }
@@ -547,12 +559,18 @@ pub(super) struct Dissected {
     pub(super) halves: Option<[usize; 2]>,
 }
 
-/// The nested-dissection elimination order of a square pattern (module docs). Only the
-/// off-diagonal entries matter, read from either triangle.
+/// The nested-dissection elimination order of a square pattern (module docs), split as
+/// deep as `depth` says. Only the off-diagonal entries matter, read from either
+/// triangle.
 ///
 /// `col_ptr` has `n + 1` entries and `row_idx[col_ptr[j]..col_ptr[j + 1]]` are the rows
 /// of column `j`, all below `n`.
-pub(super) fn nested_dissection(n: usize, col_ptr: &[usize], row_idx: &[usize]) -> Dissected {
+pub(super) fn nested_dissection(
+    n: usize,
+    col_ptr: &[usize],
+    row_idx: &[usize],
+    depth: Depth,
+) -> Dissected {
     // Renumbered in breadth-first order, a part's vertices and their neighbours lie
     // close together in memory, which the many searches of the dissection reward
     // (measured: the order of the twice-subdivided hand in 1.6 s instead of 2.1 s, of
@@ -569,6 +587,7 @@ pub(super) fn nested_dissection(n: usize, col_ptr: &[usize], row_idx: &[usize]) 
         next_part: 0,
         order: Vec::with_capacity(n),
         halves: None,
+        depth,
     };
     dissection.dissect((0..n).collect(), 0);
     Dissected {

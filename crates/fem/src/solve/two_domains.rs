@@ -40,7 +40,6 @@ use super::cholesky::{Factor, FactorFailure};
 use super::inverse_permutation;
 use crate::dof::Scalar;
 use faer::linalg::cholesky::llt::factor::LltError;
-use faer::linalg::matmul::matmul;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::{Llt, Solve};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
@@ -66,16 +65,17 @@ pub(super) struct TwoDomains<T: Scalar> {
 struct SideFactor<T: Scalar> {
     /// The row of `M` of each local row (the side's and the separator's, increasing).
     rows: Vec<usize>,
-    /// The local row of each separator row, in the separator's numbering; these are
-    /// the last rows eliminated, in that order.
-    separator_local: Vec<usize>,
-    /// The local rows of the side itself.
-    own_local: Vec<usize>,
+    /// The row of `M` of each of the side's own rows, in elimination order: the side's
+    /// factor eliminates these first, then the separator in its own numbering.
+    own_in_order: Vec<usize>,
     pattern: SymbolicSparseColMat<usize>,
     /// For each stored value of `M_A`, its position among the values of `M`.
     source: Vec<usize>,
     values: Vec<T>,
     factor: Factor<T>,
+    /// `L_A`, the factor's last `|S|` rows and columns (lower triangular, separator
+    /// numbering), after a successful factorization.
+    trailing: Mat<T>,
     /// `T_A = L_A L_A^H` (`|S| x |S|`, both triangles, separator numbering), after a
     /// successful factorization.
     schur_part: Mat<T>,
@@ -199,33 +199,25 @@ impl<T: Scalar> TwoDomains<T> {
                 got: rhs.nrows(),
             });
         }
-        let (s, k) = (self.separator.len(), rhs.ncols());
+        let k = rhs.ncols();
         let b = rhs.as_ref();
-        let zero = Mat::<T>::zeros(s, k);
         let [side_a, side_b] = &mut self.sides;
-        // Step 1: g = -T v with M_A [u; v] = [b_A; 0].
-        let (w_a, w_b) = both(
-            || side_a.solve_side(b, zero.as_ref()),
-            || side_b.solve_side(b, zero.as_ref()),
-        );
-        let g_a = -side_a.schur_times(side_a.separator_part(&w_a?).as_ref());
-        let g_b = -side_b.schur_times(side_b.separator_part(&w_b?).as_ref());
+        // Step 1: the forward solves, g = M_SA M_AA^-1 b_A.
+        let (forward_a, forward_b) = both(|| side_a.forward(b), || side_b.forward(b));
+        let ((y_a, g_a), (y_b, g_b)) = (forward_a?, forward_b?);
         // Step 2: the separator.
-        let mut x_s = Mat::<T>::from_fn(s, k, |r, c| b[(self.separator[r], c)]);
+        let mut x_s = Mat::<T>::from_fn(self.separator.len(), k, |r, c| b[(self.separator[r], c)]);
         x_s -= &g_a;
         x_s -= &g_b;
         schur.solve_in_place(x_s.as_mut());
-        // Step 3: each side under the separator value T x_S + g.
-        let d_a = side_a.schur_times(x_s.as_ref()) + &g_a;
-        let d_b = side_b.schur_times(x_s.as_ref()) + &g_b;
+        // Step 3: the backward solves under the separator's solution.
         let (x_a, x_b) = both(
-            || side_a.solve_side(b, d_a.as_ref()),
-            || side_b.solve_side(b, d_b.as_ref()),
+            || side_a.backward(y_a, x_s.as_ref()),
+            || side_b.backward(y_b, x_s.as_ref()),
         );
         let (x_a, x_b) = (x_a?, x_b?);
         for (side, x) in [(&*side_a, &x_a), (&*side_b, &x_b)] {
-            for &l in &side.own_local {
-                let i = side.rows[l];
+            for (l, &i) in side.own_in_order.iter().enumerate() {
                 for c in 0..k {
                     rhs[(i, c)] = x[(l, c)];
                 }
@@ -299,34 +291,31 @@ impl<T: Scalar> SideFactor<T> {
             .collect();
         let inverse = inverse_permutation(&forward)?;
         let factor = Factor::build(sub.as_ref(), Some((&forward, &inverse)), Par::Seq, spare)?;
-        let mut own_local = Vec::new();
-        let mut separator_local = Vec::new();
-        for (l, &i) in rows.iter().enumerate() {
-            if side_of[i] == side {
-                own_local.push(l);
-            } else {
-                separator_local.push((separator_index[i], l));
-            }
-        }
+        let mut separator_local: Vec<(usize, usize)> = rows
+            .iter()
+            .enumerate()
+            .filter(|&(_, &i)| side_of[i] != side)
+            .map(|(l, &i)| (separator_index[i], l))
+            .collect();
         separator_local.sort_unstable();
-        let separator_local: Vec<usize> = separator_local.into_iter().map(|(_, l)| l).collect();
-        let first = m - separator_local.len();
+        let s = separator_local.len();
+        let first = m - s;
         if separator_local
             .iter()
             .enumerate()
-            .any(|(r, &l)| factor.eliminated(first + r) != l)
+            .any(|(r, &(_, l))| factor.eliminated(first + r) != l)
         {
             return Ok(None);
         }
-        let s = separator_local.len();
+        let own_in_order = (0..first).map(|k| rows[factor.eliminated(k)]).collect();
         Ok(Some(Self {
             rows,
-            separator_local,
-            own_local,
+            own_in_order,
             values: vec![T::from_f64(0.0); source.len()],
             pattern: sub,
             source,
             factor,
+            trailing: Mat::zeros(s, s),
             schur_part: Mat::zeros(s, s),
         }))
     }
@@ -350,7 +339,8 @@ impl<T: Scalar> SideFactor<T> {
                     ratio,
                 },
             })?;
-        let l = self.factor.trailing_factor(self.separator_local.len());
+        self.trailing = self.factor.trailing_factor(self.trailing.nrows());
+        let l = &self.trailing;
         // Only the lower triangle of the product is computed (half the work), then
         // mirrored: T_A is Hermitian.
         triangular::matmul(
@@ -373,38 +363,53 @@ impl<T: Scalar> SideFactor<T> {
         Ok(())
     }
 
-    /// The local solution of `M_A [u; v] = [b_A; d]`, `b` the right-hand side of `M`
-    /// and `d` the separator's (separator numbering).
-    fn solve_side(&mut self, b: MatRef<'_, T>, d: MatRef<'_, T>) -> Result<Mat<T>, SolveError> {
-        let mut w = Mat::<T>::from_fn(self.rows.len(), b.ncols(), |l, c| b[(self.rows[l], c)]);
-        for (r, &l) in self.separator_local.iter().enumerate() {
-            for c in 0..b.ncols() {
-                w[(l, c)] = d[(r, c)];
-            }
-        }
-        self.factor.solve_in_place(w.as_mut())?;
-        Ok(w)
-    }
-
-    /// The separator rows of a local vector, in the separator's numbering.
-    fn separator_part(&self, w: &Mat<T>) -> Mat<T> {
-        Mat::from_fn(self.separator_local.len(), w.ncols(), |r, c| {
-            w[(self.separator_local[r], c)]
-        })
-    }
-
-    /// `T_A v` for a separator vector `v`.
-    fn schur_times(&self, v: MatRef<'_, T>) -> Mat<T> {
-        let mut out = Mat::<T>::zeros(self.separator_local.len(), v.ncols());
-        matmul(
-            out.as_mut(),
+    /// Step 1 for this side: `y = L^-1 P [b_A; 0]` (the side's rows of `b`, zero on
+    /// the separator; `y` in elimination order) and `g_A = M_SA M_AA^-1 b_A`, which is
+    /// `L_21 y_1 = -L_A y_S` since the separator rows of `L y = P [b_A; 0]` read
+    /// `L_21 y_1 + L_A y_S = 0`.
+    fn forward(&mut self, b: MatRef<'_, T>) -> Result<(Mat<T>, Mat<T>), SolveError> {
+        let (own, s, k) = (self.own_in_order.len(), self.trailing.nrows(), b.ncols());
+        let mut y = Mat::<T>::from_fn(own + s, k, |l, c| {
+            self.own_in_order
+                .get(l)
+                .map_or(T::from_f64(0.0), |&i| b[(i, c)])
+        });
+        self.factor.lower_solve_in_place(y.as_mut())?;
+        let mut g = Mat::<T>::zeros(s, k);
+        triangular::matmul(
+            g.as_mut(),
+            BlockStructure::Rectangular,
             Accum::Replace,
-            self.schur_part.as_ref(),
-            v,
+            self.trailing.as_ref(),
+            BlockStructure::TriangularLower,
+            y.as_ref().subrows(own, s),
+            BlockStructure::Rectangular,
+            T::from_f64(-1.0),
+            Par::Seq,
+        );
+        Ok((y, g))
+    }
+
+    /// Step 3 for this side, from step 1's `y`: with the separator's solution `x_S`,
+    /// the separator rows of the forward solve of `M_A [x_A; x_S] = [b_A; T_A x_S + g_A]`
+    /// are `L_A^H x_S` (the rest is `y_1` again), and the backward solve gives `x_A`,
+    /// returned in elimination order (the rows of [`SideFactor::own_in_order`]).
+    fn backward(&mut self, mut y: Mat<T>, x_s: MatRef<'_, T>) -> Result<Mat<T>, SolveError> {
+        let own = self.own_in_order.len();
+        let s = self.trailing.nrows();
+        triangular::matmul(
+            y.as_mut().subrows_mut(own, s),
+            BlockStructure::Rectangular,
+            Accum::Replace,
+            self.trailing.adjoint(),
+            BlockStructure::TriangularUpper,
+            x_s,
+            BlockStructure::Rectangular,
             T::from_f64(1.0),
             Par::Seq,
         );
-        out
+        self.factor.lower_adjoint_solve_in_place(y.as_mut())?;
+        Ok(y)
     }
 }
 
@@ -489,7 +494,10 @@ mod tests {
         let m = grid(40, 0.05, true, 1);
         let mut two = split(&m);
         let (n, s) = (m.nrows(), two.separator.len());
-        let [a, b] = [two.sides[0].own_local.len(), two.sides[1].own_local.len()];
+        let [a, b] = [
+            two.sides[0].own_in_order.len(),
+            two.sides[1].own_in_order.len(),
+        ];
         assert!(
             s > 0 && s < 120 && a + b + s == n,
             "sides {a}, {b}, separator {s}"
@@ -504,6 +512,30 @@ mod tests {
             two.solve_in_place(x.as_mut()).unwrap();
             let r = residual(&m, &x, &rhs);
             assert!(r < 1e-12, "residual {r:e}");
+        }
+    }
+
+    #[test]
+    fn sides_with_simplicial_and_supernodal_factors_solve_alike() {
+        // faer factors sparse small sides column by column (simplicial) and larger ones
+        // by supernodes; the forward and backward halves of both kernels are used.
+        for (k, supernodal) in [(17, false), (150, true)] {
+            let m = grid(k, 0.05, true, 1);
+            let mut two = split(&m);
+            assert!(
+                two.sides
+                    .iter()
+                    .all(|side| side.factor.is_supernodal() == supernodal),
+                "grid {k}"
+            );
+            two.factorize(m.as_ref(), 1e-12).unwrap();
+            let rhs = Mat::from_fn(m.nrows(), 2, |i, c| {
+                Complex64::new(1.0 + (i % 5) as f64, c as f64 - (i % 3) as f64)
+            });
+            let mut x = rhs.clone();
+            two.solve_in_place(x.as_mut()).unwrap();
+            let r = residual(&m, &x, &rhs);
+            assert!(r < 1e-12, "grid {k}: residual {r:e}");
         }
     }
 
