@@ -1127,6 +1127,33 @@ pub struct SplitOrder {
     pub sides: Option<[usize; 2]>,
 }
 
+/// AMD's multiply-subtract count over `n^(3/2)` from which [`two_core_order`] splits.
+/// Measured on the flow's vertex graphs of about 50K vertices (numeric factorization
+/// of the normal equations, whole in AMD's order against two sides at once): the scan
+/// `g0_koala` at ratio 6.6 lost 12% (0.118 -> 0.132 s), the remeshes of `mc4_face_a`
+/// at 9.2, `disk_hand` at 11.1 and `g1_kitten` at 17.6 gained 10-25%; the sides run
+/// about 1.4x slower at once than alone on the 2-core machine, and AMD's own order
+/// beats the split's where AMD does well.
+const TWO_CORES_FROM_RATIO: f64 = 8.0;
+
+/// The order [`SpdSolver::with_split_order`] factors fastest for `pattern` on two cores:
+/// AMD's order whole where AMD's factor is cheap for the size (its multiply-subtract
+/// count below `8 n^(3/2)`), else [`first_split_order`]'s two sides, factored at once.
+pub fn two_core_order(
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+) -> Result<SplitOrder, SolveError> {
+    let n = pattern.nrows();
+    check_len("the column count of the pattern", n, pattern.ncols())?;
+    let amd = amd_order_with_count(pattern)?;
+    if amd.n_mult_subs_ldl < TWO_CORES_FROM_RATIO * (n as f64).powf(1.5) {
+        return Ok(SplitOrder {
+            order: amd.order,
+            sides: None,
+        });
+    }
+    first_split_order(pattern)
+}
+
 /// The first separator of a nested dissection of `pattern + pattern^T` (a balanced
 /// level set of breadth-first searches, the `nested_dissection` module's, each side at
 /// most 52% of the rows) with each side ordered by AMD and the separator last.

@@ -3,7 +3,7 @@
 
 use beltrami_fem::solve::{
     NESTED_DISSECTION_FROM, amd_order, fill_reducing_order, first_split_order,
-    nested_dissection_order,
+    nested_dissection_order, two_core_order,
 };
 use beltrami_fem::{SolveOptions, SpdSolver};
 use faer::perm::PermRef;
@@ -287,4 +287,34 @@ fn a_split_solver_matches_the_whole_factorization() {
     let solver =
         SpdSolver::<f64>::with_split_order(m.symbolic(), &one_side, SolveOptions::default());
     assert!(!solver.unwrap().is_split());
+}
+
+#[test]
+fn two_cores_split_where_amd_struggles_and_keep_amd_where_it_does_well() {
+    // A square grid: AMD's factor grows like n^(3/2) with a large constant, so the two
+    // sides are factored at once.
+    let k = 200;
+    let grid = pattern(k * k, &triangulated_grid(k));
+    let split = two_core_order(grid.as_ref()).unwrap();
+    assert_permutation(&split.order, k * k);
+    assert_eq!(split, first_split_order(grid.as_ref()).unwrap());
+    // A strip 4 vertices wide: AMD's factor is a band, cheap for its size, and its own
+    // order is kept whole.
+    let (long, wide) = (10_000, 4);
+    let id = |i: usize, j: usize| i + long * j;
+    let mut edges = Vec::new();
+    for j in 0..wide {
+        for i in 0..long {
+            if i + 1 < long {
+                edges.push((id(i, j), id(i + 1, j)));
+            }
+            if j + 1 < wide {
+                edges.push((id(i, j), id(i, j + 1)));
+            }
+        }
+    }
+    let strip = pattern(long * wide, &edges);
+    let whole = two_core_order(strip.as_ref()).unwrap();
+    assert_eq!(whole.sides, None);
+    assert_eq!(whole.order, amd_order(strip.as_ref()).unwrap());
 }

@@ -38,7 +38,7 @@
 
 use beltrami_core::SolverError;
 use beltrami_fem::assembly::Pattern;
-use beltrami_fem::solve::{SplitOrder, fill_reducing_order, first_split_order};
+use beltrami_fem::solve::{SplitOrder, fill_reducing_order, two_core_order};
 use beltrami_fem::{DofBuilder, DofMap, Elements, SolveError, SolveOptions, SpdSolver};
 use beltrami_mesh::{FaceId, Point3, Vector3, VertexId};
 use faer::MatMut;
@@ -467,8 +467,8 @@ impl FlowSystem {
     }
 }
 
-/// Vertex count from which the flow's normal equations are factored in two sides at
-/// once ([`first_split_order`]); below it one thread factors the whole.
+/// Vertex count from which the flow's normal equations may be factored in two sides at
+/// once ([`two_core_order`]); below it one thread factors the whole.
 const TWO_SIDES_FROM: usize = 20_000;
 
 /// An elimination order of the unknowns built on the graph of the vertices (an edge per
@@ -477,9 +477,9 @@ const TWO_SIDES_FROM: usize = 20_000;
 /// vertex graph is about four times cheaper than the unknowns' graph, and keeps each
 /// vertex's pair in one supernode.
 ///
-/// From [`TWO_SIDES_FROM`] vertices the vertex order is [`first_split_order`]'s and its
-/// two sides carry over to the unknowns (the shared ones join the separator); below, it
-/// is [`fill_reducing_order`]'s, one whole.
+/// From [`TWO_SIDES_FROM`] vertices the vertex order is [`two_core_order`]'s, and its
+/// two sides, if it has them, carry over to the unknowns (the shared ones join the
+/// separator); below, it is [`fill_reducing_order`]'s, one whole.
 fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<SplitOrder, SolverError> {
     let nv = dofs.n_nodes();
     let n = dofs.reduced_len();
@@ -493,7 +493,7 @@ fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<SplitOrder, S
     }
     let graph = Pattern::new(nv, nv, &positions)?;
     let vertices = if nv >= TWO_SIDES_FROM {
-        first_split_order(graph.symbolic().as_ref())?
+        two_core_order(graph.symbolic().as_ref())?
     } else {
         SplitOrder {
             order: fill_reducing_order(graph.symbolic().as_ref())?,

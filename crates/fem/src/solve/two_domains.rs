@@ -21,14 +21,18 @@
 //! T_A = L_A L_A^H = M_SS - M_SA M_AA^-1 M_AS        (likewise T_B),
 //! ```
 //!
-//! so the Schur complement of `M` onto `S` is `T_A + T_B - M_SS`, factored dense. A solve
-//! `M x = b` takes two solves with each side's factor, the sides at once:
+//! so the Schur complement of `M` onto `S` is `T_A + T_B - M_SS`, factored dense. With
+//! the side's factor in its elimination order (side first, separator last),
+//! `L = [L_11 0; L_21 L_A]`, a solve `M x = b` takes one forward and one backward
+//! triangular solve per side, the sides at once:
 //!
-//! 1. `M_A [u; v_A] = [b_A; 0]` gives `v_A = -T_A^-1 g_A` with `g_A = M_SA M_AA^-1 b_A`,
-//!    so `g_A = -T_A v_A` (likewise `g_B`);
+//! 1. forward, `L [y_1; y_S] = P [b_A; 0]`: since `g_A = M_SA M_AA^-1 b_A = L_21 y_1` and
+//!    the separator rows read `L_21 y_1 + L_A y_S = 0`, `g_A = -L_A y_S` (likewise
+//!    `g_B`);
 //! 2. `(T_A + T_B - M_SS) x_S = b_S - g_A - g_B`;
-//! 3. `M_A [x_A; v] = [b_A; T_A x_S + g_A]` has `v = x_S`, so its first block row
-//!    `M_AA x_A = b_A - M_AS x_S` gives `x_A` (likewise `x_B`).
+//! 3. backward: `M_A [x_A; v] = [b_A; T_A x_S + g_A]` has `v = x_S`, and its forward
+//!    solve is `[y_1; L_A^H x_S]` (`y_1` kept from step 1), so one backward solve
+//!    `L^H [x_A; x_S] = [y_1; L_A^H x_S]` gives `x_A` (likewise `x_B`).
 //!
 //! The separator's dense work (its elimination in both sides, `T_A` and `T_B`, the
 //! factorization of their sum) costs a few times `|S|^3 / 3`, small against the sides
