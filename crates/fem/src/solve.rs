@@ -1115,9 +1115,9 @@ fn dissected_to(
 
 /// An elimination order made of two sides and the separator between them: `order[k]`
 /// is the row eliminated `k`-th; with `sides = Some([a, b])`, `order[..a]` are one
-/// side's rows, `order[a..a + b]` the other's, no entry of the matrix joins them, and
-/// `order[a + b..]` is the separator. [`SpdSolver::with_split_order`] factors the two
-/// sides at once, one per core.
+/// side's rows, `order[a..a + b]` the other's, and `order[a + b..]` is the separator.
+/// [`SpdSolver::with_split_order`] factors the two sides at once, one per core, when no
+/// entry of the matrix joins them (else the whole, in `order`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct SplitOrder {
     /// `order[k]` is the row eliminated `k`-th.
@@ -1138,17 +1138,28 @@ const TWO_CORES_FROM_RATIO: f64 = 8.0;
 
 /// The order [`SpdSolver::with_split_order`] factors fastest for `pattern` on two cores:
 /// AMD's order whole where AMD's factor is cheap for the size (its multiply-subtract
-/// count below `8 n^(3/2)`), else [`first_split_order`]'s two sides, factored at once.
+/// count below `8 n^(3/2)`); else two sides factored at once, ordered inside by AMD
+/// ([`first_split_order`]), or, where [`fill_reducing_order`] takes nested dissection
+/// (from [`NESTED_DISSECTION_FROM`] rows and a count of `15 n^(3/2)`), by its further
+/// separators ([`nested_dissection_order`], whose first split is the same).
 pub fn two_core_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<SplitOrder, SolveError> {
     let n = pattern.nrows();
     check_len("the column count of the pattern", n, pattern.ncols())?;
     let amd = amd_order_with_count(pattern)?;
-    if amd.n_mult_subs_ldl < TWO_CORES_FROM_RATIO * (n as f64).powf(1.5) {
+    let ratio = amd.n_mult_subs_ldl / (n as f64).powf(1.5);
+    if ratio < TWO_CORES_FROM_RATIO {
         return Ok(SplitOrder {
             order: amd.order,
             sides: None,
+        });
+    }
+    if n >= NESTED_DISSECTION_FROM && ratio >= AMD_STRUGGLES {
+        let dissected = dissected(pattern)?;
+        return Ok(SplitOrder {
+            order: dissected.order,
+            sides: dissected.halves,
         });
     }
     first_split_order(pattern)
@@ -1156,12 +1167,13 @@ pub fn two_core_order(
 
 /// The first separator of a nested dissection of `pattern + pattern^T` (a balanced
 /// level set of breadth-first searches, the `nested_dissection` module's, each side at
-/// most 52% of the rows) with each side ordered by AMD and the separator last.
+/// most 52% of the rows) with each side ordered by AMD as a whole and the separator
+/// last, for [`SpdSolver::with_split_order`] to factor the sides on two cores.
 ///
-/// Where AMD beats nested dissection (scanned meshes at their own resolution), this
-/// order keeps AMD's factor inside the sides (on mesh graphs of 50K vertices the split
-/// adds a few percent of entries) and lets [`SpdSolver::with_split_order`] factor them
-/// on two cores.
+/// AMD inside the sides is cheaper to compute than further separators, and factored
+/// no slower on the flow's 50K-vertex graphs (the remesh of `mc4_face_a`); on a
+/// 150 x 150 grid the factor stays within 10% of AMD's for the whole (test
+/// `the_first_split_separates_two_balanced_sides_ordered_by_amd`).
 pub fn first_split_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<SplitOrder, SolveError> {

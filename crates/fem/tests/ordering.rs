@@ -30,17 +30,23 @@ fn pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat<usize> {
 /// The edges of a `k x k` grid of squares each split by a diagonal (a triangulated
 /// square, every interior vertex of degree 6), vertices numbered row by row.
 fn triangulated_grid(k: usize) -> Vec<(usize, usize)> {
-    let id = |i: usize, j: usize| i + k * j;
+    triangulated_rectangle(k, k)
+}
+
+/// The edges of a grid of `long x wide` vertices, its squares split by a diagonal,
+/// vertices numbered row by row (`long` per row).
+fn triangulated_rectangle(long: usize, wide: usize) -> Vec<(usize, usize)> {
+    let id = |i: usize, j: usize| i + long * j;
     let mut edges = Vec::new();
-    for j in 0..k {
-        for i in 0..k {
-            if i + 1 < k {
+    for j in 0..wide {
+        for i in 0..long {
+            if i + 1 < long {
                 edges.push((id(i, j), id(i + 1, j)));
             }
-            if j + 1 < k {
+            if j + 1 < wide {
                 edges.push((id(i, j), id(i, j + 1)));
             }
-            if i + 1 < k && j + 1 < k {
+            if i + 1 < long && j + 1 < wide {
                 edges.push((id(i, j), id(i + 1, j + 1)));
             }
         }
@@ -301,20 +307,19 @@ fn two_cores_split_where_amd_struggles_and_keep_amd_where_it_does_well() {
     // A strip 4 vertices wide: AMD's factor is a band, cheap for its size, and its own
     // order is kept whole.
     let (long, wide) = (10_000, 4);
-    let id = |i: usize, j: usize| i + long * j;
-    let mut edges = Vec::new();
-    for j in 0..wide {
-        for i in 0..long {
-            if i + 1 < long {
-                edges.push((id(i, j), id(i + 1, j)));
-            }
-            if j + 1 < wide {
-                edges.push((id(i, j), id(i, j + 1)));
-            }
-        }
-    }
+    let edges = triangulated_rectangle(long, wide);
     let strip = pattern(long * wide, &edges);
     let whole = two_core_order(strip.as_ref()).unwrap();
     assert_eq!(whole.sides, None);
     assert_eq!(whole.order, amd_order(strip.as_ref()).unwrap());
+    // Where `fill_reducing_order` takes nested dissection (the 700 x 700 grid of the
+    // test above), the sides keep its further separators.
+    let k = 700;
+    let large = pattern(k * k, &triangulated_grid(k));
+    let split = two_core_order(large.as_ref()).unwrap();
+    assert!(split.sides.is_some());
+    assert_eq!(
+        split.order,
+        nested_dissection_order(large.as_ref()).unwrap()
+    );
 }

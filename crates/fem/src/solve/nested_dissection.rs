@@ -228,8 +228,8 @@ pub(super) enum Depth {
     /// Separators in every part down to parts of at most [`LEAF`] vertices.
     Full,
     /// The first separator only; each of its sides ordered by AMD as a whole (the
-    /// two-domain factorization of a scanned mesh: AMD keeps its advantage inside the
-    /// sides, and the sides are factored at once).
+    /// two-domain factorization of meshes below about 100K vertices, where AMD inside
+    /// the sides factors as fast as further separators and costs less to compute).
     FirstSplit,
 }
 
