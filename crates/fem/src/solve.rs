@@ -1127,18 +1127,22 @@ pub struct SplitOrder {
     pub sides: Option<[usize; 2]>,
 }
 
-/// AMD's multiply-subtract count over `n^(3/2)` from which [`two_core_order`] splits.
-/// Measured on the flow's vertex graphs of about 50K vertices (numeric factorization
-/// of the normal equations, whole in AMD's order against two sides at once): the scan
-/// `g0_koala` at ratio 6.6 lost 12% (0.118 -> 0.132 s), the remeshes of `mc4_face_a`
-/// at 9.2, `disk_hand` at 11.1 and `g1_kitten` at 17.6 gained 10-25%; the sides run
-/// about 1.4x slower at once than alone on the 2-core machine, and AMD's own order
-/// beats the split's where AMD does well.
-const TWO_CORES_FROM_RATIO: f64 = 8.0;
+/// Largest `|S|^3` of the first separator `S`, relative to AMD's multiply-subtract
+/// count for the whole, at which [`two_core_order`] splits. The sides' factors shrink
+/// the sparse work by about half, but they run about 1.4x slower at once than alone on
+/// the 2-core machine (shared memory), and the separator's dense work (its elimination
+/// in both sides, their Schur complements, its own factorization) grows like `|S|^3`.
+/// Measured on the flow's vertex graphs of 35K-53K vertices, numeric factorization
+/// whole in AMD's order against two sides at once: `|S|^3 / count` 0.05-0.19 (the
+/// remeshes of `g2_eight`, `g1_kitten`, `disk_hand`, `mc4_face_a`, and
+/// `g0_bunny_closed`) gained 10-25%; 0.25 (a generated torus, whose separators are
+/// two loops) lost 30-40%, 0.59 (the scan `g0_koala`, where AMD does well) lost 12%.
+const SEPARATOR_CUBE_SHARE: f64 = 0.22;
 
 /// The order [`SpdSolver::with_split_order`] factors fastest for `pattern` on two cores:
-/// AMD's order whole where AMD's factor is cheap for the size (its multiply-subtract
-/// count below `8 n^(3/2)`); else two sides factored at once, ordered inside by AMD
+/// two sides factored at once where the first separator `S` is small against the
+/// whole factorization (`|S|^3` at most 0.22 of AMD's multiply-subtract count), else
+/// [`fill_reducing_order`]'s order whole. The sides are ordered by AMD
 /// ([`first_split_order`]), or, where [`fill_reducing_order`] takes nested dissection
 /// (from [`NESTED_DISSECTION_FROM`] rows and a count of `15 n^(3/2)`), by its further
 /// separators ([`nested_dissection_order`], whose first split is the same).
@@ -1148,21 +1152,34 @@ pub fn two_core_order(
     let n = pattern.nrows();
     check_len("the column count of the pattern", n, pattern.ncols())?;
     let amd = amd_order_with_count(pattern)?;
-    let ratio = amd.n_mult_subs_ldl / (n as f64).powf(1.5);
-    if ratio < TWO_CORES_FROM_RATIO {
-        return Ok(SplitOrder {
+    let nested =
+        n >= NESTED_DISSECTION_FROM && amd.n_mult_subs_ldl >= AMD_STRUGGLES * (n as f64).powf(1.5);
+    let dissected = dissected_to(
+        pattern,
+        if nested {
+            nested_dissection::Depth::Full
+        } else {
+            nested_dissection::Depth::FirstSplit
+        },
+    )?;
+    let small = |[a, b]: [usize; 2]| {
+        let separator = (n - a - b) as f64;
+        separator.powi(3) <= SEPARATOR_CUBE_SHARE * amd.n_mult_subs_ldl
+    };
+    Ok(match dissected.halves {
+        Some(sides) if small(sides) => SplitOrder {
+            order: dissected.order,
+            sides: Some(sides),
+        },
+        _ if nested => SplitOrder {
+            order: dissected.order,
+            sides: None,
+        },
+        _ => SplitOrder {
             order: amd.order,
             sides: None,
-        });
-    }
-    if n >= NESTED_DISSECTION_FROM && ratio >= AMD_STRUGGLES {
-        let dissected = dissected(pattern)?;
-        return Ok(SplitOrder {
-            order: dissected.order,
-            sides: dissected.halves,
-        });
-    }
-    first_split_order(pattern)
+        },
+    })
 }
 
 /// The first separator of a nested dissection of `pattern + pattern^T` (a balanced

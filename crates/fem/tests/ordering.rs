@@ -30,23 +30,17 @@ fn pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat<usize> {
 /// The edges of a `k x k` grid of squares each split by a diagonal (a triangulated
 /// square, every interior vertex of degree 6), vertices numbered row by row.
 fn triangulated_grid(k: usize) -> Vec<(usize, usize)> {
-    triangulated_rectangle(k, k)
-}
-
-/// The edges of a grid of `long x wide` vertices, its squares split by a diagonal,
-/// vertices numbered row by row (`long` per row).
-fn triangulated_rectangle(long: usize, wide: usize) -> Vec<(usize, usize)> {
-    let id = |i: usize, j: usize| i + long * j;
+    let id = |i: usize, j: usize| i + k * j;
     let mut edges = Vec::new();
-    for j in 0..wide {
-        for i in 0..long {
-            if i + 1 < long {
+    for j in 0..k {
+        for i in 0..k {
+            if i + 1 < k {
                 edges.push((id(i, j), id(i + 1, j)));
             }
-            if j + 1 < wide {
+            if j + 1 < k {
                 edges.push((id(i, j), id(i, j + 1)));
             }
-            if i + 1 < long && j + 1 < wide {
+            if i + 1 < k && j + 1 < k {
                 edges.push((id(i, j), id(i + 1, j + 1)));
             }
         }
@@ -296,22 +290,31 @@ fn a_split_solver_matches_the_whole_factorization() {
 }
 
 #[test]
-fn two_cores_split_where_amd_struggles_and_keep_amd_where_it_does_well() {
-    // A square grid: AMD's factor grows like n^(3/2) with a large constant, so the two
-    // sides are factored at once.
+fn two_cores_split_where_the_separator_is_small_against_the_factorization() {
+    // A square grid: one line of about k vertices separates, against AMD's n^(3/2)
+    // growth, so the two sides are factored at once.
     let k = 200;
     let grid = pattern(k * k, &triangulated_grid(k));
     let split = two_core_order(grid.as_ref()).unwrap();
     assert_permutation(&split.order, k * k);
     assert_eq!(split, first_split_order(grid.as_ref()).unwrap());
-    // A strip 4 vertices wide: AMD's factor is a band, cheap for its size, and its own
-    // order is kept whole.
-    let (long, wide) = (10_000, 4);
-    let edges = triangulated_rectangle(long, wide);
-    let strip = pattern(long * wide, &edges);
-    let whole = two_core_order(strip.as_ref()).unwrap();
+    // The same grid closed into a torus: a separator takes two loops, whose dense
+    // elimination costs more than the second core saves, so AMD's order stays whole.
+    let id = |i: usize, j: usize| (i % k) + k * (j % k);
+    let torus_edges: Vec<(usize, usize)> = (0..k)
+        .flat_map(|j| (0..k).map(move |i| (i, j)))
+        .flat_map(|(i, j)| {
+            [
+                (id(i, j), id(i + 1, j)),
+                (id(i, j), id(i, j + 1)),
+                (id(i, j), id(i + 1, j + 1)),
+            ]
+        })
+        .collect();
+    let torus = pattern(k * k, &torus_edges);
+    let whole = two_core_order(torus.as_ref()).unwrap();
     assert_eq!(whole.sides, None);
-    assert_eq!(whole.order, amd_order(strip.as_ref()).unwrap());
+    assert_eq!(whole.order, amd_order(torus.as_ref()).unwrap());
     // Where `fill_reducing_order` takes nested dissection (the 700 x 700 grid of the
     // test above), the sides keep its further separators.
     let k = 700;
