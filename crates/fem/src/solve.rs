@@ -754,7 +754,13 @@ impl<T: Scalar> SpdSolver<T> {
         check_len("the length of the order", n, split.order.len())?;
         Ok(Self {
             pattern: pattern.to_owned()?,
-            cholesky: Cholesky::split(pattern, &split.order, split.sides, options.par())?,
+            cholesky: Cholesky::split(
+                pattern,
+                &split.order,
+                split.sides,
+                options.par(),
+                [None, None],
+            )?,
             options,
             factored: false,
         })
@@ -1127,6 +1133,15 @@ pub struct SplitOrder {
     pub sides: Option<[usize; 2]>,
 }
 
+impl From<nested_dissection::Dissected> for SplitOrder {
+    fn from(dissected: nested_dissection::Dissected) -> Self {
+        Self {
+            order: dissected.order,
+            sides: dissected.halves,
+        }
+    }
+}
+
 /// Largest `|S|^3` of the first separator `S`, relative to AMD's multiply-subtract
 /// count for the whole, at which [`two_core_order`] splits. The sides' factors shrink
 /// the sparse work by about half, but they run about 1.4x slower at once than alone on
@@ -1167,10 +1182,7 @@ pub fn two_core_order(
         separator.powi(3) <= SEPARATOR_CUBE_SHARE * amd.n_mult_subs_ldl
     };
     Ok(match dissected.halves {
-        Some(sides) if small(sides) => SplitOrder {
-            order: dissected.order,
-            sides: Some(sides),
-        },
+        Some(sides) if small(sides) => dissected.into(),
         _ if nested => SplitOrder {
             order: dissected.order,
             sides: None,
@@ -1194,11 +1206,7 @@ pub fn two_core_order(
 pub fn first_split_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<SplitOrder, SolveError> {
-    let dissected = dissected_to(pattern, nested_dissection::Depth::FirstSplit)?;
-    Ok(SplitOrder {
-        order: dissected.order,
-        sides: dissected.halves,
-    })
+    dissected_to(pattern, nested_dissection::Depth::FirstSplit).map(SplitOrder::from)
 }
 
 /// The approximate minimum degree order of the symmetric pattern `pattern + pattern^T`

@@ -59,39 +59,36 @@ impl<T: Scalar> Cholesky<T> {
         let Some(ordered) = planned.ordered else {
             return Self::with_ordering(pattern, None, par);
         };
-        // The inverse also checks that the order is a permutation before either path.
-        let inverse = inverse_permutation(&ordered.order)?;
-        let mut spares = ordered.meanwhile.unwrap_or_default();
-        if let Some(halves) = ordered.halves
-            && let Some(two) =
-                TwoDomains::new(pattern, &ordered.order, halves, std::mem::take(&mut spares))?
-        {
-            return Ok(Self::Halves(Box::new(two)));
-        }
-        let [spare, _] = spares;
-        let order = Some((&ordered.order[..], &inverse[..]));
-        Ok(Self::Whole(Box::new(Factor::build(
-            pattern, order, par, spare,
-        )?)))
+        let spares = ordered.meanwhile.unwrap_or_default();
+        Self::split(pattern, &ordered.order, ordered.halves, par, spares)
     }
 
     /// [`Cholesky::new`] in the order `order` (a permutation of the rows) whose first
     /// `sides[0]` and next `sides[1]` rows are two sides no entry joins, the rest their
     /// separator: factored in the two sides at once ([`TwoDomains`]) where that works,
-    /// else as a whole in `order`.
+    /// else as a whole in `order`. `spares` are blocks the factors may be stored in
+    /// ([`Factor::build`]).
     pub(super) fn split(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: &[usize],
         sides: Option<[usize; 2]>,
         par: Par,
+        mut spares: [Option<Vec<T>>; 2],
     ) -> Result<Self, SolveError> {
+        // The inverse also checks that the order is a permutation before either path.
         let inverse = inverse_permutation(order)?;
         if let Some(sides) = sides
-            && let Some(two) = TwoDomains::new(pattern, order, sides, [None, None])?
+            && let Some(two) = TwoDomains::new(pattern, order, sides, std::mem::take(&mut spares))?
         {
             return Ok(Self::Halves(Box::new(two)));
         }
-        Self::with_ordering(pattern, Some((order, &inverse)), par)
+        let [spare, _] = spares;
+        Ok(Self::Whole(Box::new(Factor::build(
+            pattern,
+            Some((order, &inverse)),
+            par,
+            spare,
+        )?)))
     }
 
     /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
