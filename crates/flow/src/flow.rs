@@ -38,9 +38,14 @@
 //!    every step size, and the step search stalled (bunny onto spot at mean `|mu|`
 //!    0.330); putting back the few vertices that fold it keeps the rest of the step.
 //!    The search starts below the first fold the flow predicts: moving the corners of
-//!    each image face by `t V` in its own frame makes its signed area a quadratic in
-//!    `t`, and its smallest positive root over the faces not flipped now is where the
-//!    first one turns over ([`first_fold`]). The sizes above it are tried only when none
+//!    each image face by `t V` makes its signed area a quadratic in `t`, both in its
+//!    own frame and against its reference normal (the sum of its corners' target
+//!    normals, which the flip test reads), and their smallest positive root over the
+//!    faces not flipped now is where the first one turns over ([`first_fold`]). The
+//!    second catches thin image triangles across a curved part of a target mesh, which
+//!    tilt over the reference while their own plane turns with them (on `mc4_face_a`
+//!    onto `mc4_face_b` remeshed to 100K faces every trial that flipped had such a face
+//!    at `|mu|` 0.75-0.89, 73 degrees from its reference). The sizes above it are tried only when none
 //!    from there down qualifies, so a stall means the same as with the full search. On
 //!    a target mesh most trials from `t = 1` flipped tens of faces (`g0_koala` onto a
 //!    100K remesh of `g0_bunny_closed`: 6.5 trials a step, each a walk of every vertex).
@@ -196,30 +201,56 @@ fn weights_and_targets(
 }
 
 /// The smallest `t > 0` at which an image face not flipped now turns over when its
-/// corners move by `t V` in its own frame `(r, s)` (infinite when none does): with
-/// `e_1, e_2` its edge vectors from the first corner and `d_1, d_2` their rates under
-/// `V`, its doubled signed area is
-/// `A(t) = e_1 x e_2 + t (e_1 x d_2 + d_1 x e_2) + t^2 d_1 x d_2`, positive at `t = 0`.
-fn first_fold(elements: &Elements, faces: &[ImageFace], flow: &[Vector3<f64>]) -> f64 {
+/// corners move by `t V` (infinite when none does), for the image `image` with target
+/// normals `normals` at its vertices. Two quadratics per face, each positive at
+/// `t = 0`: with `e_1, e_2` its edge vectors from the first corner and `d_1, d_2` their
+/// rates under `V`, the doubled signed area
+/// `A(t) = e_1 x e_2 + t (e_1 x d_2 + d_1 x e_2) + t^2 d_1 x d_2`
+/// in its own frame `(r, s)` (the corners' moves projected onto it), and the same
+/// triple products `((e_1 + t d_1) x (e_2 + t d_2)) . n` in space against the face's
+/// reference normal `n`, the sum of its corners' normals: the flip test of
+/// [`crate::measure::image_face`] is the sign of that product, and a thin face tilted
+/// steeply to `n` crosses it long before its own plane sees it fold.
+fn first_fold(
+    elements: &Elements,
+    faces: &[ImageFace],
+    flow: &[Vector3<f64>],
+    image: &[Point3<f64>],
+    normals: &[Vector3<f64>],
+) -> f64 {
     let mut first = f64::INFINITY;
     for (f, face) in faces.iter().enumerate() {
         if face.flipped() {
             continue;
         }
-        let [a, b, c] = triangle(elements, FaceId::from_usize(f)).map(|v| flow[v.idx()]);
-        let local = |v: Vector3<f64>| Vector2::new(v.dot(&face.r), v.dot(&face.s));
+        let corners = triangle(elements, FaceId::from_usize(f)).map(|v| v.idx());
+        let [a, b, c] = corners.map(|v| flow[v]);
+        let (d1, d2) = (b - a, c - a);
+        let local = |v: &Vector3<f64>| Vector2::new(v.dot(&face.r), v.dot(&face.s));
         let (e1, e2) = (face.local[1], face.local[2]);
-        let (d1, d2) = (local(b - a), local(c - a));
         let cross = |u: &Vector2<f64>, v: &Vector2<f64>| u.x * v.y - u.y * v.x;
-        let (c0, c1, c2) = (
+        let (l1, l2) = (local(&d1), local(&d2));
+        let planar = (
             cross(&e1, &e2),
-            cross(&e1, &d2) + cross(&d1, &e2),
-            cross(&d1, &d2),
+            cross(&e1, &l2) + cross(&l1, &e2),
+            cross(&l1, &l2),
         );
-        if c0 <= 0.0 {
-            continue;
+        let reference: Vector3<f64> = corners.iter().map(|&v| normals[v]).sum();
+        let (p, q) = (
+            image[corners[1]] - image[corners[0]],
+            image[corners[2]] - image[corners[0]],
+        );
+        let triple = |u: &Vector3<f64>, v: &Vector3<f64>| u.cross(v).dot(&reference);
+        let spatial = (
+            triple(&p, &q),
+            triple(&p, &d2) + triple(&d1, &q),
+            triple(&d1, &d2),
+        );
+        for (c0, c1, c2) in [planar, spatial] {
+            if c0 > 0.0 {
+                first = first.min(smallest_positive_root(c0, c1, c2));
+            }
         }
-        first = first.min(smallest_positive_root(c0, c1, c2));
     }
     first
 }
@@ -378,7 +409,7 @@ pub fn run<G: TargetGeometry>(
             let t = ladder(halvings);
             t * largest >= options.tolerance && t >= options.min_step
         };
-        let fold = first_fold(elements, &faces, &flow.vertex);
+        let fold = first_fold(elements, &faces, &flow.vertex, &image, &normals);
         let below_fold = (0..MAX_HALVINGS)
             .find(|&j| ladder(j) < fold)
             .unwrap_or(MAX_HALVINGS);
@@ -485,8 +516,8 @@ pub fn run<G: TargetGeometry>(
 #[cfg(test)]
 mod tests {
     use beltrami_fem::Frame;
-    use beltrami_mesh::Mesh;
     use beltrami_mesh::primitives::{Cells, grid};
+    use beltrami_mesh::{Mesh, PolygonSoup};
 
     use super::*;
 
@@ -525,7 +556,7 @@ mod tests {
         flow[dragged] = Vector3::new(2.0 / n as f64, 0.0, 0.0);
         let mut faces = Vec::new();
         image_faces(&elements, &normals, &image, &mut faces, 1);
-        let fold = first_fold(&elements, &faces, &flow);
+        let fold = first_fold(&elements, &faces, &flow, &image, &normals);
         assert!((fold - 0.5).abs() < 1e-12, "{fold}");
         // The flip measure agrees: none just before, some just after.
         for (t, flipped) in [(0.49, false), (0.51, true)] {
@@ -541,6 +572,47 @@ mod tests {
             .map(|p| Vector3::new(centre.y - p.y, p.x - centre.x, 0.0))
             .collect();
         image_faces(&elements, &normals, &image, &mut faces, 1);
-        assert_eq!(first_fold(&elements, &faces, &turn), f64::INFINITY);
+        assert_eq!(
+            first_fold(&elements, &faces, &turn, &image, &normals),
+            f64::INFINITY
+        );
+    }
+
+    #[test]
+    fn a_thin_face_tilted_to_its_reference_folds_where_it_crosses_it() {
+        // The image of one triangle stands at 72 degrees to the target normal z; its apex
+        // moves by (0, -0.2, 0) per unit of t, so the triangle seen from z,
+        // (1, 0) x (0.5, 0.1 - 0.2 t), turns over at t = 1/2, while in its own plane the
+        // same move only reaches the base at t = 5.
+        let soup = PolygonSoup::from_triangles(
+            vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(0.5, 0.5, 0.0),
+            ],
+            &[[0, 1, 2]],
+        );
+        let mesh = Mesh::from_soup(&soup).unwrap();
+        let elements = Elements::new(&mesh, Frame::Face).unwrap();
+        let image = vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.5, 0.1, 0.3),
+        ];
+        let normals = vec![Vector3::z(); 3];
+        let flow = vec![
+            Vector3::zeros(),
+            Vector3::zeros(),
+            Vector3::new(0.0, -0.2, 0.0),
+        ];
+        let mut faces = Vec::new();
+        image_faces(&elements, &normals, &image, &mut faces, 1);
+        let fold = first_fold(&elements, &faces, &flow, &image, &normals);
+        assert!((fold - 0.5).abs() < 1e-12, "{fold}");
+        for (t, flipped) in [(0.49, false), (0.51, true)] {
+            let moved: Vec<Point3<f64>> = image.iter().zip(&flow).map(|(p, v)| p + t * v).collect();
+            image_faces(&elements, &normals, &moved, &mut faces, 1);
+            assert_eq!(faces[0].flipped(), flipped, "t = {t}");
+        }
     }
 }
