@@ -542,6 +542,25 @@ mod tests {
         }
     }
 
+    /// Asserts that [`first_fold`] of `flow` from `image` is `t = 1/2` and that the flip
+    /// measure agrees: no face flipped at `t = 0.49`, some at `0.51`.
+    fn first_fold_at_one_half(
+        elements: &Elements,
+        image: &[Point3<f64>],
+        normals: &[Vector3<f64>],
+        flow: &[Vector3<f64>],
+    ) {
+        let mut faces = Vec::new();
+        image_faces(elements, normals, image, &mut faces, 1);
+        let fold = first_fold(elements, &faces, flow, image, normals);
+        assert!((fold - 0.5).abs() < 1e-12, "{fold}");
+        for (t, flipped) in [(0.49, false), (0.51, true)] {
+            let moved: Vec<Point3<f64>> = image.iter().zip(flow).map(|(p, v)| p + t * v).collect();
+            image_faces(elements, normals, &moved, &mut faces, 1);
+            assert_eq!(faces.iter().any(ImageFace::flipped), flipped, "t = {t}");
+        }
+    }
+
     #[test]
     fn the_first_fold_is_where_a_dragged_vertex_crosses_its_link() {
         // An 8 x 8 grid of the unit square; vertex (4, 4) moves right by 2 cells per
@@ -554,16 +573,8 @@ mod tests {
         let dragged = 4 + (n + 1) * 4;
         let mut flow = vec![Vector3::zeros(); image.len()];
         flow[dragged] = Vector3::new(2.0 / n as f64, 0.0, 0.0);
+        first_fold_at_one_half(&elements, &image, &normals, &flow);
         let mut faces = Vec::new();
-        image_faces(&elements, &normals, &image, &mut faces, 1);
-        let fold = first_fold(&elements, &faces, &flow, &image, &normals);
-        assert!((fold - 0.5).abs() < 1e-12, "{fold}");
-        // The flip measure agrees: none just before, some just after.
-        for (t, flipped) in [(0.49, false), (0.51, true)] {
-            let moved: Vec<Point3<f64>> = image.iter().zip(&flow).map(|(p, v)| p + t * v).collect();
-            image_faces(&elements, &normals, &moved, &mut faces, 1);
-            assert_eq!(faces.iter().any(ImageFace::flipped), flipped, "t = {t}");
-        }
         // The linearized rotation about the centre, V = J (p - c), scales every area by
         // 1 + t^2: nothing folds.
         let centre = Point3::new(0.5, 0.5, 0.0);
@@ -605,14 +616,6 @@ mod tests {
             Vector3::zeros(),
             Vector3::new(0.0, -0.2, 0.0),
         ];
-        let mut faces = Vec::new();
-        image_faces(&elements, &normals, &image, &mut faces, 1);
-        let fold = first_fold(&elements, &faces, &flow, &image, &normals);
-        assert!((fold - 0.5).abs() < 1e-12, "{fold}");
-        for (t, flipped) in [(0.49, false), (0.51, true)] {
-            let moved: Vec<Point3<f64>> = image.iter().zip(&flow).map(|(p, v)| p + t * v).collect();
-            image_faces(&elements, &normals, &moved, &mut faces, 1);
-            assert_eq!(faces[0].flipped(), flipped, "t = {t}");
-        }
+        first_fold_at_one_half(&elements, &image, &normals, &flow);
     }
 }

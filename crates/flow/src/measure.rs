@@ -86,6 +86,12 @@ impl ImageFace {
         self.facing < EDGE_ON
     }
 
+    /// The cosine between the image triangle's own normal and its reference normal (the
+    /// sum of its corners' target normals): 1 where it faces the target, 0 edge-on.
+    pub fn facing(&self) -> f64 {
+        self.facing
+    }
+
     /// Marks the face flipped (so that [`crate::untangle`] moves its vertices).
     pub(crate) fn mark_flipped(&mut self) {
         self.flipped = true;
@@ -187,7 +193,7 @@ fn tilt_weight(facing: f64) -> f64 {
 
 /// Faces whose own normal has at least this cosine with the target's are measured in
 /// their own plane ([`image_face`]).
-const TILT_START: f64 = 0.4;
+pub(crate) const TILT_START: f64 = 0.4;
 
 /// Faces whose own normal has at most this cosine with the target's are measured in
 /// the target's tangent plane.

@@ -45,7 +45,7 @@ use faer::MatMut;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
-use crate::measure::{ImageFace, triangle};
+use crate::measure::{ImageFace, TILT_START, triangle};
 use crate::target::{Role, TargetGeometry, orthonormal_basis};
 
 /// One term of a face: face vertex `k` contributes `g_k (b . r + i b . s)` to the
@@ -111,6 +111,8 @@ pub struct FlowSystem {
     /// when that leaves a pivot singular, each diagonal entry also gains
     /// [`OWN_DAMPING`] times itself.
     damping: f64,
+    /// The weight `c` of [`FlowSystem::set_tilt_penalty`] (zero: none).
+    tilt_penalty: f64,
 }
 
 /// Relative residual at which a step solved by conjugate gradients with a kept
@@ -264,6 +266,7 @@ impl FlowSystem {
             prescribed: false,
             diagonal,
             damping: 0.0,
+            tilt_penalty: 0.0,
         })
     }
 
@@ -277,6 +280,20 @@ impl FlowSystem {
     /// (both where the right-hand side does).
     pub fn set_damping(&mut self, relative: f64) {
         self.damping = relative;
+    }
+
+    /// Adds to every later solve, for each image face tilted from its reference normal
+    /// `n` (the sum of its corners' target normals) by more than where its measure
+    /// starts turning to the target's plane (cosine `c_f` below `c_0 = 0.4`, see
+    /// [`crate::measure::image_face`]), the term `lambda_f (dA_f / A_f)^2` with
+    /// `A_f = (e_1 x e_2) . n` its signed area against `n`, `dA_f` its change under `V`
+    /// to first order, and `lambda_f = c w_f ((c_0 - c_f) / c_0)^2` (`w_f` the face's
+    /// flow weight). Such a face's `mu` turns nonlinear in `V` (its frame tilts towards
+    /// the target's plane), so the Gauss-Newton model does not see it fold and steps
+    /// must stop short of it; the term makes the step keep its area against `n`. It is
+    /// positive semidefinite, so the step stays a descent direction of the model.
+    pub fn set_tilt_penalty(&mut self, c: f64) {
+        self.tilt_penalty = c;
     }
 
     /// Sets the known flow of fixed vertices (one vector per vertex, read at
@@ -351,11 +368,29 @@ impl FlowSystem {
                     }
                 }
             }
+            let first_slot = at;
             for a in 0..m {
                 self.rhs[list[a]] += w * (beta[a].conj() * known).re;
                 for b in 0..=a {
                     values[self.slots[at]] += w * (beta[a].conj() * beta[b]).re;
                     at += 1;
+                }
+            }
+            let tilt = (TILT_START - face.facing()) / TILT_START;
+            if self.tilt_penalty > 0.0 && w > 0.0 && tilt > 0.0 {
+                let terms = &self.face_terms[self.term_ptr[f]..self.term_ptr[f + 1]];
+                let gamma = &mut self.beta[..m];
+                if let Some(area) =
+                    area_rates(self.faces[f], terms, directions, image, normals, gamma)
+                {
+                    let lambda = self.tilt_penalty * w * tilt * tilt / (area * area);
+                    let mut at = first_slot;
+                    for a in 0..m {
+                        for b in 0..=a {
+                            values[self.slots[at]] += lambda * gamma[a].re * gamma[b].re;
+                            at += 1;
+                        }
+                    }
                 }
             }
         }
@@ -467,6 +502,41 @@ impl FlowSystem {
     }
 }
 
+/// The signed area `A = (e_1 x e_2) . n` of the image triangle `corners` against its
+/// reference normal `n` (the sum of its corners' normals), when positive, and its rate
+/// along each of the face's local unknowns (`terms`, with their `directions`) in the real
+/// parts of `rates`: a corner moving by `d` changes the edges `e_1 = p_1 - p_0`,
+/// `e_2 = p_2 - p_0` by `(-d, -d)`, `(d, 0)` or `(0, d)`, and `A` by
+/// `(de_1 x e_2 + e_1 x de_2) . n`.
+fn area_rates(
+    corners: [usize; 3],
+    terms: &[FaceTerm],
+    directions: &[f64],
+    image: &[Point3<f64>],
+    normals: &[Vector3<f64>],
+    rates: &mut [Complex64],
+) -> Option<f64> {
+    let e1 = image[corners[1]] - image[corners[0]];
+    let e2 = image[corners[2]] - image[corners[0]];
+    let n: Vector3<f64> = corners.iter().map(|&v| normals[v]).sum();
+    let area = e1.cross(&e2).dot(&n);
+    if area <= 0.0 {
+        return None;
+    }
+    rates.iter_mut().for_each(|r| *r = Complex64::default());
+    for t in terms {
+        let d = &directions[3 * t.term as usize..3 * t.term as usize + 3];
+        let d = Vector3::new(d[0], d[1], d[2]);
+        let (de1, de2) = match t.k {
+            0 => (-d, -d),
+            1 => (d, Vector3::zeros()),
+            _ => (Vector3::zeros(), d),
+        };
+        rates[t.local as usize] += (de1.cross(&e2) + e1.cross(&de2)).dot(&n);
+    }
+    Some(area)
+}
+
 /// Vertex count from which the flow's normal equations may be factored in two sides at
 /// once ([`two_core_order`]); below it one thread factors the whole.
 const TWO_SIDES_FROM: usize = 20_000;
@@ -555,7 +625,7 @@ fn dzbar_coefficients(face: &ImageFace) -> Option<[Complex64; 3]> {
 mod tests {
     use super::*;
     use crate::measure::image_faces;
-    use crate::target::{Annulus, INNER, OUTER};
+    use crate::target::{Annulus, INNER, OUTER, UnitDisk};
     use beltrami_fem::Frame;
     use beltrami_mesh::{Mesh, primitives};
 
@@ -635,5 +705,83 @@ mod tests {
                 Role::Free => assert_eq!(flow.vertex[v].z, 0.0),
             }
         }
+    }
+
+    /// The tilt penalty keeps the area against the reference normal of faces tilted
+    /// steeply to it, and leaves a system without such faces as it is.
+    #[test]
+    fn the_tilt_penalty_holds_the_area_of_tilted_faces_only() {
+        let n = 8;
+        let mesh = Mesh::from_soup(&primitives::grid(n, n, primitives::Cells::Triangles)).unwrap();
+        let elements = Elements::new(&mesh, Frame::Face).unwrap();
+        let flat = mesh.positions().to_vec();
+        let mut roles = vec![Role::Free; flat.len()];
+        roles[0] = Role::Fixed;
+        roles[n] = Role::Fixed;
+        // The centre vertex lifted by 0.3 over cells of 1/8: its six faces stand about
+        // 70 degrees from the target's normal z.
+        let lifted = {
+            let mut image = flat.clone();
+            image[n / 2 + (n + 1) * (n / 2)].z = 0.3;
+            image
+        };
+        let normals = vec![Vector3::z(); flat.len()];
+        let solve = |image: &[Point3<f64>], penalty: f64| {
+            let mut system = FlowSystem::new(
+                &elements,
+                &UnitDisk,
+                image,
+                roles.clone(),
+                SolveOptions::default(),
+            )
+            .unwrap();
+            system.set_tilt_penalty(penalty);
+            let mut faces = Vec::new();
+            image_faces(&elements, &normals, image, &mut faces, 1);
+            let weights = vec![1.0; faces.len()];
+            let rho: Vec<Complex64> = (0..faces.len())
+                .map(|f| Complex64::new(0.3, 0.1 * (f % 5) as f64))
+                .collect();
+            let mut flow = Flow::default();
+            system
+                .solve(
+                    &UnitDisk, image, &normals, &faces, &weights, &rho, &mut flow,
+                )
+                .unwrap();
+            (faces, flow.vertex)
+        };
+        // The largest relative rate of the area against z over the tilted faces.
+        let tilted_rate = |image: &[Point3<f64>], faces: &[ImageFace], v: &[Vector3<f64>]| {
+            let mut largest = 0.0f64;
+            for (f, face) in faces.iter().enumerate() {
+                if face.facing() >= TILT_START {
+                    continue;
+                }
+                let [a, b, c] = triangle(&elements, FaceId::from_usize(f)).map(|x| x.idx());
+                let (e1, e2) = (image[b] - image[a], image[c] - image[a]);
+                let (d1, d2) = (v[b] - v[a], v[c] - v[a]);
+                let area = e1.cross(&e2).z;
+                let rate = (d1.cross(&e2) + e1.cross(&d2)).z;
+                largest = largest.max((rate / area).abs());
+            }
+            largest
+        };
+        let (faces, free) = solve(&lifted, 0.0);
+        let tilted = faces.iter().filter(|f| f.facing() < TILT_START).count();
+        assert_eq!(tilted, 6);
+        let (_, held) = solve(&lifted, 100.0);
+        let (before, after) = (
+            tilted_rate(&lifted, &faces, &free),
+            tilted_rate(&lifted, &faces, &held),
+        );
+        assert!(
+            before > 0.1,
+            "the unpenalized flow barely tilts them: {before}"
+        );
+        assert!(after < 0.2 * before, "{before} -> {after}");
+        // Nothing tilted: the penalty changes nothing.
+        let (_, plain) = solve(&flat, 0.0);
+        let (_, penalized) = solve(&flat, 10.0);
+        assert_eq!(plain, penalized);
     }
 }
