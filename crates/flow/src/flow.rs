@@ -45,10 +45,11 @@
 //!    second catches thin image triangles across a curved part of a target mesh, which
 //!    tilt over the reference while their own plane turns with them (on `mc4_face_a`
 //!    onto `mc4_face_b` remeshed to 100K faces every trial that flipped had such a face
-//!    at `|mu|` 0.75-0.89, 73 degrees from its reference). The sizes above it are tried only when none
-//!    from there down qualifies, so a stall means the same as with the full search. On
-//!    a target mesh most trials from `t = 1` flipped tens of faces (`g0_koala` onto a
-//!    100K remesh of `g0_bunny_closed`: 6.5 trials a step, each a walk of every vertex).
+//!    at `|mu|` 0.75-0.89, 67-80 degrees from its reference). The sizes above it are
+//!    tried only when none from there down qualifies, so a stall means the same as with
+//!    the full search. On a target mesh most trials from `t = 1` flipped tens of faces
+//!    (`g0_koala` onto a 100K remesh of `g0_bunny_closed`: 6.5 trials a step, each a
+//!    walk of every vertex).
 //! 4. Stop when the largest vertex update `t max_i |V_i|` is below the tolerance, or no
 //!    step above it decreases `E`, or (conformal goals, whose `E` has the near-fold
 //!    barrier) `E` fell by less than [`FLAT_DECREASE`] of itself over the last
