@@ -65,7 +65,7 @@ use beltrami_mesh::{FaceId, Point3, Vector2, Vector3};
 use num_complex::Complex64;
 
 use crate::extension::HarmonicExtension;
-use crate::measure::{ImageFace, Objective, image_faces, triangle};
+use crate::measure::{ImageFace, Objective, edges_and_reference, image_faces, triangle};
 use crate::system::{Flow, FlowSystem};
 use crate::target::{Role, TargetGeometry};
 use crate::untangle::untangle;
@@ -236,11 +236,7 @@ fn first_fold(
             cross(&e1, &l2) + cross(&l1, &e2),
             cross(&l1, &l2),
         );
-        let reference: Vector3<f64> = corners.iter().map(|&v| normals[v]).sum();
-        let (p, q) = (
-            image[corners[1]] - image[corners[0]],
-            image[corners[2]] - image[corners[0]],
-        );
+        let (p, q, reference) = edges_and_reference(corners, image, normals);
         let triple = |u: &Vector3<f64>, v: &Vector3<f64>| u.cross(v).dot(&reference);
         let spatial = (
             triple(&p, &q),

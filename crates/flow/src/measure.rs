@@ -108,6 +108,19 @@ pub(crate) fn triangle(elements: &Elements, f: FaceId) -> [VertexId; 3] {
     [n[0], n[1], n[2]]
 }
 
+/// The edge vectors `e_1 = p_1 - p_0`, `e_2 = p_2 - p_0` of the image triangle with
+/// vertex indices `corners`, and its reference normal: the sum of the target's normals
+/// at its corners, against which its orientation is read.
+pub(crate) fn edges_and_reference(
+    corners: [usize; 3],
+    image: &[Point3<f64>],
+    normals: &[Vector3<f64>],
+) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let [a, b, c] = corners.map(|v| image[v]);
+    let reference = corners.iter().map(|&v| normals[v]).sum();
+    (b - a, c - a, reference)
+}
+
 /// The image face of `f` under the map `image`, oriented by the sum of the target's
 /// normals `normals` at its vertices' images (module docs).
 pub fn image_face(
@@ -118,9 +131,7 @@ pub fn image_face(
 ) -> ImageFace {
     let q = &elements.face_points(f)[0];
     let nodes = triangle(elements, f);
-    let [a, b, c] = nodes.map(|v| image[v.idx()]);
-    let (e1, e2) = (b - a, c - a);
-    let reference: Vector3<f64> = nodes.iter().map(|v| normals[v.idx()]).sum();
+    let (e1, e2, reference) = edges_and_reference(nodes.map(|v| v.idx()), image, normals);
     let own = oriented_normal(&e1, &e2, &reference);
     // The frame: the triangle's own plane where it faces the target (the measure of
     // the fem kernel), turning to the target's tangent plane (the plane of N_T) as the

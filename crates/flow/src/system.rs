@@ -45,7 +45,7 @@ use faer::MatMut;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
-use crate::measure::{ImageFace, TILT_START, triangle};
+use crate::measure::{ImageFace, TILT_START, edges_and_reference, triangle};
 use crate::target::{Role, TargetGeometry, orthonormal_basis};
 
 /// One term of a face: face vertex `k` contributes `g_k (b . r + i b . s)` to the
@@ -83,6 +83,9 @@ pub struct FlowSystem {
     face_terms: Vec<FaceTerm>,
     /// The coefficients `beta` of one face (scratch, as long as the longest local list).
     beta: Vec<Complex64>,
+    /// The rates of one face's area against its reference normal along its local
+    /// unknowns (scratch of the tilt penalty, as long as `beta`).
+    rates: Vec<f64>,
     /// The normal matrix (lower triangle), refilled in place every step.
     matrix: SparseColMat<usize, f64>,
     /// Per local entry (in assembly order), its index in the matrix's values.
@@ -254,6 +257,7 @@ impl FlowSystem {
             term_ptr,
             face_terms,
             beta: vec![Complex64::default(); longest],
+            rates: vec![0.0; longest],
             rhs: vec![0.0; n],
             trial: vec![0.0; n],
             matrix,
@@ -379,7 +383,7 @@ impl FlowSystem {
             let tilt = (TILT_START - face.facing()) / TILT_START;
             if self.tilt_penalty > 0.0 && w > 0.0 && tilt > 0.0 {
                 let terms = &self.face_terms[self.term_ptr[f]..self.term_ptr[f + 1]];
-                let gamma = &mut self.beta[..m];
+                let gamma = &mut self.rates[..m];
                 if let Some(area) =
                     area_rates(self.faces[f], terms, directions, image, normals, gamma)
                 {
@@ -387,7 +391,7 @@ impl FlowSystem {
                     let mut at = first_slot;
                     for a in 0..m {
                         for b in 0..=a {
-                            values[self.slots[at]] += lambda * gamma[a].re * gamma[b].re;
+                            values[self.slots[at]] += lambda * gamma[a] * gamma[b];
                             at += 1;
                         }
                     }
@@ -504,8 +508,8 @@ impl FlowSystem {
 
 /// The signed area `A = (e_1 x e_2) . n` of the image triangle `corners` against its
 /// reference normal `n` (the sum of its corners' normals), when positive, and its rate
-/// along each of the face's local unknowns (`terms`, with their `directions`) in the real
-/// parts of `rates`: a corner moving by `d` changes the edges `e_1 = p_1 - p_0`,
+/// along each of the face's local unknowns (`terms`, with their `directions`) in
+/// `rates`: a corner moving by `d` changes the edges `e_1 = p_1 - p_0`,
 /// `e_2 = p_2 - p_0` by `(-d, -d)`, `(d, 0)` or `(0, d)`, and `A` by
 /// `(de_1 x e_2 + e_1 x de_2) . n`.
 fn area_rates(
@@ -514,16 +518,14 @@ fn area_rates(
     directions: &[f64],
     image: &[Point3<f64>],
     normals: &[Vector3<f64>],
-    rates: &mut [Complex64],
+    rates: &mut [f64],
 ) -> Option<f64> {
-    let e1 = image[corners[1]] - image[corners[0]];
-    let e2 = image[corners[2]] - image[corners[0]];
-    let n: Vector3<f64> = corners.iter().map(|&v| normals[v]).sum();
+    let (e1, e2, n) = edges_and_reference(corners, image, normals);
     let area = e1.cross(&e2).dot(&n);
     if area <= 0.0 {
         return None;
     }
-    rates.iter_mut().for_each(|r| *r = Complex64::default());
+    rates.iter_mut().for_each(|r| *r = 0.0);
     for t in terms {
         let d = &directions[3 * t.term as usize..3 * t.term as usize + 3];
         let d = Vector3::new(d[0], d[1], d[2]);
