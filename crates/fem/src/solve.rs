@@ -38,6 +38,7 @@
 //! solution is checked for non-finite values.
 
 mod cholesky;
+mod factor_count;
 mod nested_dissection;
 mod normal;
 mod saddle;
@@ -49,6 +50,7 @@ pub use saddle::{SaddlePointSolution, SaddlePointSolver, solve_saddle_point};
 use crate::dof::{DofMap, Scalar};
 use beltrami_mesh::VertexId;
 use cholesky::{Cholesky, FactorFailure};
+pub use factor_count::{FactorCount, factor_count};
 use faer::sparse::{
     FaerError, SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef,
     Triplet,
@@ -309,45 +311,44 @@ impl<T: Scalar> LeastSquaresSolver<T> {
         dofs: &DofMap<T>,
         options: SolveOptions,
     ) -> Result<Self, SolveError> {
-        Self::build(a_pattern, dofs, options, PlannedOrder::new)
+        Self::build(a_pattern, dofs, options, || Ok(None))
     }
 
-    /// [`new`](Self::new) in the order `order()` returns, called once the scatter maps
-    /// are built: a [`PlannedOrder`] of a pattern with the graph of the normal
-    /// equations (one row per reduced unknown, an entry wherever a row of `A` couples
-    /// two unknowns: [`normal_pattern_of_cells`]), typically computed on another thread
-    /// while the caller assembled `A`. Any order of the right size gives the same
-    /// solutions; one of another graph only factors slower.
+    /// [`new`](Self::new) with the symbolic factorization `planned()` returns, called
+    /// once the scatter maps are built: a [`PlannedCholesky`] of the normal equations'
+    /// pattern ([`normal_pattern_of_cells`] gives it from the cells alone), typically
+    /// computed on another thread while the caller assembled `A`. A plan for any other
+    /// pattern is set aside and the symbolic factorization computed here, as by
+    /// [`new`](Self::new).
     ///
-    /// Errors as [`new`](Self::new), and [`SolveError::Length`] when the order is not
-    /// of `dofs.reduced_len()` unknowns.
-    pub fn with_order(
+    /// Errors as [`new`](Self::new), and those of `planned()`.
+    pub fn with_planned(
         a_pattern: SymbolicSparseColMatRef<'_, usize>,
         dofs: &DofMap<T>,
         options: SolveOptions,
-        order: impl FnOnce() -> Result<PlannedOrder<T>, SolveError>,
+        planned: impl FnOnce() -> Result<PlannedCholesky<T>, SolveError>,
     ) -> Result<Self, SolveError> {
-        Self::build(a_pattern, dofs, options, |_| order())
+        Self::build(a_pattern, dofs, options, || planned().map(Some))
     }
 
-    /// The symbolic phase, the order of the normal equations' pattern given by `order`.
+    /// The symbolic phase, with the symbolic factorization `planned()` gives when it
+    /// is for the normal equations' pattern.
     fn build(
         a_pattern: SymbolicSparseColMatRef<'_, usize>,
         dofs: &DofMap<T>,
         options: SolveOptions,
-        order: impl FnOnce(SymbolicSparseColMatRef<'_, usize>) -> Result<PlannedOrder<T>, SolveError>,
+        planned: impl FnOnce() -> Result<Option<PlannedCholesky<T>>, SolveError>,
     ) -> Result<Self, SolveError> {
         check_len("the column count of A", dofs.full_len(), a_pattern.ncols())?;
         let m = a_pattern.nrows();
         let n = dofs.reduced_len();
         let a_pattern = a_pattern.to_owned()?;
         let normal = NormalEquations::new(a_pattern.as_ref(), dofs)?;
-        let planned = order(normal.pattern())?;
-        check_len("the length of the order", n, planned.len())?;
-        let cholesky = if n > 0 {
-            Some(Cholesky::planned(normal.pattern(), planned, options.par())?)
-        } else {
-            None
+        let planned = planned()?.and_then(|planned| planned.for_pattern(normal.pattern()));
+        let cholesky = match planned {
+            Some(cholesky) => Some(cholesky),
+            None if n > 0 => Some(Cholesky::new(normal.pattern(), options.par())?),
+            None => None,
         };
         let zero = T::from_f64(0.0);
         Ok(Self {
@@ -754,13 +755,7 @@ impl<T: Scalar> SpdSolver<T> {
         check_len("the length of the order", n, split.order.len())?;
         Ok(Self {
             pattern: pattern.to_owned()?,
-            cholesky: Cholesky::split(
-                pattern,
-                &split.order,
-                split.sides,
-                options.par(),
-                [None, None],
-            )?,
+            cholesky: Cholesky::split(pattern, &split.order, split.sides, options.par())?,
             options,
             factored: false,
         })
@@ -954,137 +949,134 @@ fn inverse_permutation(order: &[usize]) -> Result<Vec<usize>, SolveError> {
 /// Unknown count from which [`fill_reducing_order`] considers nested dissection.
 pub const NESTED_DISSECTION_FROM: usize = 100_000;
 
-/// AMD's multiply-subtract count over `n^(3/2)` from which [`fill_reducing_order`]
-/// takes nested dissection. Measured on mesh graphs of 200K-1.1M vertices (the shared
-/// meshes subdivided, generated disks): where the ratio was 12 (the subdivided koala)
-/// nested dissection's factor cost 1.8x AMD's operations; from 16 to 34 it cost
-/// 0.38-0.87x (the 1M-triangle disk at 34: 0.38x).
-const AMD_STRUGGLES: f64 = 15.0;
+/// Multiply-subtract count over `n^(3/2)` up to which [`fill_reducing_order`] takes a
+/// nested-dissection order without computing AMD's to compare (AMD took longer than
+/// the dissection on two cores: 1.3 s against 1.0 s on the 1M-triangle disk). Exact
+/// counts ([`factor_count`]) of the vertex graphs of 140K-850K-vertex meshes, nested
+/// dissection against AMD: 12.8 / 34.0 (the 1M-triangle disk), 13.8 / 16.0 and
+/// 14.9 / 23.7 (`disk_hand` subdivided once and twice), 20.4 / 22.2 and 21.8 / 31.0
+/// (`g0_bunny_closed` subdivided once and twice), 29.7 / 12.3 (`g0_koala` subdivided
+/// once): at most 16, the dissection was ahead on every mesh measured; beyond, both
+/// are computed and the cheaper taken.
+const NESTED_DISSECTION_SURE: f64 = 16.0;
 
 /// The elimination order the solvers use for the symmetric pattern
 /// `pattern + pattern^T`: `order[k]` is the row to eliminate k-th.
 ///
-/// AMD ([`amd_order`]), unless the pattern has at least [`NESTED_DISSECTION_FROM`] rows
-/// and AMD's own operation count says its factor is expensive for the size
-/// (`flops >= 15 n^(3/2)`, the growth of a planar mesh's factor under a poor order):
-/// then [`nested_dissection_order`], computed on a second thread meanwhile. On large
-/// meshes with regular structure (generated disks and grids, subdivided scans) that
-/// halves the operations of the numeric factorization; on scans at their original
-/// resolution AMD stays ahead.
+/// AMD ([`amd_order`]) below [`NESTED_DISSECTION_FROM`] rows. From there the
+/// nested-dissection order ([`nested_dissection_order`], on two cores), kept when its
+/// factorization costs at most `16 n^(3/2)` multiply-subtracts (counted exactly, as a
+/// planar mesh's factor grows under a good order); else AMD's is computed too, and the
+/// order with the smaller count is taken. On large meshes with regular structure
+/// (generated disks and grids, subdivided scans) the dissection halves the operations
+/// of the numeric factorization; on scans at their original resolution AMD may stay
+/// ahead.
 pub fn fill_reducing_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<Vec<usize>, SolveError> {
-    fill_reducing_order_meanwhile(pattern, |_| ()).map(|ordered| ordered.order)
+    check_len(
+        "the column count of the pattern",
+        pattern.nrows(),
+        pattern.ncols(),
+    )?;
+    if pattern.nrows() < NESTED_DISSECTION_FROM {
+        return amd_order(pattern);
+    }
+    Ok(match chosen_order(pattern)?.0 {
+        Choice::Nested(dissected) => dissected.order,
+        Choice::Amd(order) => order,
+    })
 }
 
-/// An elimination order as [`fill_reducing_order`] chooses it.
-struct Ordered<R> {
-    /// `order[k]` is the row eliminated `k`-th.
-    order: Vec<usize>,
-    /// The first split of a nested-dissection order ([`nested_dissection::Dissected`]).
-    halves: Option<[usize; 2]>,
-    /// What `meanwhile` returned, when nested dissection was taken.
-    meanwhile: Option<R>,
+/// Which order [`fill_reducing_order`] took for a pattern of at least
+/// [`NESTED_DISSECTION_FROM`] rows.
+enum Choice {
+    Nested(nested_dissection::Dissected),
+    Amd(Vec<usize>),
 }
 
-/// [`fill_reducing_order`], running `meanwhile` on the calling thread while the
-/// nested-dissection order is still being computed, once AMD has finished and chosen it:
-/// `meanwhile` gets AMD's count of the factor's entries (diagonal included).
-fn fill_reducing_order_meanwhile<R>(
+/// [`fill_reducing_order`]'s choice from [`NESTED_DISSECTION_FROM`] rows, with the
+/// exact count of the factor in the order taken.
+fn chosen_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
-    meanwhile: impl FnOnce(usize) -> R,
-) -> Result<Ordered<R>, SolveError> {
+) -> Result<(Choice, FactorCount), SolveError> {
     let n = pattern.nrows();
-    let amd_only = |order| Ordered {
-        order,
-        halves: None,
-        meanwhile: None,
-    };
-    if n < NESTED_DISSECTION_FROM {
-        return Ok(amd_only(amd_order(pattern)?));
+    let dissected = dissected(pattern)?;
+    let nested = factor_count(pattern, &dissected.order)?;
+    if nested.multiply_subtracts <= NESTED_DISSECTION_SURE * (n as f64).powf(1.5) {
+        return Ok((Choice::Nested(dissected), nested));
     }
-    // Both orders are computed at once (on a second core where there is one), so the
-    // choice costs the longer of the two instead of their sum.
-    let (amd, nested, extra) = std::thread::scope(|scope| {
-        let nested = scope.spawn(|| dissected(pattern));
-        let amd = amd_order_with_count(pattern);
-        let extra = match &amd {
-            Ok(count) if count.n_mult_subs_ldl >= AMD_STRUGGLES * (n as f64).powf(1.5) => {
-                Some(meanwhile(count.entries))
-            }
-            _ => None,
-        };
-        (amd, nested.join(), extra)
-    });
-    let amd = amd?;
-    if extra.is_some() {
-        // A panic in the ordering thread is a bug; pass it on as one.
-        let nested = nested.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
-        Ok(Ordered {
-            order: nested.order,
-            halves: nested.halves,
-            meanwhile: extra,
-        })
+    let amd = amd_order(pattern)?;
+    let minimum = factor_count(pattern, &amd)?;
+    Ok(if minimum.multiply_subtracts < nested.multiply_subtracts {
+        (Choice::Amd(amd), minimum)
     } else {
-        Ok(amd_only(amd.order))
-    }
+        (Choice::Nested(dissected), nested)
+    })
 }
 
-/// The elimination order [`LeastSquaresSolver`] and [`SpdSolver`] use for a pattern
-/// ([`fill_reducing_order`]), computed on its own, so that a caller can compute it on
-/// another thread while it assembles the matrices ([`LeastSquaresSolver::with_order`]):
-/// on a large mesh the order takes about as long as assembling.
+/// The symbolic Cholesky factorization of a pattern, computed on its own, so that a
+/// caller can compute it on another thread while it assembles the matrices
+/// ([`LeastSquaresSolver::with_planned`]): on a large mesh the order and the symbolic
+/// analysis take about as long as assembling.
 ///
-/// Below [`NESTED_DISSECTION_FROM`] rows nothing is computed (faer's symbolic analysis
-/// computes the AMD order itself). From there, while the nested dissection is still
-/// being computed, the thread done with AMD touches two blocks of half AMD's factor
-/// size: the kernel clears every page a process touches for the first time, the factor
-/// is the largest block of a solve, and each side's factor of the two-domain
-/// factorization reuses a block when it fits, which it does where the dissection is
-/// taken for its smaller factor.
-pub struct PlannedOrder<T: Scalar> {
-    n: usize,
-    ordered: Option<Ordered<[Option<Vec<T>>; 2]>>,
+/// The elimination order is [`fill_reducing_order`]'s; a nested-dissection order is
+/// factored in its first split's two sides at once (`two_domains` module). The
+/// factor's storage is allocated and written here: the kernel clears every page a
+/// process touches for the first time, and the factor is the largest block of a solve
+/// (0.6 GB on the 1M-triangle disk).
+pub struct PlannedCholesky<T: Scalar> {
+    /// The pattern planned for.
+    pattern: SymbolicSparseColMat<usize>,
+    /// `None` when the pattern has no rows.
+    cholesky: Option<Cholesky<T>>,
 }
 
-impl<T: Scalar> fmt::Debug for PlannedOrder<T> {
+impl<T: Scalar> fmt::Debug for PlannedCholesky<T> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("PlannedOrder")
-            .field("n", &self.n)
+        f.debug_struct("PlannedCholesky")
+            .field("n", &self.pattern.nrows())
             .field(
-                "nested_dissection",
-                &self.ordered.as_ref().map(|o| o.halves),
+                "two_sides",
+                &matches!(self.cholesky, Some(Cholesky::Halves(_))),
             )
             .finish_non_exhaustive()
     }
 }
 
-impl<T: Scalar> PlannedOrder<T> {
-    /// The order of the square pattern `pattern` (only its lower triangle matters).
-    pub fn new(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, SolveError> {
+impl<T: Scalar> PlannedCholesky<T> {
+    /// The symbolic factorization of the square pattern `pattern` (only its lower
+    /// triangle matters), for factorizations with `options`' threads.
+    pub fn new(
+        pattern: SymbolicSparseColMat<usize>,
+        options: SolveOptions,
+    ) -> Result<Self, SolveError> {
         let n = pattern.nrows();
         check_len("the column count of the pattern", n, pattern.ncols())?;
-        let ordered = if n < NESTED_DISSECTION_FROM {
-            None
+        let cholesky = if n > 0 {
+            Some(Cholesky::new(pattern.as_ref(), options.par())?)
         } else {
-            Some(fill_reducing_order_meanwhile(pattern, |entries| {
-                [
-                    cholesky::touched_zeros::<T>(entries / 2),
-                    cholesky::touched_zeros::<T>(entries / 2),
-                ]
-            })?)
+            None
         };
-        Ok(Self { n, ordered })
+        Ok(Self { pattern, cholesky })
     }
 
-    /// The number of unknowns ordered.
+    /// The number of unknowns.
     pub fn len(&self) -> usize {
-        self.n
+        self.pattern.nrows()
     }
 
     /// True when there are no unknowns.
     pub fn is_empty(&self) -> bool {
-        self.n == 0
+        self.len() == 0
+    }
+
+    /// The factorization when it was planned for exactly `pattern`.
+    fn for_pattern(self, pattern: SymbolicSparseColMatRef<'_, usize>) -> Option<Cholesky<T>> {
+        let same = self.pattern.nrows() == pattern.nrows()
+            && self.pattern.col_ptr() == pattern.col_ptr()
+            && self.pattern.row_idx() == pattern.row_idx();
+        if same { self.cholesky } else { None }
     }
 }
 
@@ -1142,8 +1134,10 @@ impl From<nested_dissection::Dissected> for SplitOrder {
     }
 }
 
-/// Largest `|S|^3` of the first separator `S`, relative to AMD's multiply-subtract
-/// count for the whole, at which [`two_core_order`] splits. The sides' factors shrink
+/// Largest `|S|^3` of the first separator `S`, relative to the multiply-subtract count
+/// of the whole factorization (AMD's estimate below [`NESTED_DISSECTION_FROM`] rows,
+/// else the exact count of [`fill_reducing_order`]'s order), at which
+/// [`two_core_order`] splits. The sides' factors shrink
 /// the sparse work by about half, but they run about 1.4x slower at once than alone on
 /// the 2-core machine (shared memory), and the separator's dense work (its elimination
 /// in both sides, their Schur complements, its own factorization) grows like `|S|^3`.
@@ -1156,41 +1150,42 @@ const SEPARATOR_CUBE_SHARE: f64 = 0.22;
 
 /// The order [`SpdSolver::with_split_order`] factors fastest for `pattern` on two cores:
 /// two sides factored at once where the first separator `S` is small against the
-/// whole factorization (`|S|^3` at most 0.22 of AMD's multiply-subtract count), else
+/// whole factorization (`|S|^3` at most 0.22 of its multiply-subtract count), else
 /// [`fill_reducing_order`]'s order whole. The sides are ordered by AMD
-/// ([`first_split_order`]), or, where [`fill_reducing_order`] takes nested dissection
-/// (from [`NESTED_DISSECTION_FROM`] rows and a count of `15 n^(3/2)`), by its further
-/// separators ([`nested_dissection_order`], whose first split is the same).
+/// ([`first_split_order`]), or, where [`fill_reducing_order`] takes nested dissection,
+/// by its further separators ([`nested_dissection_order`], whose first split is the
+/// same).
 pub fn two_core_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<SplitOrder, SolveError> {
     let n = pattern.nrows();
     check_len("the column count of the pattern", n, pattern.ncols())?;
-    let amd = amd_order_with_count(pattern)?;
-    let nested =
-        n >= NESTED_DISSECTION_FROM && amd.n_mult_subs_ldl >= AMD_STRUGGLES * (n as f64).powf(1.5);
-    let dissected = dissected_to(
-        pattern,
-        if nested {
-            nested_dissection::Depth::Full
-        } else {
-            nested_dissection::Depth::FirstSplit
-        },
-    )?;
+    let (choice, count) = if n >= NESTED_DISSECTION_FROM {
+        let (choice, count) = chosen_order(pattern)?;
+        (choice, count.multiply_subtracts)
+    } else {
+        let amd = amd_order_with_count(pattern)?;
+        (Choice::Amd(amd.order), amd.n_mult_subs_ldl)
+    };
     let small = |[a, b]: [usize; 2]| {
         let separator = (n - a - b) as f64;
-        separator.powi(3) <= SEPARATOR_CUBE_SHARE * amd.n_mult_subs_ldl
+        separator.powi(3) <= SEPARATOR_CUBE_SHARE * count
     };
-    Ok(match dissected.halves {
-        Some(sides) if small(sides) => dissected.into(),
-        _ if nested => SplitOrder {
-            order: dissected.order,
-            sides: None,
+    Ok(match choice {
+        Choice::Nested(dissected) => match dissected.halves {
+            Some(sides) if small(sides) => dissected.into(),
+            _ => SplitOrder {
+                order: dissected.order,
+                sides: None,
+            },
         },
-        _ => SplitOrder {
-            order: amd.order,
-            sides: None,
-        },
+        Choice::Amd(order) => {
+            let first = dissected_to(pattern, nested_dissection::Depth::FirstSplit)?;
+            match first.halves {
+                Some(sides) if small(sides) => first.into(),
+                _ => SplitOrder { order, sides: None },
+            }
+        }
     })
 }
 
@@ -1215,16 +1210,14 @@ pub fn amd_order(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Vec<usiz
     amd_order_with_count(pattern).map(|count| count.order)
 }
 
-/// An AMD order and AMD's own counts for the factor in that order.
+/// An AMD order and AMD's own estimate of the factor's cost in that order.
 struct AmdOrder {
     order: Vec<usize>,
     /// Multiply-subtract operations of the `L D L^T` factorization.
     n_mult_subs_ldl: f64,
-    /// Entries of `L`, diagonal included.
-    entries: usize,
 }
 
-/// [`amd_order`] with AMD's estimates of the factor's cost and size in that order.
+/// [`amd_order`] with AMD's estimate of the factor's cost in that order.
 fn amd_order_with_count(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<AmdOrder, SolveError> {
@@ -1243,11 +1236,9 @@ fn amd_order_with_count(
         Default::default(),
         MemStack::new(&mut buffer),
     )?;
-    // AMD counts one division per entry below the diagonal.
     Ok(AmdOrder {
         order: forward,
         n_mult_subs_ldl: count.n_mult_subs_ldl,
-        entries: n + count.n_div as usize,
     })
 }
 

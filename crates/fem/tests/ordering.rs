@@ -2,7 +2,7 @@
 //! them.
 
 use beltrami_fem::solve::{
-    NESTED_DISSECTION_FROM, amd_order, fill_reducing_order, first_split_order,
+    NESTED_DISSECTION_FROM, amd_order, factor_count, fill_reducing_order, first_split_order,
     nested_dissection_order, two_core_order,
 };
 use beltrami_fem::{SolveOptions, SpdSolver};
@@ -126,15 +126,52 @@ fn fill_reducing_order_switches_only_on_large_regular_meshes() {
         fill_reducing_order(small.as_ref()).unwrap(),
         amd_order(small.as_ref()).unwrap()
     );
-    // Above it, on a regular mesh where AMD's count is large for the size (the
-    // triangulated 700 x 700 grid: 15.6 n^(3/2) multiply-subtracts; 13.9 at 400 x 400),
-    // nested dissection.
+    // Above it, on a regular mesh, nested dissection, whose factor costs few
+    // operations for the size (the triangulated 700 x 700 grid: under 16 n^(3/2)
+    // multiply-subtracts, so AMD's order is not computed to compare).
     let k = 700;
-    assert!(k * k >= NESTED_DISSECTION_FROM);
-    let large = pattern(k * k, &triangulated_grid(k));
+    let n = k * k;
+    assert!(n >= NESTED_DISSECTION_FROM);
+    let large = pattern(n, &triangulated_grid(k));
+    let nested = nested_dissection_order(large.as_ref()).unwrap();
+    let count = factor_count(large.as_ref(), &nested).unwrap();
+    assert!(count.multiply_subtracts <= 16.0 * (n as f64).powf(1.5));
+    assert_eq!(fill_reducing_order(large.as_ref()).unwrap(), nested);
+}
+
+#[test]
+fn fill_reducing_order_takes_the_cheaper_order_where_the_dissection_is_costly() {
+    // A 47 x 47 x 47 grid of cubes (103,823 vertices, neighbours along the axes): its
+    // separators are planes of about n^(2/3) vertices, so the dissection's factor costs
+    // far more than 16 n^(3/2) operations; AMD's order is computed too, and the one
+    // with fewer operations taken.
+    let k = 47;
+    let n = k * k * k;
+    let id = |i: usize, j: usize, l: usize| i + k * (j + k * l);
+    let mut edges = Vec::new();
+    for l in 0..k {
+        for j in 0..k {
+            for i in 0..k {
+                if i + 1 < k {
+                    edges.push((id(i, j, l), id(i + 1, j, l)));
+                }
+                if j + 1 < k {
+                    edges.push((id(i, j, l), id(i, j + 1, l)));
+                }
+                if l + 1 < k {
+                    edges.push((id(i, j, l), id(i, j, l + 1)));
+                }
+            }
+        }
+    }
+    let p = pattern(n, &edges);
+    let cost = |order: &[usize]| factor_count(p.as_ref(), order).unwrap().multiply_subtracts;
+    let nested = cost(&nested_dissection_order(p.as_ref()).unwrap());
+    let amd = cost(&amd_order(p.as_ref()).unwrap());
+    assert!(nested > 16.0 * (n as f64).powf(1.5), "{nested:e}");
     assert_eq!(
-        fill_reducing_order(large.as_ref()).unwrap(),
-        nested_dissection_order(large.as_ref()).unwrap()
+        cost(&fill_reducing_order(p.as_ref()).unwrap()),
+        nested.min(amd)
     );
 }
 

@@ -29,7 +29,7 @@ use beltrami_core::{
 };
 use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::operators::{apply, beltrami_operator};
-use beltrami_fem::solve::{PlannedOrder, normal_pattern_of_cells};
+use beltrami_fem::solve::{PlannedCholesky, normal_pattern_of_cells};
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::{FaceId, VertexId};
 use num_complex::Complex64;
@@ -109,26 +109,30 @@ impl Solver for Lscm {
                 constraints.fix(v, z);
             }
             let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
-            // The elimination order needs only the mesh's connectivity: it is computed
-            // on another thread while the elements and D_zbar are assembled (on a large
-            // mesh the two take about as long).
+            // The symbolic factorization (elimination order, analysis, the factor's
+            // storage) needs only the mesh's connectivity: it is computed on another
+            // thread while the elements and D_zbar are assembled (on a large mesh the
+            // two take about as long).
             std::thread::scope(|scope| {
-                let order = scope.spawn(|| {
+                let planned = scope.spawn(|| {
                     let faces =
                         (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
-                    PlannedOrder::new(normal_pattern_of_cells(faces, &dofs)?.as_ref())
+                    PlannedCholesky::new(
+                        normal_pattern_of_cells(faces, &dofs)?,
+                        solve_options(settings),
+                    )
                 });
                 let elements = Elements::new(mesh, Frame::Face)?;
                 // D_zbar is the Beltrami operator of mu = 0.
                 let conformal = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
                 let dzbar = beltrami_operator(mesh, &elements, &conformal)?;
-                let solver = LeastSquaresSolver::with_order(
+                let solver = LeastSquaresSolver::with_planned(
                     dzbar.symbolic(),
                     &dofs,
                     solve_options(settings),
                     // A panic in the ordering thread is a bug; pass it on as one.
                     || {
-                        order
+                        planned
                             .join()
                             .unwrap_or_else(|p| std::panic::resume_unwind(p))
                     },

@@ -6,7 +6,7 @@
 //! wrapper keeps both and calls the low-level `SymbolicCholesky::factorize_numeric_llt`.
 
 use super::two_domains::TwoDomains;
-use super::{PlannedOrder, SolveError, inverse_permutation};
+use super::{Choice, NESTED_DISSECTION_FROM, SolveError, chosen_order, inverse_permutation};
 use crate::dof::Scalar;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -40,55 +40,46 @@ pub(super) enum Cholesky<T: Scalar> {
 impl<T: Scalar> Cholesky<T> {
     /// Symbolic analysis (fill-reducing order, elimination tree, supernodes) of
     /// `pattern` (square; only its lower triangle matters). The order is
-    /// [`PlannedOrder::new`]'s; below [`NESTED_DISSECTION_FROM`](super::NESTED_DISSECTION_FROM)
-    /// rows that is AMD, left to faer. A nested-dissection order is factored in its two
-    /// sides at once ([`TwoDomains`]) when its first split has two sides.
+    /// [`fill_reducing_order`](super::fill_reducing_order)'s; below
+    /// [`NESTED_DISSECTION_FROM`] rows that is AMD, left to faer. A nested-dissection
+    /// order is factored in its two sides at once ([`TwoDomains`]) when its first split
+    /// has two sides.
     pub(super) fn new(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         par: Par,
     ) -> Result<Self, SolveError> {
-        Self::planned(pattern, PlannedOrder::new(pattern)?, par)
-    }
-
-    /// [`Cholesky::new`] in an order computed beforehand for `pattern`.
-    pub(super) fn planned(
-        pattern: SymbolicSparseColMatRef<'_, usize>,
-        planned: PlannedOrder<T>,
-        par: Par,
-    ) -> Result<Self, SolveError> {
-        let Some(ordered) = planned.ordered else {
+        if pattern.nrows() < NESTED_DISSECTION_FROM {
             return Self::with_ordering(pattern, None, par);
-        };
-        let spares = ordered.meanwhile.unwrap_or_default();
-        Self::split(pattern, &ordered.order, ordered.halves, par, spares)
+        }
+        match chosen_order(pattern)?.0 {
+            Choice::Nested(dissected) => {
+                Self::split(pattern, &dissected.order, dissected.halves, par)
+            }
+            Choice::Amd(order) => {
+                let inverse = inverse_permutation(&order)?;
+                Self::with_ordering(pattern, Some((&order, &inverse)), par)
+            }
+        }
     }
 
     /// [`Cholesky::new`] in the order `order` (a permutation of the rows) whose first
     /// `sides[0]` and next `sides[1]` rows are two sides no entry joins, the rest their
     /// separator: factored in the two sides at once ([`TwoDomains`]) where that works,
-    /// else as a whole in `order`. `spares` are blocks the factors may be stored in
-    /// ([`Factor::build`]).
+    /// else as a whole in `order`.
     pub(super) fn split(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: &[usize],
         sides: Option<[usize; 2]>,
         par: Par,
-        mut spares: [Option<Vec<T>>; 2],
     ) -> Result<Self, SolveError> {
         // The inverse also checks that the order is a permutation before either path.
         let inverse = inverse_permutation(order)?;
         if let Some(sides) = sides
-            && let Some(two) = TwoDomains::new(pattern, order, sides, std::mem::take(&mut spares))?
+            && let Some(two) = TwoDomains::new(pattern, order, sides)?
         {
             return Ok(Self::Halves(Box::new(two)));
         }
-        let [spare, _] = spares;
-        Ok(Self::Whole(Box::new(Factor::build(
-            pattern,
-            Some((order, &inverse)),
-            par,
-            spare,
-        )?)))
+        Self::with_ordering(pattern, Some((order, &inverse)), par)
     }
 
     /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
@@ -98,9 +89,7 @@ impl<T: Scalar> Cholesky<T> {
         order: Option<(&[usize], &[usize])>,
         par: Par,
     ) -> Result<Self, SolveError> {
-        Ok(Self::Whole(Box::new(Factor::build(
-            pattern, order, par, None,
-        )?)))
+        Ok(Self::Whole(Box::new(Factor::build(pattern, order, par)?)))
     }
 
     /// Numeric factorization of `matrix` (the pattern given at construction, lower
@@ -140,13 +129,14 @@ pub(super) struct Factor<T: Scalar> {
 
 impl<T: Scalar> Factor<T> {
     /// Symbolic analysis of `pattern` in the elimination order `order` (forward and
-    /// inverse arrays; AMD's when `None`), the factor's values stored in `spare` when it
-    /// is long enough.
+    /// inverse arrays; AMD's when `None`). The factor's storage is written now, so that
+    /// the kernel's first touch of its pages (which it clears) falls here, where a
+    /// caller may have planned it ([`PlannedCholesky`](super::PlannedCholesky)), rather
+    /// than in the first numeric factorization.
     pub(super) fn build(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: Option<(&[usize], &[usize])>,
         par: Par,
-        spare: Option<Vec<T>>,
     ) -> Result<Self, SolveError> {
         let ordering = match order {
             Some((forward, inverse)) => {
@@ -158,13 +148,11 @@ impl<T: Scalar> Factor<T> {
             factorize_symbolic_cholesky(pattern, Side::Lower, ordering, Default::default())?;
         let n = symbolic.nrows();
         let req = Self::scratch(&symbolic, 1, par);
-        let values = match spare {
-            Some(mut values) if values.len() >= symbolic.len_val() => {
-                values.truncate(symbolic.len_val());
-                values
-            }
-            _ => vec![T::from_f64(0.0); symbolic.len_val()],
-        };
+        let mut values = Vec::new();
+        values
+            .try_reserve_exact(symbolic.len_val())
+            .map_err(|_| FaerError::OutOfMemory)?;
+        values.resize(symbolic.len_val(), T::from_f64(0.0));
         Ok(Self {
             values,
             diagonal: vec![0.0; n],
@@ -391,59 +379,5 @@ impl<T: Scalar> Factor<T> {
             }
         }
         l
-    }
-}
-
-/// `len` zeros written one by one, so that every page of the block is touched now (a
-/// zero-filled allocation may be left to the kernel's lazy zero pages); `None` when the
-/// memory is not available, which only forgoes the early touch.
-pub(super) fn touched_zeros<T: Scalar>(len: usize) -> Option<Vec<T>> {
-    let mut values = Vec::new();
-    values.try_reserve_exact(len).ok()?;
-    values.resize(len, T::from_f64(0.0));
-    Some(values)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use faer::Mat;
-    use faer::sparse::{SparseColMat, Triplet};
-
-    /// The path graph's Laplacian plus the identity (lower triangle), `n x n`.
-    fn path_matrix(n: usize) -> SparseColMat<usize, f64> {
-        let mut triplets: Vec<_> = (0..n).map(|i| Triplet::new(i, i, 3.0)).collect();
-        triplets.extend((1..n).map(|i| Triplet::new(i, i - 1, -1.0)));
-        SparseColMat::try_new_from_triplets(n, n, &triplets).unwrap()
-    }
-
-    #[test]
-    fn a_spare_block_holds_the_factor_only_when_long_enough() {
-        let n = 50;
-        let m = path_matrix(n);
-        let expected = {
-            let mut fresh = Factor::<f64>::build(m.symbolic(), None, Par::Seq, None).unwrap();
-            fresh.factorize(m.as_ref(), 0.0).unwrap();
-            let mut x = Mat::from_fn(n, 1, |i, _| i as f64);
-            fresh.solve_in_place(x.as_mut()).unwrap();
-            x
-        };
-        let len = Factor::<f64>::build(m.symbolic(), None, Par::Seq, None)
-            .unwrap()
-            .values
-            .len();
-        // Whatever the spare holds (here not zeros), the factor is the same.
-        for spare_len in [len - 1, len, len + 7] {
-            let spare = vec![7.5; spare_len];
-            let spare_ptr = spare.as_ptr();
-            let mut cholesky =
-                Factor::<f64>::build(m.symbolic(), None, Par::Seq, Some(spare)).unwrap();
-            assert_eq!(cholesky.values.len(), len);
-            assert_eq!(cholesky.values.as_ptr() == spare_ptr, spare_len >= len);
-            cholesky.factorize(m.as_ref(), 0.0).unwrap();
-            let mut x = Mat::from_fn(n, 1, |i, _| i as f64);
-            cholesky.solve_in_place(x.as_mut()).unwrap();
-            assert!((&x - &expected).norm_max() < 1e-14);
-        }
     }
 }

@@ -295,8 +295,9 @@ impl<T: Scalar> NormalEquations<T> {
 /// nodes of one cell (the quadrature points of a face couple all its vertices), built
 /// without `A`: an entry `(c, d)`, `c >= d`, wherever reduced unknowns `c` and `d` are
 /// unknowns of nodes of one cell (a node's unknowns are those of its terms in `dofs`;
-/// a fixed node has none). Cheap enough to compute, with the order of the pattern, on
-/// another thread while `A` is assembled ([`super::LeastSquaresSolver::with_order`]).
+/// a fixed node has none). Cheap enough to compute, with the symbolic factorization of
+/// the pattern, on another thread while `A` is assembled
+/// ([`super::LeastSquaresSolver::with_planned`]).
 ///
 /// Errors: [`SolveError::Length`] for a node beyond `dofs`' nodes.
 pub fn normal_pattern_of_cells<T: Scalar, C: IntoIterator<Item = VertexId>>(

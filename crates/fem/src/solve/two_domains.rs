@@ -91,15 +91,13 @@ const SEPARATOR: u8 = 2;
 impl<T: Scalar> TwoDomains<T> {
     /// Symbolic phase for `pattern` (lower triangle read) in the nested-dissection order
     /// `order` whose first split has sides of `halves[0]` and `halves[1]` rows, the rest
-    /// being their separator; `spares` are blocks the sides' factors may be stored in
-    /// (see [`Factor::build`]). `None` when the split does not separate (an entry
-    /// joins the two sides), a side is empty, or a side's factorization would not
-    /// eliminate the separator last: the caller then factors the whole.
+    /// being their separator. `None` when the split does not separate (an entry joins
+    /// the two sides), a side is empty, or a side's factorization would not eliminate
+    /// the separator last: the caller then factors the whole.
     pub(super) fn new(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: &[usize],
         halves: [usize; 2],
-        spares: [Option<Vec<T>>; 2],
     ) -> Result<Option<Self>, SolveError> {
         let n = pattern.nrows();
         let [a, b] = halves;
@@ -123,13 +121,9 @@ impl<T: Scalar> TwoDomains<T> {
                 }
             }
         }
-        let [spare_a, spare_b] = spares;
-        let by_side =
-            |side, spare| SideFactor::new(pattern, order, &side_of, side, &separator_index, spare);
-        // One after the other: on a second thread the symbolic analysis took 4x as long
-        // (0.5-0.6 s against 0.13-0.17 s on the 1M-triangle disk's sides), its many
-        // fresh blocks cleared page by page, more than the two analyses in a row.
-        let (Some(side_a), Some(side_b)) = (by_side(0, spare_a)?, by_side(1, spare_b)?) else {
+        let by_side = |side| SideFactor::new(pattern, order, &side_of, side, &separator_index);
+        let (side_a, side_b) = both(|| by_side(0), || by_side(1));
+        let (Some(side_a), Some(side_b)) = (side_a?, side_b?) else {
             return Ok(None);
         };
         Ok(Some(Self {
@@ -257,7 +251,6 @@ impl<T: Scalar> SideFactor<T> {
         side_of: &[u8],
         side: u8,
         separator_index: &[usize],
-        spare: Option<Vec<T>>,
     ) -> Result<Option<Self>, SolveError> {
         let other = 1 - side;
         let n = pattern.nrows();
@@ -294,7 +287,7 @@ impl<T: Scalar> SideFactor<T> {
             .map(|&i| local[i])
             .collect();
         let inverse = inverse_permutation(&forward)?;
-        let factor = Factor::build(sub.as_ref(), Some((&forward, &inverse)), Par::Seq, spare)?;
+        let factor = Factor::build(sub.as_ref(), Some((&forward, &inverse)), Par::Seq)?;
         let mut separator_local: Vec<(usize, usize)> = rows
             .iter()
             .enumerate()
@@ -470,7 +463,7 @@ mod tests {
     fn split(m: &SparseColMat<usize, Complex64>) -> TwoDomains<Complex64> {
         let dissection = dissected(m.symbolic()).unwrap();
         let halves = dissection.halves.expect("a split");
-        TwoDomains::new(m.symbolic(), &dissection.order, halves, [None, None])
+        TwoDomains::new(m.symbolic(), &dissection.order, halves)
             .unwrap()
             .expect("the split separates")
     }
@@ -584,7 +577,7 @@ mod tests {
         // Rows in plain order cut after the first row of the grid: rows 0 and 20 are
         // joined by an edge, but 0 is on one side and 20 on the other.
         let order: Vec<usize> = (0..m.nrows()).collect();
-        let two = TwoDomains::<Complex64>::new(m.symbolic(), &order, [20, 20], [None, None]);
+        let two = TwoDomains::<Complex64>::new(m.symbolic(), &order, [20, 20]);
         assert!(two.unwrap().is_none());
     }
 }
