@@ -2,11 +2,11 @@
 
 mod cli;
 #[cfg(target_os = "linux")]
-mod huge_pages;
+mod large_blocks;
 
 #[cfg(target_os = "linux")]
 #[global_allocator]
-static ALLOCATOR: huge_pages::HugePages = huge_pages::HugePages;
+static ALLOCATOR: large_blocks::LargeBlocks = large_blocks::LargeBlocks;
 
 use std::process::ExitCode;
 
