@@ -267,9 +267,8 @@ unsafe impl GlobalAlloc for LargeBlocks {
                 }
                 // SAFETY: the block is this module's mapping of `old_len` bytes; mremap
                 // keeps its contents, and on failure the block as it was.
-                let moved = unsafe {
-                    libc::mremap(ptr.cast(), old_len, new_len, libc::MREMAP_MAYMOVE)
-                };
+                let moved =
+                    unsafe { libc::mremap(ptr.cast(), old_len, new_len, libc::MREMAP_MAYMOVE) };
                 if moved == libc::MAP_FAILED {
                     return std::ptr::null_mut();
                 }
