@@ -89,7 +89,18 @@ impl<T: Scalar> Cholesky<T> {
         order: Option<(&[usize], &[usize])>,
         par: Par,
     ) -> Result<Self, SolveError> {
-        Ok(Self::Whole(Box::new(Factor::build(pattern, order, par)?)))
+        let ordering = match order {
+            Some((forward, inverse)) => {
+                SymmetricOrdering::Custom(PermRef::new_checked(forward, inverse, pattern.nrows()))
+            }
+            None => SymmetricOrdering::Amd,
+        };
+        Ok(Self::Whole(Box::new(Factor::build(
+            pattern,
+            Side::Lower,
+            ordering,
+            par,
+        )?)))
     }
 
     /// Numeric factorization of `matrix` (the pattern given at construction, lower
@@ -128,24 +139,21 @@ pub(super) struct Factor<T: Scalar> {
 }
 
 impl<T: Scalar> Factor<T> {
-    /// Symbolic analysis of `pattern` in the elimination order `order` (forward and
-    /// inverse arrays; AMD's when `None`). The factor's storage is written now, so that
+    /// Symbolic analysis of `pattern` in the elimination order `ordering` (AMD's,
+    /// the rows as numbered, or given), of which `pattern` holds the triangle `side`:
+    /// the matrices factored give their lower triangle, but faer analyses the pattern
+    /// as numbered (`SymmetricOrdering::Identity`) only from its upper triangle. The
+    /// factor's storage is written now, so that
     /// the kernel's first touch of its pages (which it clears) falls here, where a
     /// caller may have planned it ([`PlannedCholesky`](super::PlannedCholesky)), rather
     /// than in the first numeric factorization.
     pub(super) fn build(
         pattern: SymbolicSparseColMatRef<'_, usize>,
-        order: Option<(&[usize], &[usize])>,
+        side: Side,
+        ordering: SymmetricOrdering<'_, usize>,
         par: Par,
     ) -> Result<Self, SolveError> {
-        let ordering = match order {
-            Some((forward, inverse)) => {
-                SymmetricOrdering::Custom(PermRef::new_checked(forward, inverse, pattern.nrows()))
-            }
-            None => SymmetricOrdering::Amd,
-        };
-        let symbolic =
-            factorize_symbolic_cholesky(pattern, Side::Lower, ordering, Default::default())?;
+        let symbolic = factorize_symbolic_cholesky(pattern, side, ordering, Default::default())?;
         let n = symbolic.nrows();
         let req = Self::scratch(&symbolic, 1, par);
         let mut values = Vec::new();

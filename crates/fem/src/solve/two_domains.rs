@@ -41,11 +41,11 @@
 
 use super::SolveError;
 use super::cholesky::{Factor, FactorFailure};
-use super::inverse_permutation;
 use crate::dof::Scalar;
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::{Llt, Solve};
+use faer::sparse::linalg::cholesky::SymmetricOrdering;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 
@@ -64,17 +64,19 @@ pub(super) struct TwoDomains<T: Scalar> {
     schur: Option<Llt<T>>,
 }
 
-/// One side's submatrix `M_A`, numbered by increasing row of `M` (so that the lower
-/// triangle of `M` stays the lower triangle), and its factorization.
+/// One side's submatrix `M_A`, numbered in the elimination order (the side's rows,
+/// then the separator's), and its factorization.
 struct SideFactor<T: Scalar> {
-    /// The row of `M` of each local row (the side's and the separator's, increasing).
+    /// The row of `M` of each local row (the side's, then the separator's, in the
+    /// elimination order).
     rows: Vec<usize>,
     /// The row of `M` of each of the side's own rows, in elimination order: the side's
     /// factor eliminates these first, then the separator in its own numbering.
     own_in_order: Vec<usize>,
     pattern: SymbolicSparseColMat<usize>,
-    /// For each stored value of `M_A`, its position among the values of `M`.
-    source: Vec<usize>,
+    /// For each stored value of `M_A`, its position among the values of `M` and whether
+    /// it is that value's conjugate (read above the diagonal in this numbering).
+    source: Vec<(usize, bool)>,
     values: Vec<T>,
     factor: Factor<T>,
     /// `L_A`, the factor's last `|S|` rows and columns (lower triangular, separator
@@ -245,6 +247,11 @@ impl<T: Scalar> SideFactor<T> {
     /// factorization in `order` restricted to it (one thread); `None` when an entry of
     /// `pattern` joins the two sides or the factorization would not eliminate the
     /// separator last, in its own order.
+    ///
+    /// The submatrix is stored numbered in that order (its lower triangle: an entry of
+    /// `M`'s lower triangle that falls above the diagonal there is stored conjugated at
+    /// the mirror position), so that faer factors it as numbered and its numeric phase
+    /// reads the values as they are instead of permuting a copy at every factorization.
     fn new(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: &[usize],
@@ -254,15 +261,20 @@ impl<T: Scalar> SideFactor<T> {
     ) -> Result<Option<Self>, SolveError> {
         let other = 1 - side;
         let n = pattern.nrows();
-        let rows: Vec<usize> = (0..n).filter(|&i| side_of[i] != other).collect();
+        // The global order lists this side's rows, then the separator's.
+        let rows: Vec<usize> = order
+            .iter()
+            .copied()
+            .filter(|&i| side_of[i] != other)
+            .collect();
         let mut local = vec![usize::MAX; n];
         for (l, &i) in rows.iter().enumerate() {
             local[i] = l;
         }
-        let mut col_ptr = Vec::with_capacity(rows.len() + 1);
-        let mut row_idx = Vec::new();
-        let mut source = Vec::new();
-        col_ptr.push(0);
+        let m = rows.len();
+        // The entries (column, row, position among M's values, conjugated) of the lower
+        // triangle in the local numbering, placed column by column.
+        let mut entries = Vec::new();
         for &j in &rows {
             for p in pattern.col_range(j) {
                 let i = pattern.row_idx()[p];
@@ -273,35 +285,56 @@ impl<T: Scalar> SideFactor<T> {
                     // An entry of the other side's block of a separator column.
                     continue;
                 }
-                row_idx.push(local[i]);
-                source.push(p);
+                if i < j {
+                    // Above M's diagonal: not read.
+                    continue;
+                }
+                let (a, b) = (local[i], local[j]);
+                entries.push(if a >= b {
+                    (b, a, p, false)
+                } else {
+                    (a, b, p, true)
+                });
             }
-            col_ptr.push(row_idx.len());
         }
-        let m = rows.len();
+        let mut col_ptr = vec![0usize; m + 1];
+        for &(c, ..) in &entries {
+            col_ptr[c + 1] += 1;
+        }
+        for c in 0..m {
+            col_ptr[c + 1] += col_ptr[c];
+        }
+        let mut next = col_ptr[..m].to_vec();
+        let mut cells = vec![(0usize, 0usize, false); entries.len()];
+        for (c, r, p, conjugated) in entries {
+            cells[next[c]] = (r, p, conjugated);
+            next[c] += 1;
+        }
+        for c in 0..m {
+            cells[col_ptr[c]..col_ptr[c + 1]].sort_unstable_by_key(|&(r, ..)| r);
+        }
+        let row_idx = cells.iter().map(|&(r, ..)| r).collect();
+        let source: Vec<(usize, bool)> = cells
+            .iter()
+            .map(|&(_, p, conjugated)| (p, conjugated))
+            .collect();
         let sub = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
-        // The global order lists this side's rows, then the separator's.
-        let forward: Vec<usize> = order
-            .iter()
-            .filter(|&&i| side_of[i] != other)
-            .map(|&i| local[i])
-            .collect();
-        let inverse = inverse_permutation(&forward)?;
-        let factor = Factor::build(sub.as_ref(), Some((&forward, &inverse)), Par::Seq)?;
-        let mut separator_local: Vec<(usize, usize)> = rows
-            .iter()
-            .enumerate()
-            .filter(|&(_, &i)| side_of[i] != side)
-            .map(|(l, &i)| (separator_index[i], l))
-            .collect();
-        separator_local.sort_unstable();
-        let s = separator_local.len();
+        let upper = sub.as_ref().transpose().to_col_major()?;
+        let factor = Factor::build(
+            upper.as_ref(),
+            Side::Upper,
+            SymmetricOrdering::Identity,
+            Par::Seq,
+        )?;
+        drop(upper);
+        let s = rows.iter().filter(|&&i| side_of[i] != side).count();
         let first = m - s;
-        if separator_local
-            .iter()
-            .enumerate()
-            .any(|(r, &(_, l))| factor.eliminated(first + r) != l)
-        {
+        // The separator comes last in `order`, in its own numbering; faer must keep it
+        // there.
+        if (0..s).any(|r| {
+            let l = factor.eliminated(first + r);
+            l >= m || side_of[rows[l]] == side || separator_index[rows[l]] != r
+        }) {
             return Ok(None);
         }
         let own_in_order = (0..first).map(|k| rows[factor.eliminated(k)]).collect();
@@ -320,8 +353,12 @@ impl<T: Scalar> SideFactor<T> {
     /// Factors `M_A` from the values of `M`, then forms `T_A = L_A L_A^H` from the
     /// factor's last `|S|` columns (the separator, in its own order).
     fn factorize(&mut self, values: &[T], tolerance: f64) -> Result<(), FactorFailure> {
-        for (v, &p) in self.values.iter_mut().zip(&self.source) {
-            *v = values[p];
+        for (v, &(p, conjugated)) in self.values.iter_mut().zip(&self.source) {
+            *v = if conjugated {
+                values[p].conjugate()
+            } else {
+                values[p]
+            };
         }
         let matrix = SparseColMatRef::new(self.pattern.as_ref(), &self.values);
         let rows = &self.rows;
