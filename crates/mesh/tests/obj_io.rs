@@ -462,3 +462,21 @@ fn failed_writes_leave_no_file_and_keep_an_existing_one() {
         .collect();
     assert_eq!(names, vec![std::ffi::OsString::from("existing.obj")]);
 }
+
+#[test]
+fn a_group_line_after_faces_leaves_the_numbering_and_the_faces_as_they_were() {
+    // Read as it is until the `o` line; from there the reader copies the lines it keeps.
+    let plain = "# a comment\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n\nv 1 1 0\nf 2 4 3\n";
+    let grouped =
+        "# a comment\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\no second\nv 1 1 0\ng g\nf 2 4 3\n";
+    let dir = tempfile::tempdir().unwrap();
+    let read = |name: &str, text: &str| obj::read(&write_file(dir.path(), name, text)).unwrap();
+    let (a, b) = (read("plain.obj", plain), read("grouped.obj", grouped));
+    assert_eq!(a.soup.positions, v_lines(plain));
+    assert_eq!(b.soup.positions, a.soup.positions);
+    let faces = |raw: &io::RawMesh| raw.soup.faces().map(<[u32]>::to_vec).collect::<Vec<_>>();
+    assert_eq!(faces(&a), vec![vec![0, 1, 2], vec![1, 3, 2]]);
+    assert_eq!(faces(&b), faces(&a));
+    assert_eq!(a.face_lines, Some(vec![5, 8]));
+    assert_eq!(b.face_lines, Some(vec![5, 9]));
+}

@@ -10,12 +10,14 @@
 //! `tobj` numbers vertices in the order faces first use them, and starts a new index
 //! space at every `o`/`g`/`usemtl` line. To keep the file's own numbering, the reader
 //! drops those lines and puts in front of the file a single face that lists every `v` in
-//! order: first use is then file order. That face is removed from the result.
+//! order: first use is then file order. That face is removed from the result. A file
+//! with nothing to drop (only `v`, `vt`, `f`, blank lines and comments) reaches tobj
+//! behind that face without being copied.
 //!
 //! Positions are read as `f64` (tobj's `use_f64` feature). Texture coordinates are kept
 //! per face corner when every face corner names one.
 
-use std::io::Write as _;
+use std::io::{Read as _, Write as _};
 use std::path::Path;
 
 use nalgebra::{Point3, Vector2};
@@ -35,8 +37,12 @@ pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
 
 /// What the first pass over the file found.
 struct Prepared {
-    /// The lines tobj should see, behind the face that lists every vertex.
-    text: Vec<u8>,
+    /// The face that lists every vertex, which tobj reads first.
+    prefix: Vec<u8>,
+    /// The lines tobj should read after the prefix, when the file has lines to leave
+    /// out (anything but `v`, `vt`, `f`, blank lines and comments); `None` when tobj
+    /// can read the file as it is.
+    kept: Option<Vec<u8>>,
     vertex_count: usize,
     /// 1-based line of every face.
     face_lines: Vec<u32>,
@@ -73,27 +79,35 @@ fn corner_has_uv(token: &[u8]) -> bool {
     parts.next().is_some_and(|vt| !vt.is_empty())
 }
 
-fn prepare(bytes: &[u8]) -> Prepared {
-    let vertex_count = bytes
-        .split(|&c| c == b'\n')
-        .filter(|l| first_token(l) == b"v")
-        .count();
-    let mut text = Vec::with_capacity(bytes.len() + 8 * vertex_count + 8);
-    if vertex_count > 0 {
-        text.push(b'f');
-        for i in 1..=vertex_count {
-            text.push(b' ');
-            text.extend_from_slice(i.to_string().as_bytes());
+/// The face `f 1 2 ... n` listing `n` vertices (nothing for none).
+fn listing_face(n: usize) -> Vec<u8> {
+    let mut face = Vec::with_capacity(8 * n + 2);
+    if n > 0 {
+        face.push(b'f');
+        for i in 1..=n {
+            face.push(b' ');
+            face.extend_from_slice(i.to_string().as_bytes());
         }
-        text.push(b'\n');
+        face.push(b'\n');
     }
+    face
+}
+
+fn prepare(bytes: &[u8]) -> Prepared {
+    let mut vertex_count = 0;
+    let mut kept: Option<Vec<u8>> = None;
     let mut face_lines = Vec::new();
     let mut all_corners_have_uv = true;
     let mut non_finite_uv = None;
     let mut texcoords = 0usize;
+    let mut start = 0;
     for (i, line) in bytes.split(|&c| c == b'\n').enumerate() {
-        let keep = match first_token(line) {
-            b"v" => true,
+        let token = first_token(line);
+        let keep = match token {
+            b"v" => {
+                vertex_count += 1;
+                true
+            }
             b"vt" => {
                 if let Some((u, v)) = texcoord(line)
                     && !(u.is_finite() && v.is_finite())
@@ -116,13 +130,20 @@ fn prepare(bytes: &[u8]) -> Prepared {
             }
             _ => false,
         };
-        if keep {
-            text.extend_from_slice(line);
-            text.push(b'\n');
+        if let Some(text) = &mut kept {
+            if keep {
+                text.extend_from_slice(line);
+                text.push(b'\n');
+            }
+        } else if !keep && !token.is_empty() && !token.starts_with(b"#") {
+            // The first line tobj must not see: from here on the lines are copied.
+            kept = Some(bytes[..start].to_vec());
         }
+        start += line.len() + 1;
     }
     Prepared {
-        text,
+        prefix: listing_face(vertex_count),
+        kept,
         vertex_count,
         face_lines,
         all_corners_have_uv,
@@ -149,9 +170,12 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
         ignore_points: false,
         ignore_lines: false,
     };
-    let loaded = tobj::load_obj_buf(&mut prepared.text.as_slice(), &options, |_| {
-        Ok(Default::default())
-    });
+    let body = prepared.kept.as_deref().unwrap_or(bytes);
+    let loaded = tobj::load_obj_buf(
+        &mut prepared.prefix.as_slice().chain(body),
+        &options,
+        |_| Ok(Default::default()),
+    );
     let models = match loaded {
         Ok((models, _)) => models,
         Err(e) => return Err(locate_tobj_error(path, bytes, e, &prepared)),
