@@ -70,11 +70,7 @@ struct Kept {
     bytes: usize,
 }
 
-static KEPT: Mutex<Kept> = Mutex::new(Kept {
-    ranges: [Range { start: 0, len: 0 }; KEEP_BLOCKS],
-    count: 0,
-    bytes: 0,
-});
+static KEPT: Mutex<Kept> = Mutex::new(Kept::EMPTY);
 
 /// The kept ranges (nothing panics while they are locked, so a poisoned lock is only
 /// another thread's panic elsewhere).
@@ -83,6 +79,13 @@ fn kept() -> MutexGuard<'static, Kept> {
 }
 
 impl Kept {
+    /// No range kept.
+    const EMPTY: Kept = Kept {
+        ranges: [Range { start: 0, len: 0 }; KEEP_BLOCKS],
+        count: 0,
+        bytes: 0,
+    };
+
     /// Keeps `range` if the limits allow; whether it was kept.
     fn keep(&mut self, range: Range) -> bool {
         if self.count == KEEP_BLOCKS || self.bytes + range.len > KEEP_BYTES {
@@ -330,11 +333,7 @@ mod tests {
 
     #[test]
     fn a_request_takes_the_head_of_the_smallest_range_that_holds_it() {
-        let mut kept = Kept {
-            ranges: [range(0, 0); KEEP_BLOCKS],
-            count: 0,
-            bytes: 0,
-        };
+        let mut kept = Kept::EMPTY;
         assert_eq!(kept.take(HUGE), None);
         for r in [range(1 << 40, 8), range(2 << 40, 3), range(3 << 40, 5)] {
             assert!(kept.keep(r));
@@ -354,11 +353,7 @@ mod tests {
 
     #[test]
     fn kept_ranges_stay_within_the_limits() {
-        let mut kept = Kept {
-            ranges: [range(0, 0); KEEP_BLOCKS],
-            count: 0,
-            bytes: 0,
-        };
+        let mut kept = Kept::EMPTY;
         assert!(!kept.keep(Range {
             start: 0,
             len: KEEP_BYTES + HUGE
