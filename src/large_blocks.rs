@@ -163,6 +163,24 @@ fn map(len: usize) -> *mut u8 {
     ptr
 }
 
+/// The mapping of `old_len` bytes at `ptr` resized to `new_len` bytes (moved if need
+/// be, contents kept) and advised; null when the kernel refuses, the mapping then left
+/// as it was.
+///
+/// # Safety
+/// `ptr..ptr + old_len` is a mapping of this module that nothing else refers to.
+unsafe fn remap(ptr: *mut u8, old_len: usize, new_len: usize) -> *mut u8 {
+    // SAFETY: the caller's contract; mremap moves page tables only.
+    let moved = unsafe { libc::mremap(ptr.cast(), old_len, new_len, libc::MREMAP_MAYMOVE) };
+    if moved == libc::MAP_FAILED {
+        return std::ptr::null_mut();
+    }
+    let moved = moved.cast::<u8>();
+    // SAFETY: `moved..moved + new_len` is now mapped.
+    unsafe { advise(moved, new_len) };
+    moved
+}
+
 /// `len` bytes from a kept range, when one is kept: the start and how many of the
 /// first bytes may hold old contents (a grown range's new pages are zeros).
 fn reuse(len: usize) -> Option<(*mut u8, usize)> {
@@ -171,22 +189,12 @@ fn reuse(len: usize) -> Option<(*mut u8, usize)> {
         Reuse::Head(start) => Some((start as *mut u8, len)),
         Reuse::Grow(range) => {
             // SAFETY: the range was mapped here and freed; nothing else refers to it.
-            let moved = unsafe {
-                libc::mremap(
-                    range.start as *mut libc::c_void,
-                    range.len,
-                    len,
-                    libc::MREMAP_MAYMOVE,
-                )
-            };
-            if moved == libc::MAP_FAILED {
+            let moved = unsafe { remap(range.start as *mut u8, range.len, len) };
+            if moved.is_null() {
                 // SAFETY: as above; a failed mremap leaves the range mapped.
                 unsafe { libc::munmap(range.start as *mut libc::c_void, range.len) };
                 return None;
             }
-            let moved = moved.cast::<u8>();
-            // SAFETY: `moved..moved + len` is now mapped.
-            unsafe { advise(moved, len) };
             Some((moved, range.len))
         }
     }
@@ -268,17 +276,9 @@ unsafe impl GlobalAlloc for LargeBlocks {
                 if old_len == new_len {
                     return ptr;
                 }
-                // SAFETY: the block is this module's mapping of `old_len` bytes; mremap
-                // keeps its contents, and on failure the block as it was.
-                let moved =
-                    unsafe { libc::mremap(ptr.cast(), old_len, new_len, libc::MREMAP_MAYMOVE) };
-                if moved == libc::MAP_FAILED {
-                    return std::ptr::null_mut();
-                }
-                let moved = moved.cast::<u8>();
-                // SAFETY: `moved..moved + new_len` is now mapped.
-                unsafe { advise(moved, new_len) };
-                moved
+                // SAFETY: the block is this module's mapping of `old_len` bytes, owned by
+                // the caller; on failure it stays as it was (realloc's contract).
+                unsafe { remap(ptr, old_len, new_len) }
             }
             // Crossing the threshold changes who holds the block: move it.
             // SAFETY: `new_layout` has a non-zero size (realloc's contract) and the old
