@@ -217,6 +217,15 @@ impl Mesh {
             ..self.clone()
         })
     }
+    /// The same mesh with other input maps (a renumbering's composed ones).
+    pub(crate) fn with_input_maps(self, vertex_map: VertexMap, face_to_input: Vec<u32>) -> Mesh {
+        Mesh {
+            vertex_map,
+            face_to_input,
+            ..self
+        }
+    }
+
     /// The map between input vertex indices and mesh vertices.
     pub fn vertex_map(&self) -> &VertexMap {
         &self.vertex_map

@@ -47,6 +47,26 @@ impl VertexMap {
         }
     }
 
+    /// The map of the same input onto the mesh vertices renumbered by `old_vertex[new]`
+    /// (and its inverse `new_vertex[old]`).
+    pub(crate) fn renumbered(&self, old_vertex: &[VertexId], new_vertex: &[VertexId]) -> Self {
+        Self {
+            to_input: old_vertex.iter().map(|v| self.to_input[v.idx()]).collect(),
+            from_input: self
+                .from_input
+                .iter()
+                .map(|&v| {
+                    if v == NONE {
+                        NONE
+                    } else {
+                        new_vertex[v as usize].0
+                    }
+                })
+                .collect(),
+            unreferenced: self.unreferenced.clone(),
+        }
+    }
+
     /// Number of vertices in the input.
     pub fn input_len(&self) -> usize {
         self.from_input.len()

@@ -45,6 +45,7 @@ mod modulus;
 mod param;
 mod polygon;
 mod projection;
+mod renumbered;
 mod routing;
 mod skeleton;
 mod solver;

@@ -10,6 +10,7 @@ use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::compose::flipped_faces;
+use crate::renumbered::{Renumbered, SCATTERED_SPREAD};
 use crate::{Landmark, LandmarkTarget, RegisterError, check_topology, initial_map};
 
 /// Surface registration: the initial bijection of [`initial_map`] (through a common
@@ -22,6 +23,11 @@ use crate::{Landmark, LandmarkTarget, RegisterError, check_topology, initial_map
 /// fixed, sliding between), and the flow's options. The map is `Map::OnMesh`. The
 /// metrics have the initial map's `|mu|` statistics and the flow's history; the notes
 /// the loops cut along and the alignment.
+///
+/// A mesh whose vertices are numbered in scattered order (median index spread of a
+/// face above 4096) is registered as a breadth-first renumbered copy, for cache
+/// locality, and the result carried back: maps, fields and messages are in the given
+/// meshes' numbering.
 ///
 /// A registration promises a bijection: when flipped faces remain after the flow and
 /// its untangling, the solve fails with [`RegisterError::Flipped`] naming them and
@@ -54,6 +60,14 @@ static OPTIONS: LazyLock<Vec<OptionSpec>> = LazyLock::new(|| {
     });
     options
 });
+
+/// A registration error as a solver error.
+fn plugin(error: RegisterError) -> SolverError {
+    SolverError::Plugin {
+        solver: NAME,
+        error: Box::new(error),
+    }
+}
 
 /// Most flipped faces named in an error or a note.
 const NAMED_FLIPS: usize = 10;
@@ -205,43 +219,58 @@ impl Solver for Register {
         let Target::Mesh(target) = &problem.target else {
             return Err(unsupported("register maps onto a target mesh"));
         };
-        let source = problem.source;
-        let marks = landmarks(problem)?;
-        let mut report = Report::new(NAME);
-        let initial = context.stage("initial map", &mut report, || {
-            initial_map(source, target, &marks).map_err(|e| SolverError::Plugin {
-                solver: NAME,
-                error: Box::new(e),
-            })
-        })?;
-        report.notes.extend(initial.notes.iter().cloned());
-        let mut flow = problem.clone();
-        flow.initial = Some(Map::OnMesh(initial.points));
-        let mut solution =
-            beltrami_flow_engine::solve(&flow, settings, initial.positions, report, context)?;
-        // Judged against the target's normals at the images (the rule of `beltrami
-        // distortion --target` and of the flow), when the initial map was built.
-        solution.metrics.initial_distortion = Some(initial.distortion);
-        solution.metrics.teichmueller_bound = initial.teichmueller_bound;
-        if solution.metrics.flipped().unwrap_or(0) > 0
-            && let Some(Map::OnMesh(points)) = solution.map().cloned()
-        {
-            let plugin = |error: RegisterError| SolverError::Plugin {
-                solver: NAME,
-                error: Box::new(error),
-            };
-            let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
-            let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
-            judge_flips(
-                source,
-                &index,
-                &points,
-                &positions,
-                settings.flag("allow-flips"),
-                &mut solution.report,
-            )
-            .map_err(plugin)?;
-        }
-        Ok(solution)
+        let Some(renumbered) =
+            Renumbered::new(problem, target, SCATTERED_SPREAD).map_err(plugin)?
+        else {
+            return register(problem, settings, context);
+        };
+        let mut solution = register(&renumbered.problem(problem, target), settings, context)?;
+        solution
+            .report
+            .notes
+            .insert(0, renumbered.note(problem, target));
+        Ok(renumbered.solution_to_old(solution))
     }
+}
+
+/// The registration of `problem`, in the numbering of its meshes ([`Register`]).
+pub(crate) fn register(
+    problem: &Problem<'_>,
+    settings: &Settings,
+    context: &mut Context<'_>,
+) -> Result<Solution, SolverError> {
+    let Target::Mesh(target) = problem.target else {
+        return Err(unsupported("register maps onto a target mesh"));
+    };
+    let source = problem.source;
+    let marks = landmarks(problem)?;
+    let mut report = Report::new(NAME);
+    let initial = context.stage("initial map", &mut report, || {
+        initial_map(source, target, &marks).map_err(plugin)
+    })?;
+    report.notes.extend(initial.notes.iter().cloned());
+    let mut flow = problem.clone();
+    flow.initial = Some(Map::OnMesh(initial.points));
+    let mut solution =
+        beltrami_flow_engine::solve(&flow, settings, initial.positions, report, context)?;
+    // Judged against the target's normals at the images (the rule of `beltrami
+    // distortion --target` and of the flow), when the initial map was built.
+    solution.metrics.initial_distortion = Some(initial.distortion);
+    solution.metrics.teichmueller_bound = initial.teichmueller_bound;
+    if solution.metrics.flipped().unwrap_or(0) > 0
+        && let Some(Map::OnMesh(points)) = solution.map().cloned()
+    {
+        let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
+        let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
+        judge_flips(
+            source,
+            &index,
+            &points,
+            &positions,
+            settings.flag("allow-flips"),
+            &mut solution.report,
+        )
+        .map_err(plugin)?;
+    }
+    Ok(solution)
 }
