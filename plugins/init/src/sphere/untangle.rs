@@ -50,10 +50,16 @@ pub(super) fn untangle(
     image: &mut [Point3<f64>],
     options: SolveOptions,
 ) -> Result<Untangled, SolveError> {
+    // Each patch solve moves its neighbours' images, so the outcome depends on the
+    // order: taken by input index, it does not depend on how the mesh was numbered
+    // (a registration renumbers scattered meshes).
     let flipped = |image: &[Point3<f64>]| -> Vec<FaceId> {
-        mesh.faces()
+        let mut faces: Vec<FaceId> = mesh
+            .faces()
             .filter(|&f| is_inward(mesh, image, f))
-            .collect()
+            .collect();
+        faces.sort_by_key(|&f| mesh.face_to_input(f));
+        faces
     };
     let mut result = Untangled::default();
     let mut remaining = flipped(image);
