@@ -299,7 +299,8 @@ impl Elements {
         frame: Frame,
         corners: impl Fn(FaceId, &[Point3<f64>; 4], usize) -> Result<[Point3<f64>; 4], FemError>,
     ) -> Result<Self, FemError> {
-        let mut points = Vec::with_capacity(mesh.face_count() * 4);
+        // One point per triangle, four per quad (`reference_rule`).
+        let mut points = Vec::with_capacity(mesh.triangle_count() + 4 * mesh.quad_count());
         let mut offsets = Vec::with_capacity(mesh.face_count() + 1);
         let mut nodes = Vec::with_capacity(mesh.face_count());
         let mut degree = Vec::with_capacity(mesh.face_count());
