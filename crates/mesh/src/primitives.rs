@@ -201,6 +201,35 @@ fn split_triangles(
     next
 }
 
+/// `soup` with its vertices renumbered `i -> s i mod n` (`n` vertices, `s` the first
+/// integer from `0.618 n` prime to `n`: steps of the golden ratio's share spread
+/// consecutive indices evenly over the range): the same surface with neighbouring
+/// vertices far apart in the numbering, as in the files of many scanned meshes; for
+/// tests of numbering independence ([`crate::renumber`]).
+pub fn scattered(soup: &PolygonSoup) -> PolygonSoup {
+    let n = soup.vertex_count();
+    let gcd = |mut a: usize, mut b: usize| {
+        while b != 0 {
+            (a, b) = (b, a % b);
+        }
+        a
+    };
+    let start = (0.618 * n as f64).round() as usize;
+    let stride = (start.max(1)..).find(|&s| gcd(s, n) == 1).unwrap_or(1);
+    let place: Vec<u32> = (0..n).map(|i| ((stride * i) % n.max(1)) as u32).collect();
+    let mut positions = soup.positions.clone();
+    for (i, p) in soup.positions.iter().enumerate() {
+        positions[place[i] as usize] = *p;
+    }
+    let mut out = PolygonSoup::new(positions);
+    out.reserve(soup.face_count(), soup.faces().map(<[u32]>::len).sum());
+    for face in soup.faces() {
+        let corners: Vec<u32> = face.iter().map(|&v| place[v as usize]).collect();
+        out.push_face(&corners);
+    }
+    out
+}
+
 /// The square `[-1, 1]^2` of Wong-Zhao's Table 5.3 in the plane z = 0: [`grid`] with `n`
 /// by `n` cells split into triangles, scaled and centred (vertex `i + (n + 1) j` at
 /// `(2 i / n - 1, 2 j / n - 1)`).

@@ -191,31 +191,17 @@ pub fn index_spread(mesh: &Mesh) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::primitives::{Cells, grid, torus};
+    use crate::primitives::{Cells, grid, scattered, torus};
     use crate::{BoundaryLoopId, SurfacePoint};
     use nalgebra::{Point3, Vector3};
 
-    /// `soup` with its vertices listed in a scattered order (a fixed permutation that
-    /// sends neighbours far apart) and one unreferenced vertex in front.
-    fn scattered(soup: &PolygonSoup) -> PolygonSoup {
-        let n = soup.vertex_count();
-        // 7919 is prime to every count used here, so `i -> 7919 i mod n` permutes.
-        let place: Vec<u32> = (0..n).map(|i| (1 + (7919 * i) % n) as u32).collect();
-        let mut positions = vec![Point3::new(9.0, 9.0, 9.0); n + 1];
-        for (i, p) in soup.positions.iter().enumerate() {
-            positions[place[i] as usize] = *p;
-        }
-        let mut out = PolygonSoup::new(positions);
-        for face in soup.faces() {
-            let corners: Vec<u32> = face.iter().map(|&v| place[v as usize]).collect();
-            out.push_face(&corners);
-        }
-        out
-    }
-
     #[test]
     fn a_scattered_grid_comes_back_compact_with_its_faces_and_input_indices() {
-        let mesh = Mesh::from_soup(&scattered(&grid(40, 30, Cells::Triangles))).unwrap();
+        let mut soup = scattered(&grid(40, 30, Cells::Triangles));
+        // An unreferenced input vertex, last.
+        let unreferenced = soup.vertex_count();
+        soup.positions.push(Point3::new(9.0, 9.0, 9.0));
+        let mesh = Mesh::from_soup(&soup).unwrap();
         let (renumbered, numbering) = renumber_breadth_first(&mesh).unwrap();
         let (before, after) = (index_spread(&mesh), index_spread(&renumbered));
         assert!(before > 300, "scattered spread {before}");
@@ -249,8 +235,7 @@ mod tests {
             assert_eq!(map.to_input(v), old_map.to_input(old));
             assert_eq!(map.from_input(map.to_input(v)), Some(v));
         }
-        // The unreferenced input vertex 0 stays unreferenced and listed.
-        assert_eq!(map.from_input(0), None);
+        assert_eq!(map.from_input(unreferenced), None);
         assert_eq!(map.unreferenced(), old_map.unreferenced());
         assert!(map.is_order_preserving());
         let ids: Vec<usize> = mesh.vertices().map(|v| v.idx()).collect();
@@ -316,6 +301,29 @@ mod tests {
         for (lo, hi, count) in stretch {
             assert_eq!((hi - lo + 1) as usize, count, "one stretch of ids");
         }
+    }
+
+    #[test]
+    fn a_scattered_soup_is_the_same_surface_renumbered() {
+        // 7919 vertices (a prime count: any stride below it permutes them).
+        let positions: Vec<Point3<f64>> = (0..7919)
+            .map(|i| Point3::new(i as f64, (i % 7) as f64, 0.0))
+            .collect();
+        let mut soup = PolygonSoup::new(positions.clone());
+        soup.push_face(&[0, 1, 2]);
+        soup.push_face(&[7918, 5, 3]);
+        let out = scattered(&soup);
+        let mut seen = vec![false; 7919];
+        for p in &out.positions {
+            let i = p.x as usize;
+            assert!(!std::mem::replace(&mut seen[i], true), "vertex {i} twice");
+        }
+        for (face, moved) in soup.faces().zip(out.faces()) {
+            for (&v, &w) in face.iter().zip(moved) {
+                assert_eq!(out.positions[w as usize], positions[v as usize]);
+            }
+        }
+        assert_ne!(out.faces().next(), soup.faces().next());
     }
 
     #[test]
