@@ -75,6 +75,7 @@ mod map;
 mod options;
 mod problem;
 mod registry;
+mod renumbered;
 mod report;
 mod solution;
 mod solver;
@@ -90,6 +91,7 @@ pub use map::{Map, SurfacePoint};
 pub use options::{OptionError, OptionKind, OptionSpec, OptionValue, Options, Settings, THREADS};
 pub use problem::{Goal, PlanarBoundary, Position, Problem, Target};
 pub use registry::Registry;
+pub use renumbered::{Renumbered, SCATTERED_SPREAD, solve_renumbered};
 pub use report::Report;
 pub use solution::{
     AnnulusRadius, Circle, Extras, Metrics, Output, QuadraticDifferential, Remeshed, Solution, Stop,

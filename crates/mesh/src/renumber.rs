@@ -147,6 +147,16 @@ impl Renumbering {
             .collect()
     }
 
+    /// Values by old vertex id put in new order. Panics unless there is one value per
+    /// vertex.
+    pub fn vertex_values_to_new<T: Clone>(&self, values: &[T]) -> Vec<T> {
+        assert_eq!(values.len(), self.old_vertex.len(), "one value per vertex");
+        self.old_vertex
+            .iter()
+            .map(|v| values[v.idx()].clone())
+            .collect()
+    }
+
     /// Values by old face id put in new order. Panics unless there is one value per
     /// face.
     pub fn face_values_to_new<T: Clone>(&self, values: &[T]) -> Vec<T> {
@@ -239,10 +249,9 @@ mod tests {
         assert_eq!(map.unreferenced(), old_map.unreferenced());
         assert!(map.is_order_preserving());
         let ids: Vec<usize> = mesh.vertices().map(|v| v.idx()).collect();
-        assert_eq!(
-            numbering.vertex_values_to_old(&ids_by_new(&numbering, &ids)),
-            ids
-        );
+        let moved = numbering.vertex_values_to_new(&ids);
+        assert_eq!(moved[0], numbering.old_vertex(VertexId(0)).idx());
+        assert_eq!(numbering.vertex_values_to_old(&moved), ids);
         let faces: Vec<usize> = mesh.faces().map(|f| f.idx()).collect();
         let moved = numbering.face_values_to_new(&faces);
         assert_eq!(moved[0], numbering.old_face(FaceId(0)).idx());
@@ -251,13 +260,6 @@ mod tests {
             renumbered.loop_vertices(BoundaryLoopId(0)).count(),
             mesh.loop_vertices(BoundaryLoopId(0)).count()
         );
-    }
-
-    /// Old ids by new vertex.
-    fn ids_by_new(numbering: &Renumbering, ids: &[usize]) -> Vec<usize> {
-        (0..ids.len())
-            .map(|v| ids[numbering.old_vertex(VertexId(v as u32)).idx()])
-            .collect()
     }
 
     #[test]

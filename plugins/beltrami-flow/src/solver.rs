@@ -4,7 +4,7 @@
 
 use beltrami_core::{
     Accepts, Context, Map, OptionSpec, Output, PlanarBoundary, Problem, Report, Settings, Solution,
-    Solver, SolverError, Target,
+    Solver, SolverError, Target, solve_renumbered,
 };
 use beltrami_fem::element::is_planar;
 use beltrami_flow_engine::{ACCEPTS, NAME, ON_TARGET, OPTIONS, annulus_of, given_initial};
@@ -51,12 +51,20 @@ impl Solver for BeltramiFlow {
         settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
-        let mut report = Report::new(NAME);
-        let threads = settings.int("threads");
-        let initial =
-            context.stage("initial map", &mut report, || initial_map(problem, threads))?;
-        beltrami_flow_engine::solve(problem, settings, initial, report, context)
+        solve_renumbered(problem, |problem| flow(problem, settings, context))
     }
+}
+
+/// The flow of `problem`, in the numbering of its meshes.
+fn flow(
+    problem: &Problem<'_>,
+    settings: &Settings,
+    context: &mut Context<'_>,
+) -> Result<Solution, SolverError> {
+    let mut report = Report::new(NAME);
+    let threads = settings.int("threads");
+    let initial = context.stage("initial map", &mut report, || initial_map(problem, threads))?;
+    beltrami_flow_engine::solve(problem, settings, initial, report, context)
 }
 
 fn invalid(message: &str) -> SolverError {

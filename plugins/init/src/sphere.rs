@@ -121,7 +121,7 @@ use std::f64::consts::{PI, TAU};
 use beltrami_core::{
     Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
     Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, THREADS, Target,
-    TargetKind, Topology, topology,
+    TargetKind, Topology, solve_renumbered, topology,
 };
 use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
@@ -247,90 +247,98 @@ impl Solver for Sphere {
         settings: &Settings,
         context: &mut Context<'_>,
     ) -> Result<Solution, SolverError> {
-        let mesh = problem.source;
-        let kind = weights(problem, settings)?;
-        let mut report = Report::new(NAME);
-        let mut metrics = Metrics::default();
-
-        let removed = removed_face(mesh);
-        let (mut image, cotangent) = match start_of(settings) {
-            Start::Conformal => {
-                let (image, weights) =
-                    conformal_start(mesh, removed, settings, context, &mut report)?;
-                (image, Some(weights))
-            }
-            Start::Tutte => (
-                tutte_start(mesh, removed, kind, settings, context, &mut report)?,
-                None,
-            ),
-        };
-
-        normalize(
-            mesh,
-            &mut image,
-            settings.int("max-steps"),
-            context,
-            &mut report,
-            &mut metrics,
-        )?;
-
-        let untangled = context.stage("untangle", &mut report, || {
-            if !mesh.faces().any(|f| is_inward(mesh, &image, f)) {
-                return Ok(Untangled::default());
-            }
-            let weights = match cotangent {
-                Some(weights) => weights,
-                None => EdgeWeights::cotangent(mesh).map_err(weight_error)?,
-            };
-            Ok(untangle(
-                mesh,
-                &weights,
-                &mut image,
-                solve_options(settings),
-            )?)
-        })?;
-        if untangled.flipped > 0 {
-            report.notes.push(format!(
-                "{} faces were flipped after the linear solves; {} patches around them (up to {} rings of edges) were re-solved with positive weights, leaving {} flipped",
-                untangled.flipped, untangled.patches, untangled.rings, untangled.remaining
-            ));
-        }
-
-        let (inward, distortion) = context.stage("distortion", &mut report, || {
-            let inward = inward_faces(mesh, &image);
-            Ok((
-                inward,
-                measure_surface(mesh, &image, ReferenceNormal::Radial)?,
-            ))
-        })?;
-        let flipped = inward
-            .iter()
-            .zip(&distortion.flipped)
-            .filter(|&(&a, &b)| a || b)
-            .count();
-        let mut stats = distortion.stats;
-        stats.flipped = flipped;
-        metrics.mu = Some(distortion.field);
-        metrics.distortion = Some(stats);
-        if flipped > 0 {
-            report.notes.push(format!(
-                "{flipped} of {} faces are flipped: their images face the centre of the sphere (very obtuse faces, whose circumcircles the projection blows up)",
-                mesh.face_count()
-            ));
-        }
-        if signed_volume(mesh) < 0.0 {
-            report.notes.push(
-                "the source's faces face inward (negative signed volume); the image faces face outward, so the map reverses orientation in space"
-                    .to_string(),
-            );
-        }
-        Ok(Solution {
-            output: Output::Map(Map::Spatial(image)),
-            metrics,
-            extras: Extras::default(),
-            report,
-        })
+        solve_renumbered(problem, |problem| sphere_map(problem, settings, context))
     }
+}
+
+/// The sphere map of `problem`, in the numbering of its mesh ([`Sphere`]).
+fn sphere_map(
+    problem: &Problem<'_>,
+    settings: &Settings,
+    context: &mut Context<'_>,
+) -> Result<Solution, SolverError> {
+    let mesh = problem.source;
+    let kind = weights(problem, settings)?;
+    let mut report = Report::new(NAME);
+    let mut metrics = Metrics::default();
+
+    let removed = removed_face(mesh);
+    let (mut image, cotangent) = match start_of(settings) {
+        Start::Conformal => {
+            let (image, weights) = conformal_start(mesh, removed, settings, context, &mut report)?;
+            (image, Some(weights))
+        }
+        Start::Tutte => (
+            tutte_start(mesh, removed, kind, settings, context, &mut report)?,
+            None,
+        ),
+    };
+
+    normalize(
+        mesh,
+        &mut image,
+        settings.int("max-steps"),
+        context,
+        &mut report,
+        &mut metrics,
+    )?;
+
+    let untangled = context.stage("untangle", &mut report, || {
+        if !mesh.faces().any(|f| is_inward(mesh, &image, f)) {
+            return Ok(Untangled::default());
+        }
+        let weights = match cotangent {
+            Some(weights) => weights,
+            None => EdgeWeights::cotangent(mesh).map_err(weight_error)?,
+        };
+        Ok(untangle(
+            mesh,
+            &weights,
+            &mut image,
+            solve_options(settings),
+        )?)
+    })?;
+    if untangled.flipped > 0 {
+        report.notes.push(format!(
+            "{} faces were flipped after the linear solves; {} patches around them (up to {} rings of edges) were re-solved with positive weights, leaving {} flipped",
+            untangled.flipped, untangled.patches, untangled.rings, untangled.remaining
+        ));
+    }
+
+    let (inward, distortion) = context.stage("distortion", &mut report, || {
+        let inward = inward_faces(mesh, &image);
+        Ok((
+            inward,
+            measure_surface(mesh, &image, ReferenceNormal::Radial)?,
+        ))
+    })?;
+    let flipped = inward
+        .iter()
+        .zip(&distortion.flipped)
+        .filter(|&(&a, &b)| a || b)
+        .count();
+    let mut stats = distortion.stats;
+    stats.flipped = flipped;
+    metrics.mu = Some(distortion.field);
+    metrics.distortion = Some(stats);
+    if flipped > 0 {
+        report.notes.push(format!(
+            "{flipped} of {} faces are flipped: their images face the centre of the sphere (very obtuse faces, whose circumcircles the projection blows up)",
+            mesh.face_count()
+        ));
+    }
+    if signed_volume(mesh) < 0.0 {
+        report.notes.push(
+            "the source's faces face inward (negative signed volume); the image faces face outward, so the map reverses orientation in space"
+                .to_string(),
+        );
+    }
+    Ok(Solution {
+        output: Output::Map(Map::Spatial(image)),
+        metrics,
+        extras: Extras::default(),
+        report,
+    })
 }
 
 /// The start of the solver's `start` option.

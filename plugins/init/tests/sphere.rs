@@ -360,8 +360,10 @@ fn the_koala_renumbered_gets_the_same_patches_and_map() {
         note.unwrap_or_else(|| panic!("no untangling: {notes:?}"))
             .clone()
     };
-    // Patched in input order, the same patches clear them whatever the numbering (in
-    // face order, the renumbered koala's patches left 2 of them).
+    // The solver renumbers the scattered koala itself, then patches the folded faces
+    // in input order: the same patches as on the koala renumbered beforehand, and they
+    // clear all 15 (in the renumbered face order they left 2).
+    assert!(given.report.notes[0].starts_with("renumbered breadth-first"));
     assert_eq!(patches(&given), patches(&other));
     assert!(
         patches(&given).ends_with("leaving 0 flipped"),

@@ -128,14 +128,6 @@ pub enum RegisterError {
         /// The mesh error.
         error: MeshError,
     },
-    /// Renumbering a scattered mesh for cache locality failed (its rebuild).
-    #[error("renumbering the {side}: {error}")]
-    Renumbering {
-        /// Which mesh.
-        side: Side,
-        /// The mesh error.
-        error: MeshError,
-    },
     /// The finite elements of a mesh could not be set up (a degenerate face).
     #[error("finite elements of the {side}: {error}")]
     Elements {

@@ -45,7 +45,6 @@ mod modulus;
 mod param;
 mod polygon;
 mod projection;
-mod renumbered;
 mod routing;
 mod skeleton;
 mod solver;
