@@ -4,17 +4,19 @@
 //! assembly, image faces, walks on a target). When a file lists its vertices in
 //! scattered order, nearly every such access misses the cache: the shared `g0_koala`
 //! has a median distance of 20461 between the largest and smallest vertex index of a
-//! face, of 49999 vertices; numbered breadth-first, 376. A registration of it onto a
-//! 100K-face remesh then takes 28% less time per flow step (docs/register.md).
+//! face, of 49999 vertices; numbered breadth-first, 375. A registration of it onto a
+//! 100K-face remesh then takes a third less time per flow step (0.47 -> 0.30-0.33 s,
+//! docs/register.md), its sphere map a quarter less.
 //!
 //! [`renumber_breadth_first`] numbers the vertices of each component in the order a
 //! breadth-first search from its lowest-numbered vertex reaches them (Cuthill-McKee
 //! without the degree sort), and the faces by their lowest new vertex index (ties in
-//! the old order), and builds the renumbered mesh: every face keeps
-//! its corner order and its first corner, so face frames and the barycentric
-//! coordinates of surface points carry over unchanged, and the input maps are composed,
-//! so that [`VertexMap::to_input`](crate::VertexMap::to_input) and
-//! [`Mesh::face_to_input`] still name the file's indices in messages and written files.
+//! the old order), and builds the renumbered mesh: every face keeps its corner order and
+//! its first corner, so face frames and the barycentric coordinates of surface points
+//! carry over unchanged, and the input maps are composed, so that
+//! [`VertexMap::to_input`](crate::VertexMap::to_input) and [`Mesh::face_to_input`] still
+//! name the file's indices in messages and written files. Solvers use it through
+//! `beltrami_core::solve_renumbered`.
 
 use std::collections::VecDeque;
 
