@@ -39,8 +39,8 @@ use crate::{
 /// (`g0_koala`: 20461).
 pub const SCATTERED_SPREAD: usize = 4096;
 
-/// A mesh renumbered, or `None` when its numbering was kept.
-type MaybeRenumbered = Option<(Mesh, Renumbering)>;
+/// A mesh renumbered, its index spread before, or `None` when its numbering was kept.
+type MaybeRenumbered = Option<(Mesh, Renumbering, usize)>;
 
 /// The renumbered meshes of a problem (module docs).
 #[derive(Debug)]
@@ -51,8 +51,10 @@ pub struct Renumbered {
 
 /// `mesh` renumbered when its index spread exceeds `spread`.
 fn renumbered_if_scattered(mesh: &Mesh, spread: usize) -> Result<MaybeRenumbered, MeshError> {
-    if index_spread(mesh) > spread {
-        renumber_breadth_first(mesh).map(Some)
+    let before = index_spread(mesh);
+    if before > spread {
+        let (renumbered, numbering) = renumber_breadth_first(mesh)?;
+        Ok(Some((renumbered, numbering, before)))
     } else {
         Ok(None)
     }
@@ -81,7 +83,7 @@ pub fn solve_renumbered(
         return run(problem);
     };
     let mut solution = run(&renumbered.problem(problem))?;
-    solution.report.notes.insert(0, renumbered.note(problem));
+    solution.report.notes.insert(0, renumbered.note());
     Ok(renumbered.solution_to_old(solution))
 }
 
@@ -115,30 +117,21 @@ impl Renumbered {
     }
 
     fn source_numbering(&self) -> Option<&Renumbering> {
-        self.source.as_ref().map(|(_, n)| n)
+        self.source.as_ref().map(|(_, n, _)| n)
     }
 
     fn target_numbering(&self) -> Option<&Renumbering> {
-        self.target.as_ref().map(|(_, n)| n)
+        self.target.as_ref().map(|(_, n, _)| n)
     }
 
     /// What was renumbered, with the spreads before and after, for the report.
-    pub fn note(&self, problem: &Problem<'_>) -> String {
-        let target = match problem.target {
-            Target::Mesh(target) => Some(target),
-            _ => None,
-        };
-        let sides = [
-            ("source", Some(problem.source), &self.source),
-            ("target", target, &self.target),
-        ];
-        let done: Vec<String> = sides
+    pub fn note(&self) -> String {
+        let done: Vec<String> = [("source", &self.source), ("target", &self.target)]
             .iter()
-            .filter_map(|(name, mesh, side)| {
-                let (mesh, (renumbered, _)) = (mesh.as_ref()?, side.as_ref()?);
+            .filter_map(|(name, side)| {
+                let (renumbered, _, before) = side.as_ref()?;
                 Some(format!(
-                    "the {name} (median index spread of a face {} -> {})",
-                    index_spread(mesh),
+                    "the {name} (median index spread of a face {before} -> {})",
                     index_spread(renumbered)
                 ))
             })
@@ -207,11 +200,13 @@ impl Renumbered {
             }
         });
         let target = match &problem.target {
-            Target::Mesh(target) => Target::Mesh(self.target.as_ref().map_or(*target, |(m, _)| m)),
+            Target::Mesh(target) => {
+                Target::Mesh(self.target.as_ref().map_or(*target, |(m, _, _)| m))
+            }
             other => other.clone(),
         };
         Problem {
-            source: self.source.as_ref().map_or(problem.source, |(m, _)| m),
+            source: self.source.as_ref().map_or(problem.source, |(m, _, _)| m),
             target,
             goal,
             constraints,
@@ -338,7 +333,7 @@ mod tests {
         assert_eq!(back.map().and_then(Map::as_spatial), Some(mesh.positions()));
         assert!(
             renumbered
-                .note(&problem)
+                .note()
                 .contains("the source (median index spread")
         );
     }

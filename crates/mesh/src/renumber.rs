@@ -142,42 +142,48 @@ impl Renumbering {
     /// Values by new vertex id (`values[new]`) put in old order. Panics unless there
     /// is one value per vertex.
     pub fn vertex_values_to_old<T: Clone>(&self, values: &[T]) -> Vec<T> {
-        assert_eq!(values.len(), self.new_vertex.len(), "one value per vertex");
-        self.new_vertex
-            .iter()
-            .map(|v| values[v.idx()].clone())
-            .collect()
+        gather(
+            &self.new_vertex,
+            |v| v.idx(),
+            values,
+            "one value per vertex",
+        )
     }
 
     /// Values by old vertex id put in new order. Panics unless there is one value per
     /// vertex.
     pub fn vertex_values_to_new<T: Clone>(&self, values: &[T]) -> Vec<T> {
-        assert_eq!(values.len(), self.old_vertex.len(), "one value per vertex");
-        self.old_vertex
-            .iter()
-            .map(|v| values[v.idx()].clone())
-            .collect()
+        gather(
+            &self.old_vertex,
+            |v| v.idx(),
+            values,
+            "one value per vertex",
+        )
     }
 
     /// Values by old face id put in new order. Panics unless there is one value per
     /// face.
     pub fn face_values_to_new<T: Clone>(&self, values: &[T]) -> Vec<T> {
-        assert_eq!(values.len(), self.old_face.len(), "one value per face");
-        self.old_face
-            .iter()
-            .map(|f| values[f.idx()].clone())
-            .collect()
+        gather(&self.old_face, |f| f.idx(), values, "one value per face")
     }
 
     /// Values by new face id put in old order. Panics unless there is one value per
     /// face.
     pub fn face_values_to_old<T: Clone>(&self, values: &[T]) -> Vec<T> {
-        assert_eq!(values.len(), self.new_face.len(), "one value per face");
-        self.new_face
-            .iter()
-            .map(|f| values[f.idx()].clone())
-            .collect()
+        gather(&self.new_face, |f| f.idx(), values, "one value per face")
     }
+}
+
+/// `values[index(k)]` for every `k` of `order` (as long as `values`, else a panic with
+/// `what`).
+fn gather<I: Copy, T: Clone>(
+    order: &[I],
+    index: impl Fn(I) -> usize,
+    values: &[T],
+    what: &str,
+) -> Vec<T> {
+    assert_eq!(values.len(), order.len(), "{what}");
+    order.iter().map(|&k| values[index(k)].clone()).collect()
 }
 
 /// The median over faces of the difference between the largest and the smallest index

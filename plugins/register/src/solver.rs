@@ -326,7 +326,7 @@ mod tests {
         assert!((energy(&given) - energy(&solution)).abs() < 1e-2 * energy(&given));
         assert!(
             renumbered
-                .note(&problem)
+                .note()
                 .contains("the source (median index spread")
         );
     }
