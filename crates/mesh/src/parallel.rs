@@ -37,6 +37,24 @@ pub fn chunk_ranges(len: usize, threads: usize) -> Vec<Range<usize>> {
         .collect()
 }
 
+/// Runs `a` on the calling thread and `b` on a scoped thread at once and returns both
+/// results: two independent computations (the two sides of a factorization, the two
+/// meshes of a registration) on two cores. A panic in `b` is passed on.
+pub fn join<A: Send, B: Send>(
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    std::thread::scope(|scope| {
+        let b = scope.spawn(b);
+        let a = a();
+        (
+            a,
+            b.join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+        )
+    })
+}
+
 /// Runs `work` on every item of `chunks` (in turns, on the calling thread and
 /// `threads - 1` scoped threads) and returns the results in the order of `chunks`.
 fn in_turns<C: Send, R: Send>(
@@ -195,5 +213,25 @@ mod tests {
         let ranges = map_ranges(len, 2, |r| r);
         assert_eq!(ranges, chunk_ranges(len, 2));
         assert_eq!(map_ranges(0, 2, |r| r.len()), vec![0]);
+    }
+
+    #[test]
+    fn join_runs_both_at_once_and_passes_on_the_other_s_panic() {
+        // Each side waits for the other's signal: only two threads at once finish.
+        let (to_b, from_a) = std::sync::mpsc::channel();
+        let (to_a, from_b) = std::sync::mpsc::channel();
+        let (a, b) = join(
+            move || {
+                to_b.send(1).unwrap();
+                from_b.recv().unwrap() + 10
+            },
+            move || {
+                to_a.send(2).unwrap();
+                from_a.recv().unwrap() + 20
+            },
+        );
+        assert_eq!((a, b), (12, 21));
+        let panicked = std::panic::catch_unwind(|| join(|| 1, || -> i32 { panic!("b failed") }));
+        assert!(panicked.is_err());
     }
 }

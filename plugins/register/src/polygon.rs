@@ -33,7 +33,7 @@
 use std::f64::consts::TAU;
 
 use beltrami_fem::BoundaryMap;
-use beltrami_mesh::{Mesh, SurfacePoint, VertexId, cut_along, cut_graph};
+use beltrami_mesh::{Mesh, SurfacePoint, VertexId, cut_along, cut_graph, parallel};
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
@@ -142,20 +142,13 @@ pub(crate) fn map(
         .iter()
         .map(|&t| -TAU * t)
         .collect();
-    let target_param = tutte(
-        &target_cut,
-        &BoundaryMap {
-            vertices: target_word.vertices.clone(),
-            positions: angles
-                .iter()
-                .map(|&a| Complex64::from_polar(1.0, a))
-                .collect(),
-        },
-        Side::Target,
-    )?;
-    let radial = Radial::new(&angles).ok_or_else(|| RegisterError::Seams {
-        reason: "one side of the target's cut disk is longer than half its boundary".to_string(),
-    })?;
+    let target_boundary = BoundaryMap {
+        vertices: target_word.vertices.clone(),
+        positions: angles
+            .iter()
+            .map(|&a| Complex64::from_polar(1.0, a))
+            .collect(),
+    };
     let boundary = source_boundary(
         &source_cut,
         &source_word,
@@ -164,7 +157,16 @@ pub(crate) fn map(
         &angles,
         shift,
     );
-    let source_param = tutte(&source_cut, &boundary, Side::Source)?;
+    // The two Tutte maps are independent: both at once, on two cores.
+    let (target_param, source_param) = parallel::join(
+        || tutte(&target_cut, &target_boundary, Side::Target),
+        || tutte(&source_cut, &boundary, Side::Source),
+    );
+    let target_param = target_param?;
+    let radial = Radial::new(&angles).ok_or_else(|| RegisterError::Seams {
+        reason: "one side of the target's cut disk is longer than half its boundary".to_string(),
+    })?;
+    let source_param = source_param?;
     let images: Vec<Complex64> = source_param[..source.vertex_count()]
         .iter()
         .map(|&z| radial.apply(z))

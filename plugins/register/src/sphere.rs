@@ -19,7 +19,7 @@
 
 use beltrami_core::{Context, Map, Problem, Solver, SolverError, Target};
 use beltrami_init::Sphere;
-use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3};
+use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3, parallel};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::compose;
@@ -41,8 +41,15 @@ pub(crate) fn map(
     marks: &[Resolved],
     notes: &mut Vec<String>,
 ) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
-    let source_sphere = sphere(source, Side::Source, notes)?;
-    let target_sphere = sphere(target, Side::Target, notes)?;
+    // The two sphere maps are independent: computed at once, on two cores.
+    let mut target_notes = Vec::new();
+    let (source_sphere, target_sphere) = parallel::join(
+        || sphere(source, Side::Source, notes),
+        || sphere(target, Side::Target, &mut target_notes),
+    );
+    let source_sphere = source_sphere?;
+    notes.extend(target_notes);
+    let target_sphere = target_sphere?;
     let target_at =
         |p: &SurfacePoint| -> Vector3<f64> { interpolate(target, &target_sphere, p).normalize() };
 

@@ -44,7 +44,7 @@
 //! The notes give the pairing, both moduli and the bound of the class taken.
 
 use beltrami_fem::BoundaryMap;
-use beltrami_mesh::{CutMesh, Mesh, Point3, SurfacePoint, VertexId, cut_to_disk};
+use beltrami_mesh::{CutMesh, Mesh, Point3, SurfacePoint, VertexId, cut_to_disk, parallel};
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
@@ -97,26 +97,40 @@ pub(crate) fn map(
     marks: &[Resolved],
     notes: &mut Vec<String>,
 ) -> Result<TorusMap, RegisterError> {
-    let source_square = square(source, Side::Source, notes)?;
-    let target_square = square(target, Side::Target, notes)?;
+    // Each mesh's square and periods are its own: both meshes at once, on two cores.
+    let mut target_notes = Vec::new();
+    let (source_square, target_square) = parallel::join(
+        || square(source, Side::Source, notes),
+        || square(target, Side::Target, &mut target_notes),
+    );
+    let source_square = source_square?;
+    notes.extend(target_notes);
+    let target_square = target_square?;
     let domain = domain_mesh(
         &target_square.cut.mesh,
         planar_points(&target_square.param),
         Side::Target,
     )?;
     let s_param = &source_square.param[..source.vertex_count()];
-    let source_periods = periods(
-        source,
-        &source_square.cut,
-        &source_square.param,
-        Side::Source,
-    )?;
-    let target_periods = periods(
-        target,
-        &target_square.cut,
-        &target_square.param,
-        Side::Target,
-    )?;
+    let (source_periods, target_periods) = parallel::join(
+        || {
+            periods(
+                source,
+                &source_square.cut,
+                &source_square.param,
+                Side::Source,
+            )
+        },
+        || {
+            periods(
+                target,
+                &target_square.cut,
+                &target_square.param,
+                Side::Target,
+            )
+        },
+    );
+    let (source_periods, target_periods) = (source_periods?, target_periods?);
     let tau = source_periods.tau();
 
     let (map, honoured) = if marks.is_empty() {

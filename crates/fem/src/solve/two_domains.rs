@@ -42,6 +42,7 @@
 use super::SolveError;
 use super::cholesky::{Factor, FactorFailure};
 use crate::dof::Scalar;
+use beltrami_mesh::parallel::join;
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::{Llt, Solve};
@@ -124,7 +125,7 @@ impl<T: Scalar> TwoDomains<T> {
             }
         }
         let by_side = |side| SideFactor::new(pattern, order, &side_of, side, &separator_index);
-        let (side_a, side_b) = both(|| by_side(0), || by_side(1));
+        let (side_a, side_b) = join(|| by_side(0), || by_side(1));
         let (Some(side_a), Some(side_b)) = (side_a?, side_b?) else {
             return Ok(None);
         };
@@ -149,7 +150,7 @@ impl<T: Scalar> TwoDomains<T> {
         self.schur = None;
         let values = matrix.val();
         let [side_a, side_b] = &mut self.sides;
-        let (a, b) = both(
+        let (a, b) = join(
             || side_a.factorize(values, tolerance),
             || side_b.factorize(values, tolerance),
         );
@@ -203,7 +204,7 @@ impl<T: Scalar> TwoDomains<T> {
         let b = rhs.as_ref();
         let [side_a, side_b] = &mut self.sides;
         // Step 1: the forward solves, g = M_SA M_AA^-1 b_A.
-        let (forward_a, forward_b) = both(|| side_a.forward(b), || side_b.forward(b));
+        let (forward_a, forward_b) = join(|| side_a.forward(b), || side_b.forward(b));
         let ((y_a, g_a), (y_b, g_b)) = (forward_a?, forward_b?);
         // Step 2: the separator.
         let mut x_s = Mat::<T>::from_fn(self.separator.len(), k, |r, c| b[(self.separator[r], c)]);
@@ -211,7 +212,7 @@ impl<T: Scalar> TwoDomains<T> {
         x_s -= &g_b;
         schur.solve_in_place(x_s.as_mut());
         // Step 3: the backward solves under the separator's solution.
-        let (x_a, x_b) = both(
+        let (x_a, x_b) = join(
             || side_a.backward(y_a, x_s.as_ref()),
             || side_b.backward(y_b, x_s.as_ref()),
         );
@@ -230,16 +231,6 @@ impl<T: Scalar> TwoDomains<T> {
         }
         Ok(())
     }
-}
-
-/// Runs `a` on this thread and `b` on another, at once.
-fn both<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send) -> (A, B) {
-    std::thread::scope(|scope| {
-        let b = scope.spawn(b);
-        let a = a();
-        // A panic on the other thread is a bug; pass it on as one.
-        (a, b.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
-    })
 }
 
 impl<T: Scalar> SideFactor<T> {
