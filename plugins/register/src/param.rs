@@ -3,10 +3,29 @@
 //! parameter positions as vertices.
 
 use beltrami_fem::{BoundaryMap, EdgeWeights, SolveOptions, WeightError, WeightedMeanSystem};
-use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, VertexId};
+use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, VertexId, parallel};
 use num_complex::Complex64;
 
 use crate::error::{RegisterError, Side};
+
+/// `work` on the source and on the target at once, one per core ([`parallel::join`]):
+/// the two results, the target's notes after the source's, and the source's error
+/// before the target's, as if run one after the other.
+pub(crate) fn each_mesh<T: Send>(
+    source: &Mesh,
+    target: &Mesh,
+    notes: &mut Vec<String>,
+    work: impl Fn(&Mesh, Side, &mut Vec<String>) -> Result<T, RegisterError> + Sync,
+) -> Result<(T, T), RegisterError> {
+    let mut target_notes = Vec::new();
+    let (on_source, on_target) = parallel::join(
+        || work(source, Side::Source, notes),
+        || work(target, Side::Target, &mut target_notes),
+    );
+    let on_source = on_source?;
+    notes.extend(target_notes);
+    Ok((on_source, on_target?))
+}
 
 /// The Tutte weights used for a mesh: Floater's mean-value weights on triangle meshes
 /// (positive, so the embedding onto a convex boundary is a bijection), uniform weights

@@ -19,7 +19,7 @@
 
 use beltrami_core::{Context, Map, Problem, Solver, SolverError, Target};
 use beltrami_init::Sphere;
-use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3, parallel};
+use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::compose;
@@ -27,7 +27,7 @@ use crate::error::{RegisterError, Side};
 use crate::landmarks::{
     Moebius, Resolved, SpatialMatch, best_rotation, interpolate, rotation_between,
 };
-use crate::param::domain_mesh;
+use crate::param::{domain_mesh, each_mesh};
 
 /// Source vertices used by the rotation fit at most.
 const FIT_SAMPLES: usize = 4096;
@@ -42,14 +42,7 @@ pub(crate) fn map(
     notes: &mut Vec<String>,
 ) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
     // The two sphere maps are independent: computed at once, on two cores.
-    let mut target_notes = Vec::new();
-    let (source_sphere, target_sphere) = parallel::join(
-        || sphere(source, Side::Source, notes),
-        || sphere(target, Side::Target, &mut target_notes),
-    );
-    let source_sphere = source_sphere?;
-    notes.extend(target_notes);
-    let target_sphere = target_sphere?;
+    let (source_sphere, target_sphere) = each_mesh(source, target, notes, sphere)?;
     let target_at =
         |p: &SurfacePoint| -> Vector3<f64> { interpolate(target, &target_sphere, p).normalize() };
 

@@ -52,7 +52,7 @@ use crate::compose;
 use crate::error::{RegisterError, Side};
 use crate::landmarks::{Resolved, SpatialMatch, interpolate};
 use crate::modulus::{TorusPeriods, periods, teichmueller_bound};
-use crate::param::{domain_mesh, input_indices, path_fractions, planar_points, tutte};
+use crate::param::{domain_mesh, each_mesh, input_indices, path_fractions, planar_points, tutte};
 use crate::square_map::{LatticeMap, SquareMap, periodic_distance};
 
 /// Translations per direction tried without landmarks.
@@ -98,14 +98,7 @@ pub(crate) fn map(
     notes: &mut Vec<String>,
 ) -> Result<TorusMap, RegisterError> {
     // Each mesh's square and periods are its own: both meshes at once, on two cores.
-    let mut target_notes = Vec::new();
-    let (source_square, target_square) = parallel::join(
-        || square(source, Side::Source, notes),
-        || square(target, Side::Target, &mut target_notes),
-    );
-    let source_square = source_square?;
-    notes.extend(target_notes);
-    let target_square = target_square?;
+    let (source_square, target_square) = each_mesh(source, target, notes, square)?;
     let domain = domain_mesh(
         &target_square.cut.mesh,
         planar_points(&target_square.param),
