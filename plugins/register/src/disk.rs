@@ -26,7 +26,7 @@
 use std::f64::consts::TAU;
 
 use beltrami_fem::BoundaryMap;
-use beltrami_mesh::{BoundaryLoopId, Mesh, Point3, SurfacePoint, VertexId};
+use beltrami_mesh::{BoundaryLoopId, Mesh, Point3, SurfacePoint, VertexId, parallel};
 use num_complex::Complex64;
 
 use crate::compose;
@@ -104,14 +104,10 @@ pub(crate) fn map(
         fractions,
         images,
     };
-    let target_param = tutte(
-        target,
-        &BoundaryMap {
-            vertices: outline.vertices.clone(),
-            positions: outline.images.clone(),
-        },
-        Side::Target,
-    )?;
+    let target_boundary = BoundaryMap {
+        vertices: outline.vertices.clone(),
+        positions: outline.images.clone(),
+    };
 
     let source_loop: Vec<VertexId> = source.loop_vertices(BoundaryLoopId(0)).collect();
     let mut loop_index = vec![usize::MAX; source.vertex_count()];
@@ -120,37 +116,18 @@ pub(crate) fn map(
     }
     let sigma = arc_fractions(source, &source_loop);
 
-    let mut pinned: Option<(usize, usize, f64, Complex64)> = None;
-    for (m, mark) in marks.iter().enumerate() {
-        let on_source = source.is_boundary_vertex(mark.source);
-        let on_target = boundary_fraction(target, &outline, mark)?;
-        match (on_source, on_target) {
-            (true, Some(tau)) => {
-                if pinned.is_none() {
-                    let image = interpolate(target, &target_param, &mark.target);
-                    pinned = Some((m, loop_index[mark.source.idx()], tau, image));
-                }
-            }
-            (false, None) => {}
-            (true, None) => {
-                return Err(RegisterError::Landmark {
-                    index: mark.index,
-                    vertex: mark.source,
-                    reason: "the source vertex is on the boundary but its target is not: a disk map takes the boundary onto the boundary".to_string(),
-                });
-            }
-            (false, Some(_)) => {
-                return Err(RegisterError::Landmark {
-                    index: mark.index,
-                    vertex: mark.source,
-                    reason: "the source vertex is inside the disk but its target is on the boundary: a disk map takes the boundary onto the boundary".to_string(),
-                });
-            }
+    // The landmarks are read before the target's Tutte map, but their errors come after
+    // its own, as when it was computed first.
+    let pinned = match boundary_landmark(source, target, &outline, marks, &loop_index) {
+        Ok(pinned) => pinned,
+        Err(error) => {
+            tutte(target, &target_boundary, Side::Target)?;
+            return Err(error);
         }
-    }
+    };
 
     let delta = match pinned {
-        Some((m, i, tau, _)) => {
+        Some((m, i, tau)) => {
             notes.push(format!(
                 "disk: boundary rotated so that landmark {} (source vertex {}) lands on its target",
                 marks[m].index,
@@ -173,18 +150,28 @@ pub(crate) fn map(
             "disk: {collapsed} source ears (faces with two boundary edges) have all three vertices on one boundary edge of the target and collapse onto it (refine the target's boundary)"
         ));
     }
-    let mut boundary_images: Vec<Complex64> = tau.iter().map(|&t| outline.image(t)).collect();
-    if let Some((_, i, _, image)) = pinned {
-        boundary_images[i] = image;
-    }
-    let source_param = tutte(
-        source,
-        &BoundaryMap {
-            vertices: source_loop,
-            positions: boundary_images,
-        },
-        Side::Source,
-    )?;
+    let mut source_boundary = BoundaryMap {
+        vertices: source_loop,
+        positions: tau.iter().map(|&t| outline.image(t)).collect(),
+    };
+    let (target_param, source_param) = match pinned {
+        // The two Tutte maps are independent: both at once, on two cores.
+        None => {
+            let (target_param, source_param) = parallel::join(
+                || tutte(target, &target_boundary, Side::Target),
+                || tutte(source, &source_boundary, Side::Source),
+            );
+            (target_param?, source_param?)
+        }
+        // The pinned landmark's source vertex goes where its target lies in the
+        // target's map.
+        Some((m, i, _)) => {
+            let target_param = tutte(target, &target_boundary, Side::Target)?;
+            source_boundary.positions[i] = interpolate(target, &target_param, &marks[m].target);
+            let source_param = tutte(source, &source_boundary, Side::Source)?;
+            (target_param, source_param)
+        }
+    };
     let domain = domain_mesh(target, planar_points(&target_param), Side::Target)?;
     let (points, gap) = compose::locate(&domain, &planar_points(&source_param))?;
     if gap > 1e-12 {
@@ -193,6 +180,46 @@ pub(crate) fn map(
         ));
     }
     Ok((points, pinned.map(|p| vec![p.0]).unwrap_or_default()))
+}
+
+/// The first landmark whose source vertex is on the boundary, as `(index into marks,
+/// position in the source's loop, fraction of its target along the target's loop)`;
+/// an error names a landmark with one end on the boundary and the other inside.
+fn boundary_landmark(
+    source: &Mesh,
+    target: &Mesh,
+    outline: &Outline,
+    marks: &[Resolved],
+    loop_index: &[usize],
+) -> Result<Option<(usize, usize, f64)>, RegisterError> {
+    let mut pinned = None;
+    for (m, mark) in marks.iter().enumerate() {
+        let on_source = source.is_boundary_vertex(mark.source);
+        let on_target = boundary_fraction(target, outline, mark)?;
+        match (on_source, on_target) {
+            (true, Some(tau)) => {
+                if pinned.is_none() {
+                    pinned = Some((m, loop_index[mark.source.idx()], tau));
+                }
+            }
+            (false, None) => {}
+            (true, None) => {
+                return Err(RegisterError::Landmark {
+                    index: mark.index,
+                    vertex: mark.source,
+                    reason: "the source vertex is on the boundary but its target is not: a disk map takes the boundary onto the boundary".to_string(),
+                });
+            }
+            (false, Some(_)) => {
+                return Err(RegisterError::Landmark {
+                    index: mark.index,
+                    vertex: mark.source,
+                    reason: "the source vertex is inside the disk but its target is on the boundary: a disk map takes the boundary onto the boundary".to_string(),
+                });
+            }
+        }
+    }
+    Ok(pinned)
 }
 
 /// The boundary fraction of a landmark's target when it lies on the target's boundary:

@@ -131,6 +131,26 @@ fn disk_boundary_landmark_lands_exactly() {
         initial_map(&source, &target, &bad),
         Err(RegisterError::Landmark { index: 0, .. })
     ));
+    // Nor a boundary one inside, also after a landmark that pins the boundary.
+    let inside = target
+        .vertices()
+        .find(|&v| !target.is_boundary_vertex(v))
+        .unwrap();
+    let bad = [
+        landmarks[0].clone(),
+        Landmark {
+            source: source
+                .vertices()
+                .filter(|&v| source.is_boundary_vertex(v))
+                .nth(9)
+                .unwrap(),
+            target: LandmarkTarget::Vertex(inside),
+        },
+    ];
+    assert!(matches!(
+        initial_map(&source, &target, &bad),
+        Err(RegisterError::Landmark { index: 1, .. })
+    ));
 }
 
 #[test]
