@@ -116,15 +116,9 @@ pub(crate) fn map(
     }
     let sigma = arc_fractions(source, &source_loop);
 
-    // The landmarks are read before the target's Tutte map, but their errors come after
-    // its own, as when it was computed first.
-    let pinned = match boundary_landmark(source, target, &outline, marks, &loop_index) {
-        Ok(pinned) => pinned,
-        Err(error) => {
-            tutte(target, &target_boundary, Side::Target)?;
-            return Err(error);
-        }
-    };
+    // A landmark with one end on the boundary and the other inside is refused before
+    // either Tutte map is computed.
+    let pinned = boundary_landmark(source, target, &outline, marks, &loop_index)?;
 
     let delta = match pinned {
         Some((m, i, tau)) => {

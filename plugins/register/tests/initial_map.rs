@@ -137,7 +137,7 @@ fn disk_boundary_landmark_lands_exactly() {
         .find(|&v| !target.is_boundary_vertex(v))
         .unwrap();
     let bad = [
-        landmarks[0].clone(),
+        landmarks[0],
         Landmark {
             source: source
                 .vertices()
