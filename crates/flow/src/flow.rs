@@ -311,7 +311,8 @@ fn step<G: TargetGeometry>(
 
 /// Runs the flow from `image` (one point per source vertex, projected onto `target`
 /// first) with the unknowns of `system`, for `objective` measured on the source
-/// `elements`.
+/// `elements`. A system that served an earlier run serves again (its first solve
+/// factors afresh); the run's work counts only its own.
 #[allow(clippy::too_many_arguments)]
 pub fn run<G: TargetGeometry>(
     elements: &Elements,
@@ -323,6 +324,8 @@ pub fn run<G: TargetGeometry>(
     options: FlowOptions,
     context: &mut Context<'_>,
 ) -> Result<FlowRun<G>, SolverError> {
+    system.forget_factorization();
+    let (factorizations, cg_iterations) = system.work();
     // Fixed vertices pulled towards a goal move by a known flow and are projected onto
     // the target like free ones.
     let pulled: Vec<bool> = (0..image.len())
@@ -505,8 +508,8 @@ pub fn run<G: TargetGeometry>(
         stop,
         solve_seconds,
         step_seconds,
-        factorizations: system.work().0,
-        cg_iterations: system.work().1,
+        factorizations: system.work().0 - factorizations,
+        cg_iterations: system.work().1 - cg_iterations,
     })
 }
 
@@ -614,5 +617,84 @@ mod tests {
             Vector3::new(0.0, -0.2, 0.0),
         ];
         first_fold_at_one_half(&elements, &image, &normals, &flow);
+    }
+
+    /// A system that served one run serves the next like a fresh one: from the same
+    /// map the second run takes the same steps to the same image with the same work
+    /// (its first solve factors its own matrix instead of starting conjugate gradients
+    /// from the last run's factor, and its counts are its own).
+    #[test]
+    fn a_system_serves_a_second_run_like_a_fresh_one() {
+        let mesh = Mesh::from_soup(&beltrami_mesh::primitives::disk(3)).unwrap();
+        let elements = Elements::new(&mesh, Frame::Global).unwrap();
+        let image = mesh.positions().to_vec();
+        let centre = (0..image.len())
+            .min_by(|&a, &b| image[a].coords.norm().total_cmp(&image[b].coords.norm()))
+            .unwrap();
+        let mut roles: Vec<Role> = image
+            .iter()
+            .map(|p| {
+                if (p.coords.norm() - 1.0).abs() < 1e-9 {
+                    Role::Curve(0)
+                } else {
+                    Role::Free
+                }
+            })
+            .collect();
+        let rim = roles.iter().position(|&r| r == Role::Curve(0)).unwrap();
+        roles[rim] = Role::Fixed;
+        roles[centre] = Role::Fixed;
+        let sigma = vec![Complex64::new(0.3, 0.1); mesh.face_count()];
+        let objective = Objective::new(
+            elements.face_areas(),
+            Some(sigma),
+            2.0,
+            crate::measure::Barrier::PLANAR,
+        );
+        let options = FlowOptions {
+            tolerance: 1e-12,
+            max_iterations: 6,
+            solve: SolveOptions::default(),
+            max_move: f64::INFINITY,
+            min_step: 2f64.powi(-50),
+            untangle_trials: false,
+            threads: 1,
+        };
+        let target = crate::target::UnitDisk;
+        let flow_from = |system: &mut FlowSystem| {
+            run(
+                &elements,
+                target,
+                system,
+                image.clone(),
+                &[],
+                &objective,
+                options,
+                &mut Context::new(),
+            )
+            .unwrap()
+        };
+        let fresh =
+            || FlowSystem::new(&elements, &target, &image, roles.clone(), options.solve).unwrap();
+        let mut system = fresh();
+        let first = flow_from(&mut system);
+        let second = flow_from(&mut system);
+        let alone = flow_from(&mut fresh());
+        assert!(first.iterations() >= 3, "{:?}", first.step_sizes);
+        assert!(first.cg_iterations > 0, "no step reused a factorization");
+        for run in [&second, &alone] {
+            let apart = run
+                .image
+                .iter()
+                .zip(&first.image)
+                .map(|(p, q)| (p - q).norm())
+                .fold(0.0, f64::max);
+            assert!(apart == 0.0, "the images differ by up to {apart:e}");
+            assert_eq!(run.step_sizes, first.step_sizes);
+            assert_eq!(
+                (run.factorizations, run.cg_iterations),
+                (first.factorizations, first.cg_iterations)
+            );
+        }
     }
 }

@@ -188,7 +188,10 @@ pub fn solve(
         // a fixed landmark for 55 steps); it stays the fallback when flips remain.
         let faces = mesh_image_faces(&elements, &geometry, &initial);
         let flipped_start = faces.iter().any(ImageFace::flipped);
+        // One symbolic factorization serves every flow below (the roles do not change).
+        let mut system = runner.system(&geometry, &initial, roles.clone(), context, &mut report)?;
         let mut run = runner.run_on_mesh(
+            &mut system,
             &geometry,
             &roles,
             initial.clone(),
@@ -201,6 +204,7 @@ pub fn solve(
         let first = left(&run);
         if first > 0 && flipped_start && !context.is_cancelled() {
             let again = runner.run_on_mesh(
+                &mut system,
                 &geometry,
                 &roles,
                 initial,
@@ -419,10 +423,12 @@ struct Runner<'a, 'p> {
 impl Runner<'_, '_> {
     /// Runs the flow on a target mesh from `image`, untangling its flips (the image's
     /// before the flow when `untangle_first` gives its image faces) and flowing again
-    /// while the untangling removes some ([`UNTANGLE_RESTARTS`] times at most).
+    /// while the untangling removes some ([`UNTANGLE_RESTARTS`] times at most), every
+    /// flow with the unknowns of `system` (built for `roles`).
     #[allow(clippy::too_many_arguments)]
     fn run_on_mesh<'t>(
         &self,
+        system: &mut FlowSystem,
         geometry: &MeshTarget<'t>,
         roles: &[Role],
         mut image: Vec<Point3<f64>>,
@@ -436,18 +442,18 @@ impl Runner<'_, '_> {
         // blocks every step size otherwise. The flows after an untangling go without:
         // there it bought 2% of the mean for twice the time (koala onto spot 0.0260 ->
         // 0.0255 in 52 s instead of 26 s).
-        let flow = |image,
-                    untangle_trials,
-                    context: &mut Context<'_>,
-                    report: &mut Report,
-                    metrics: &mut Metrics| {
+        let mut flow = |image,
+                        untangle_trials,
+                        context: &mut Context<'_>,
+                        report: &mut Report,
+                        metrics: &mut Metrics| {
             let runner = Runner {
                 untangle_trials,
                 ..*self
             };
-            runner.run(
+            runner.run_with(
+                system,
                 geometry.clone(),
-                roles.to_vec(),
                 image,
                 scale,
                 context,
@@ -510,12 +516,55 @@ impl Runner<'_, '_> {
         Ok(run)
     }
 
+    /// The flow's unknowns and symbolic factorization for `roles` on `target` (the
+    /// stage "symbolic"), damped on a target mesh, with the tilt penalty of the
+    /// settings.
+    fn system<G: TargetGeometry>(
+        &self,
+        target: &G,
+        image: &[Point3<f64>],
+        roles: Vec<Role>,
+        context: &mut Context<'_>,
+        report: &mut Report,
+    ) -> Result<FlowSystem, SolverError> {
+        let mut system = context.stage("symbolic", report, || {
+            FlowSystem::new(self.elements, target, image, roles, self.options)
+        })?;
+        if matches!(self.problem.target, Target::Mesh(_)) {
+            system.set_damping(MESH_DAMPING);
+        }
+        system.set_tilt_penalty(self.settings.float("tilt-penalty"));
+        Ok(system)
+    }
+
     /// Runs the flow on `target` from `image` with `roles` (tolerances relative to
     /// `scale`) and records its history in `report`.
     fn run<G: TargetGeometry>(
         &self,
         target: G,
         roles: Vec<Role>,
+        image: Vec<Point3<f64>>,
+        scale: f64,
+        context: &mut Context<'_>,
+        (report, metrics): (&mut Report, &mut Metrics),
+    ) -> Result<FlowRun<G>, SolverError> {
+        let mut system = self.system(&target, &image, roles, context, report)?;
+        self.run_with(
+            &mut system,
+            target,
+            image,
+            scale,
+            context,
+            (report, metrics),
+        )
+    }
+
+    /// [`Runner::run`] with the unknowns of `system`, built by [`Runner::system`] for
+    /// this target's roles (a flow started again after an untangling reuses them).
+    fn run_with<G: TargetGeometry>(
+        &self,
+        system: &mut FlowSystem,
+        target: G,
         image: Vec<Point3<f64>>,
         scale: f64,
         context: &mut Context<'_>,
@@ -528,13 +577,6 @@ impl Runner<'_, '_> {
             self.settings,
             self.options,
         );
-        let mut system = context.stage("symbolic", report, || {
-            FlowSystem::new(elements, &target, &image, roles, options)
-        })?;
-        if matches!(problem.target, Target::Mesh(_)) {
-            system.set_damping(MESH_DAMPING);
-        }
-        system.set_tilt_penalty(settings.float("tilt-penalty"));
         let flow_options = FlowOptions {
             tolerance: settings.float("tolerance") * scale,
             max_iterations: settings.int("max-iters"),
@@ -552,7 +594,7 @@ impl Runner<'_, '_> {
         flow::run(
             elements,
             target,
-            &mut system,
+            system,
             image,
             &goals(problem),
             objective,

@@ -96,6 +96,9 @@ pub struct FlowSystem {
     trial: Vec<f64>,
     /// `V` as a full nodal vector of the DOF map (scratch).
     flow: Vec<f64>,
+    /// Whether the factorization of this run's last matrix is kept for reuse
+    /// ([`FlowSystem::forget_factorization`] clears it).
+    kept: bool,
     /// Steps to solve directly before trying to reuse the factorization again.
     skip_reuse: usize,
     /// How many steps the next failed reuse makes the solver skip (doubling after each
@@ -263,6 +266,7 @@ impl FlowSystem {
             matrix,
             slots,
             solver,
+            kept: false,
             skip_reuse: 0,
             backoff: 1,
             factorizations: 0,
@@ -472,13 +476,23 @@ impl FlowSystem {
         (self.factorizations, self.cg_iterations)
     }
 
+    /// Makes the next solve factor its matrix, as the first solve of a new system
+    /// does: a flow started again from another map (after an untangling) keeps the
+    /// unknowns, the pattern and the symbolic factorization, but the last run's factor
+    /// belongs to a matrix of another map.
+    pub fn forget_factorization(&mut self) {
+        self.kept = false;
+        self.skip_reuse = 0;
+        self.backoff = 1;
+    }
+
     /// Solves the assembled normal equations in place of `rhs`: by conjugate gradients
     /// preconditioned with the kept factorization when there is one (the matrix changes
     /// little between late steps), else — or when that does not converge within
     /// [`CG_ITERATIONS`] — by factoring the new matrix. After a failed reuse the next
     /// 1, 2, 4, .. steps factor directly.
     fn solve_normal_equations(&mut self) -> Result<(), SolverError> {
-        if self.factorizations > 0 && self.skip_reuse == 0 {
+        if self.kept && self.skip_reuse == 0 {
             self.trial.copy_from_slice(&self.rhs);
             let outcome = self.solver.solve_preconditioned(
                 self.matrix.as_ref(),
@@ -499,6 +513,7 @@ impl FlowSystem {
         }
         self.solver.factorize(self.matrix.as_ref())?;
         self.factorizations += 1;
+        self.kept = true;
         let n = self.rhs.len();
         self.solver
             .solve_in_place(MatMut::from_column_major_slice_mut(&mut self.rhs, n, 1))?;
