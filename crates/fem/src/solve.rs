@@ -43,6 +43,7 @@ mod nested_dissection;
 mod normal;
 mod saddle;
 mod two_domains;
+mod vertex_separator;
 
 pub use normal::normal_pattern_of_cells;
 pub use saddle::{SaddlePointSolution, SaddlePointSolver, solve_saddle_point};
@@ -1145,7 +1146,9 @@ impl From<nested_dissection::Dissected> for SplitOrder {
 /// whole in AMD's order against two sides at once: `|S|^3 / count` 0.05-0.19 (the
 /// remeshes of `g2_eight`, `g1_kitten`, `disk_hand`, `mc4_face_a`, and
 /// `g0_bunny_closed`) gained 10-25%; 0.25 (a generated torus, whose separators are
-/// two loops) lost 30-40%, 0.59 (the scan `g0_koala`, where AMD does well) lost 12%.
+/// two loops) lost 30-40%, 0.59 (the scan `g0_koala`, where AMD does well, split by the
+/// level sets' 352-vertex separator) lost 12%; its multilevel separator (182 vertices,
+/// 0.08) gains 40% (docs/register.md).
 const SEPARATOR_CUBE_SHARE: f64 = 0.22;
 
 /// The order [`SpdSolver::with_split_order`] factors fastest for `pattern` on two cores:
@@ -1189,10 +1192,14 @@ pub fn two_core_order(
     })
 }
 
-/// The first separator of a nested dissection of `pattern + pattern^T` (a balanced
-/// level set of breadth-first searches, the `nested_dissection` module's, each side at
-/// most 52% of the rows) with each side ordered by AMD as a whole and the separator
-/// last, for [`SpdSolver::with_split_order`] to factor the sides on two cores.
+/// A separator of `pattern + pattern^T` (multilevel, the `vertex_separator` module's,
+/// each side at most 52% of the rows) with each side ordered by AMD as a whole and the
+/// separator last, for [`SpdSolver::with_split_order`] to factor the sides on two
+/// cores. The multilevel separator costs more than the level sets of
+/// [`nested_dissection_order`] (0.1-0.2 s on 50K-vertex meshes) but is computed once for
+/// a factorization repeated at every step of a flow, and is often much smaller: on the
+/// scan `g0_koala` 182 vertices against the level sets' 352, which made the two-core
+/// factorization worth it there (`|S|^3` 0.08 of the whole's count instead of 0.59).
 ///
 /// AMD inside the sides is cheaper to compute than further separators, and factored
 /// no slower on the flow's 50K-vertex graphs (the remesh of `mc4_face_a`); on a
