@@ -660,13 +660,13 @@ impl Pass {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// Adjacency lists of a `k x k` grid of squares, vertex `i + k j` at column `i`,
     /// row `j`, each square split by a diagonal: always the same one, or, with
     /// `irregular`, one a fixed pseudo-random bit picks (degrees 2 to 8).
-    fn grid(k: usize, irregular: bool) -> (Vec<usize>, Vec<u32>) {
+    pub(in crate::solve) fn grid(k: usize, irregular: bool) -> (Vec<usize>, Vec<u32>) {
         let mut lists = vec![Vec::new(); k * k];
         let mut edge = |a: usize, b: usize| {
             lists[a].push(b as u32);
