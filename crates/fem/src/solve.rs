@@ -1154,10 +1154,9 @@ const SEPARATOR_CUBE_SHARE: f64 = 0.22;
 /// The order [`SpdSolver::with_split_order`] factors fastest for `pattern` on two cores:
 /// two sides factored at once where the first separator `S` is small against the
 /// whole factorization (`|S|^3` at most 0.22 of its multiply-subtract count), else
-/// [`fill_reducing_order`]'s order whole. The sides are ordered by AMD
-/// ([`first_split_order`]), or, where [`fill_reducing_order`] takes nested dissection,
-/// by its further separators ([`nested_dissection_order`], whose first split is the
-/// same).
+/// [`fill_reducing_order`]'s order whole. Below [`NESTED_DISSECTION_FROM`] rows the
+/// split is [`first_split_order`]'s (multilevel separators); from there, where
+/// [`fill_reducing_order`] takes nested dissection, that order's own first split.
 pub fn two_core_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<SplitOrder, SolveError> {
@@ -1183,7 +1182,7 @@ pub fn two_core_order(
             },
         },
         Choice::Amd(order) => {
-            let first = dissected_to(pattern, nested_dissection::Depth::FirstSplit)?;
+            let first = dissected_to(pattern, nested_dissection::Depth::Multilevel)?;
             match first.halves {
                 Some(sides) if small(sides) => first.into(),
                 _ => SplitOrder { order, sides: None },
@@ -1192,23 +1191,24 @@ pub fn two_core_order(
     })
 }
 
-/// A separator of `pattern + pattern^T` (multilevel, the `vertex_separator` module's,
-/// each side at most 52% of the rows) with each side ordered by AMD as a whole and the
-/// separator last, for [`SpdSolver::with_split_order`] to factor the sides on two
-/// cores. The multilevel separator costs more than the level sets of
-/// [`nested_dissection_order`] (0.1-0.2 s on 50K-vertex meshes) but is computed once for
-/// a factorization repeated at every step of a flow, and is often much smaller: on the
-/// scan `g0_koala` 182 vertices against the level sets' 352, which made the two-core
-/// factorization worth it there (`|S|^3` 0.08 of the whole's count instead of 0.59).
+/// The nested dissection of `pattern + pattern^T` by multilevel separators (the
+/// `vertex_separator` module's; the first one leaves each side at most 52% of the rows,
+/// the others 60%), whose first split [`SpdSolver::with_split_order`] factors as two
+/// sides on two cores. Multilevel separators cost about 2.5 times as much as the level
+/// sets of [`nested_dissection_order`] (0.2-0.3 s on 50K-vertex meshes) but the order is
+/// computed once for a factorization repeated at every step of a flow, and they are
+/// often much smaller: on the scan `g0_koala` the first has 182 vertices against the
+/// level sets' 352, which made the two-core factorization worth it there (`|S|^3` 0.08
+/// of the whole's count instead of 0.59).
 ///
-/// AMD inside the sides is cheaper to compute than further separators, and factored
-/// no slower on the flow's 50K-vertex graphs (the remesh of `mc4_face_a`); on a
-/// 150 x 150 grid the factor stays within 10% of AMD's for the whole (test
-/// `the_first_split_separates_two_balanced_sides_ordered_by_amd`).
+/// Inside the sides, further multilevel separators factor the flow's 50K-vertex graphs
+/// with 16-45% fewer multiply-subtracts than AMD did (docs/benchmarks.md, 2026-11-28);
+/// on a 150 x 150 grid with diagonals, fewer than AMD on the whole grid (test
+/// `the_first_split_separates_two_balanced_sides_dissected_further`).
 pub fn first_split_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<SplitOrder, SolveError> {
-    dissected_to(pattern, nested_dissection::Depth::FirstSplit).map(SplitOrder::from)
+    dissected_to(pattern, nested_dissection::Depth::Multilevel).map(SplitOrder::from)
 }
 
 /// The approximate minimum degree order of the symmetric pattern `pattern + pattern^T`

@@ -22,6 +22,11 @@
 //! vertex with no neighbour on one side moves to the other. Parts of at most [`LEAF`]
 //! vertices are ordered by AMD.
 //!
+//! [`Depth::Multilevel`] takes multilevel separators instead ([`vertex_separator`]:
+//! coarsening, a separator of the coarsest graph, refinement on the way back), smaller
+//! and about 2.5 times as costly to compute; the flow, which factors one pattern at
+//! every step, orders with them.
+//!
 //! The two sides of the first separator are dissected at once, one on a second thread
 //! as a graph of its own: the order is the same as one thread's (the 1M-triangle disk's
 //! in 0.9 s instead of 1.5 s on two cores, 2026-11-27).
@@ -269,10 +274,10 @@ struct Dissection<'g> {
 pub(super) enum Depth {
     /// Separators in every part down to parts of at most [`LEAF`] vertices.
     Full,
-    /// The first separator only; each of its sides ordered by AMD as a whole (the
-    /// two-domain factorization of meshes below about 100K vertices, where AMD inside
-    /// the sides factors as fast as further separators and costs less to compute).
-    FirstSplit,
+    /// Multilevel separators ([`vertex_separator`]) in every part down to parts of at
+    /// most [`LEAF`] vertices: smaller separators than the level sets' at 2.5 times
+    /// their cost, for orders computed once and factored many times (the flow's).
+    Multilevel,
 }
 
 /// A breadth-first search inside one part: the vertices reached in search order and
@@ -513,7 +518,7 @@ impl<'g> Dissection<'g> {
 
     /// Appends the elimination order of the part `id`, whose vertices are `vertices`.
     fn dissect(&mut self, vertices: Vec<usize>, id: u32) {
-        if vertices.len() <= LEAF || (self.depth == Depth::FirstSplit && self.halves.is_some()) {
+        if vertices.len() <= LEAF {
             self.eliminate_leaf(vertices, id);
             return;
         }
@@ -533,7 +538,7 @@ impl<'g> Dissection<'g> {
             return;
         }
         self.assign(&levels.queue, id);
-        if self.depth == Depth::FirstSplit {
+        if self.depth == Depth::Multilevel {
             self.split_multilevel(levels.queue, id);
             return;
         }
@@ -599,13 +604,14 @@ impl<'g> Dissection<'g> {
         self.split([a, b], [a_id, b_id], separator, levels.queue);
     }
 
-    /// The first split of a [`Depth::FirstSplit`] dissection: the connected part `id`
-    /// (its vertices `reached`, in breadth-first order) cut out as a graph of its own and
-    /// separated by the multilevel method ([`vertex_separator`]), each side at most
-    /// [`FIRST_BALANCE`] of it. Its separator is computed once for a factorization that
-    /// runs many times, and it decides whether the two sides can be factored at once
-    /// (`two_core_order`): on the scan `g0_koala` it has 182 vertices where the level
-    /// sets of [`Dissection::dissect`] had 352, on 50K-vertex remeshes 4-24% fewer.
+    /// Splits the connected part `id` of a [`Depth::Multilevel`] dissection (its
+    /// vertices `reached`, in breadth-first order), cut out as a graph of its own, by the
+    /// multilevel method ([`vertex_separator`]), each side at most [`FIRST_BALANCE`] of
+    /// it at the first split and [`BALANCE`] below. On the scan `g0_koala` the first
+    /// separator has 182 vertices where the level sets of [`Dissection::dissect`] had
+    /// 352, on 50K-vertex remeshes 4-24% fewer; on the flow's 50K-vertex graphs the
+    /// whole order factors with 16-45% fewer multiply-subtracts than AMD inside the
+    /// first split's sides (docs/benchmarks.md, 2026-11-28).
     fn split_multilevel(&mut self, reached: Vec<usize>, id: u32) {
         // No level set is computed here: the distances hold the local index.
         for (k, &v) in reached.iter().enumerate() {
@@ -614,8 +620,12 @@ impl<'g> Dissection<'g> {
         let part_graph = self
             .graph
             .induced(&reached, &self.distance_u, |w| self.part[w] == id);
-        let places =
-            vertex_separator::separator(part_graph.start, part_graph.neighbours, FIRST_BALANCE);
+        let balance = if self.halves.is_none() {
+            FIRST_BALANCE
+        } else {
+            BALANCE
+        };
+        let places = vertex_separator::separator(part_graph.start, part_graph.neighbours, balance);
         let (a_id, b_id) = (self.fresh_part(), self.fresh_part());
         let (mut a, mut b, mut separator) = (Vec::new(), Vec::new(), Vec::new());
         for (&v, place) in reached.iter().zip(places) {
@@ -782,7 +792,7 @@ mod tests {
         assert!(first.iter().all(|&v| v < m));
         assert_eq!(first, shifted.as_slice());
     }
-    /// The first split of a [`Depth::FirstSplit`] order is the multilevel separator:
+    /// The first split of a [`Depth::Multilevel`] order is the multilevel separator:
     /// on a 150 x 150 grid with diagonals at random 152 vertices (the level sets used
     /// before: 201), within the balance.
     #[test]
@@ -791,7 +801,7 @@ mod tests {
         // Adjacency lists are a pattern of both triangles without the diagonal.
         let (col_ptr, neighbours) = super::super::vertex_separator::tests::grid(k, true);
         let row_idx: Vec<usize> = neighbours.iter().map(|&w| w as usize).collect();
-        let dissected = nested_dissection(k * k, &col_ptr, &row_idx, Depth::FirstSplit);
+        let dissected = nested_dissection(k * k, &col_ptr, &row_idx, Depth::Multilevel);
         let [a, b] = dissected.halves.expect("a split");
         let separator = k * k - a - b;
         assert!(
