@@ -360,6 +360,17 @@ impl Objective {
         (m - m0) * (1.0 - m0) / (m * gap * gap * gap)
     }
 
+    /// Face `f`'s term of `E` (with its barrier for the conformal goals) at `face`.
+    pub fn face_energy(&self, f: usize, face: &ImageFace) -> f64 {
+        let d = (face.mu() - self.sigma(f)).norm();
+        let e = if self.p == 2.0 { d * d } else { d.powf(self.p) };
+        let mut energy = self.areas[f] * e;
+        if self.has_barrier() {
+            energy += self.barrier_area(f) * barrier(d, self.barrier_start);
+        }
+        energy
+    }
+
     /// `E` (with the barrier for the conformal goals) and the number of flipped faces of
     /// `faces`, summed over blocks of [`EVALUATION_BLOCK`] faces on `threads` threads
     /// (the blocks' sums are added in order: the same value for any number).
@@ -369,12 +380,7 @@ impl Objective {
             let mut flipped = 0;
             for f in range {
                 let face = &faces[f];
-                let d = (face.mu() - self.sigma(f)).norm();
-                let e = if self.p == 2.0 { d * d } else { d.powf(self.p) };
-                energy += self.areas[f] * e;
-                if self.has_barrier() {
-                    energy += self.barrier_area(f) * barrier(d, self.barrier_start);
-                }
+                energy += self.face_energy(f, face);
                 flipped += usize::from(face.flipped());
             }
             (energy, flipped)

@@ -119,6 +119,10 @@ pub struct FlowSystem {
     damping: f64,
     /// The weight `c` of [`FlowSystem::set_tilt_penalty`] (zero: none).
     tilt_penalty: f64,
+    /// The right-hand side of the last solve, kept for [`FlowSystem::model_decrease`].
+    rhs_before: Vec<f64>,
+    /// [`FlowSystem::model_decrease`] of the last solve.
+    model_decrease: f64,
 }
 
 /// Relative residual at which a step solved by conjugate gradients with a kept
@@ -275,6 +279,8 @@ impl FlowSystem {
             diagonal,
             damping: 0.0,
             tilt_penalty: 0.0,
+            rhs_before: Vec::new(),
+            model_decrease: 0.0,
         })
     }
 
@@ -319,6 +325,16 @@ impl FlowSystem {
             }
         }
         Ok(())
+    }
+
+    /// `Q = c^T b` of the last solve (`H c = b` its normal equations, damping and tilt
+    /// penalty included in `H`): the Gauss-Newton model of `E` along the flow,
+    /// `sum_T w_T |t V_zbar - rho_T|^2` less its value at `t = 0`, is
+    /// `t^2 c^T H c - 2 t c^T b = -(2 t - t^2) Q`, so a step of size `t` is predicted to
+    /// lower `E` by `(2 t - t^2) Q` (to first order in `t`, `2 t Q`, the slope of `E`
+    /// itself, the weights being its Gauss-Newton weights; [`crate::flow`]).
+    pub fn model_decrease(&self) -> f64 {
+        self.model_decrease
     }
 
     /// The role of every vertex.
@@ -410,6 +426,8 @@ impl FlowSystem {
                 values[d] += lambda;
             }
         }
+        self.rhs_before.clear();
+        self.rhs_before.extend_from_slice(&self.rhs);
         match self.solve_normal_equations() {
             Err(SolverError::Solve(SolveError::Singular { .. })) if self.damping > 0.0 => {
                 let values = self.matrix.val_mut();
@@ -420,6 +438,13 @@ impl FlowSystem {
             }
             outcome => outcome?,
         }
+        // The solution is in `rhs` now, in every branch above.
+        self.model_decrease = self
+            .rhs_before
+            .iter()
+            .zip(&self.rhs)
+            .map(|(b, c)| b * c)
+            .sum();
         self.dofs.expand_into(&self.rhs, &mut self.flow)?;
         flow.vertex.clear();
         flow.vertex.extend(
