@@ -652,10 +652,17 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_first_fold_is_where_a_dragged_vertex_crosses_its_link() {
-        // An 8 x 8 grid of the unit square; vertex (4, 4) moves right by 2 cells per
-        // unit of t and reaches its link's side x = 5/8 at t = 1/2.
+    /// An 8 x 8 grid of the unit square at its own place (normals `z`) whose vertex
+    /// (4, 4) moves right by 2 cells per unit of `t` (the flow) and reaches its link's
+    /// side `x = 5/8` at `t = 1/2`.
+    struct DraggedVertex {
+        elements: Elements,
+        image: Vec<Point3<f64>>,
+        normals: Vec<Vector3<f64>>,
+        flow: Vec<Vector3<f64>>,
+    }
+
+    fn dragged_vertex() -> DraggedVertex {
         let n = 8;
         let mesh = Mesh::from_soup(&grid(n, n, Cells::Triangles)).unwrap();
         let elements = Elements::new(&mesh, Frame::Face).unwrap();
@@ -664,6 +671,22 @@ mod tests {
         let dragged = 4 + (n + 1) * 4;
         let mut flow = vec![Vector3::zeros(); image.len()];
         flow[dragged] = Vector3::new(2.0 / n as f64, 0.0, 0.0);
+        DraggedVertex {
+            elements,
+            image,
+            normals,
+            flow,
+        }
+    }
+
+    #[test]
+    fn the_first_fold_is_where_a_dragged_vertex_crosses_its_link() {
+        let DraggedVertex {
+            elements,
+            image,
+            normals,
+            flow,
+        } = dragged_vertex();
         first_fold_at_one_half(&elements, &image, &normals, &flow);
         let mut faces = Vec::new();
         // The linearized rotation about the centre, V = J (p - c), scales every area by
@@ -710,21 +733,26 @@ mod tests {
         first_fold_at_one_half(&elements, &image, &normals, &flow);
     }
 
-    /// The slope of `E` along the flow is `-2 Q` ([`FlowSystem::model_decrease`]): the
-    /// step search compares the faces near a fold with the decrease `(2 t - t^2) Q` the
-    /// Gauss-Newton model predicts, so `Q` must have `E`'s own scale.
-    #[test]
-    fn the_model_decrease_is_the_slope_of_the_error() {
+    /// A flow of the unit disk onto itself towards the constant coefficient
+    /// `0.3 + 0.1 i` (`p = 2`): the rim slides along the circle except one vertex, which
+    /// is held with the centre.
+    struct PrescribedDisk {
+        elements: Elements,
+        image: Vec<Point3<f64>>,
+        roles: Vec<Role>,
+        objective: Objective,
+    }
+
+    fn prescribed_disk() -> PrescribedDisk {
         let mesh = Mesh::from_soup(&beltrami_mesh::primitives::disk(3)).unwrap();
         let elements = Elements::new(&mesh, Frame::Global).unwrap();
-        let mut image = mesh.positions().to_vec();
-        // The rim slides except one vertex; the centre is held too.
+        let image = mesh.positions().to_vec();
         let on_rim = |p: &Point3<f64>| (p.coords.norm() - 1.0).abs() < 1e-9;
         let rim = image.iter().position(on_rim).unwrap();
         let centre = (0..image.len())
             .min_by(|&a, &b| image[a].coords.norm().total_cmp(&image[b].coords.norm()))
             .unwrap();
-        let roles: Vec<Role> = (0..image.len())
+        let roles = (0..image.len())
             .map(|v| match v {
                 _ if v == rim || v == centre => Role::Fixed,
                 _ if on_rim(&image[v]) => Role::Curve(0),
@@ -738,6 +766,25 @@ mod tests {
             2.0,
             crate::measure::Barrier::PLANAR,
         );
+        PrescribedDisk {
+            elements,
+            image,
+            roles,
+            objective,
+        }
+    }
+
+    /// The slope of `E` along the flow is `-2 Q` ([`FlowSystem::model_decrease`]): the
+    /// step search compares the faces near a fold with the decrease `(2 t - t^2) Q` the
+    /// Gauss-Newton model predicts, so `Q` must have `E`'s own scale.
+    #[test]
+    fn the_model_decrease_is_the_slope_of_the_error() {
+        let PrescribedDisk {
+            elements,
+            mut image,
+            roles,
+            objective,
+        } = prescribed_disk();
         let target = crate::target::UnitDisk;
         let mut normals = Vec::new();
         target
@@ -776,14 +823,12 @@ mod tests {
     /// vertex nears its link (the near-fold barrier), none at all once a face turns.
     #[test]
     fn the_rise_near_a_fold_grows_to_the_fold() {
-        let n = 8;
-        let mesh = Mesh::from_soup(&grid(n, n, Cells::Triangles)).unwrap();
-        let elements = Elements::new(&mesh, Frame::Face).unwrap();
-        let image: Vec<Point3<f64>> = mesh.positions().to_vec();
-        let normals = vec![Vector3::z(); image.len()];
-        let dragged = 4 + (n + 1) * 4;
-        let mut flow = vec![Vector3::zeros(); image.len()];
-        flow[dragged] = Vector3::new(2.0 / n as f64, 0.0, 0.0);
+        let DraggedVertex {
+            elements,
+            image,
+            normals,
+            flow,
+        } = dragged_vertex();
         let objective = Objective::new(
             elements.face_areas(),
             None,
@@ -817,32 +862,12 @@ mod tests {
     /// from the last run's factor, and its counts are its own).
     #[test]
     fn a_system_serves_a_second_run_like_a_fresh_one() {
-        let mesh = Mesh::from_soup(&beltrami_mesh::primitives::disk(3)).unwrap();
-        let elements = Elements::new(&mesh, Frame::Global).unwrap();
-        let image = mesh.positions().to_vec();
-        let centre = (0..image.len())
-            .min_by(|&a, &b| image[a].coords.norm().total_cmp(&image[b].coords.norm()))
-            .unwrap();
-        let mut roles: Vec<Role> = image
-            .iter()
-            .map(|p| {
-                if (p.coords.norm() - 1.0).abs() < 1e-9 {
-                    Role::Curve(0)
-                } else {
-                    Role::Free
-                }
-            })
-            .collect();
-        let rim = roles.iter().position(|&r| r == Role::Curve(0)).unwrap();
-        roles[rim] = Role::Fixed;
-        roles[centre] = Role::Fixed;
-        let sigma = vec![Complex64::new(0.3, 0.1); mesh.face_count()];
-        let objective = Objective::new(
-            elements.face_areas(),
-            Some(sigma),
-            2.0,
-            crate::measure::Barrier::PLANAR,
-        );
+        let PrescribedDisk {
+            elements,
+            image,
+            roles,
+            objective,
+        } = prescribed_disk();
         let options = FlowOptions {
             tolerance: 1e-12,
             max_iterations: 6,
