@@ -285,7 +285,8 @@ fn first_fold(
 /// How much the faces `near` (from [`first_fold`]) alone raise `E` when their corners
 /// move by `t V` (before any projection onto the target, at the present normals);
 /// `None` when one of them turns over (the trial itself decides then). `probe` is
-/// scratch, left equal to `image`.
+/// scratch as long as `image`: only the near faces' corners are read from it, each
+/// written first and put back to `image` afterwards.
 #[allow(clippy::too_many_arguments)]
 fn near_fold_rise(
     elements: &Elements,

@@ -119,10 +119,9 @@ pub struct FlowSystem {
     damping: f64,
     /// The weight `c` of [`FlowSystem::set_tilt_penalty`] (zero: none).
     tilt_penalty: f64,
-    /// The right-hand side of the last solve, kept for [`FlowSystem::model_decrease`].
+    /// The right-hand side of the last solve, kept for [`FlowSystem::model_decrease`]
+    /// (`rhs` holds its solution).
     rhs_before: Vec<f64>,
-    /// [`FlowSystem::model_decrease`] of the last solve.
-    model_decrease: f64,
 }
 
 /// Relative residual at which a step solved by conjugate gradients with a kept
@@ -280,7 +279,6 @@ impl FlowSystem {
             damping: 0.0,
             tilt_penalty: 0.0,
             rhs_before: Vec::new(),
-            model_decrease: 0.0,
         })
     }
 
@@ -334,7 +332,11 @@ impl FlowSystem {
     /// lower `E` by `(2 t - t^2) Q` (to first order in `t`, `2 t Q`, the slope of `E`
     /// itself, the weights being its Gauss-Newton weights; [`crate::flow`]).
     pub fn model_decrease(&self) -> f64 {
-        self.model_decrease
+        self.rhs_before
+            .iter()
+            .zip(&self.rhs)
+            .map(|(b, c)| b * c)
+            .sum()
     }
 
     /// The role of every vertex.
@@ -438,13 +440,6 @@ impl FlowSystem {
             }
             outcome => outcome?,
         }
-        // The solution is in `rhs` now, in every branch above.
-        self.model_decrease = self
-            .rhs_before
-            .iter()
-            .zip(&self.rhs)
-            .map(|(b, c)| b * c)
-            .sum();
         self.dofs.expand_into(&self.rhs, &mut self.flow)?;
         flow.vertex.clear();
         flow.vertex.extend(

@@ -321,6 +321,17 @@ impl<'g> Dissection<'g> {
         self.order
     }
 
+    /// The largest share of a part one side of its separator may hold:
+    /// [`FIRST_BALANCE`] at the first split (before its sides are known), else
+    /// [`BALANCE`].
+    fn balance(&self) -> f64 {
+        if self.halves.is_none() {
+            FIRST_BALANCE
+        } else {
+            BALANCE
+        }
+    }
+
     fn fresh_part(&mut self) -> u32 {
         self.next_part += 1;
         self.next_part
@@ -561,12 +572,7 @@ impl<'g> Dissection<'g> {
             std::mem::swap(&mut self.distance_u, &mut self.distance_v);
         }
         let total = levels.queue.len();
-        let balance = if self.halves.is_none() {
-            FIRST_BALANCE
-        } else {
-            BALANCE
-        };
-        let cut = self.best_cut(id, &levels, &far, total, balance);
+        let cut = self.best_cut(id, &levels, &far, total, self.balance());
         let (a_id, b_id, s_id) = (self.fresh_part(), self.fresh_part(), self.fresh_part());
         let mut a = Vec::new();
         let mut b = Vec::new();
@@ -620,12 +626,8 @@ impl<'g> Dissection<'g> {
         let part_graph = self
             .graph
             .induced(&reached, &self.distance_u, |w| self.part[w] == id);
-        let balance = if self.halves.is_none() {
-            FIRST_BALANCE
-        } else {
-            BALANCE
-        };
-        let places = vertex_separator::separator(part_graph.start, part_graph.neighbours, balance);
+        let places =
+            vertex_separator::separator(part_graph.start, part_graph.neighbours, self.balance());
         let (a_id, b_id) = (self.fresh_part(), self.fresh_part());
         let (mut a, mut b, mut separator) = (Vec::new(), Vec::new(), Vec::new());
         for (&v, place) in reached.iter().zip(places) {
