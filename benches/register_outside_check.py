@@ -8,7 +8,9 @@ CORRESPONDENCE.txt its `-o` and `--correspondence` outputs. The check does not u
 flow's own flip rule (a face against the sum of the target's interpolated vertex
 normals at its corners' images): each source face's image triangle, taken from OUT.obj,
 is compared with the normals of the three target faces its corners lie on (the first
-number of each correspondence line). It prints how many faces point against all three,
+number of each correspondence line). It prints how many faces have no normal to
+compare (an image triangle or a corner's target face of zero area), how many point
+against all three,
 against two or more, against at least one, and the lowest over faces of the best of the
 three cosines, with the angles between the corner faces of the faces counted: a face
 whose corners sit on target faces far apart in angle spans a fold or a ridge of the
@@ -68,9 +70,14 @@ def main():
     against = [0, 0, 0, 0]
     lowest_best = 1.0
     spread = []
+    degenerate = 0
     for face in source_faces:
         n = normal(image, face)
         corner_normals = [target_normals[under[v]] for v in face]
+        # A zero normal has no side: such faces are counted apart, not compared.
+        if dot(n, n) == 0.0 or any(dot(m, m) == 0.0 for m in corner_normals):
+            degenerate += 1
+            continue
         cosines = [cosine(n, m) for m in corner_normals]
         against[sum(c < 0 for c in cosines)] += 1
         lowest_best = min(lowest_best, max(cosines))
@@ -78,6 +85,7 @@ def main():
             widest = min(cosine(corner_normals[i], corner_normals[j]) for i, j in ((0, 1), (0, 2), (1, 2)))
             spread.append(math.degrees(math.acos(max(-1.0, min(1.0, widest)))))
     print(f"faces {len(source_faces)}")
+    print(f"degenerate (an image or corner face of zero area): {degenerate}")
     print(f"against all three corner faces: {against[3]}")
     print(f"against two or more: {against[2] + against[3]}")
     print(f"against at least one: {against[1] + against[2] + against[3]}")
