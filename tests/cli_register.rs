@@ -528,10 +528,13 @@ fn a_registration_with_flips_fails_naming_them_unless_allowed() {
     // The initial map has flips; untangled first it still ends with flips, so the flow
     // from the initial map as it was is tried too, and the notes say which was kept.
     assert!(r["initial_flipped"].as_u64().unwrap() > 0, "{r}");
+    // (The discarded start's count is not a promise: the sliding round the target's
+    // corners changed it from 3 to 4.)
     assert!(
-        notes.contains("untangled first left 3 flipped faces; from the initial map as it was, 3: kept the first"),
+        notes.contains("the flow from the initial map untangled first left 3 flipped faces; from the initial map as it was, "),
         "{notes}"
     );
+    assert!(notes.contains(": kept the first"), "{notes}");
     assert!(out.exists());
 }
 

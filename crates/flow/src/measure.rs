@@ -129,9 +129,45 @@ pub fn image_face(
     image: &[Point3<f64>],
     f: FaceId,
 ) -> ImageFace {
+    let nodes = triangle(elements, f).map(|v| v.idx());
+    image_face_of(
+        elements,
+        f,
+        nodes.map(|v| image[v]),
+        nodes.map(|v| normals[v]),
+    )
+}
+
+/// `mu` ([`ImageFace::mu`]) of face `f` of `image` with its corner `k` moved to `to`,
+/// where the target's normal is `normal` (the other corners and normals kept): the
+/// measure whose rate the flow takes by differences where the frame tilts with the
+/// corners ([`crate::system::FlowSystem::solve`]).
+pub(crate) fn mu_with_corner_moved(
+    elements: &Elements,
+    normals: &[Vector3<f64>],
+    image: &[Point3<f64>],
+    f: FaceId,
+    k: usize,
+    (to, normal): (Point3<f64>, Vector3<f64>),
+) -> Complex64 {
+    let nodes = triangle(elements, f).map(|v| v.idx());
+    let mut corners = nodes.map(|v| image[v]);
+    let mut corner_normals = nodes.map(|v| normals[v]);
+    (corners[k], corner_normals[k]) = (to, normal);
+    image_face_of(elements, f, corners, corner_normals).mu()
+}
+
+/// [`image_face`] of face `f` with corners `corners` and the target's normals
+/// `corner_normals` there.
+fn image_face_of(
+    elements: &Elements,
+    f: FaceId,
+    corners: [Point3<f64>; 3],
+    corner_normals: [Vector3<f64>; 3],
+) -> ImageFace {
     let q = &elements.face_points(f)[0];
-    let nodes = triangle(elements, f);
-    let (e1, e2, reference) = edges_and_reference(nodes.map(|v| v.idx()), image, normals);
+    let (e1, e2) = (corners[1] - corners[0], corners[2] - corners[0]);
+    let reference: Vector3<f64> = corner_normals.iter().sum();
     let own = oriented_normal(&e1, &e2, &reference);
     // The frame: the triangle's own plane where it faces the target (the measure of
     // the fem kernel), turning to the target's tangent plane (the plane of N_T) as the
@@ -151,7 +187,7 @@ pub fn image_face(
         }
         (Some(own), None) => (own, true),
         (None, Some(unit)) => (unit, false),
-        (None, None) => (normals[nodes[0].idx()], false),
+        (None, None) => (corner_normals[0], false),
     };
     let r = {
         let t = e1 - n * n.dot(&e1);
@@ -163,9 +199,9 @@ pub fn image_face(
     };
     let s = n.cross(&r);
     let (mut fx, mut fy) = (Vector3::zeros(), Vector3::zeros());
-    for (k, v) in nodes.iter().enumerate() {
-        fx += image[v.idx()].coords * q.grad[k].x;
-        fy += image[v.idx()].coords * q.grad[k].y;
+    for (k, p) in corners.iter().enumerate() {
+        fx += p.coords * q.grad[k].x;
+        fy += p.coords * q.grad[k].y;
     }
     let along = |v: &Vector3<f64>| Complex64::new(v.dot(&r), v.dot(&s));
     let derivatives = PointDerivatives::from_xy(along(&fx), along(&fy));
@@ -208,7 +244,7 @@ pub(crate) const TILT_START: f64 = 0.4;
 
 /// Faces whose own normal has at most this cosine with the target's are measured in
 /// the target's tangent plane.
-const TILT_FULL: f64 = 0.1;
+pub(crate) const TILT_FULL: f64 = 0.1;
 
 /// Every image face of the map `image` ([`image_face`]), into `out` (resized to the face
 /// count, every entry overwritten), on `threads` threads ([`beltrami_mesh::parallel`];

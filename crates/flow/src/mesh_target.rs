@@ -22,6 +22,13 @@ use crate::target::{Role, TargetGeometry};
 /// the same result.
 pub const CORRECTION_RINGS: usize = 8;
 
+/// A slide that ends closer to the next point of its polyline than this share of its
+/// length ends on that point instead ([`TargetCurve::slide`]): left just short of a
+/// corner, a vertex would cross it within the smallest step of every later search,
+/// where the model's tangent no longer holds; on the corner it takes the tangent of the
+/// side it moves to ([`TargetGeometry::curve_corner`]).
+pub const CORNER_SNAP: f64 = 0.01;
+
 /// A polyline of target vertices a chain of source vertices slides along, indexed for
 /// exact closest points ([`PolylineIndex`]; shared by the clones of a target, one per
 /// trial step).
@@ -57,6 +64,45 @@ impl TargetCurve {
                 self.index.points().first().copied().unwrap_or(*p),
                 Vector3::x(),
             ),
+        }
+    }
+
+    /// The tangents `[behind, ahead]` of the curve at `p` when the closest point of the
+    /// curve to `p` is a corner of it ([`PolylineIndex::corner`]).
+    pub fn corner(&self, p: &Point3<f64>) -> Option<[Vector3<f64>; 2]> {
+        let on = self.index.closest(p)?;
+        self.index.corner(&on).map(|c| [c.behind, c.ahead])
+    }
+
+    /// The point of the curve reached from the closest point to `p` by walking along
+    /// the curve by the arc length `d . T`, `T` the tangent there most nearly parallel
+    /// to `d` (one of a corner's two; [`PolylineIndex::walk`]).
+    pub fn slide(&self, p: &Point3<f64>, d: &Vector3<f64>) -> Point3<f64> {
+        let Some(on) = self.index.closest(p) else {
+            return *p;
+        };
+        let arc = match self.index.corner(&on) {
+            Some(corner) => {
+                let (behind, ahead) = (d.dot(&corner.behind), d.dot(&corner.ahead));
+                if behind.abs() >= ahead.abs() {
+                    behind
+                } else {
+                    ahead
+                }
+            }
+            None => d.dot(&on.direction),
+        };
+        let end = self.index.walk(&on, arc);
+        let points = self.index.points();
+        let next = if arc > 0.0 {
+            points[(end.segment + 1) % points.len()]
+        } else {
+            points[end.segment]
+        };
+        if (next - end.position).norm() <= CORNER_SNAP * arc.abs() {
+            next
+        } else {
+            end.position
         }
     }
 
@@ -146,6 +192,14 @@ impl TargetGeometry for MeshTarget<'_> {
 
     fn curve_tangent(&self, curve: usize, p: &Point3<f64>) -> Vector3<f64> {
         self.curves[curve].closest(p).1
+    }
+
+    fn curve_corner(&self, curve: usize, p: &Point3<f64>) -> Option<[Vector3<f64>; 2]> {
+        self.curves[curve].corner(p)
+    }
+
+    fn slide(&self, curve: usize, p: &Point3<f64>, d: &Vector3<f64>) -> Point3<f64> {
+        self.curves[curve].slide(p, d)
     }
 
     /// Keeps the surface points of the last [`TargetGeometry::project_all`] where they
@@ -324,6 +378,38 @@ mod tests {
                 "vertex {i} ({:?}) starts at {kept} instead of {}",
                 roles[i],
                 moved_image[i]
+            );
+        }
+    }
+
+    /// A slide goes round a corner by arc length, and one that would end within
+    /// [`CORNER_SNAP`] of its length short of a corner ends on it.
+    #[test]
+    fn a_slide_goes_round_corners_and_ends_on_one_it_nearly_reaches() {
+        let square = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+            .map(|(x, y)| Point3::new(x, y, 0.0))
+            .to_vec();
+        let mut soup = beltrami_mesh::PolygonSoup::new(square);
+        soup.push_face(&[0, 1, 2, 3]);
+        let mesh = Mesh::from_soup(&soup).unwrap();
+        let loops = TargetCurve::boundary_loops(&mesh).unwrap();
+        let curve = &loops[0];
+        let [behind, ahead] = curve.corner(&Point3::new(1.0, 0.0, 0.0)).unwrap();
+        let from = Point3::new(0.5, 0.0, 0.0);
+        let turn = if behind.x > 0.0 { ahead } else { -behind };
+        let cases = [
+            (0.75, Point3::new(1.0, 0.0, 0.0) + turn * 0.25),
+            (0.5 * (1.0 - 0.5 * CORNER_SNAP), Point3::new(1.0, 0.0, 0.0)),
+            (
+                0.5 * (1.0 - 2.0 * CORNER_SNAP),
+                Point3::new(0.5 + 0.5 * (1.0 - 2.0 * CORNER_SNAP), 0.0, 0.0),
+            ),
+        ];
+        for (length, expected) in cases {
+            let got = curve.slide(&from, &(Vector3::x() * length));
+            assert!(
+                (got - expected).norm() < 1e-14,
+                "{length}: {got} instead of {expected}"
             );
         }
     }

@@ -45,7 +45,9 @@ use faer::MatMut;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
-use crate::measure::{ImageFace, TILT_START, edges_and_reference, triangle};
+use crate::measure::{
+    ImageFace, TILT_FULL, TILT_START, edges_and_reference, mu_with_corner_moved, triangle,
+};
 use crate::target::{Role, TargetGeometry, orthonormal_basis};
 
 /// One term of a face: face vertex `k` contributes `g_k (b . r + i b . s)` to the
@@ -68,6 +70,10 @@ const OWN_DAMPING: f64 = 1e-6;
 /// The unknowns of the flow and the factorization of its normal equations.
 pub struct FlowSystem {
     roles: Vec<Role>,
+    /// Per vertex, whether a curve vertex at a corner of its curve moves along the
+    /// tangent ahead of the corner (else the one behind): the side its last solved move
+    /// pointed to ([`FlowSystem::solve`]).
+    ahead: Vec<bool>,
     /// `V = K c + V0` on the vertices, in R^3 (module docs): the unknowns, their
     /// directions (refilled every step) and the prescribed flow `V0` of fixed vertices.
     dofs: DofMap<f64>,
@@ -253,6 +259,7 @@ impl FlowSystem {
         let order = block_order(&faces, &dofs)?;
         let solver = SpdSolver::with_split_order(pattern.symbolic().as_ref(), &order, options)?;
         Ok(Self {
+            ahead: vec![false; roles.len()],
             roles,
             flow: vec![0.0; dofs.full_len()],
             dofs,
@@ -356,9 +363,62 @@ impl FlowSystem {
 
     /// The minimizer of `E_V` for per-face weights `w_T` and targets `rho_T` on the image
     /// faces `faces` of `image`, written into `flow`.
+    ///
+    /// A curve vertex at a corner of its curve ([`TargetGeometry::curve_corner`]) moves
+    /// along one side's tangent, and the step slides it along that side only if the
+    /// solved move points into it: a move along the tangent behind with a positive
+    /// coefficient would leave along the segment ahead, a first-order error of the model
+    /// for every face at the vertex. Where the solved move points out of the side it was
+    /// solved on, the vertex takes the other side and the system is solved once more
+    /// (a vertex that points out of both keeps its second side: its best move is to stay,
+    /// and the model errs for it alone).
     #[allow(clippy::too_many_arguments)]
     pub fn solve<G: TargetGeometry>(
         &mut self,
+        elements: &Elements,
+        target: &G,
+        image: &[Point3<f64>],
+        normals: &[Vector3<f64>],
+        faces: &[ImageFace],
+        weights: &[f64],
+        rho: &[Complex64],
+        flow: &mut Flow,
+    ) -> Result<(), SolverError> {
+        self.solve_on_sides(elements, target, image, normals, faces, weights, rho, flow)?;
+        if self.turn_corner_sides(target, image, flow) {
+            self.solve_on_sides(elements, target, image, normals, faces, weights, rho, flow)?;
+        }
+        Ok(())
+    }
+
+    /// Turns every curve vertex at a corner whose move in `flow` points out of the side
+    /// it was solved on to the other side; whether any turned.
+    fn turn_corner_sides<G: TargetGeometry>(
+        &mut self,
+        target: &G,
+        image: &[Point3<f64>],
+        flow: &Flow,
+    ) -> bool {
+        let mut turned = false;
+        for (v, &role) in self.roles.iter().enumerate() {
+            if let Role::Curve(c) = role
+                && let Some([behind, ahead]) = target.curve_corner(c, &image[v])
+            {
+                let along = flow.vertex[v].dot(if self.ahead[v] { &ahead } else { &behind });
+                if (self.ahead[v] && along < 0.0) || (!self.ahead[v] && along > 0.0) {
+                    self.ahead[v] = !self.ahead[v];
+                    turned = true;
+                }
+            }
+        }
+        turned
+    }
+
+    /// [`FlowSystem::solve`] with the corner sides as they are.
+    #[allow(clippy::too_many_arguments)]
+    fn solve_on_sides<G: TargetGeometry>(
+        &mut self,
+        elements: &Elements,
         target: &G,
         image: &[Point3<f64>],
         normals: &[Vector3<f64>],
@@ -381,9 +441,33 @@ impl FlowSystem {
             let g = g.unwrap_or_default();
             let beta = &mut self.beta[..m];
             beta.iter_mut().for_each(|b| *b = Complex64::default());
+            // Where the face's frame tilts towards the target's plane, its mu depends on
+            // the target's normals at its corners, which turn as the corners move over
+            // a curved target: a first-order term the model's `g_k` leaves out (on
+            // `face50k` onto `disk_hand`, a face across a fold whose measure rose
+            // linearly along every step the model said would lower it). There the rate
+            // of mu is taken by central differences of the measure itself, each corner
+            // moved on the target with the normal there, and turned into the rate of
+            // V_zbar that composition gives it (`crate::flow`, item 1).
+            let tilted = (w > 0.0 && face.facing() <= TILT_FULL)
+                .then(|| tilt_rate_scale(face, image, &self.faces[f]))
+                .flatten();
             for t in &self.face_terms[self.term_ptr[f]..self.term_ptr[f + 1]] {
                 let b = &directions[3 * t.term as usize..3 * t.term as usize + 3];
-                beta[t.local as usize] += g[t.k as usize] * along(face, b);
+                beta[t.local as usize] += match tilted {
+                    Some((to_flow, h)) => {
+                        let (k, b) = (t.k as usize, Vector3::new(b[0], b[1], b[2]));
+                        let from = image[self.faces[f][k]];
+                        let mu = |d: Vector3<f64>| {
+                            let to = target.project(Role::Free, &(from + d));
+                            let face_id = FaceId::from_usize(f);
+                            let moved = (to, target.normal(&to));
+                            mu_with_corner_moved(elements, normals, image, face_id, k, moved)
+                        };
+                        (mu(b * h) - mu(-b * h)) / (2.0 * h) * to_flow
+                    }
+                    None => g[t.k as usize] * along(face, b),
+                };
             }
             let mut known = rho[f];
             if self.prescribed {
@@ -455,7 +539,7 @@ impl FlowSystem {
 
     /// States the directions of the current image in the DOF map: the tangent basis of
     /// the target's normal at a free vertex ([`orthonormal_basis`]), the curve tangent at
-    /// a curve vertex, and the curve's offset direction there (zero where the target
+    /// a curve vertex (of its side at a corner), and the curve's offset direction there (zero where the target
     /// has none).
     fn refill_directions<G: TargetGeometry>(
         &mut self,
@@ -474,7 +558,11 @@ impl FlowSystem {
                     }
                 }
                 Role::Curve(c) => {
-                    let tangent = target.curve_tangent(c, p);
+                    let tangent = match target.curve_corner(c, p) {
+                        Some([_, ahead]) if self.ahead[v] => ahead,
+                        Some([behind, _]) => behind,
+                        None => target.curve_tangent(c, p),
+                    };
                     self.dofs.set_direction(first, tangent.as_slice())?;
                     if self.offset[c].is_some() {
                         let b = target
@@ -640,6 +728,30 @@ fn along(face: &ImageFace, b: &[f64]) -> Complex64 {
     Complex64::new(b.dot(&face.r), b.dot(&face.s))
 }
 
+/// For a face whose frame tilts with its corners: `1 / ((1 - |mu|^2) theta)`, which
+/// turns a rate of its `mu` into the rate of `V_zbar` that composition gives it
+/// (`crate::flow`, item 1: `d mu = (1 - |mu|^2) theta d tau`), and the difference step
+/// `h` for its corners ([`TILT_DIFFERENCE`] of its longest edge); `None` where
+/// `|mu| >= 1` or `f_z = 0`.
+fn tilt_rate_scale(
+    face: &ImageFace,
+    image: &[Point3<f64>],
+    corners: &[usize; 3],
+) -> Option<(Complex64, f64)> {
+    let mu = face.mu();
+    let shrink = 1.0 - mu.norm_sqr();
+    let fz = face.derivatives.fz;
+    if shrink <= 0.0 || fz.norm_sqr() == 0.0 {
+        return None;
+    }
+    let [a, b, c] = corners.map(|v| image[v]);
+    let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+    (longest > 0.0).then(|| (fz / (shrink * fz.conj()), TILT_DIFFERENCE * longest))
+}
+
+/// The difference step of [`tilt_rate_scale`], relative to the face's longest edge.
+const TILT_DIFFERENCE: f64 = 1e-6;
+
 /// `g_k = (d_r N_k + i d_s N_k) / 2` of the image triangle, or `None` when it is
 /// degenerate. With `q_k` its vertices in the frame and `D = (q_1 - q_0) x (q_2 - q_0)`
 /// twice its signed area, `grad N_k = J (q_(k+2) - q_(k+1)) / D`, `J` the rotation by
@@ -727,7 +839,9 @@ mod tests {
         system.set_prescribed(&prescribed).unwrap();
         let mut flow = Flow::default();
         system
-            .solve(&target, &image, &normals, &faces, &weights, &rho, &mut flow)
+            .solve(
+                &elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+            )
             .unwrap();
         let offset = flow.offset[INNER];
         assert!(offset.abs() > 1e-6, "the radius did not move: {offset}");
@@ -782,7 +896,7 @@ mod tests {
             let mut flow = Flow::default();
             system
                 .solve(
-                    &UnitDisk, image, &normals, &faces, &weights, &rho, &mut flow,
+                    &elements, &UnitDisk, image, &normals, &faces, &weights, &rho, &mut flow,
                 )
                 .unwrap();
             (faces, flow.vertex)
@@ -820,5 +934,69 @@ mod tests {
         let (_, plain) = solve(&flat, 0.0);
         let (_, penalized) = solve(&flat, 10.0);
         assert_eq!(plain, penalized);
+    }
+
+    /// A curve vertex on a corner of a target mesh's boundary moves along the side its
+    /// solved move points into, whichever way the goal pushes it.
+    #[test]
+    fn a_vertex_on_a_corner_moves_along_the_side_it_moves_into() {
+        use crate::mesh_target::{MeshTarget, TargetCurve};
+        use beltrami_spatial::SurfaceIndex;
+        let n = 6;
+        let mesh = Mesh::from_soup(&primitives::grid(n, n, primitives::Cells::Triangles)).unwrap();
+        let elements = Elements::new(&mesh, Frame::Face).unwrap();
+        let index = SurfaceIndex::new(&mesh).unwrap();
+        let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh).unwrap());
+        let image = mesh.positions().to_vec();
+        let mut roles: Vec<Role> = mesh
+            .vertices()
+            .map(|v| {
+                if mesh.is_boundary_vertex(v) {
+                    Role::Curve(0)
+                } else {
+                    Role::Free
+                }
+            })
+            .collect();
+        // The corners (0, 0) and (0, 1) held; the corner (1, 0) free to slide.
+        roles[0] = Role::Fixed;
+        roles[(n + 1) * n] = Role::Fixed;
+        let corner = n;
+        assert_eq!(image[corner], Point3::new(1.0, 0.0, 0.0));
+        let [behind, ahead] = target.curve_corner(0, &image[corner]).unwrap();
+        let normals = vec![Vector3::z(); image.len()];
+        let mut faces = Vec::new();
+        image_faces(&elements, &normals, &image, &mut faces, 1);
+        let weights = vec![1.0; faces.len()];
+        let mut sides = Vec::new();
+        for sign in [1.0, -1.0] {
+            let mut system = FlowSystem::new(
+                &elements,
+                &target,
+                &image,
+                roles.clone(),
+                SolveOptions::default(),
+            )
+            .unwrap();
+            let rho = vec![Complex64::new(0.3, 0.2) * sign; faces.len()];
+            let mut flow = Flow::default();
+            system
+                .solve(
+                    &elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+                )
+                .unwrap();
+            let v = flow.vertex[corner];
+            assert!(v.norm() > 1e-3, "{v}");
+            let (forward, back) = (v.dot(&ahead), v.dot(&behind));
+            let side = if (v - ahead * forward).norm() < 1e-12 && forward > 0.0 {
+                "ahead"
+            } else if (v - behind * back).norm() < 1e-12 && back < 0.0 {
+                "behind"
+            } else {
+                panic!("{v} moves along neither side it points into: {behind} / {ahead}")
+            };
+            sides.push(side);
+        }
+        assert_ne!(sides[0], sides[1]);
     }
 }

@@ -37,6 +37,22 @@ pub trait TargetGeometry: Clone {
     /// The unit tangent of boundary curve `curve` at `p`.
     fn curve_tangent(&self, curve: usize, p: &Point3<f64>) -> Vector3<f64>;
 
+    /// The unit tangents `[behind, ahead]` of curve `curve` on either side of `p` when
+    /// `p` is a corner of it (two pieces meeting at an angle), both along the curve's
+    /// orientation: a move forward from `p` follows `ahead`, a move back `behind`.
+    /// `None` where the curve is smooth (the default).
+    fn curve_corner(&self, _curve: usize, _p: &Point3<f64>) -> Option<[Vector3<f64>; 2]> {
+        None
+    }
+
+    /// `p`, a point of curve `curve`, moved along the curve by `d`, a tangent of the
+    /// curve at `p` (at a corner, of the side it points to). The default projects
+    /// `p + d` onto the curve; a polyline walks `|d|` along itself instead, so that a
+    /// point past a corner goes on along the next segment as far as the step asked.
+    fn slide(&self, curve: usize, p: &Point3<f64>, d: &Vector3<f64>) -> Point3<f64> {
+        self.project(Role::Curve(curve), &(p + d))
+    }
+
     /// The direction a free offset of `curve` moves its points at `p`, or `None` when
     /// the curve is fixed (the default).
     fn curve_offset_direction(&self, _curve: usize, _p: &Point3<f64>) -> Option<Vector3<f64>> {

@@ -85,4 +85,4 @@ pub use error::SpatialError;
 pub use frame::TangentFrame;
 pub use index::{Located, SurfaceIndex};
 pub use motion::{BoundaryMode, MoveMethod, MoveOptions, MoveOutcome, MoveSummary, Moved};
-pub use polyline::{OnPolyline, PolylineIndex};
+pub use polyline::{CORNER_TOLERANCE, Corner, OnPolyline, PolylineIndex};

@@ -15,6 +15,11 @@
 //! and measuring exactly the segments of every piece within `r + rho` of `p` finds `c`.
 //! Ties go to the lowest segment index, as a scan of the segments in order would give.
 //! Segments of zero length are left out (they have no direction).
+//!
+//! A point on the polyline moves along it by arc length ([`PolylineIndex::walk`]), and
+//! one at a point where two segments meet at an angle has a tangent on either side
+//! ([`PolylineIndex::corner`]): a move forward from there follows the segment ahead,
+//! a move back the segment behind.
 
 use beltrami_mesh::{Point3, Vector3};
 use kiddo::SquaredEuclidean;
@@ -41,9 +46,31 @@ pub struct OnPolyline {
     pub distance_squared: f64,
 }
 
+/// How near, relative to the length of its segment, a point of a polyline must be to
+/// one of the segment's ends for [`PolylineIndex::corner`] to place it there: a point
+/// that far before a corner and moved past it by `s` first covers the remaining
+/// `1e-6 l` along its own segment, a difference from the move along the segment ahead
+/// of at most `2e-6 l`, small against any step that is not itself that short.
+pub const CORNER_TOLERANCE: f64 = 1e-6;
+
+/// A point of a polyline where two segments meet at an angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Corner {
+    /// The index of the point.
+    pub point: usize,
+    /// The unit direction of the segment that ends there.
+    pub behind: Vector3<f64>,
+    /// The unit direction of the segment that starts there.
+    pub ahead: Vector3<f64>,
+}
+
 /// A polyline with a kd-tree for exact closest-point queries (module docs).
 pub struct PolylineIndex {
     points: Vec<Point3<f64>>,
+    /// Whether the last point is joined to the first.
+    closed: bool,
+    /// The total length of the segments.
+    length: f64,
     /// `None` when every segment has zero length.
     tree: Option<Tree>,
     /// The segment of each piece, in the tree's item order.
@@ -101,10 +128,111 @@ impl PolylineIndex {
         };
         Ok(Self {
             points,
+            closed,
+            length: lengths.iter().sum(),
             tree,
             pieces,
             reach,
         })
+    }
+
+    /// The number of segments.
+    fn segment_count(&self) -> usize {
+        let n = self.points.len();
+        if self.closed { n } else { n.saturating_sub(1) }
+    }
+
+    /// The nearest segment of positive length after segment `s` (`ahead`) or before it,
+    /// `None` past an end of an open polyline.
+    fn neighbour(&self, s: usize, ahead: bool) -> Option<usize> {
+        let count = self.segment_count();
+        let mut at = s;
+        for _ in 1..count {
+            at = match (ahead, self.closed) {
+                (true, _) if at + 1 < count => at + 1,
+                (true, true) => 0,
+                (false, _) if at > 0 => at - 1,
+                (false, true) => count - 1,
+                _ => return None,
+            };
+            let (a, b) = self.segment(at);
+            if a != b {
+                return Some(at);
+            }
+        }
+        None
+    }
+
+    /// The corner at `on` (a point of the polyline, as [`PolylineIndex::closest`] or
+    /// [`PolylineIndex::walk`] gives it) when it lies within [`CORNER_TOLERANCE`] of
+    /// its segment's length from an end of its segment where the next segment of
+    /// positive length turns; `None` inside a segment, at an end of an open polyline
+    /// and where the segments meet straight.
+    pub fn corner(&self, on: &OnPolyline) -> Option<Corner> {
+        let (a, b) = self.segment(on.segment);
+        let tolerance = CORNER_TOLERANCE * (b - a).norm();
+        let at_end = if (on.position - b).norm() <= tolerance {
+            true
+        } else if (on.position - a).norm() <= tolerance {
+            false
+        } else {
+            return None;
+        };
+        let other = self.neighbour(on.segment, at_end)?;
+        let (c, d) = self.segment(other);
+        let turn = (d - c).normalize();
+        let corner = if at_end {
+            Corner {
+                point: (on.segment + 1) % self.points.len(),
+                behind: on.direction,
+                ahead: turn,
+            }
+        } else {
+            Corner {
+                point: on.segment,
+                behind: turn,
+                ahead: on.direction,
+            }
+        };
+        (corner.behind != corner.ahead).then_some(corner)
+    }
+
+    /// The point `arc` away from `on` (a point of the polyline) along the polyline by
+    /// arc length: towards higher point indices for `arc > 0`, lower ones for `arc < 0`;
+    /// it stops at the ends of an open polyline, and goes round a closed one as often
+    /// as `arc` asks. Its `distance_squared` is zero.
+    pub fn walk(&self, on: &OnPolyline, arc: f64) -> OnPolyline {
+        let ahead = arc > 0.0;
+        let mut left = arc.abs();
+        if self.closed && self.length > 0.0 {
+            left %= self.length;
+        }
+        let (mut s, mut at) = (on.segment, on.position);
+        loop {
+            let (a, b) = self.segment(s);
+            let end = if ahead { b } else { a };
+            let room = (end - at).norm();
+            let next = if left <= room {
+                None
+            } else {
+                self.neighbour(s, ahead)
+            };
+            let Some(next) = next else {
+                let position = if room > left {
+                    at + (end - at) * (left / room)
+                } else {
+                    end
+                };
+                return OnPolyline {
+                    position,
+                    segment: s,
+                    direction: (b - a).normalize(),
+                    distance_squared: 0.0,
+                };
+            };
+            left -= room;
+            (s, at) = (next, end);
+        }
     }
 
     /// The polyline's points.
@@ -249,5 +377,108 @@ mod tests {
             let index = PolylineIndex::new(points, false).unwrap();
             assert_eq!(index.closest(&Point3::origin()), None);
         }
+    }
+
+    /// An L of two unit segments and a unit segment back down, open: (0,0) (1,0)
+    /// (1,1) and a repeated point, then (0,1).
+    fn hook() -> PolylineIndex {
+        let points = vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(1.0, 1.0, 0.0),
+            Point3::new(1.0, 1.0, 0.0),
+            Point3::new(0.0, 1.0, 0.0),
+        ];
+        PolylineIndex::new(points, false).unwrap()
+    }
+
+    #[test]
+    fn a_walk_goes_by_arc_length_round_corners_and_stops_at_the_ends() {
+        let index = hook();
+        let start = index.closest(&Point3::new(0.25, -0.5, 0.0)).unwrap();
+        let cases = [
+            (0.5, Point3::new(0.75, 0.0, 0.0), 0),
+            (1.25, Point3::new(1.0, 0.5, 0.0), 1),
+            // Over the repeated point: the segment of zero length is skipped.
+            (2.0, Point3::new(0.75, 1.0, 0.0), 3),
+            (9.0, Point3::new(0.0, 1.0, 0.0), 3),
+            (-0.125, Point3::new(0.125, 0.0, 0.0), 0),
+            (-9.0, Point3::new(0.0, 0.0, 0.0), 0),
+            (0.0, Point3::new(0.25, 0.0, 0.0), 0),
+        ];
+        for (arc, position, segment) in cases {
+            let got = index.walk(&start, arc);
+            assert!((got.position - position).norm() < 1e-15, "{arc}: {got:?}");
+            assert_eq!(got.segment, segment, "{arc}");
+            assert_eq!(got.distance_squared, 0.0);
+        }
+        // Back from the last segment round both corners.
+        let end = index.closest(&Point3::new(0.5, 1.5, 0.0)).unwrap();
+        let got = index.walk(&end, -2.0);
+        assert!((got.position - Point3::new(0.5, 0.0, 0.0)).norm() < 1e-15);
+        assert_eq!(got.segment, 0);
+        // A closed square goes round as often as asked.
+        let square = PolylineIndex::new(
+            vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(1.0, 1.0, 0.0),
+                Point3::new(0.0, 1.0, 0.0),
+            ],
+            true,
+        )
+        .unwrap();
+        let start = square.closest(&Point3::new(0.5, -1.0, 0.0)).unwrap();
+        for (arc, position) in [
+            (4.25, Point3::new(0.75, 0.0, 0.0)),
+            (-0.75, Point3::new(0.0, 0.25, 0.0)),
+            (-8.75, Point3::new(0.0, 0.25, 0.0)),
+        ] {
+            let got = square.walk(&start, arc);
+            assert!((got.position - position).norm() < 1e-12, "{arc}: {got:?}");
+        }
+    }
+
+    #[test]
+    fn corners_have_a_tangent_on_either_side_within_the_tolerance() {
+        let index = hook();
+        let (x, y) = (Vector3::x(), Vector3::y());
+        // Past the convex corner (1, 0): the closest point is the corner itself.
+        let at = index.closest(&Point3::new(2.0, -1.0, 0.0)).unwrap();
+        assert_eq!(at.position, Point3::new(1.0, 0.0, 0.0));
+        let corner = index.corner(&at).unwrap();
+        assert_eq!((corner.point, corner.behind, corner.ahead), (1, x, y));
+        // Just inside the tolerance on either segment, and just outside it.
+        let near = 0.5 * CORNER_TOLERANCE;
+        for p in [
+            Point3::new(1.0 - near, 0.0, 0.0),
+            Point3::new(1.0, near, 0.0),
+        ] {
+            let on = index.closest(&p).unwrap();
+            assert_eq!(index.corner(&on).map(|c| c.point), Some(1), "{p}");
+        }
+        let far = index
+            .closest(&Point3::new(1.0 - 2.0 * CORNER_TOLERANCE, 0.0, 0.0))
+            .unwrap();
+        assert_eq!(index.corner(&far), None);
+        // The corner (1, 1) across the repeated point turns from y to -x.
+        let on = index.closest(&Point3::new(2.0, 2.0, 0.0)).unwrap();
+        let corner = index.corner(&on).unwrap();
+        assert_eq!((corner.behind, corner.ahead), (y, -x));
+        // The ends of an open polyline and a straight joint are not corners.
+        for p in [Point3::new(-1.0, 0.0, 0.0), Point3::new(-1.0, 1.0, 0.0)] {
+            assert_eq!(index.corner(&index.closest(&p).unwrap()), None, "{p}");
+        }
+        let straight = PolylineIndex::new(
+            vec![
+                Point3::origin(),
+                Point3::new(1.0, 0.0, 0.0),
+                Point3::new(3.0, 0.0, 0.0),
+            ],
+            false,
+        )
+        .unwrap();
+        let on = straight.closest(&Point3::new(1.0, 1.0, 0.0)).unwrap();
+        assert_eq!(straight.corner(&on), None);
     }
 }
