@@ -138,6 +138,19 @@ const CG_TOLERANCE: f64 = 1e-7;
 /// (each costs about a fifth of a factorization).
 const CG_ITERATIONS: usize = 4;
 
+/// The share of the largest vertex move from which a corner vertex that turned to its
+/// other side makes [`FlowSystem::solve`] solve again: a wrong side errs in the model
+/// by as much as the vertex moves, so only the large movers limit the step search; the
+/// others take their new side in the next step. On `mc4_face_b` onto `mc4_face_a`
+/// remeshed to 100K faces, solving again for every turned vertex cost 186
+/// conjugate-gradient iterations over 100 steps (a third more time in the solves), for
+/// those above half the largest move 85, with the same result.
+const CORNER_RESOLVE_SHARE: f64 = 0.5;
+
+/// The most conjugate-gradient iterations a solve again after corner vertices turned
+/// tries before refactoring ([`FlowSystem::solve`]): past it a factorization costs less.
+const CG_TURNED_ITERATIONS: usize = 5 * CG_ITERATIONS;
+
 impl std::fmt::Debug for FlowSystem {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("FlowSystem")
@@ -384,22 +397,30 @@ impl FlowSystem {
         rho: &[Complex64],
         flow: &mut Flow,
     ) -> Result<(), SolverError> {
-        self.solve_on_sides(elements, target, image, normals, faces, weights, rho, flow)?;
-        if self.turn_corner_sides(target, image, flow) {
-            self.solve_on_sides(elements, target, image, normals, faces, weights, rho, flow)?;
+        self.solve_on_sides(
+            elements, target, image, normals, faces, weights, rho, flow, 0,
+        )?;
+        let turned = self.turn_corner_sides(target, image, flow);
+        if turned > 0 {
+            self.solve_on_sides(
+                elements, target, image, normals, faces, weights, rho, flow, turned,
+            )?;
         }
         Ok(())
     }
 
     /// Turns every curve vertex at a corner whose move in `flow` points out of the side
-    /// it was solved on to the other side; whether any turned.
+    /// it was solved on to the other side; how many of them move by at least
+    /// [`CORNER_RESOLVE_SHARE`] of the largest move (the others keep their new side for
+    /// the next step without a solve again).
     fn turn_corner_sides<G: TargetGeometry>(
         &mut self,
         target: &G,
         image: &[Point3<f64>],
         flow: &Flow,
-    ) -> bool {
-        let mut turned = false;
+    ) -> usize {
+        let mut turned = 0;
+        let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
         for (v, &role) in self.roles.iter().enumerate() {
             if let Role::Curve(c) = role
                 && let Some([behind, ahead]) = target.curve_corner(c, &image[v])
@@ -407,14 +428,17 @@ impl FlowSystem {
                 let along = flow.vertex[v].dot(if self.ahead[v] { &ahead } else { &behind });
                 if (self.ahead[v] && along < 0.0) || (!self.ahead[v] && along > 0.0) {
                     self.ahead[v] = !self.ahead[v];
-                    turned = true;
+                    if flow.vertex[v].norm() >= CORNER_RESOLVE_SHARE * largest {
+                        turned += 1;
+                    }
                 }
             }
         }
         turned
     }
 
-    /// [`FlowSystem::solve`] with the corner sides as they are.
+    /// [`FlowSystem::solve`] with the corner sides as they are; `turned` vertices took
+    /// the other side since the last solve of the same step (0 for a new step).
     #[allow(clippy::too_many_arguments)]
     fn solve_on_sides<G: TargetGeometry>(
         &mut self,
@@ -426,6 +450,7 @@ impl FlowSystem {
         weights: &[f64],
         rho: &[Complex64],
         flow: &mut Flow,
+        turned: usize,
     ) -> Result<(), SolverError> {
         self.refill_directions(target, image, normals)?;
         self.rhs.iter_mut().for_each(|r| *r = 0.0);
@@ -514,13 +539,13 @@ impl FlowSystem {
         }
         self.rhs_before.clear();
         self.rhs_before.extend_from_slice(&self.rhs);
-        match self.solve_normal_equations() {
+        match self.solve_normal_equations(turned) {
             Err(SolverError::Solve(SolveError::Singular { .. })) if self.damping > 0.0 => {
                 let values = self.matrix.val_mut();
                 for &d in &self.diagonal {
                     values[d] *= 1.0 + OWN_DAMPING;
                 }
-                self.solve_normal_equations()?;
+                self.solve_normal_equations(turned)?;
             }
             outcome => outcome?,
         }
@@ -599,8 +624,29 @@ impl FlowSystem {
     /// little between late steps), else — or when that does not converge within
     /// [`CG_ITERATIONS`] — by factoring the new matrix. After a failed reuse the next
     /// 1, 2, 4, .. steps factor directly.
-    fn solve_normal_equations(&mut self) -> Result<(), SolverError> {
-        if self.kept && self.skip_reuse == 0 {
+    ///
+    /// A solve again after `turned > 0` corner vertices took the other side differs from
+    /// the matrix just solved in their rows and columns only, a perturbation of rank at
+    /// most `2 turned` that conjugate gradients preconditioned with the kept
+    /// factorization resolve in as many iterations more; it is tried with that many
+    /// (up to [`CG_TURNED_ITERATIONS`]) and leaves the reuse schedule of the steps as it
+    /// is.
+    fn solve_normal_equations(&mut self, turned: usize) -> Result<(), SolverError> {
+        if self.kept && turned > 0 {
+            self.trial.copy_from_slice(&self.rhs);
+            let iterations = (CG_ITERATIONS + 2 * turned).min(CG_TURNED_ITERATIONS);
+            let outcome = self.solver.solve_preconditioned(
+                self.matrix.as_ref(),
+                &mut self.trial,
+                CG_TOLERANCE,
+                iterations,
+            )?;
+            self.cg_iterations += outcome.iterations;
+            if outcome.converged {
+                std::mem::swap(&mut self.rhs, &mut self.trial);
+                return Ok(());
+            }
+        } else if self.kept && self.skip_reuse == 0 {
             self.trial.copy_from_slice(&self.rhs);
             let outcome = self.solver.solve_preconditioned(
                 self.matrix.as_ref(),
@@ -616,7 +662,7 @@ impl FlowSystem {
             }
             self.skip_reuse = self.backoff;
             self.backoff *= 2;
-        } else {
+        } else if turned == 0 {
             self.skip_reuse = self.skip_reuse.saturating_sub(1);
         }
         self.solver.factorize(self.matrix.as_ref())?;
