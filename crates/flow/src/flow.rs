@@ -28,7 +28,8 @@
 //! 3. Step (section 4.4). The largest `t` in `{1, 1/2, 1/4, ...}` (on target meshes
 //!    starting below the cap of [`FlowOptions::max_move`]) for which (while a landmark
 //!    is still pulled towards its goal, only the first condition)
-//!    `Y' = P(Y + t V)` (each vertex projected back onto the target by its role) has no
+//!    `Y' = P(Y + t V)` (each vertex projected back onto the target by its role, a
+//!    curve vertex slid along its curve by `t V` first) has no
 //!    more flipped faces than `Y` and a smaller `E`. When no `t` qualifies and
 //!    [`FlowOptions::untangle_trials`] is set, the search runs again with each trial's
 //!    new flips untangled first ([`crate::untangle`], a vertex of a flipped face trying

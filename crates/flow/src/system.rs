@@ -382,9 +382,10 @@ impl FlowSystem {
     /// solved move points into it: a move along the tangent behind with a positive
     /// coefficient would leave along the segment ahead, a first-order error of the model
     /// for every face at the vertex. Where the solved move points out of the side it was
-    /// solved on, the vertex takes the other side and the system is solved once more
-    /// (a vertex that points out of both keeps its second side: its best move is to stay,
-    /// and the model errs for it alone).
+    /// solved on, the vertex takes the other side, and when it moves by at least
+    /// [`CORNER_RESOLVE_SHARE`] of the largest move the system is solved once more (a
+    /// vertex that points out of both sides keeps its second one: its best move is to
+    /// stay, and the model errs for it alone).
     #[allow(clippy::too_many_arguments)]
     pub fn solve<G: TargetGeometry>(
         &mut self,

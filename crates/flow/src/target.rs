@@ -4,8 +4,10 @@
 //! target (Wong-Zhao 2014, section 4.5): a vertex with [`Role::Free`] moves in the
 //! target's tangent plane at `Y_i` (two unknowns), a vertex with [`Role::Curve`] along
 //! the tangent of a boundary curve (one unknown), a [`Role::Fixed`] vertex not at all.
-//! After each step [`TargetGeometry::project`] puts every image back onto the target
-//! (the surface, or its boundary curve). A curve may have a free normal offset (the
+//! After each step a curve vertex slides along its curve by its move
+//! ([`TargetGeometry::slide`]; at a corner of a polyline, along the side its move points
+//! into, [`TargetGeometry::curve_corner`]) and [`TargetGeometry::project`] puts every
+//! image back onto the target (the surface, or its boundary curve). A curve may have a free normal offset (the
 //! inner circle of an annulus whose radius is an unknown): one more unknown shared by the
 //! vertices on it, moving them along [`TargetGeometry::curve_offset_direction`].
 //!
