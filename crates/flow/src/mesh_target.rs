@@ -273,8 +273,14 @@ impl TargetGeometry for MeshTarget<'_> {
                 }
                 let displacements: Vec<Vector3<f64>> =
                     points.iter().zip(from).map(|(p, q)| p - q).collect();
+                // A free vertex whose walk meets the target's boundary slides along it
+                // by the rest of its move: stopped there, a vertex the flow pushes
+                // outwards would not move at all, and the model would be wrong for all
+                // of its faces (on `mc4_face_b` onto `mc4_face_a` remeshed to 100K
+                // faces, the flow stalled with five such vertices moving by 0 of their
+                // modeled moves, the largest of the step).
                 let options = MoveOptions {
-                    boundary: BoundaryMode::Stop,
+                    boundary: BoundaryMode::Slide,
                     ..MoveOptions::default()
                 };
                 self.index
@@ -412,5 +418,39 @@ mod tests {
                 "{length}: {got} instead of {expected}"
             );
         }
+    }
+
+    /// A free point on the target's boundary pushed outwards slides along the boundary
+    /// by its move's component along it instead of stopping where it is.
+    #[test]
+    fn a_free_point_pushed_out_of_the_target_slides_along_its_boundary() {
+        let mesh = Mesh::from_soup(&grid(4, 4, Cells::Triangles)).unwrap();
+        let index = SurfaceIndex::new(&mesh).unwrap();
+        let target = MeshTarget::new(&index, Vec::new());
+        let from = vec![Point3::new(0.4, 0.0, 0.0), Point3::new(0.5, 0.5, 0.0)];
+        let roles = vec![Role::Free; 2];
+        let mut normals = Vec::new();
+        let mut start = from.clone();
+        target
+            .project_all(&roles, None, &mut start, &mut normals)
+            .unwrap();
+        target.prepare_step(&start).unwrap();
+        let mut moved = vec![
+            from[0] + Vector3::new(0.1, -0.3, 0.0),
+            from[1] + Vector3::new(0.1, -0.3, 0.0),
+        ];
+        target
+            .project_all(&roles, Some(&start), &mut moved, &mut normals)
+            .unwrap();
+        assert!(
+            (moved[0] - Point3::new(0.5, 0.0, 0.0)).norm() < 1e-12,
+            "{}",
+            moved[0]
+        );
+        assert!(
+            (moved[1] - Point3::new(0.6, 0.2, 0.0)).norm() < 1e-12,
+            "{}",
+            moved[1]
+        );
     }
 }
