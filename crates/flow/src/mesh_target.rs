@@ -76,7 +76,8 @@ impl TargetCurve {
 
     /// The point of the curve reached from the closest point to `p` by walking along
     /// the curve by the arc length `d . T`, `T` the tangent there most nearly parallel
-    /// to `d` (one of a corner's two; [`PolylineIndex::walk`]).
+    /// to `d` (one of a corner's two; [`PolylineIndex::walk`]), or the next point of the
+    /// polyline when the walk ends within [`CORNER_SNAP`] of its length short of it.
     pub fn slide(&self, p: &Point3<f64>, d: &Vector3<f64>) -> Point3<f64> {
         let Some(on) = self.index.closest(p) else {
             return *p;

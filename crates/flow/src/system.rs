@@ -412,8 +412,9 @@ impl FlowSystem {
 
     /// Turns every curve vertex at a corner whose move in `flow` points out of the side
     /// it was solved on to the other side; how many of them move by at least
-    /// [`CORNER_RESOLVE_SHARE`] of the largest move (the others keep their new side for
-    /// the next step without a solve again).
+    /// [`CORNER_RESOLVE_SHARE`] of the largest move. Only these call for a solve again;
+    /// the others keep their new side, in that solve when there is one, else from the
+    /// next step on.
     fn turn_corner_sides<G: TargetGeometry>(
         &mut self,
         target: &G,
@@ -565,8 +566,8 @@ impl FlowSystem {
 
     /// States the directions of the current image in the DOF map: the tangent basis of
     /// the target's normal at a free vertex ([`orthonormal_basis`]), the curve tangent at
-    /// a curve vertex (of its side at a corner), and the curve's offset direction there (zero where the target
-    /// has none).
+    /// a curve vertex (of its side at a corner), and the curve's offset direction there
+    /// (zero where the target has none).
     fn refill_directions<G: TargetGeometry>(
         &mut self,
         target: &G,
@@ -626,12 +627,13 @@ impl FlowSystem {
     /// [`CG_ITERATIONS`] — by factoring the new matrix. After a failed reuse the next
     /// 1, 2, 4, .. steps factor directly.
     ///
-    /// A solve again after `turned > 0` corner vertices took the other side differs from
-    /// the matrix just solved in their rows and columns only, a perturbation of rank at
-    /// most `2 turned` that conjugate gradients preconditioned with the kept
-    /// factorization resolve in as many iterations more; it is tried with that many
-    /// (up to [`CG_TURNED_ITERATIONS`]) and leaves the reuse schedule of the steps as it
-    /// is.
+    /// A solve again after `turned > 0` large movers at corners took the other side
+    /// differs from the matrix just solved in the rows and columns of the vertices that
+    /// turned, a perturbation of rank twice their number, which conjugate gradients
+    /// preconditioned with the kept factorization resolve in as many iterations more.
+    /// It is tried with `2 turned` more (the small movers that turned with them are
+    /// not counted), up to [`CG_TURNED_ITERATIONS`], and leaves the reuse schedule of
+    /// the steps as it is.
     fn solve_normal_equations(&mut self, turned: usize) -> Result<(), SolverError> {
         if self.kept && turned > 0 {
             self.trial.copy_from_slice(&self.rhs);
@@ -995,19 +997,9 @@ mod tests {
         let index = SurfaceIndex::new(&mesh).unwrap();
         let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh).unwrap());
         let image = mesh.positions().to_vec();
-        let mut roles: Vec<Role> = mesh
-            .vertices()
-            .map(|v| {
-                if mesh.is_boundary_vertex(v) {
-                    Role::Curve(0)
-                } else {
-                    Role::Free
-                }
-            })
-            .collect();
         // The corners (0, 0) and (0, 1) held; the corner (1, 0) free to slide.
-        roles[0] = Role::Fixed;
-        roles[(n + 1) * n] = Role::Fixed;
+        let held = [VertexId::from_usize(0), VertexId::from_usize((n + 1) * n)];
+        let roles = crate::setup::curve_roles(&mesh, &held, |_| 0);
         let corner = n;
         assert_eq!(image[corner], Point3::new(1.0, 0.0, 0.0));
         let [behind, ahead] = target.curve_corner(0, &image[corner]).unwrap();
