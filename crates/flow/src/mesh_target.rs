@@ -199,6 +199,17 @@ impl TargetGeometry for MeshTarget<'_> {
         self.curves[curve].corner(p)
     }
 
+    /// From the surface point the last projection or step left `vertex` at, while its
+    /// image is still there ([`beltrami_spatial::boundary::outward_at`]).
+    fn boundary_outward(&self, vertex: usize, p: &Point3<f64>) -> Option<Vector3<f64>> {
+        let start = self.start.borrow();
+        let at = start.get(vertex)?;
+        let mesh = self.mesh();
+        (at.position(mesh) == *p)
+            .then(|| beltrami_spatial::boundary::outward_at(mesh, at))
+            .flatten()
+    }
+
     fn slide(&self, curve: usize, p: &Point3<f64>, d: &Vector3<f64>) -> Point3<f64> {
         self.curves[curve].slide(p, d)
     }

@@ -74,6 +74,13 @@ pub struct FlowSystem {
     /// tangent ahead of the corner (else the one behind): the side its last solved move
     /// pointed to ([`FlowSystem::solve`]).
     ahead: Vec<bool>,
+    /// Per vertex, whether a free vertex on the target's boundary is held to it: its
+    /// second unknown moves it along the boundary's outward direction and is held near
+    /// zero ([`CONTACT_STIFFNESS`]), the first along the boundary ([`FlowSystem::solve`]).
+    contact: Vec<bool>,
+    /// Per vertex, the target boundary's outward direction in the tangent plane at a free
+    /// vertex's image where it touches the boundary (refilled every solve).
+    outward: Vec<Option<Vector3<f64>>>,
     /// `V = K c + V0` on the vertices, in R^3 (module docs): the unknowns, their
     /// directions (refilled every step) and the prescribed flow `V0` of fixed vertices.
     dofs: DofMap<f64>,
@@ -146,6 +153,13 @@ const CG_ITERATIONS: usize = 4;
 /// conjugate-gradient iterations over 100 steps (a third more time in the solves), for
 /// those above half the largest move 85, with the same result.
 const CORNER_RESOLVE_SHARE: f64 = 0.5;
+
+/// How much stiffer than its own diagonal entry the outward unknown of a free vertex
+/// held to the target's boundary is made: the outward part of its move shrinks by this
+/// factor (the step's slide along the boundary would drop it), while the sign of what
+/// is left says which way the vertex pulls (outwards: it stays held; inwards: it is
+/// let go).
+const CONTACT_STIFFNESS: f64 = 1e4;
 
 /// The most conjugate-gradient iterations a solve again after corner vertices turned
 /// tries before refactoring ([`FlowSystem::solve`]): past it a factorization costs less.
@@ -273,6 +287,8 @@ impl FlowSystem {
         let solver = SpdSolver::with_split_order(pattern.symbolic().as_ref(), &order, options)?;
         Ok(Self {
             ahead: vec![false; roles.len()],
+            contact: vec![false; roles.len()],
+            outward: vec![None; roles.len()],
             roles,
             flow: vec![0.0; dofs.full_len()],
             dofs,
@@ -386,6 +402,15 @@ impl FlowSystem {
     /// [`CORNER_RESOLVE_SHARE`] of the largest move the system is solved once more (a
     /// vertex that points out of both sides keeps its second one: its best move is to
     /// stay, and the model errs for it alone).
+    ///
+    /// A free vertex whose image lies on the target's boundary
+    /// ([`TargetGeometry::boundary_outward`]) and whose solved move points outwards
+    /// would slide along the boundary, its outward part lost: a contact, which the model
+    /// honours by holding the vertex's move along the boundary (its outward unknown made
+    /// [`CONTACT_STIFFNESS`] times stiffer). A held vertex whose outward unknown comes
+    /// out negative pulls inwards and is let go. Either change makes a solve again as
+    /// a corner's turn does, and lasts into the next steps while the vertex stays on
+    /// the boundary.
     #[allow(clippy::too_many_arguments)]
     pub fn solve<G: TargetGeometry>(
         &mut self,
@@ -401,7 +426,7 @@ impl FlowSystem {
         self.solve_on_sides(
             elements, target, image, normals, faces, weights, rho, flow, 0,
         )?;
-        let turned = self.turn_corner_sides(target, image, flow);
+        let turned = self.turn_corner_sides(target, image, flow) + self.touch_boundary(flow)?;
         if turned > 0 {
             self.solve_on_sides(
                 elements, target, image, normals, faces, weights, rho, flow, turned,
@@ -437,6 +462,45 @@ impl FlowSystem {
             }
         }
         turned
+    }
+
+    /// Holds every free vertex on the target's boundary whose move in `flow` points
+    /// outwards, and lets go every held one whose outward unknown came out negative;
+    /// how many of them move by at least [`CORNER_RESOLVE_SHARE`] of the largest move
+    /// (as [`FlowSystem::turn_corner_sides`]).
+    fn touch_boundary(&mut self, flow: &Flow) -> Result<usize, SolverError> {
+        let mut changed = 0;
+        let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        for v in 0..self.roles.len() {
+            let Some(outward) = self.outward[v] else {
+                continue;
+            };
+            let change = if self.contact[v] {
+                self.rhs[self.outward_unknown(v)?] < 0.0
+            } else {
+                flow.vertex[v].dot(&outward) > 0.0
+            };
+            if change {
+                self.contact[v] = !self.contact[v];
+                if flow.vertex[v].norm() >= CORNER_RESOLVE_SHARE * largest {
+                    changed += 1;
+                }
+            }
+        }
+        Ok(changed)
+    }
+
+    /// The unknown of free vertex `v` along its second direction (the boundary's outward
+    /// one while `v` is held to it).
+    fn outward_unknown(&self, v: usize) -> Result<usize, SolverError> {
+        let term = self.dofs.terms(VertexId::from_usize(v))?.start + 1;
+        self.dofs
+            .term(term)
+            .map(|t| t.dof)
+            .ok_or_else(|| SolverError::InvalidInput {
+                solver: crate::NAME,
+                message: format!("vertex {v} has no second flow unknown"),
+            })
     }
 
     /// [`FlowSystem::solve`] with the corner sides as they are; `turned` vertices took
@@ -539,6 +603,13 @@ impl FlowSystem {
                 values[d] += lambda;
             }
         }
+        for v in 0..self.roles.len() {
+            if self.contact[v] {
+                let out = self.outward_unknown(v)?;
+                let values = self.matrix.val_mut();
+                values[self.diagonal[out]] *= 1.0 + CONTACT_STIFFNESS;
+            }
+        }
         self.rhs_before.clear();
         self.rhs_before.extend_from_slice(&self.rhs);
         match self.solve_normal_equations(turned) {
@@ -580,7 +651,17 @@ impl FlowSystem {
             let first = self.dofs.terms(VertexId::from_usize(v))?.start;
             match role {
                 Role::Free => {
-                    for (t, b) in orthonormal_basis(normal).iter().enumerate() {
+                    self.outward[v] = target
+                        .boundary_outward(v, p)
+                        .and_then(|o| (o - normal * normal.dot(&o)).try_normalize(1e-6));
+                    let basis = match self.outward[v] {
+                        Some(out) if self.contact[v] => [normal.cross(&out), out],
+                        _ => {
+                            self.contact[v] = false;
+                            orthonormal_basis(normal)
+                        }
+                    };
+                    for (t, b) in basis.iter().enumerate() {
                         self.dofs.set_direction(first + t, b.as_slice())?;
                     }
                 }
@@ -1037,5 +1118,67 @@ mod tests {
             sides.push(side);
         }
         assert_ne!(sides[0], sides[1]);
+    }
+
+    #[test]
+    fn a_free_vertex_on_the_boundary_is_held_to_it_while_it_pulls_outwards() {
+        use crate::mesh_target::{MeshTarget, TargetCurve};
+        use beltrami_spatial::SurfaceIndex;
+        let n = 4;
+        let mesh = Mesh::from_soup(&primitives::grid(n, n, primitives::Cells::Triangles)).unwrap();
+        let elements = Elements::new(&mesh, Frame::Face).unwrap();
+        let index = SurfaceIndex::new(&mesh).unwrap();
+        let target = MeshTarget::new(&index, TargetCurve::boundary_loops(&mesh).unwrap());
+        // Every vertex held but the middle of the bottom side, a free vertex on the
+        // target's boundary (outwards is -y there).
+        let free = n / 2;
+        let mut roles = vec![Role::Fixed; mesh.vertex_count()];
+        roles[free] = Role::Free;
+        let mut image = mesh.positions().to_vec();
+        let mut normals = Vec::new();
+        target
+            .project_all(&roles, None, &mut image, &mut normals)
+            .unwrap();
+        assert_eq!(image[free], Point3::new(0.5, 0.0, 0.0));
+        let mut faces = Vec::new();
+        image_faces(&elements, &normals, &image, &mut faces, 1);
+        let weights = vec![1.0; faces.len()];
+        let mut system =
+            FlowSystem::new(&elements, &target, &image, roles, SolveOptions::default()).unwrap();
+        // The targets `rho` that the move `wanted` of the free vertex meets exactly.
+        let solve = |system: &mut FlowSystem, wanted: Vector3<f64>| {
+            let rho: Vec<Complex64> = (0..faces.len())
+                .map(|f| {
+                    let g = dzbar_coefficients(&faces[f]).unwrap();
+                    let corners = triangle(&elements, FaceId::from_usize(f));
+                    corners
+                        .iter()
+                        .zip(g)
+                        .filter(|(v, _)| v.idx() == free)
+                        .map(|(_, g)| g * along(&faces[f], wanted.as_slice()))
+                        .sum()
+                })
+                .collect();
+            let mut flow = Flow::default();
+            system
+                .solve(
+                    &elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+                )
+                .unwrap();
+            flow.vertex[free]
+        };
+        let (outwards, inwards) = (Vector3::new(0.1, -0.1, 0.0), Vector3::new(0.1, 0.1, 0.0));
+        let held = solve(&mut system, outwards);
+        assert!(
+            (held - Vector3::new(0.1, 0.0, 0.0)).norm() < 1e-4,
+            "pulled outwards, it moves along the boundary only: {held}"
+        );
+        let let_go = solve(&mut system, inwards);
+        assert!(
+            (let_go - inwards).norm() < 1e-9,
+            "pulled inwards, it is let go and moves freely: {let_go}"
+        );
+        let held_again = solve(&mut system, outwards);
+        assert!((held_again - held).norm() < 1e-9, "{held_again} / {held}");
     }
 }

@@ -55,6 +55,15 @@ pub trait TargetGeometry: Clone {
         self.project(Role::Curve(curve), &(p + d))
     }
 
+    /// The unit outward direction of the target's boundary where the image `p` of free
+    /// vertex `vertex` touches it, `None` where it does not (the default: targets whose
+    /// free vertices cannot reach a boundary). A free vertex there that the flow pushes
+    /// outwards slides along the boundary instead (its outward part is lost), which the
+    /// flow models as a contact ([`crate::system::FlowSystem::solve`]).
+    fn boundary_outward(&self, _vertex: usize, _p: &Point3<f64>) -> Option<Vector3<f64>> {
+        None
+    }
+
     /// The direction a free offset of `curve` moves its points at `p`, or `None` when
     /// the curve is fixed (the default).
     fn curve_offset_direction(&self, _curve: usize, _p: &Point3<f64>) -> Option<Vector3<f64>> {

@@ -72,6 +72,7 @@
 //! assert_eq!(summary.arrived, images.len());
 //! ```
 
+pub mod boundary;
 pub mod closest_point;
 pub mod error;
 pub mod frame;

@@ -60,6 +60,7 @@ use beltrami_mesh::surface_point::bilinear_weights;
 use beltrami_mesh::{FaceId, HalfedgeId, Mesh, SurfacePoint, VertexId};
 use nalgebra::{Point3, Vector3};
 
+use crate::boundary::{OnBoundary, on_boundary};
 use crate::closest_point::{closest_on_triangle, quad_edge_parameter, refine_on_quad};
 use crate::error::{SpatialError, check_displacement};
 use crate::frame::{any_orthogonal, interpolated_normal};
@@ -67,7 +68,7 @@ use crate::index::SurfaceIndex;
 
 /// A barycentric coordinate at most this small puts the point on the opposite edge
 /// (a path within it of a vertex passes through the vertex).
-const VERTEX_TOLERANCE: f64 = 1e-12;
+pub(crate) const VERTEX_TOLERANCE: f64 = 1e-12;
 
 /// Barycentric rates below this fraction of the largest one count as zero (the path runs
 /// parallel to that edge).
@@ -679,36 +680,6 @@ fn slide(mesh: &Mesh, b: HalfedgeId, s: f64, distance: f64) -> (HalfedgeId, f64)
             return (b, s);
         }
     }
-}
-
-/// Where a surface point lies on the boundary.
-enum OnBoundary {
-    /// At a boundary vertex.
-    Vertex(VertexId),
-    /// On the boundary edge of face halfedge `h`, at fraction `t` from its origin.
-    Edge(HalfedgeId, f64),
-}
-
-/// Whether `p` is on the boundary (coordinates within [`VERTEX_TOLERANCE`] of a boundary
-/// vertex or edge).
-fn on_boundary(mesh: &Mesh, p: &SurfacePoint) -> Option<OnBoundary> {
-    let (v, n) = mesh.face_vertex_array(p.face);
-    if let Some(k) = (0..n).find(|&k| p.coords[k] >= 1.0 - VERTEX_TOLERANCE) {
-        return mesh
-            .is_boundary_vertex(v[k])
-            .then_some(OnBoundary::Vertex(v[k]));
-    }
-    (0..n).find_map(|j| {
-        let next = (j + 1) % n;
-        let on_edge = (0..n)
-            .filter(|&k| k != j && k != next)
-            .all(|k| p.coords[k] <= VERTEX_TOLERANCE);
-        let h = HalfedgeId(mesh.face_halfedge(p.face).0 + j as u32);
-        (on_edge && mesh.is_boundary_halfedge(mesh.twin(h))).then(|| {
-            let (a, b) = (p.coords[j], p.coords[next]);
-            OnBoundary::Edge(h, b / (a + b))
-        })
-    })
 }
 
 impl SurfaceIndex<'_> {
