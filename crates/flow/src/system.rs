@@ -75,8 +75,8 @@ pub struct FlowSystem {
     /// pointed to ([`FlowSystem::solve`]).
     ahead: Vec<bool>,
     /// Per vertex, whether a free vertex on the target's boundary is held to it: its
-    /// second unknown moves it along the boundary's outward direction and is held near
-    /// zero ([`CONTACT_STIFFNESS`]), the first along the boundary ([`FlowSystem::solve`]).
+    /// first unknown moves it along the boundary, its second not at all
+    /// ([`FlowSystem::solve`]).
     contact: Vec<bool>,
     /// Per vertex, the target boundary's outward direction in the tangent plane at a free
     /// vertex's image where it touches the boundary (refilled every solve).
@@ -153,13 +153,6 @@ const CG_ITERATIONS: usize = 4;
 /// conjugate-gradient iterations over 100 steps (a third more time in the solves), for
 /// those above half the largest move 85, with the same result.
 const CORNER_RESOLVE_SHARE: f64 = 0.5;
-
-/// How much stiffer than its own diagonal entry the outward unknown of a free vertex
-/// held to the target's boundary is made: the outward part of its move shrinks by this
-/// factor (the step's slide along the boundary would drop it), while the sign of what
-/// is left says which way the vertex pulls (outwards: it stays held; inwards: it is
-/// let go).
-const CONTACT_STIFFNESS: f64 = 1e4;
 
 /// The most conjugate-gradient iterations a solve again after corner vertices turned
 /// tries before refactoring ([`FlowSystem::solve`]): past it a factorization costs less.
@@ -406,11 +399,14 @@ impl FlowSystem {
     /// A free vertex whose image lies on the target's boundary
     /// ([`TargetGeometry::boundary_outward`]) and whose solved move points outwards
     /// would slide along the boundary, its outward part lost: a contact, which the model
-    /// honours by holding the vertex's move along the boundary (its outward unknown made
-    /// [`CONTACT_STIFFNESS`] times stiffer). A held vertex whose outward unknown comes
-    /// out negative pulls inwards and is let go. Either change makes a solve again as
-    /// a corner's turn does, and lasts into the next steps while the vertex stays on
-    /// the boundary.
+    /// honours by holding the vertex's move along the boundary (its second unknown has
+    /// no direction, and a diagonal entry that keeps the matrix definite). A held
+    /// vertex is let go where it pulls inwards: where `E_V` falls as it moves inwards
+    /// from the solution, `dE_V/de > 0` along its outward direction `o`,
+    /// `dE_V/de = 2 sum_T w_T Re(conj(g_k (o . r + i o . s)) (V_zbar(T) - rho_T))` over
+    /// its faces (corner `k`; the plain coefficients, also on faces edge-on to the
+    /// target). Either change makes a solve again as a corner's turn does, and lasts
+    /// into the next steps while the vertex stays on the boundary.
     #[allow(clippy::too_many_arguments)]
     pub fn solve<G: TargetGeometry>(
         &mut self,
@@ -426,7 +422,8 @@ impl FlowSystem {
         self.solve_on_sides(
             elements, target, image, normals, faces, weights, rho, flow, 0,
         )?;
-        let turned = self.turn_corner_sides(target, image, flow) + self.touch_boundary(flow)?;
+        let turned = self.turn_corner_sides(target, image, flow)
+            + self.touch_boundary(faces, weights, rho, flow)?;
         if turned > 0 {
             self.solve_on_sides(
                 elements, target, image, normals, faces, weights, rho, flow, turned,
@@ -465,10 +462,17 @@ impl FlowSystem {
     }
 
     /// Holds every free vertex on the target's boundary whose move in `flow` points
-    /// outwards, and lets go every held one whose outward unknown came out negative;
+    /// outwards, and lets go every held one that pulls inwards ([`FlowSystem::solve`]);
     /// how many of them move by at least [`CORNER_RESOLVE_SHARE`] of the largest move
     /// (as [`FlowSystem::turn_corner_sides`]).
-    fn touch_boundary(&mut self, flow: &Flow) -> Result<usize, SolverError> {
+    fn touch_boundary(
+        &mut self,
+        faces: &[ImageFace],
+        weights: &[f64],
+        rho: &[Complex64],
+        flow: &Flow,
+    ) -> Result<usize, SolverError> {
+        let pulls = self.outward_pulls(faces, weights, rho, flow);
         let mut changed = 0;
         let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
         for v in 0..self.roles.len() {
@@ -476,7 +480,7 @@ impl FlowSystem {
                 continue;
             };
             let change = if self.contact[v] {
-                self.rhs[self.outward_unknown(v)?] < 0.0
+                pulls.get(&v).is_some_and(|&pull| pull > 0.0)
             } else {
                 flow.vertex[v].dot(&outward) > 0.0
             };
@@ -490,17 +494,53 @@ impl FlowSystem {
         Ok(changed)
     }
 
-    /// The unknown of free vertex `v` along its second direction (the boundary's outward
-    /// one while `v` is held to it).
-    fn outward_unknown(&self, v: usize) -> Result<usize, SolverError> {
-        let term = self.dofs.terms(VertexId::from_usize(v))?.start + 1;
-        self.dofs
-            .term(term)
-            .map(|t| t.dof)
-            .ok_or_else(|| SolverError::InvalidInput {
+    /// Per held vertex, `dE_V/de` along its outward direction at the solution `flow`
+    /// ([`FlowSystem::solve`]; half of it: only the sign matters).
+    fn outward_pulls(
+        &self,
+        faces: &[ImageFace],
+        weights: &[f64],
+        rho: &[Complex64],
+        flow: &Flow,
+    ) -> std::collections::HashMap<usize, f64> {
+        let mut pulls = std::collections::HashMap::new();
+        if !self.contact.iter().any(|&c| c) {
+            return pulls;
+        }
+        for (f, (face, corners)) in faces.iter().zip(&self.faces).enumerate() {
+            if !corners.iter().any(|&v| self.contact[v]) {
+                continue;
+            }
+            let Some(g) = dzbar_coefficients(face) else {
+                continue;
+            };
+            let residual = corners
+                .iter()
+                .zip(&g)
+                .map(|(&v, gk)| gk * along(face, flow.vertex[v].as_slice()))
+                .sum::<Complex64>()
+                - rho[f];
+            for (&v, gk) in corners.iter().zip(&g) {
+                if let (true, Some(out)) = (self.contact[v], self.outward[v]) {
+                    let beta = gk * along(face, out.as_slice());
+                    *pulls.entry(v).or_insert(0.0) += weights[f] * (beta.conj() * residual).re;
+                }
+            }
+        }
+        pulls
+    }
+
+    /// The two unknowns of free vertex `v` (the second is the held one while `v` is
+    /// held to the boundary).
+    fn free_unknowns(&self, v: usize) -> Result<[usize; 2], SolverError> {
+        let mut terms = self.dofs.node_terms(VertexId::from_usize(v))?;
+        match (terms.next(), terms.next()) {
+            (Some((_, first)), Some((_, second))) => Ok([first.dof, second.dof]),
+            _ => Err(SolverError::InvalidInput {
                 solver: crate::NAME,
-                message: format!("vertex {v} has no second flow unknown"),
-            })
+                message: format!("free vertex {v} does not have two flow unknowns"),
+            }),
+        }
     }
 
     /// [`FlowSystem::solve`] with the corner sides as they are; `turned` vertices took
@@ -605,9 +645,11 @@ impl FlowSystem {
         }
         for v in 0..self.roles.len() {
             if self.contact[v] {
-                let out = self.outward_unknown(v)?;
+                // The held unknown has no direction, so its row and column are empty:
+                // the diagonal entry of its vertex's other unknown keeps the scale.
+                let [along, held] = self.free_unknowns(v)?;
                 let values = self.matrix.val_mut();
-                values[self.diagonal[out]] *= 1.0 + CONTACT_STIFFNESS;
+                values[self.diagonal[held]] = values[self.diagonal[along]];
             }
         }
         self.rhs_before.clear();
@@ -655,7 +697,7 @@ impl FlowSystem {
                         .boundary_outward(v, p)
                         .and_then(|o| (o - normal * normal.dot(&o)).try_normalize(1e-6));
                     let basis = match self.outward[v] {
-                        Some(out) if self.contact[v] => [normal.cross(&out), out],
+                        Some(out) if self.contact[v] => [normal.cross(&out), Vector3::zeros()],
                         _ => {
                             self.contact[v] = false;
                             orthonormal_basis(normal)
@@ -709,8 +751,9 @@ impl FlowSystem {
     /// 1, 2, 4, .. steps factor directly.
     ///
     /// A solve again after `turned > 0` large movers at corners took the other side
-    /// differs from the matrix just solved in the rows and columns of the vertices that
-    /// turned, a perturbation of rank twice their number, which conjugate gradients
+    /// (or, on the target's boundary, were held or let go) differs from the matrix just
+    /// solved in the rows and columns of the vertices that changed, a perturbation of
+    /// rank two to four times their number, which conjugate gradients
     /// preconditioned with the kept factorization resolve in as many iterations more.
     /// It is tried with `2 turned` more (the small movers that turned with them are
     /// not counted), up to [`CG_TURNED_ITERATIONS`], and leaves the reuse schedule of
@@ -1170,7 +1213,7 @@ mod tests {
         let (outwards, inwards) = (Vector3::new(0.1, -0.1, 0.0), Vector3::new(0.1, 0.1, 0.0));
         let held = solve(&mut system, outwards);
         assert!(
-            (held - Vector3::new(0.1, 0.0, 0.0)).norm() < 1e-4,
+            (held - Vector3::new(0.1, 0.0, 0.0)).norm() < 1e-9,
             "pulled outwards, it moves along the boundary only: {held}"
         );
         let let_go = solve(&mut system, inwards);
