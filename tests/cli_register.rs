@@ -917,6 +917,54 @@ fn higher_genus_onto_remeshed_copies_both_ways() {
 }
 
 #[test]
+fn two_and_eight_boundary_loops_onto_bent_remeshes() {
+    let Some(shared) = shared_meshes("two_and_eight_boundary_loops_onto_bent_remeshes") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    // The peaks (34 units across, 7 holes) both ways, the annulus (160 units) one way:
+    // loops paired spatially, the bends of docs/register.md.
+    let peaks = shared.join("mc8_peaks.obj");
+    let bent_peaks = remeshed(dir.path(), &peaks, 3000, |p| {
+        Point3::new(
+            p.x + 1.5 * (p.y / 10.0).cos(),
+            p.y,
+            p.z + 3.0 * (p.x / 8.0).sin(),
+        )
+    });
+    let sophie = shared.join("mc2_sophie.obj");
+    let bent_sophie = remeshed(dir.path(), &sophie, 8000, |p| {
+        Point3::new(
+            p.x,
+            p.y + 5.0 * (p.x / 30.0).cos(),
+            p.z + 10.0 * (p.x / 40.0).sin(),
+        )
+    });
+    for (from, onto, bound) in [
+        (&peaks, &bent_peaks, 0.07),
+        (&bent_peaks, &peaks, 0.07),
+        (&sophie, &bent_sophie, 0.02),
+    ] {
+        let (image, r) = register(from, onto, &[], 0.5);
+        let mean = r["mu_mean"].as_f64().unwrap();
+        assert!(mean < bound, "{}: mean |mu| {mean}", s(from));
+        // Every boundary vertex lands on the target's boundary.
+        let (source, target) = (read(from), read(onto));
+        let index = SurfaceIndex::new(&target).unwrap();
+        for l in source.boundary_loop_list() {
+            for v in &l.vertices {
+                let at = index.locate(&image[v.idx()]).unwrap().point;
+                assert!(
+                    beltrami_spatial::boundary::on_boundary(&target, &at).is_some(),
+                    "{}: boundary vertex {v:?} lands inside the target at {at:?}",
+                    s(from)
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn genus_four_onto_a_bent_remesh_with_landmarks() {
     let Some(shared) = shared_meshes("genus_four_onto_a_bent_remesh_with_landmarks") else {
         return;
