@@ -11,7 +11,7 @@ use beltrami_core::SolverError;
 use beltrami_mesh::parallel::map_chunks_mut;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3, VertexId};
 use beltrami_spatial::frame::interpolated_normal;
-use beltrami_spatial::{BoundaryMode, MoveOptions, PolylineIndex, SurfaceIndex};
+use beltrami_spatial::{BoundaryMode, MoveOptions, PolylineIndex, SurfaceIndex, boundary};
 
 use crate::target::{Role, TargetGeometry};
 
@@ -200,13 +200,17 @@ impl TargetGeometry for MeshTarget<'_> {
     }
 
     /// From the surface point the last projection or step left `vertex` at, while its
-    /// image is still there ([`beltrami_spatial::boundary::outward_at`]).
+    /// image is still there ([`beltrami_spatial::boundary::outward`]).
     fn boundary_outward(&self, vertex: usize, p: &Point3<f64>) -> Option<Vector3<f64>> {
+        let mesh = self.mesh();
+        if mesh.boundary_loop_count() == 0 {
+            return None;
+        }
         let start = self.start.borrow();
         let at = start.get(vertex)?;
-        let mesh = self.mesh();
+        let on = boundary::on_boundary(mesh, at)?;
         (at.position(mesh) == *p)
-            .then(|| beltrami_spatial::boundary::outward_at(mesh, at))
+            .then(|| boundary::outward(mesh, on))
             .flatten()
     }
 
