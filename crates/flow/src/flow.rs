@@ -75,7 +75,7 @@ use crate::extension::HarmonicExtension;
 use crate::measure::{
     ImageFace, Objective, edges_and_reference, image_face, image_faces, triangle,
 };
-use crate::system::{Flow, FlowSystem};
+use crate::system::{Flow, FlowInput, FlowSystem};
 use crate::target::{Role, TargetGeometry};
 use crate::untangle::untangle;
 
@@ -478,7 +478,16 @@ pub fn run<G: TargetGeometry>(
             system.set_prescribed(&prescribed)?;
         }
         system.solve(
-            elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+            FlowInput {
+                elements,
+                target: &target,
+                image: &image,
+                normals: &normals,
+                faces: &faces,
+                weights: &weights,
+                rho: &rho,
+            },
+            &mut flow,
         )?;
         solve_seconds += clock.elapsed().as_secs_f64();
         let clock = Instant::now();
@@ -808,7 +817,16 @@ mod tests {
         weights_and_targets(&objective, &faces, &mut weights, &mut rho);
         system
             .solve(
-                &elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+                FlowInput {
+                    elements: &elements,
+                    target: &target,
+                    image: &image,
+                    normals: &normals,
+                    faces: &faces,
+                    weights: &weights,
+                    rho: &rho,
+                },
+                &mut flow,
             )
             .unwrap();
         let q = system.model_decrease();
@@ -901,7 +919,16 @@ mod tests {
         weights_and_targets(&objective, &faces, &mut weights, &mut rho);
         system
             .solve(
-                &elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+                FlowInput {
+                    elements: &elements,
+                    target: &target,
+                    image: &image,
+                    normals: &normals,
+                    faces: &faces,
+                    weights: &weights,
+                    rho: &rho,
+                },
+                &mut flow,
             )
             .unwrap();
         let q = system.model_decrease();

@@ -81,6 +81,9 @@ pub struct FlowSystem {
     /// Per vertex, the target boundary's outward direction in the tangent plane at a free
     /// vertex's image where it touches the boundary (refilled every solve).
     outward: Vec<Option<Vector3<f64>>>,
+    /// Per vertex, `dE_V/de` along the outward direction of a held vertex (scratch of
+    /// [`FlowSystem::solve`]).
+    pulls: Vec<f64>,
     /// `V = K c + V0` on the vertices, in R^3 (module docs): the unknowns, their
     /// directions (refilled every step) and the prescribed flow `V0` of fixed vertices.
     dofs: DofMap<f64>,
@@ -176,6 +179,35 @@ pub struct Flow {
     /// The offset of each curve (0 for curves without a free offset).
     pub offset: Vec<f64>,
 }
+
+/// What a step's flow is solved at ([`FlowSystem::solve`]): the source's elements, the
+/// target, the images of the source vertices with the target's normals there, the
+/// image faces measured at them, and per face the weight `w_T` and target `rho_T` of
+/// `E_V`.
+pub struct FlowInput<'a, G> {
+    /// The source mesh's elements.
+    pub elements: &'a Elements,
+    /// The target the images live on.
+    pub target: &'a G,
+    /// The image of every source vertex.
+    pub image: &'a [Point3<f64>],
+    /// The target's normal at every image.
+    pub normals: &'a [Vector3<f64>],
+    /// The image faces ([`crate::measure::image_faces`]).
+    pub faces: &'a [ImageFace],
+    /// `w_T` per face.
+    pub weights: &'a [f64],
+    /// `rho_T` per face.
+    pub rho: &'a [Complex64],
+}
+
+impl<G> Clone for FlowInput<'_, G> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<G> Copy for FlowInput<'_, G> {}
 
 /// The coordinate axes, the directions the DOF map is built with; every solve refills
 /// them with the directions of the current image before assembling.
@@ -282,6 +314,7 @@ impl FlowSystem {
             ahead: vec![false; roles.len()],
             contact: vec![false; roles.len()],
             outward: vec![None; roles.len()],
+            pulls: vec![0.0; roles.len()],
             roles,
             flow: vec![0.0; dofs.full_len()],
             dofs,
@@ -407,52 +440,40 @@ impl FlowSystem {
     /// its faces (corner `k`; the plain coefficients, also on faces edge-on to the
     /// target). Either change makes a solve again as a corner's turn does, and lasts
     /// into the next steps while the vertex stays on the boundary.
-    #[allow(clippy::too_many_arguments)]
     pub fn solve<G: TargetGeometry>(
         &mut self,
-        elements: &Elements,
-        target: &G,
-        image: &[Point3<f64>],
-        normals: &[Vector3<f64>],
-        faces: &[ImageFace],
-        weights: &[f64],
-        rho: &[Complex64],
+        at: FlowInput<'_, G>,
         flow: &mut Flow,
     ) -> Result<(), SolverError> {
-        self.solve_on_sides(
-            elements, target, image, normals, faces, weights, rho, flow, 0,
-        )?;
-        let turned = self.turn_corner_sides(target, image, flow)
-            + self.touch_boundary(faces, weights, rho, flow)?;
+        self.solve_on_sides(at, flow, 0)?;
+        let large = CORNER_RESOLVE_SHARE * flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let turned = self.turn_corner_sides(at, flow, large) + self.touch_boundary(at, flow, large);
         if turned > 0 {
-            self.solve_on_sides(
-                elements, target, image, normals, faces, weights, rho, flow, turned,
-            )?;
+            self.solve_on_sides(at, flow, turned)?;
         }
         Ok(())
     }
 
     /// Turns every curve vertex at a corner whose move in `flow` points out of the side
-    /// it was solved on to the other side; how many of them move by at least
-    /// [`CORNER_RESOLVE_SHARE`] of the largest move. Only these call for a solve again;
-    /// the others keep their new side, in that solve when there is one, else from the
-    /// next step on.
+    /// it was solved on to the other side; how many of them move by at least `large`
+    /// ([`CORNER_RESOLVE_SHARE`] of the largest move). Only these call for a solve
+    /// again; the others keep their new side, in that solve when there is one, else from
+    /// the next step on.
     fn turn_corner_sides<G: TargetGeometry>(
         &mut self,
-        target: &G,
-        image: &[Point3<f64>],
+        at: FlowInput<'_, G>,
         flow: &Flow,
+        large: f64,
     ) -> usize {
         let mut turned = 0;
-        let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
         for (v, &role) in self.roles.iter().enumerate() {
             if let Role::Curve(c) = role
-                && let Some([behind, ahead]) = target.curve_corner(c, &image[v])
+                && let Some([behind, ahead]) = at.target.curve_corner(c, &at.image[v])
             {
                 let along = flow.vertex[v].dot(if self.ahead[v] { &ahead } else { &behind });
                 if (self.ahead[v] && along < 0.0) || (!self.ahead[v] && along > 0.0) {
                     self.ahead[v] = !self.ahead[v];
-                    if flow.vertex[v].norm() >= CORNER_RESOLVE_SHARE * largest {
+                    if flow.vertex[v].norm() >= large {
                         turned += 1;
                     }
                 }
@@ -463,50 +484,38 @@ impl FlowSystem {
 
     /// Holds every free vertex on the target's boundary whose move in `flow` points
     /// outwards, and lets go every held one that pulls inwards ([`FlowSystem::solve`]);
-    /// how many of them move by at least [`CORNER_RESOLVE_SHARE`] of the largest move
-    /// (as [`FlowSystem::turn_corner_sides`]).
-    fn touch_boundary(
-        &mut self,
-        faces: &[ImageFace],
-        weights: &[f64],
-        rho: &[Complex64],
-        flow: &Flow,
-    ) -> Result<usize, SolverError> {
-        let pulls = self.outward_pulls(faces, weights, rho, flow);
+    /// how many of them move by at least `large` (as [`FlowSystem::turn_corner_sides`]).
+    fn touch_boundary<G>(&mut self, at: FlowInput<'_, G>, flow: &Flow, large: f64) -> usize {
+        self.outward_pulls(at, flow);
         let mut changed = 0;
-        let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
         for v in 0..self.roles.len() {
             let Some(outward) = self.outward[v] else {
                 continue;
             };
             let change = if self.contact[v] {
-                pulls.get(&v).is_some_and(|&pull| pull > 0.0)
+                self.pulls[v] > 0.0
             } else {
                 flow.vertex[v].dot(&outward) > 0.0
             };
             if change {
                 self.contact[v] = !self.contact[v];
-                if flow.vertex[v].norm() >= CORNER_RESOLVE_SHARE * largest {
+                if flow.vertex[v].norm() >= large {
                     changed += 1;
                 }
             }
         }
-        Ok(changed)
+        changed
     }
 
-    /// Per held vertex, `dE_V/de` along its outward direction at the solution `flow`
-    /// ([`FlowSystem::solve`]; half of it: only the sign matters).
-    fn outward_pulls(
-        &self,
-        faces: &[ImageFace],
-        weights: &[f64],
-        rho: &[Complex64],
-        flow: &Flow,
-    ) -> std::collections::HashMap<usize, f64> {
-        let mut pulls = std::collections::HashMap::new();
+    /// Per held vertex, `dE_V/de` along its outward direction at the solution `flow`,
+    /// into `pulls` ([`FlowSystem::solve`]; half of it: only the sign matters).
+    fn outward_pulls<G>(&mut self, at: FlowInput<'_, G>, flow: &Flow) {
         if !self.contact.iter().any(|&c| c) {
-            return pulls;
+            return;
         }
+        let pulls = &mut self.pulls;
+        pulls.iter_mut().for_each(|p| *p = 0.0);
+        let (faces, weights, rho) = (at.faces, at.weights, at.rho);
         for (f, (face, corners)) in faces.iter().zip(&self.faces).enumerate() {
             if !corners.iter().any(|&v| self.contact[v]) {
                 continue;
@@ -523,11 +532,10 @@ impl FlowSystem {
             for (&v, gk) in corners.iter().zip(&g) {
                 if let (true, Some(out)) = (self.contact[v], self.outward[v]) {
                     let beta = gk * along(face, out.as_slice());
-                    *pulls.entry(v).or_insert(0.0) += weights[f] * (beta.conj() * residual).re;
+                    pulls[v] += weights[f] * (beta.conj() * residual).re;
                 }
             }
         }
-        pulls
     }
 
     /// The two unknowns of free vertex `v` (the second is the held one while `v` is
@@ -545,19 +553,21 @@ impl FlowSystem {
 
     /// [`FlowSystem::solve`] with the corner sides as they are; `turned` vertices took
     /// the other side since the last solve of the same step (0 for a new step).
-    #[allow(clippy::too_many_arguments)]
     fn solve_on_sides<G: TargetGeometry>(
         &mut self,
-        elements: &Elements,
-        target: &G,
-        image: &[Point3<f64>],
-        normals: &[Vector3<f64>],
-        faces: &[ImageFace],
-        weights: &[f64],
-        rho: &[Complex64],
+        at: FlowInput<'_, G>,
         flow: &mut Flow,
         turned: usize,
     ) -> Result<(), SolverError> {
+        let FlowInput {
+            elements,
+            target,
+            image,
+            normals,
+            faces,
+            weights,
+            rho,
+        } = at;
         self.refill_directions(target, image, normals)?;
         self.rhs.iter_mut().for_each(|r| *r = 0.0);
         let values = self.matrix.val_mut();
@@ -1013,7 +1023,16 @@ mod tests {
         let mut flow = Flow::default();
         system
             .solve(
-                &elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+                FlowInput {
+                    elements: &elements,
+                    target: &target,
+                    image: &image,
+                    normals: &normals,
+                    faces: &faces,
+                    weights: &weights,
+                    rho: &rho,
+                },
+                &mut flow,
             )
             .unwrap();
         let offset = flow.offset[INNER];
@@ -1069,7 +1088,16 @@ mod tests {
             let mut flow = Flow::default();
             system
                 .solve(
-                    &elements, &UnitDisk, image, &normals, &faces, &weights, &rho, &mut flow,
+                    FlowInput {
+                        elements: &elements,
+                        target: &UnitDisk,
+                        image,
+                        normals: &normals,
+                        faces: &faces,
+                        weights: &weights,
+                        rho: &rho,
+                    },
+                    &mut flow,
                 )
                 .unwrap();
             (faces, flow.vertex)
@@ -1145,7 +1173,16 @@ mod tests {
             let mut flow = Flow::default();
             system
                 .solve(
-                    &elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+                    FlowInput {
+                        elements: &elements,
+                        target: &target,
+                        image: &image,
+                        normals: &normals,
+                        faces: &faces,
+                        weights: &weights,
+                        rho: &rho,
+                    },
+                    &mut flow,
                 )
                 .unwrap();
             let v = flow.vertex[corner];
@@ -1205,7 +1242,16 @@ mod tests {
             let mut flow = Flow::default();
             system
                 .solve(
-                    &elements, &target, &image, &normals, &faces, &weights, &rho, &mut flow,
+                    FlowInput {
+                        elements: &elements,
+                        target: &target,
+                        image: &image,
+                        normals: &normals,
+                        faces: &faces,
+                        weights: &weights,
+                        rho: &rho,
+                    },
+                    &mut flow,
                 )
                 .unwrap();
             flow.vertex[free]
