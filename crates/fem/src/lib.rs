@@ -21,6 +21,7 @@
 pub mod assembly;
 pub mod beltrami;
 pub mod boundary;
+pub mod conformal_energy;
 pub mod distortion;
 pub mod dof;
 pub mod element;

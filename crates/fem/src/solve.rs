@@ -762,6 +762,32 @@ impl<T: Scalar> SpdSolver<T> {
         })
     }
 
+    /// The solver of a symbolic factorization planned on its own ([`PlannedCholesky`],
+    /// typically computed on another thread while the matrix was assembled): for
+    /// matrices with the planned pattern ([`SpdSolver::pattern`]).
+    ///
+    /// Errors: those of the symbolic factorization of an empty pattern (none planned).
+    pub fn from_planned(
+        planned: PlannedCholesky<T>,
+        options: SolveOptions,
+    ) -> Result<Self, SolveError> {
+        let cholesky = match planned.cholesky {
+            Some(cholesky) => cholesky,
+            None => Cholesky::new(planned.pattern.as_ref(), options.par())?,
+        };
+        Ok(Self {
+            pattern: planned.pattern,
+            cholesky,
+            options,
+            factored: false,
+        })
+    }
+
+    /// The pattern of the matrices the solver factors (their lower triangle is read).
+    pub fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        self.pattern.as_ref()
+    }
+
     /// Whether the factorization runs in two sides at once
     /// ([`SpdSolver::with_split_order`]).
     pub fn is_split(&self) -> bool {
@@ -1070,6 +1096,11 @@ impl<T: Scalar> PlannedCholesky<T> {
     /// True when there are no unknowns.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// The pattern planned for.
+    pub fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        self.pattern.as_ref()
     }
 
     /// The factorization when it was planned for exactly `pattern`.

@@ -2,8 +2,8 @@
 //! them.
 
 use beltrami_fem::solve::{
-    NESTED_DISSECTION_FROM, amd_order, factor_count, fill_reducing_order, first_split_order,
-    nested_dissection_order, two_core_order,
+    NESTED_DISSECTION_FROM, PlannedCholesky, amd_order, factor_count, fill_reducing_order,
+    first_split_order, nested_dissection_order, two_core_order,
 };
 use beltrami_fem::{SolveOptions, SpdSolver};
 use faer::perm::PermRef;
@@ -384,4 +384,35 @@ fn two_cores_split_where_the_separator_is_small_against_the_factorization() {
         split.order,
         nested_dissection_order(large.as_ref()).unwrap()
     );
+}
+
+#[test]
+fn a_planned_solver_solves_as_a_fresh_one() {
+    // Below and above the nested-dissection size: the plan computed on its own (as on
+    // another thread) factors and solves the matrix of its pattern.
+    for k in [60, 400] {
+        let n = k * k;
+        let (m, rhs) = shifted_grid_laplacian(k, 0.01);
+        let planned =
+            PlannedCholesky::<f64>::new(m.symbolic().to_owned().unwrap(), SolveOptions::default())
+                .unwrap();
+        assert_eq!(planned.len(), n);
+        assert_eq!(planned.pattern().row_idx(), m.symbolic().row_idx());
+        let mut solver = SpdSolver::from_planned(planned, SolveOptions::default()).unwrap();
+        assert_eq!(solver.is_split(), n >= NESTED_DISSECTION_FROM);
+        assert_eq!(solver.pattern().col_ptr(), m.symbolic().col_ptr());
+        solver.factorize(m.as_ref()).unwrap();
+        let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
+        solver.solve_in_place(x.as_mut()).unwrap();
+        let x: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+        let residual = relative_residual(&m, &x, &rhs);
+        assert!(residual < 1e-9, "k = {k}: residual {residual:e}");
+    }
+    let empty = SymbolicSparseColMat::new_checked(0, 0, vec![0], None, Vec::new());
+    let planned = PlannedCholesky::<f64>::new(empty, SolveOptions::default()).unwrap();
+    assert!(planned.is_empty());
+    let mut solver = SpdSolver::from_planned(planned, SolveOptions::default()).unwrap();
+    solver
+        .solve_in_place(Mat::<f64>::zeros(0, 1).as_mut())
+        .unwrap();
 }

@@ -28,10 +28,15 @@ use beltrami_core::{
     Target, TargetKind, Topology, topology,
 };
 use beltrami_fem::boundary::far_boundary_pair;
+use beltrami_fem::conformal_energy::{ConformalSystem, conformal_energy, conformal_system};
 use beltrami_fem::operators::{apply, beltrami_operator};
 use beltrami_fem::solve::{PlannedCholesky, normal_pattern_of_cells};
-use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
-use beltrami_mesh::{FaceId, VertexId};
+use beltrami_fem::{
+    DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveError, SpdSolver,
+};
+use beltrami_mesh::{FaceId, Mesh, VertexId};
+use faer::MatMut;
+use faer::sparse::SparseColMatRef;
 use num_complex::Complex64;
 
 use crate::{NOT_A_DISK, check_goal_and_curves, measure, solve_options};
@@ -103,58 +108,23 @@ impl Solver for Lscm {
                 input(pinned[1].0)
             ));
         }
-        let (elements, dzbar, mut solver) = context.stage("assembly", &mut report, || {
-            let mut constraints = DofConstraints::new();
-            for &(v, z) in &pinned {
-                constraints.fix(v, z);
-            }
-            let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
-            // The symbolic factorization (elimination order, analysis, the factor's
-            // storage) needs only the mesh's connectivity: it is computed on another
-            // thread while the elements and D_zbar are assembled (on a large mesh the
-            // two take about as long).
-            std::thread::scope(|scope| {
-                let planned = scope.spawn(|| {
-                    let faces =
-                        (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
-                    PlannedCholesky::new(
-                        normal_pattern_of_cells(faces, &dofs)?,
-                        solve_options(settings),
-                    )
-                });
-                let elements = Elements::new(mesh, Frame::Face)?;
-                // D_zbar is the Beltrami operator of mu = 0.
-                let conformal = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
-                let dzbar = beltrami_operator(mesh, &elements, &conformal)?;
-                let solver = LeastSquaresSolver::with_planned(
-                    dzbar.symbolic(),
-                    &dofs,
-                    solve_options(settings),
-                    // A panic in the ordering thread is a bug; pass it on as one.
-                    || {
-                        planned
-                            .join()
-                            .unwrap_or_else(|p| std::panic::resume_unwind(p))
-                    },
-                )?;
-                Ok((elements, dzbar, solver))
-            })
-        })?;
-        let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
-        let map = context.stage("solve", &mut report, || {
-            let zero = vec![Complex64::new(0.0, 0.0); dzbar.nrows()];
-            Ok(solver.solve(dzbar.as_ref(), Some(&weights), &zero)?)
-        })?;
-        let residual = apply(&dzbar, &map);
-        let energy = residual
-            .iter()
-            .zip(&weights)
-            .map(|(r, w)| w * r.norm_sqr())
-            .sum();
-        metrics.energy_history.push(energy);
+        let mut constraints = DofConstraints::new();
+        for &(v, z) in &pinned {
+            constraints.fix(v, z);
+        }
+        let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
+        let (map, elements) = if mesh.quad_count() == 0 {
+            (by_sides(mesh, &dofs, settings, context, &mut report)?, None)
+        } else {
+            let (map, elements) = by_elements(mesh, &dofs, settings, context, &mut report)?;
+            (map, Some(elements))
+        };
+        metrics
+            .energy_history
+            .push(conformal_energy_of(mesh, elements.as_ref(), &map)?);
         let flipped = measure(
             mesh,
-            Some(&elements),
+            elements.as_ref(),
             &map,
             context,
             &mut report,
@@ -173,6 +143,131 @@ impl Solver for Lscm {
             report,
         })
     }
+}
+
+/// LSCM of a triangle mesh: the normal equations assembled face by face from the
+/// sides ([`conformal_system`]: no elements, `D_zbar` or scatter maps, so a large mesh
+/// touches far less memory), their symbolic factorization planned on another thread
+/// meanwhile.
+fn by_sides(
+    mesh: &Mesh,
+    dofs: &DofMap<Complex64>,
+    settings: &Settings,
+    context: &mut Context<'_>,
+    report: &mut Report,
+) -> Result<Vec<Complex64>, SolverError> {
+    let options = solve_options(settings);
+    let faces = (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
+    let (pattern, system, solver) = context.stage("assembly", report, || {
+        let pattern = normal_pattern_of_cells(faces, dofs)?;
+        std::thread::scope(|scope| {
+            let copy = pattern.clone();
+            let planned = scope.spawn(move || PlannedCholesky::new(copy, options));
+            let system = conformal_system(mesh, dofs, pattern.as_ref());
+            // A panic in the ordering thread is a bug; pass it on as one.
+            let planned = planned
+                .join()
+                .unwrap_or_else(|p| std::panic::resume_unwind(p))?;
+            let solver = match dofs.reduced_len() {
+                0 => None,
+                _ => Some(SpdSolver::from_planned(planned, options)?),
+            };
+            Ok((pattern, system?, solver))
+        })
+    })?;
+    context.stage("solve", report, || {
+        let ConformalSystem { values, mut rhs } = system;
+        if let Some(mut solver) = solver {
+            let singular = |index: usize, ratio: f64| SolveError::Singular {
+                index,
+                node: dofs.dof_node(index),
+                ratio,
+            };
+            solver
+                .factorize(SparseColMatRef::new(pattern.as_ref(), &values))
+                .map_err(|e| match e {
+                    // The energy is semidefinite: a non-positive pivot is a zero one
+                    // perturbed by rounding.
+                    SolveError::NotPositiveDefinite { index } => singular(index, 0.0),
+                    SolveError::Singular { index, ratio, .. } => singular(index, ratio),
+                    other => other,
+                })?;
+            drop(values);
+            let n = rhs.len();
+            solver.solve_in_place(MatMut::from_column_major_slice_mut(&mut rhs, n, 1))?;
+        }
+        Ok(dofs.expand(&rhs)?)
+    })
+}
+
+/// LSCM through the elements (quads, or any mesh): `E_C = |W^(1/2) D_zbar x|^2` as a
+/// weighted least-squares problem ([`LeastSquaresSolver`]), its symbolic factorization
+/// planned on another thread while the elements and `D_zbar` are assembled. Returns the
+/// map and the elements (the distortion is measured on them).
+fn by_elements(
+    mesh: &Mesh,
+    dofs: &DofMap<Complex64>,
+    settings: &Settings,
+    context: &mut Context<'_>,
+    report: &mut Report,
+) -> Result<(Vec<Complex64>, Elements), SolverError> {
+    let (elements, dzbar, mut solver) = context.stage("assembly", report, || {
+        // The symbolic factorization (elimination order, analysis, the factor's
+        // storage) needs only the mesh's connectivity: it is computed on another
+        // thread while the elements and D_zbar are assembled (on a large mesh the
+        // two take about as long).
+        std::thread::scope(|scope| {
+            let planned = scope.spawn(|| {
+                let faces =
+                    (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
+                PlannedCholesky::new(
+                    normal_pattern_of_cells(faces, dofs)?,
+                    solve_options(settings),
+                )
+            });
+            let elements = Elements::new(mesh, Frame::Face)?;
+            // D_zbar is the Beltrami operator of mu = 0.
+            let conformal = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
+            let dzbar = beltrami_operator(mesh, &elements, &conformal)?;
+            let solver = LeastSquaresSolver::with_planned(
+                dzbar.symbolic(),
+                dofs,
+                solve_options(settings),
+                // A panic in the ordering thread is a bug; pass it on as one.
+                || {
+                    planned
+                        .join()
+                        .unwrap_or_else(|p| std::panic::resume_unwind(p))
+                },
+            )?;
+            Ok((elements, dzbar, solver))
+        })
+    })?;
+    let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
+    let map = context.stage("solve", report, || {
+        let zero = vec![Complex64::new(0.0, 0.0); dzbar.nrows()];
+        Ok(solver.solve(dzbar.as_ref(), Some(&weights), &zero)?)
+    })?;
+    Ok((map, elements))
+}
+
+/// The final `E_C` of `map`: `sum_q w_q |f_zbar(q)|^2` on the elements when there are
+/// some, else face by face from the sides ([`conformal_energy`]).
+fn conformal_energy_of(
+    mesh: &Mesh,
+    elements: Option<&Elements>,
+    map: &[Complex64],
+) -> Result<f64, SolverError> {
+    let Some(elements) = elements else {
+        return Ok(conformal_energy(mesh, map)?);
+    };
+    let conformal = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
+    let dzbar = beltrami_operator(mesh, elements, &conformal)?;
+    Ok(apply(&dzbar, map)
+        .iter()
+        .zip(elements.points())
+        .map(|(r, q)| q.weight * r.norm_sqr())
+        .sum())
 }
 
 /// The capability check, returning the pinned vertices and their images.

@@ -4,6 +4,8 @@
 mod common;
 
 use beltrami_core::{Context, Pin, PlanarBoundary, Position, Problem, Solver, SolverError, Target};
+use beltrami_fem::operators::{apply, beltrami_operator};
+use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveOptions};
 use beltrami_init::Lscm;
 use beltrami_mesh::primitives::{Cells, icosphere, torus};
 use beltrami_mesh::{Mesh, Point3};
@@ -86,6 +88,49 @@ fn hemisphere_is_nearly_conformal() {
     let at = |z: Complex64| map.iter().filter(|&&w| w == z).count();
     assert_eq!(at(Complex64::new(0.0, 0.0)), 1);
     assert_eq!(at(Complex64::new(1.0, 0.0)), 1);
+}
+
+/// On triangles LSCM assembles its normal equations from the faces' sides; the map is
+/// the minimizer of `|W^(1/2) D_zbar x|^2` through the elements all the same.
+#[test]
+fn triangles_minimize_the_weighted_d_zbar_residual() {
+    let mesh = hemisphere();
+    let solution = Lscm.solve(&free(&mesh), &mut Context::new()).unwrap();
+    let map = planar(solution.map().expect("a map"));
+    let pinned = |z: Complex64| {
+        mesh.vertices()
+            .find(|v| map[v.idx()] == z)
+            .expect("a pinned vertex")
+    };
+    let mut constraints = DofConstraints::new();
+    for z in [Complex64::new(0.0, 0.0), Complex64::new(1.0, 0.0)] {
+        constraints.fix(pinned(z), z);
+    }
+    let dofs = DofMap::complex(mesh.vertex_count(), &constraints).unwrap();
+    let elements = Elements::new(&mesh, Frame::Face).unwrap();
+    let zero = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
+    let dzbar = beltrami_operator(&mesh, &elements, &zero).unwrap();
+    let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
+    let mut solver =
+        LeastSquaresSolver::new(dzbar.symbolic(), &dofs, SolveOptions::default()).unwrap();
+    let rhs = vec![Complex64::new(0.0, 0.0); dzbar.nrows()];
+    let expected = solver.solve(dzbar.as_ref(), Some(&weights), &rhs).unwrap();
+    let worst = map
+        .iter()
+        .zip(&expected)
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-11, "{worst:e}");
+    let energy: f64 = apply(&dzbar, &expected)
+        .iter()
+        .zip(&weights)
+        .map(|(r, w)| w * r.norm_sqr())
+        .sum();
+    let reported = solution.metrics.energy_history[0];
+    assert!(
+        (reported - energy).abs() < 1e-9 * energy,
+        "{reported} against {energy}"
+    );
 }
 
 #[test]
