@@ -23,6 +23,7 @@ use beltrami_mesh::{FaceId, Mesh, Point3};
 use num_complex::Complex64;
 
 use crate::beltrami::{self, PointDerivatives, ReferenceNormal};
+use crate::element::for_each_face_points;
 use crate::{BeltramiField, Elements, FemError, Frame};
 
 /// A histogram of `|mu|` over faces: [`Histogram::BINS`] bins of width
@@ -179,7 +180,9 @@ impl Distortion {
 
 /// The distortion of a map into the plane, `map[v]` the image of vertex `v`, measured in
 /// `frame` ([`Frame::Global`] for a mesh in the plane z = 0, [`Frame::Face`] for a
-/// surface).
+/// surface): the values of [`Distortion::from_derivatives`] on
+/// [`beltrami::planar_map`]'s derivatives, computed face by face without keeping the
+/// elements ([`for_each_face_points`]).
 ///
 /// Fails like [`Elements::new`] (non-planar mesh for the global frame, degenerate face)
 /// and [`beltrami::planar_map`] (wrong length, non-finite image).
@@ -188,9 +191,54 @@ pub fn measure_planar(
     map: &[Complex64],
     frame: Frame,
 ) -> Result<Distortion, FemError> {
-    let elements = Elements::new(mesh, frame)?;
-    let derivatives = beltrami::planar_map(&elements, mesh.vertex_count(), map)?;
-    Distortion::from_derivatives(&elements, &derivatives)
+    beltrami::check_len("map", mesh.vertex_count(), map.len())?;
+    if let Some(index) = map
+        .iter()
+        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+    {
+        return Err(FemError::NonFinite { what: "map", index });
+    }
+    let faces = mesh.face_count();
+    let (mut mu, mut areas, mut flipped) = (
+        Vec::with_capacity(faces),
+        Vec::with_capacity(faces),
+        Vec::with_capacity(faces),
+    );
+    for_each_face_points(mesh, frame, |_, vertices, points| {
+        // The arithmetic of `planar_map`, `point_mu`, `face_mu`, `flipped_faces` and
+        // `face_areas`, point by point.
+        let mut point_mu = [Complex64::new(0.0, 0.0); 4];
+        let mut turned = false;
+        for (q, m) in points.iter().zip(&mut point_mu) {
+            let (mut fx, mut fy) = (Complex64::default(), Complex64::default());
+            for (k, v) in vertices.iter().enumerate() {
+                fx += map[v.idx()] * q.grad[k].x;
+                fy += map[v.idx()] * q.grad[k].y;
+            }
+            let derivatives = PointDerivatives::from_xy(fx, fy);
+            *m = derivatives.mu();
+            turned |= derivatives.jacobian() <= 0.0;
+        }
+        let area: f64 = points.iter().map(|q| q.weight).sum();
+        mu.push(if points.len() == 1 {
+            point_mu[0]
+        } else {
+            points
+                .iter()
+                .zip(&point_mu)
+                .map(|(q, &m)| m * q.weight)
+                .sum::<Complex64>()
+                / area
+        });
+        areas.push(area);
+        flipped.push(turned);
+    })?;
+    let stats = DistortionStats::new(&mu, &areas, &flipped)?;
+    Ok(Distortion {
+        field: BeltramiField::new(frame, mu),
+        flipped,
+        stats,
+    })
 }
 
 /// The distortion of a map of a surface into R^3, `image[v]` the image of vertex `v`,

@@ -217,6 +217,92 @@ fn reference_polygon(
     }))
 }
 
+/// The quadrature points of face `f` with corners `p` (`n` of them; unused entries
+/// repeat the last) in `frame`, given one by one to `emit` (reference_rule's order).
+/// Fails with [`FemError::DegenerateElement`] where `det J` vanishes relative to the
+/// squared size of the face.
+fn face_points(
+    f: FaceId,
+    p: &[Point3<f64>; 4],
+    n: usize,
+    frame: Frame,
+    mut emit: impl FnMut(QuadraturePoint),
+) -> Result<(), FemError> {
+    let first_edge = p[1] - p[0];
+    let size2 = first_edge.norm_squared().max((p[2] - p[0]).norm_squared());
+    for &(u, w, ref_weight) in reference_rule(n) {
+        let (shape, dref) = reference_shape(n, u, w);
+        let (mut x1, mut x2) = (Vector3::zeros(), Vector3::zeros());
+        for k in 0..n {
+            x1 += dref[k][0] * p[k].coords;
+            x2 += dref[k][1] * p[k].coords;
+        }
+        let tangent = match frame {
+            Frame::Global => TangentFrame {
+                e1: Vector3::x(),
+                e2: Vector3::y(),
+                normal: Vector3::z(),
+            },
+            Frame::Face => {
+                let normal = x1.cross(&x2).normalize();
+                let e1 = (first_edge - first_edge.dot(&normal) * normal).normalize();
+                TangentFrame {
+                    e1,
+                    e2: normal.cross(&e1),
+                    normal,
+                }
+            }
+        };
+        let (a, b) = (tangent.local(&x1), tangent.local(&x2));
+        let det = a.x * b.y - b.x * a.y;
+        if !det.is_finite() || det.abs() <= 1e-14 * size2 {
+            return Err(FemError::DegenerateElement { face: f, det });
+        }
+        let mut grad = [Vector2::zeros(); 4];
+        for k in 0..n {
+            let (du, dv) = (dref[k][0], dref[k][1]);
+            grad[k] = Vector2::new(b.y * du - a.y * dv, -b.x * du + a.x * dv) / det;
+        }
+        let g12 = x1.dot(&x2);
+        emit(QuadraturePoint {
+            face: f,
+            weight: ref_weight * det.abs(),
+            frame: tangent,
+            shape,
+            grad,
+            det,
+            metric: [[x1.norm_squared(), g12], [g12, x2.norm_squared()]],
+        });
+    }
+    Ok(())
+}
+
+/// Visits the quadrature points of every face of `mesh` in `frame`, face by face, without
+/// keeping them: `visit(f, vertices, points)` with the face's vertices and its points
+/// (1 for a triangle, 4 for a quad), as [`Elements::new`] computes them. For one pass
+/// over a large mesh (a distortion measure), where the stored points would cost a few
+/// hundred bytes per face.
+///
+/// Errors as [`Elements::new`].
+pub fn for_each_face_points(
+    mesh: &Mesh,
+    frame: Frame,
+    mut visit: impl FnMut(FaceId, &[VertexId], &[QuadraturePoint]),
+) -> Result<(), FemError> {
+    if frame == Frame::Global {
+        check_planar(mesh)?;
+    }
+    let mut points = Vec::with_capacity(4);
+    for f in mesh.faces() {
+        let (v, n) = mesh.face_vertex_array(f);
+        let p = std::array::from_fn(|k| mesh.position(v[k.min(n - 1)]));
+        points.clear();
+        face_points(f, &p, n, frame, |q| points.push(q))?;
+        visit(f, &v[..n], &points);
+    }
+    Ok(())
+}
+
 /// Checks that every vertex has z = 0 up to `1e-12` times the bounding-box diagonal.
 pub fn check_planar(mesh: &Mesh) -> Result<(), FemError> {
     let tol = 1e-12 * mesh.bounding_box().diagonal();
@@ -313,52 +399,7 @@ impl Elements {
                 &std::array::from_fn(|k| mesh.position(v[k.min(n - 1)])),
                 n,
             )?;
-            let first_edge = p[1] - p[0];
-            let size2 = first_edge.norm_squared().max((p[2] - p[0]).norm_squared());
-            for &(u, w, ref_weight) in reference_rule(n) {
-                let (shape, dref) = reference_shape(n, u, w);
-                let (mut x1, mut x2) = (Vector3::zeros(), Vector3::zeros());
-                for k in 0..n {
-                    x1 += dref[k][0] * p[k].coords;
-                    x2 += dref[k][1] * p[k].coords;
-                }
-                let tangent = match frame {
-                    Frame::Global => TangentFrame {
-                        e1: Vector3::x(),
-                        e2: Vector3::y(),
-                        normal: Vector3::z(),
-                    },
-                    Frame::Face => {
-                        let normal = x1.cross(&x2).normalize();
-                        let e1 = (first_edge - first_edge.dot(&normal) * normal).normalize();
-                        TangentFrame {
-                            e1,
-                            e2: normal.cross(&e1),
-                            normal,
-                        }
-                    }
-                };
-                let (a, b) = (tangent.local(&x1), tangent.local(&x2));
-                let det = a.x * b.y - b.x * a.y;
-                if !det.is_finite() || det.abs() <= 1e-14 * size2 {
-                    return Err(FemError::DegenerateElement { face: f, det });
-                }
-                let mut grad = [Vector2::zeros(); 4];
-                for k in 0..n {
-                    let (du, dv) = (dref[k][0], dref[k][1]);
-                    grad[k] = Vector2::new(b.y * du - a.y * dv, -b.x * du + a.x * dv) / det;
-                }
-                let g12 = x1.dot(&x2);
-                points.push(QuadraturePoint {
-                    face: f,
-                    weight: ref_weight * det.abs(),
-                    frame: tangent,
-                    shape,
-                    grad,
-                    det,
-                    metric: [[x1.norm_squared(), g12], [g12, x2.norm_squared()]],
-                });
-            }
+            face_points(f, &p, n, frame, |q| points.push(q))?;
             let first = points[points.len() - reference_rule(n).len()].frame;
             sides.push(std::array::from_fn(|k| {
                 if k < n {

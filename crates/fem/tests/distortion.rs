@@ -1,7 +1,10 @@
 //! Distortion statistics: formulas by hand, affine maps (constant mu), flipped faces.
 
+use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::distortion::{measure_planar, measure_surface};
-use beltrami_fem::{DistortionStats, FemError, Frame, Histogram, ReferenceNormal};
+use beltrami_fem::{
+    Distortion, DistortionStats, Elements, FemError, Frame, Histogram, ReferenceNormal,
+};
 use beltrami_mesh::primitives::{Cells, grid, icosphere, torus};
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector3, VertexId};
 use num_complex::Complex64;
@@ -322,4 +325,70 @@ fn a_quad_folded_by_a_moved_corner_is_flipped() {
         }
     }
     assert_eq!(d.stats.flipped, d.flipped.iter().filter(|&&f| f).count());
+}
+
+#[test]
+fn measured_face_by_face_as_through_the_stored_elements() {
+    // A curved surface (triangles and quads) under a map that folds part of it: the
+    // streamed measure gives the very values of the elements' path.
+    for cells in [Cells::Triangles, Cells::Quads] {
+        let flat = jittered(9, cells, 0.3, 41);
+        let bent: Vec<Point3<f64>> = flat
+            .positions()
+            .iter()
+            .map(|p| Point3::new(p.x, p.y, 0.5 * p.x * p.y - 0.3 * p.x * p.x))
+            .collect();
+        let mesh = flat.with_positions(bent).unwrap();
+        let map: Vec<Complex64> = mesh
+            .positions()
+            .iter()
+            .map(|p| {
+                let z = complex(p);
+                // |mu| = 3 |z| / |1 - 0.9 z^2| passes 1 (a fold) beyond |z| ~ 1/3.
+                z - Complex64::new(0.0, 0.3) * z * z * z + 1.5 * z.conj() * z.conj()
+            })
+            .collect();
+        {
+            let frame = Frame::Face;
+            let elements = Elements::new(&mesh, frame).unwrap();
+            let derivatives = planar_map(&elements, mesh.vertex_count(), &map).unwrap();
+            let expected = Distortion::from_derivatives(&elements, &derivatives).unwrap();
+            let got = measure_planar(&mesh, &map, frame).unwrap();
+            assert!(
+                expected.flipped.iter().any(|&f| f),
+                "{cells:?}: nothing folds"
+            );
+            assert_eq!(got, expected, "{cells:?}");
+        }
+    }
+    // The global frame on a planar mesh, and its check.
+    let mesh = jittered(9, Cells::Triangles, 0.3, 42);
+    let map: Vec<Complex64> = mesh
+        .positions()
+        .iter()
+        .map(|p| complex(p) * complex(p))
+        .collect();
+    let elements = Elements::new(&mesh, Frame::Global).unwrap();
+    let derivatives = planar_map(&elements, mesh.vertex_count(), &map).unwrap();
+    let expected = Distortion::from_derivatives(&elements, &derivatives).unwrap();
+    assert_eq!(
+        measure_planar(&mesh, &map, Frame::Global).unwrap(),
+        expected
+    );
+    let lifted: Vec<Point3<f64>> = mesh
+        .positions()
+        .iter()
+        .map(|p| Point3::new(p.x, p.y, p.x))
+        .collect();
+    let lifted = mesh.with_positions(lifted).unwrap();
+    assert!(matches!(
+        measure_planar(&lifted, &map, Frame::Global),
+        Err(FemError::NotPlanar { .. })
+    ));
+    let mut broken = map.clone();
+    broken[3] = Complex64::new(f64::NAN, 0.0);
+    assert!(matches!(
+        measure_planar(&mesh, &broken, Frame::Face),
+        Err(FemError::NonFinite { index: 3, .. })
+    ));
 }
