@@ -19,9 +19,11 @@
 //! [`measure_planar`] and [`measure_surface`] go from a mesh and the images of its
 //! vertices to a [`Distortion`]: the field, the flags and the statistics.
 
-use beltrami_mesh::{FaceId, Mesh, Point3};
+use beltrami_mesh::parallel::{available_threads, map_ranges};
+use beltrami_mesh::{FaceId, Mesh, Point3, VertexId};
 use num_complex::Complex64;
 
+use crate::QuadraturePoint;
 use crate::beltrami::{self, PointDerivatives, ReferenceNormal};
 use crate::element::for_each_face_points;
 use crate::{BeltramiField, Elements, FemError, Frame};
@@ -182,7 +184,8 @@ impl Distortion {
 /// `frame` ([`Frame::Global`] for a mesh in the plane z = 0, [`Frame::Face`] for a
 /// surface): the values of [`Distortion::from_derivatives`] on
 /// [`beltrami::planar_map`]'s derivatives, computed face by face without keeping the
-/// elements ([`for_each_face_points`]).
+/// elements ([`for_each_face_points`]), ranges of faces on all cores (the values do not
+/// depend on their number).
 ///
 /// Fails like [`Elements::new`] (non-planar mesh for the global frame, degenerate face)
 /// and [`beltrami::planar_map`] (wrong length, non-finite image).
@@ -198,15 +201,49 @@ pub fn measure_planar(
     {
         return Err(FemError::NonFinite { what: "map", index });
     }
-    let faces = mesh.face_count();
-    let (mut mu, mut areas, mut flipped) = (
-        Vec::with_capacity(faces),
-        Vec::with_capacity(faces),
-        Vec::with_capacity(faces),
-    );
-    for_each_face_points(mesh, frame, |_, vertices, points| {
-        // The arithmetic of `planar_map`, `point_mu`, `face_mu`, `flipped_faces` and
-        // `face_areas`, point by point.
+    let parts = map_ranges(mesh.face_count(), available_threads(), |faces| {
+        let mut part = FaceDistortion::with_capacity(faces.len());
+        for_each_face_points(mesh, frame, faces, |_, vertices, points| {
+            part.push(map, vertices, points)
+        })
+        .map(|()| part)
+    });
+    let mut all = FaceDistortion::with_capacity(mesh.face_count());
+    for part in parts {
+        let part = part?;
+        all.mu.extend(part.mu);
+        all.areas.extend(part.areas);
+        all.flipped.extend(part.flipped);
+    }
+    let FaceDistortion { mu, areas, flipped } = all;
+    let stats = DistortionStats::new(&mu, &areas, &flipped)?;
+    Ok(Distortion {
+        field: BeltramiField::new(frame, mu),
+        flipped,
+        stats,
+    })
+}
+
+/// `mu`, area and flip flag of consecutive faces of a planar map ([`measure_planar`]).
+struct FaceDistortion {
+    mu: Vec<Complex64>,
+    areas: Vec<f64>,
+    flipped: Vec<bool>,
+}
+
+impl FaceDistortion {
+    fn with_capacity(faces: usize) -> Self {
+        Self {
+            mu: Vec::with_capacity(faces),
+            areas: Vec::with_capacity(faces),
+            flipped: Vec::with_capacity(faces),
+        }
+    }
+
+    /// Appends the face with `vertices` and quadrature `points` under `map`, with the
+    /// arithmetic of `planar_map`, `point_mu`, `face_mu`, `flipped_faces` and
+    /// `face_areas`.
+    fn push(&mut self, map: &[Complex64], vertices: &[VertexId], points: &[QuadraturePoint]) {
         let mut point_mu = [Complex64::new(0.0, 0.0); 4];
         let mut turned = false;
         for (q, m) in points.iter().zip(&mut point_mu) {
@@ -220,7 +257,7 @@ pub fn measure_planar(
             turned |= derivatives.jacobian() <= 0.0;
         }
         let area: f64 = points.iter().map(|q| q.weight).sum();
-        mu.push(if points.len() == 1 {
+        self.mu.push(if points.len() == 1 {
             point_mu[0]
         } else {
             points
@@ -230,15 +267,9 @@ pub fn measure_planar(
                 .sum::<Complex64>()
                 / area
         });
-        areas.push(area);
-        flipped.push(turned);
-    })?;
-    let stats = DistortionStats::new(&mu, &areas, &flipped)?;
-    Ok(Distortion {
-        field: BeltramiField::new(frame, mu),
-        flipped,
-        stats,
-    })
+        self.areas.push(area);
+        self.flipped.push(turned);
+    }
 }
 
 /// The distortion of a map of a surface into R^3, `image[v]` the image of vertex `v`,

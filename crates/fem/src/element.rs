@@ -33,6 +33,7 @@
 //! the reference weight times `|det J|`.
 
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector2, Vector3, VertexId};
+use std::ops::Range;
 
 use crate::FemError;
 
@@ -277,23 +278,32 @@ fn face_points(
     Ok(())
 }
 
-/// Visits the quadrature points of every face of `mesh` in `frame`, face by face, without
-/// keeping them: `visit(f, vertices, points)` with the face's vertices and its points
-/// (1 for a triangle, 4 for a quad), as [`Elements::new`] computes them. For one pass
-/// over a large mesh (a distortion measure), where the stored points would cost a few
-/// hundred bytes per face.
+/// Visits the quadrature points of the faces `faces` (indices) of `mesh` in `frame`, face
+/// by face, without keeping them: `visit(f, vertices, points)` with the face's vertices
+/// and its points (1 for a triangle, 4 for a quad), as [`Elements::new`] computes them.
+/// For one pass over a large mesh (a distortion measure), where the stored points would
+/// cost a few hundred bytes per face; ranges of faces can be visited on several threads.
 ///
-/// Errors as [`Elements::new`].
+/// Errors as [`Elements::new`] (the first degenerate face of the range);
+/// [`FemError::Length`] for a range beyond the faces.
 pub fn for_each_face_points(
     mesh: &Mesh,
     frame: Frame,
+    faces: Range<usize>,
     mut visit: impl FnMut(FaceId, &[VertexId], &[QuadraturePoint]),
 ) -> Result<(), FemError> {
+    if faces.end > mesh.face_count() {
+        return Err(FemError::Length {
+            what: "the range of faces",
+            expected: mesh.face_count(),
+            got: faces.end,
+        });
+    }
     if frame == Frame::Global {
         check_planar(mesh)?;
     }
     let mut points = Vec::with_capacity(4);
-    for f in mesh.faces() {
+    for f in faces.map(FaceId::from_usize) {
         let (v, n) = mesh.face_vertex_array(f);
         let p = std::array::from_fn(|k| mesh.position(v[k.min(n - 1)]));
         points.clear();
