@@ -305,6 +305,17 @@ pub fn normal_pattern_of_cells<T: Scalar, C: IntoIterator<Item = VertexId>>(
     dofs: &DofMap<T>,
 ) -> Result<SymbolicSparseColMat<usize>, SolveError> {
     let n = dofs.reduced_len();
+    // The reduced unknowns of every node, looked up once instead of once per cell
+    // corner: those of node `v` are `node_unknowns[node_ptr[v]..node_ptr[v + 1]]`.
+    let mut node_ptr = Vec::with_capacity(dofs.n_nodes() + 1);
+    let mut node_unknowns = Vec::with_capacity(n);
+    node_ptr.push(0);
+    for v in 0..dofs.n_nodes() {
+        if let Ok(terms) = dofs.terms(VertexId::from_usize(v)) {
+            node_unknowns.extend(terms.filter_map(|t| dofs.term(t).map(|term| term.dof)));
+        }
+        node_ptr.push(node_unknowns.len());
+    }
     let mut unknowns = Vec::new();
     // Each cell's couplings `(c, d)`, `c >= d`, go to column `d`: counted in a first
     // pass over the cells, written in a second (no list of pairs is kept), then each
@@ -315,12 +326,15 @@ pub fn normal_pattern_of_cells<T: Scalar, C: IntoIterator<Item = VertexId>>(
         for cell in cells {
             unknowns.clear();
             for node in cell {
-                let terms = dofs.terms(node).map_err(|_| SolveError::Length {
-                    what: "the node index of a cell",
-                    expected: dofs.n_nodes(),
-                    got: node.idx(),
-                })?;
-                unknowns.extend(terms.filter_map(|t| dofs.term(t).map(|term| term.dof)));
+                let v = node.idx();
+                if v >= dofs.n_nodes() {
+                    return Err(SolveError::Length {
+                        what: "the node index of a cell",
+                        expected: dofs.n_nodes(),
+                        got: v,
+                    });
+                }
+                unknowns.extend_from_slice(&node_unknowns[node_ptr[v]..node_ptr[v + 1]]);
             }
             for (p, &c) in unknowns.iter().enumerate() {
                 for &d in &unknowns[..=p] {
