@@ -58,8 +58,6 @@ struct Prepared {
     /// The first `vt` line with a NaN or infinite coordinate: its 1-based line, its
     /// 0-based texture coordinate index and its two values.
     non_finite_uv: Option<(usize, usize, f64, f64)>,
-    /// The number of `vt` lines.
-    texcoords: usize,
 }
 
 /// The first two numbers of a `vt` line, when both parse.
@@ -157,12 +155,18 @@ fn prepare(bytes: &[u8]) -> Prepared {
         face_lines,
         all_corners_have_uv,
         non_finite_uv,
-        texcoords,
     }
 }
 
 /// Parses OBJ text held in memory; `path` only names the file in errors.
 pub fn parse(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
+    if let Some((soup, face_lines)) = parse_plain(bytes) {
+        return Ok(RawMesh {
+            soup,
+            corner_uvs: None,
+            face_lines: Some(face_lines),
+        });
+    }
     let prepared = prepare(bytes);
     if let Some((line, index, u, v)) = prepared.non_finite_uv {
         return Err(ReadError::NonFiniteTexCoord {
@@ -172,16 +176,6 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
             index,
             u,
             v,
-        });
-    }
-    if prepared.kept.is_none()
-        && prepared.texcoords == 0
-        && let Some(soup) = parse_plain(bytes, prepared.vertex_count, prepared.face_lines.len())
-    {
-        return Ok(RawMesh {
-            soup,
-            corner_uvs: None,
-            face_lines: Some(prepared.face_lines),
         });
     }
     parse_with_tobj(path, bytes, prepared)
@@ -265,19 +259,19 @@ fn parse_with_tobj(path: &Path, bytes: &[u8], prepared: Prepared) -> Result<RawM
     })
 }
 
-/// The positions and faces of a plain OBJ file, read without tobj: every line is blank,
-/// a comment, `v x y z` (three numbers) or `f a b c ...` (at least three vertex indices,
-/// 1-based or negative relative to the `v` lines before it, no `/`). `None` as soon as a
-/// line is anything else, or names a vertex not yet listed: tobj then reads the file and
-/// words any error. tobj's generality costs on large files (per-face records and a hash
-/// map of corners: 255 MB and 0.8 s for a 44 MB file of 1M triangles); the values are the
-/// same (both parse numbers with the standard library's correctly rounded parser).
-/// `vertex_count` and `face_count` (from the first pass) size the arrays.
-fn parse_plain(bytes: &[u8], vertex_count: usize, face_count: usize) -> Option<PolygonSoup> {
-    let mut soup = PolygonSoup::new(Vec::with_capacity(vertex_count));
-    soup.reserve(face_count, 3 * face_count);
+/// The positions and faces of a plain OBJ file, read without tobj, with the 1-based line
+/// of every face: every line is blank, a comment, `v x y z` (three numbers) or
+/// `f a b c ...` (at least three vertex indices, 1-based or negative relative to the `v`
+/// lines before it, no `/`). `None` as soon as a line is anything else, or names a
+/// vertex not yet listed: tobj then reads the file and words any error. tobj's
+/// generality costs on large files (per-face records and a hash map of corners: 255 MB
+/// and 0.8 s for a 44 MB file of 1M triangles); the values are the same (both parse
+/// numbers with the standard library's correctly rounded parser).
+fn parse_plain(bytes: &[u8]) -> Option<(PolygonSoup, Vec<u32>)> {
+    let mut soup = PolygonSoup::new(Vec::new());
+    let mut face_lines = Vec::new();
     let mut corners: Vec<u32> = Vec::with_capacity(4);
-    for line in bytes.split(|&c| c == b'\n') {
+    for (i, line) in bytes.split(|&c| c == b'\n').enumerate() {
         let mut tokens = line
             .split(|c| c.is_ascii_whitespace())
             .filter(|t| !t.is_empty());
@@ -312,11 +306,12 @@ fn parse_plain(bytes: &[u8], vertex_count: usize, face_count: usize) -> Option<P
                     return None;
                 }
                 soup.push_face(&corners);
+                face_lines.push(u32::try_from(i + 1).ok()?);
             }
             Some(_) => return None,
         }
     }
-    Some(soup)
+    Some((soup, face_lines))
 }
 
 /// tobj's errors carry no line number: find the first line that explains the error.
@@ -745,11 +740,7 @@ mod plain_tests {
         ] {
             let text = format!("{prefix}{body}");
             let bytes = text.as_bytes();
-            let first = prepare(bytes);
-            assert!(
-                parse_plain(bytes, first.vertex_count, first.face_lines.len()).is_none(),
-                "{why}"
-            );
+            assert!(parse_plain(bytes).is_none(), "{why}");
         }
         // tobj reads what it can, and the result is the same as before the fast path.
         let text = format!("{prefix}vt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n");
@@ -775,10 +766,9 @@ mod plain_tests {
                 continue;
             }
             let bytes = std::fs::read(&path).unwrap();
-            let first = prepare(&bytes);
-            let fast = parse_plain(&bytes, first.vertex_count, first.face_lines.len());
-            if let Some(fast) = fast {
+            if let Some((fast, face_lines)) = parse_plain(&bytes) {
                 assert_same(&fast, &through_tobj(&bytes));
+                assert_eq!(face_lines, prepare(&bytes).face_lines);
                 plain += 1;
             }
         }
