@@ -45,7 +45,7 @@
 //! For an image in the plane z = 0 with [`ReferenceNormal::Plane`] this is the planar
 //! coefficient of [`planar_map`] with `f = x + i y`.
 
-use beltrami_mesh::{FaceId, Point3, Vector3};
+use beltrami_mesh::{FaceId, Point3, Vector3, VertexId};
 use num_complex::Complex64;
 
 use crate::{Elements, FemError, QuadraturePoint};
@@ -116,25 +116,40 @@ pub fn planar_map(
     vertex_count: usize,
     map: &[Complex64],
 ) -> Result<Vec<PointDerivatives>, FemError> {
-    check_len("map", vertex_count, map.len())?;
-    if let Some(index) = map
-        .iter()
-        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
-    {
-        return Err(FemError::NonFinite { what: "map", index });
-    }
+    check_planar_map(vertex_count, map)?;
     Ok(elements
         .points()
         .iter()
-        .map(|q| {
-            let (mut fx, mut fy) = (Complex64::default(), Complex64::default());
-            for (k, v) in elements.nodes(q.face).iter().enumerate() {
-                fx += map[v.idx()] * q.grad[k].x;
-                fy += map[v.idx()] * q.grad[k].y;
-            }
-            PointDerivatives::from_xy(fx, fy)
-        })
+        .map(|q| planar_derivatives(q, elements.nodes(q.face), map))
         .collect())
+}
+
+/// Checks a map into the plane: one finite value per vertex ([`FemError::Length`],
+/// [`FemError::NonFinite`] naming the first bad vertex).
+pub(crate) fn check_planar_map(vertex_count: usize, map: &[Complex64]) -> Result<(), FemError> {
+    check_len("map", vertex_count, map.len())?;
+    match map
+        .iter()
+        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+    {
+        Some(index) => Err(FemError::NonFinite { what: "map", index }),
+        None => Ok(()),
+    }
+}
+
+/// The derivatives at quadrature point `q` of the planar map `map` on the face with
+/// vertices `nodes`: `f_x = sum_k map[v_k] d_x N_k`, likewise `f_y`.
+pub(crate) fn planar_derivatives(
+    q: &QuadraturePoint,
+    nodes: &[VertexId],
+    map: &[Complex64],
+) -> PointDerivatives {
+    let (mut fx, mut fy) = (Complex64::default(), Complex64::default());
+    for (k, v) in nodes.iter().enumerate() {
+        fx += map[v.idx()] * q.grad[k].x;
+        fy += map[v.idx()] * q.grad[k].y;
+    }
+    PointDerivatives::from_xy(fx, fy)
 }
 
 /// The derivatives of a map into R^3 along the frame axes at one quadrature point.

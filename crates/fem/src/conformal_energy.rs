@@ -86,7 +86,7 @@ impl Face {
         // `det` is twice the area, as the Jacobian determinant of `Elements`.
         let det = sides[2].cross(&(p[2] - p[0])).norm();
         let size2 = sides[2].norm_squared().max(sides[1].norm_squared());
-        if !det.is_finite() || det <= 1e-14 * size2 {
+        if crate::element::is_degenerate(det, size2) {
             return Err(FemError::DegenerateElement { face: f, det });
         }
         Ok((
@@ -206,22 +206,7 @@ pub fn conformal_system(
 /// Errors: as [`conformal_system`] for the faces, [`FemError::Length`] when `map` has
 /// not one value per vertex, [`FemError::NonFinite`] for a non-finite image.
 pub fn conformal_energy(mesh: &Mesh, map: &[Complex64]) -> Result<f64, FemError> {
-    if map.len() != mesh.vertex_count() {
-        return Err(FemError::Length {
-            what: "the map",
-            expected: mesh.vertex_count(),
-            got: map.len(),
-        });
-    }
-    if let Some(index) = map
-        .iter()
-        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
-    {
-        return Err(FemError::NonFinite {
-            what: "the map",
-            index,
-        });
-    }
+    crate::beltrami::check_planar_map(mesh.vertex_count(), map)?;
     let mut energy = 0.0;
     for f in mesh.faces() {
         let (face, nodes) = Face::new(mesh, f)?;

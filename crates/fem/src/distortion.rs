@@ -25,7 +25,7 @@ use num_complex::Complex64;
 
 use crate::QuadraturePoint;
 use crate::beltrami::{self, PointDerivatives, ReferenceNormal};
-use crate::element::for_each_face_points;
+use crate::element::{check_planar, visit_face_points};
 use crate::{BeltramiField, Elements, FemError, Frame};
 
 /// A histogram of `|mu|` over faces: [`Histogram::BINS`] bins of width
@@ -184,7 +184,7 @@ impl Distortion {
 /// `frame` ([`Frame::Global`] for a mesh in the plane z = 0, [`Frame::Face`] for a
 /// surface): the values of [`Distortion::from_derivatives`] on
 /// [`beltrami::planar_map`]'s derivatives, computed face by face without keeping the
-/// elements ([`for_each_face_points`]), ranges of faces on all cores (the values do not
+/// elements ([`for_each_face_points`](crate::element::for_each_face_points)), ranges of faces on all cores (the values do not
 /// depend on their number).
 ///
 /// Fails like [`Elements::new`] (non-planar mesh for the global frame, degenerate face)
@@ -194,16 +194,13 @@ pub fn measure_planar(
     map: &[Complex64],
     frame: Frame,
 ) -> Result<Distortion, FemError> {
-    beltrami::check_len("map", mesh.vertex_count(), map.len())?;
-    if let Some(index) = map
-        .iter()
-        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
-    {
-        return Err(FemError::NonFinite { what: "map", index });
+    beltrami::check_planar_map(mesh.vertex_count(), map)?;
+    if frame == Frame::Global {
+        check_planar(mesh)?;
     }
     let parts = map_ranges(mesh.face_count(), available_threads(), |faces| {
         let mut part = FaceDistortion::with_capacity(faces.len());
-        for_each_face_points(mesh, frame, faces, |_, vertices, points| {
+        visit_face_points(mesh, frame, faces, |_, vertices, points| {
             part.push(map, vertices, points)
         })
         .map(|()| part)
@@ -247,12 +244,7 @@ impl FaceDistortion {
         let mut point_mu = [Complex64::new(0.0, 0.0); 4];
         let mut turned = false;
         for (q, m) in points.iter().zip(&mut point_mu) {
-            let (mut fx, mut fy) = (Complex64::default(), Complex64::default());
-            for (k, v) in vertices.iter().enumerate() {
-                fx += map[v.idx()] * q.grad[k].x;
-                fy += map[v.idx()] * q.grad[k].y;
-            }
-            let derivatives = PointDerivatives::from_xy(fx, fy);
+            let derivatives = beltrami::planar_derivatives(q, vertices, map);
             *m = derivatives.mu();
             turned |= derivatives.jacobian() <= 0.0;
         }

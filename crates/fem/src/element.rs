@@ -256,7 +256,7 @@ fn face_points(
         };
         let (a, b) = (tangent.local(&x1), tangent.local(&x2));
         let det = a.x * b.y - b.x * a.y;
-        if !det.is_finite() || det.abs() <= 1e-14 * size2 {
+        if is_degenerate(det, size2) {
             return Err(FemError::DegenerateElement { face: f, det });
         }
         let mut grad = [Vector2::zeros(); 4];
@@ -290,7 +290,7 @@ pub fn for_each_face_points(
     mesh: &Mesh,
     frame: Frame,
     faces: Range<usize>,
-    mut visit: impl FnMut(FaceId, &[VertexId], &[QuadraturePoint]),
+    visit: impl FnMut(FaceId, &[VertexId], &[QuadraturePoint]),
 ) -> Result<(), FemError> {
     if faces.end > mesh.face_count() {
         return Err(FemError::Length {
@@ -302,6 +302,17 @@ pub fn for_each_face_points(
     if frame == Frame::Global {
         check_planar(mesh)?;
     }
+    visit_face_points(mesh, frame, faces, visit)
+}
+
+/// [`for_each_face_points`] with the range and, for [`Frame::Global`], the planarity
+/// already checked by the caller (once for all its ranges).
+pub(crate) fn visit_face_points(
+    mesh: &Mesh,
+    frame: Frame,
+    faces: Range<usize>,
+    mut visit: impl FnMut(FaceId, &[VertexId], &[QuadraturePoint]),
+) -> Result<(), FemError> {
     let mut points = Vec::with_capacity(4);
     for f in faces.map(FaceId::from_usize) {
         let (v, n) = mesh.face_vertex_array(f);
@@ -311,6 +322,13 @@ pub fn for_each_face_points(
         visit(f, &v[..n], &points);
     }
     Ok(())
+}
+
+/// Whether a Jacobian determinant `det` (twice the area of a triangle) vanishes relative
+/// to `size2`, the squared size of its face (the larger of its first two sides): the
+/// test of [`Elements::new`] and of the faces of the conformal energy.
+pub(crate) fn is_degenerate(det: f64, size2: f64) -> bool {
+    !det.is_finite() || det.abs() <= 1e-14 * size2
 }
 
 /// Checks that every vertex has z = 0 up to `1e-12` times the bounding-box diagonal.

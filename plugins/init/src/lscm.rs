@@ -113,15 +113,15 @@ impl Solver for Lscm {
             constraints.fix(v, z);
         }
         let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
-        let (map, elements) = if mesh.quad_count() == 0 {
-            (by_sides(mesh, &dofs, settings, context, &mut report)?, None)
+        let (map, energy, elements) = if mesh.quad_count() == 0 {
+            let map = by_sides(mesh, &dofs, settings, context, &mut report)?;
+            let energy = conformal_energy(mesh, &map)?;
+            (map, energy, None)
         } else {
-            let (map, elements) = by_elements(mesh, &dofs, settings, context, &mut report)?;
-            (map, Some(elements))
+            let (map, energy, elements) = by_elements(mesh, &dofs, settings, context, &mut report)?;
+            (map, energy, Some(elements))
         };
-        metrics
-            .energy_history
-            .push(conformal_energy_of(mesh, elements.as_ref(), &map)?);
+        metrics.energy_history.push(energy);
         let flipped = measure(
             mesh,
             elements.as_ref(),
@@ -203,14 +203,15 @@ fn by_sides(
 /// LSCM through the elements (quads, or any mesh): `E_C = |W^(1/2) D_zbar x|^2` as a
 /// weighted least-squares problem ([`LeastSquaresSolver`]), its symbolic factorization
 /// planned on another thread while the elements and `D_zbar` are assembled. Returns the
-/// map and the elements (the distortion is measured on them).
+/// map, its energy `sum_q w_q |f_zbar(q)|^2` and the elements (the distortion is measured
+/// on them).
 fn by_elements(
     mesh: &Mesh,
     dofs: &DofMap<Complex64>,
     settings: &Settings,
     context: &mut Context<'_>,
     report: &mut Report,
-) -> Result<(Vec<Complex64>, Elements), SolverError> {
+) -> Result<(Vec<Complex64>, f64, Elements), SolverError> {
     let (elements, dzbar, mut solver) = context.stage("assembly", report, || {
         // The symbolic factorization (elimination order, analysis, the factor's
         // storage) needs only the mesh's connectivity: it is computed on another
@@ -248,26 +249,12 @@ fn by_elements(
         let zero = vec![Complex64::new(0.0, 0.0); dzbar.nrows()];
         Ok(solver.solve(dzbar.as_ref(), Some(&weights), &zero)?)
     })?;
-    Ok((map, elements))
-}
-
-/// The final `E_C` of `map`: `sum_q w_q |f_zbar(q)|^2` on the elements when there are
-/// some, else face by face from the sides ([`conformal_energy`]).
-fn conformal_energy_of(
-    mesh: &Mesh,
-    elements: Option<&Elements>,
-    map: &[Complex64],
-) -> Result<f64, SolverError> {
-    let Some(elements) = elements else {
-        return Ok(conformal_energy(mesh, map)?);
-    };
-    let conformal = vec![Complex64::new(0.0, 0.0); mesh.face_count()];
-    let dzbar = beltrami_operator(mesh, elements, &conformal)?;
-    Ok(apply(&dzbar, map)
+    let energy = apply(&dzbar, &map)
         .iter()
-        .zip(elements.points())
-        .map(|(r, q)| q.weight * r.norm_sqr())
-        .sum())
+        .zip(&weights)
+        .map(|(r, w)| w * r.norm_sqr())
+        .sum();
+    Ok((map, energy, elements))
 }
 
 /// The capability check, returning the pinned vertices and their images.
