@@ -1027,10 +1027,22 @@ enum Choice {
 fn chosen_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<(Choice, FactorCount), SolveError> {
-    let n = pattern.nrows();
-    let dissected = dissected(pattern)?;
+    choose(pattern, dissected(pattern)?)
+}
+
+/// The multiply-subtract count up to which the nested-dissection order of `n` rows is
+/// taken without computing AMD's: [`NESTED_DISSECTION_SURE`]` n^(3/2)`.
+fn nested_dissection_sure(n: usize) -> f64 {
+    NESTED_DISSECTION_SURE * (n as f64).powf(1.5)
+}
+
+/// [`chosen_order`] with the nested-dissection order `dissected` of `pattern` computed.
+fn choose(
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+    dissected: nested_dissection::Dissected,
+) -> Result<(Choice, FactorCount), SolveError> {
     let nested = factor_count(pattern, &dissected.order)?;
-    if nested.multiply_subtracts <= NESTED_DISSECTION_SURE * (n as f64).powf(1.5) {
+    if nested.multiply_subtracts <= nested_dissection_sure(pattern.nrows()) {
         return Ok((Choice::Nested(dissected), nested));
     }
     let amd = amd_order(pattern)?;

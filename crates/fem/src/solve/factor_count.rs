@@ -16,6 +16,7 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::simplicial::{
     prefactorize_symbolic_cholesky, prefactorize_symbolic_cholesky_scratch,
 };
+use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymbolicCholeskyRaw};
 use faer::sparse::{FaerError, SymbolicSparseColMatRef};
 
 /// The entries and operations of a Cholesky factor (module docs).
@@ -85,10 +86,45 @@ pub fn factor_count(
     })
 }
 
+/// The multiply-subtract count (`sum_j r_j (r_j + 1) / 2`, as in [`FactorCount`]) of
+/// the first `columns` columns of the factor as faer stores it (`symbolic`): exact for
+/// a simplicial factor; a supernodal factor stores each supernode's columns with the
+/// union of their rows, so where faer's relaxation merged columns of different
+/// structure the zeros it stores count too, and the result is at least the exact count.
+pub(super) fn stored_multiply_subtracts(symbolic: &SymbolicCholesky<usize>, columns: usize) -> f64 {
+    let term = |below: usize| {
+        let below = below as f64;
+        below * (below + 1.0) / 2.0
+    };
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..=columns.min(s.nrows())]
+            .windows(2)
+            .map(|w| term(w[1] - w[0] - 1))
+            .sum(),
+        SymbolicCholeskyRaw::Supernodal(s) => (0..s.n_supernodes())
+            .map(|node| {
+                let (begin, end) = (s.supernode_begin()[node], s.supernode_end()[node]);
+                let below_block = s.supernode(node).pattern().len();
+                // Column `begin + k` stores the rest of the diagonal block and the
+                // supernode's rows below it.
+                (begin..end.min(columns))
+                    .map(|j| term(end - 1 - j + below_block))
+                    .sum::<f64>()
+            })
+            .sum(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::Side;
+    use faer::perm::PermRef;
     use faer::sparse::SymbolicSparseColMat;
+    use faer::sparse::linalg::SupernodalThreshold;
+    use faer::sparse::linalg::cholesky::{
+        CholeskySymbolicParams, SymmetricOrdering, factorize_symbolic_cholesky,
+    };
 
     /// The lower triangle (diagonal included) of the pattern with the given edges.
     fn pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat<usize> {
@@ -126,6 +162,83 @@ mod tests {
         assert_eq!(count.entries, n * (n + 1) / 2);
         let dense: f64 = (0..n).map(|r| (r * (r + 1) / 2) as f64).sum();
         assert_eq!(count.multiply_subtracts, dense);
+    }
+
+    /// faer's symbolic analysis of `pattern` in `order`, simplicial or supernodal.
+    fn analysed(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: &[usize],
+        threshold: SupernodalThreshold,
+    ) -> SymbolicCholesky<usize> {
+        let inverse = inverse_permutation(order).unwrap();
+        factorize_symbolic_cholesky(
+            pattern,
+            Side::Lower,
+            SymmetricOrdering::Custom(PermRef::new_checked(order, &inverse, order.len())),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold: threshold,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn the_stored_count_is_exact_for_simplicial_factors_and_bounds_supernodal_ones() {
+        // A 30 x 30 grid with diagonals in a scattered order (plenty of fill, supernodes
+        // of varied structure for faer's relaxation to merge).
+        let k = 30;
+        let id = |i: usize, j: usize| i + k * j;
+        let mut edges = Vec::new();
+        for j in 0..k {
+            for i in 0..k {
+                if i + 1 < k {
+                    edges.push((id(i, j), id(i + 1, j)));
+                }
+                if j + 1 < k {
+                    edges.push((id(i, j), id(i, j + 1)));
+                }
+                if i + 1 < k && j + 1 < k {
+                    edges.push((id(i, j), id(i + 1, j + 1)));
+                }
+            }
+        }
+        let n = k * k;
+        let grid = pattern(n, &edges);
+        let order: Vec<usize> = (0..n).map(|i| (i * 37) % n).collect();
+        let exact = factor_count(grid.as_ref(), &order)
+            .unwrap()
+            .multiply_subtracts;
+        let simplicial = analysed(grid.as_ref(), &order, SupernodalThreshold::FORCE_SIMPLICIAL);
+        assert!(matches!(
+            simplicial.raw(),
+            SymbolicCholeskyRaw::Simplicial(_)
+        ));
+        assert_eq!(stored_multiply_subtracts(&simplicial, n), exact);
+        let supernodal = analysed(grid.as_ref(), &order, SupernodalThreshold::FORCE_SUPERNODAL);
+        assert!(matches!(
+            supernodal.raw(),
+            SymbolicCholeskyRaw::Supernodal(_)
+        ));
+        let stored = stored_multiply_subtracts(&supernodal, n);
+        assert!(
+            (exact..1.2 * exact).contains(&stored),
+            "stored {stored}, exact {exact}"
+        );
+        // A prefix of the columns: the same sums cut at the same column.
+        let half = n / 2;
+        let SymbolicCholeskyRaw::Simplicial(columns) = simplicial.raw() else {
+            unreachable!()
+        };
+        let prefix: f64 = (0..half)
+            .map(|j| {
+                let below = (columns.col_ptr()[j + 1] - columns.col_ptr()[j] - 1) as f64;
+                below * (below + 1.0) / 2.0
+            })
+            .sum();
+        assert_eq!(stored_multiply_subtracts(&simplicial, half), prefix);
+        let stored_half = stored_multiply_subtracts(&supernodal, half);
+        assert!(prefix <= stored_half && stored_half < stored);
     }
 
     #[test]

@@ -40,13 +40,14 @@
 //! mesh).
 
 use super::SolveError;
-use super::cholesky::{Factor, FactorFailure};
+use super::cholesky::{Factor, FactorFailure, analyse, eliminated};
+use super::factor_count::stored_multiply_subtracts;
 use crate::dof::Scalar;
 use beltrami_mesh::parallel::join;
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::{Llt, Solve};
-use faer::sparse::linalg::cholesky::SymmetricOrdering;
+use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymmetricOrdering};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
 
@@ -63,6 +64,28 @@ pub(super) struct TwoDomains<T: Scalar> {
     separator_entries: Vec<(usize, usize, usize)>,
     /// The factorization of `T_A + T_B - M_SS`, after a successful `factorize`.
     schur: Option<Llt<T>>,
+}
+
+/// The symbolic phase of [`TwoDomains`]: both sides' submatrices and analyses, before
+/// their factors' storage is written, so that a caller can first weigh the order by
+/// its cost ([`TwoDomainsPlan::multiply_subtracts_bound`]).
+pub(super) struct TwoDomainsPlan {
+    n: usize,
+    sides: [SidePlan; 2],
+    /// As in [`TwoDomains`].
+    separator: Vec<usize>,
+    separator_entries: Vec<(usize, usize, usize)>,
+}
+
+/// One side's submatrix `M_A` and its symbolic analysis ([`SideFactor`] without the
+/// factor's storage).
+struct SidePlan {
+    /// As in [`SideFactor`].
+    rows: Vec<usize>,
+    own_in_order: Vec<usize>,
+    pattern: SymbolicSparseColMat<usize>,
+    source: Vec<(usize, bool)>,
+    symbolic: SymbolicCholesky<usize>,
 }
 
 /// One side's submatrix `M_A`, numbered in the elimination order (the side's rows,
@@ -91,12 +114,13 @@ struct SideFactor<T: Scalar> {
 /// Which side a row of `M` is on, [`SEPARATOR`] for the separator.
 const SEPARATOR: u8 = 2;
 
-impl<T: Scalar> TwoDomains<T> {
+impl TwoDomainsPlan {
     /// Symbolic phase for `pattern` (lower triangle read) in the nested-dissection order
     /// `order` whose first split has sides of `halves[0]` and `halves[1]` rows, the rest
-    /// being their separator. `None` when the split does not separate (an entry joins
-    /// the two sides), a side is empty, or a side's factorization would not eliminate
-    /// the separator last: the caller then factors the whole.
+    /// being their separator: the two sides analysed at once. `None` when the split does
+    /// not separate (an entry joins the two sides), a side is empty, or a side's
+    /// factorization would not eliminate the separator last: the caller then factors
+    /// the whole.
     pub(super) fn new(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: &[usize],
@@ -124,7 +148,7 @@ impl<T: Scalar> TwoDomains<T> {
                 }
             }
         }
-        let by_side = |side| SideFactor::new(pattern, order, &side_of, side, &separator_index);
+        let by_side = |side| SidePlan::new(pattern, order, &side_of, side, &separator_index);
         let (side_a, side_b) = join(|| by_side(0), || by_side(1));
         let (Some(side_a), Some(side_b)) = (side_a?, side_b?) else {
             return Ok(None);
@@ -134,8 +158,52 @@ impl<T: Scalar> TwoDomains<T> {
             sides: [side_a, side_b],
             separator,
             separator_entries,
-            schur: None,
         }))
+    }
+
+    /// An upper bound of the multiply-subtract count of the whole matrix's
+    /// factorization in the plan's order (the quantity of
+    /// [`factor_count`](super::factor_count)): each side's own columns as faer stores
+    /// them (exact, or more where its relaxed supernodes hold zeros; they are the
+    /// whole factor's columns, since no entry joins the sides and the separator is
+    /// eliminated last), and the separator's columns taken dense.
+    pub(super) fn multiply_subtracts_bound(&self) -> f64 {
+        let sides: f64 = self
+            .sides
+            .iter()
+            .map(|side| stored_multiply_subtracts(&side.symbolic, side.own_in_order.len()))
+            .sum();
+        let dense: f64 = (0..self.separator.len())
+            .map(|r| (r * (r + 1) / 2) as f64)
+            .sum();
+        sides + dense
+    }
+
+    /// The factorization of the planned pattern: both sides' storage written at once
+    /// (see [`Factor::build`]).
+    pub(super) fn into_factors<T: Scalar>(self) -> Result<TwoDomains<T>, SolveError> {
+        let [side_a, side_b] = self.sides;
+        let (side_a, side_b) = join(|| side_a.into_factor(), || side_b.into_factor());
+        Ok(TwoDomains {
+            n: self.n,
+            sides: [side_a?, side_b?],
+            separator: self.separator,
+            separator_entries: self.separator_entries,
+            schur: None,
+        })
+    }
+}
+
+impl<T: Scalar> TwoDomains<T> {
+    /// [`TwoDomainsPlan::new`], then the storage of both sides' factors.
+    pub(super) fn new(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        order: &[usize],
+        halves: [usize; 2],
+    ) -> Result<Option<Self>, SolveError> {
+        TwoDomainsPlan::new(pattern, order, halves)?
+            .map(TwoDomainsPlan::into_factors)
+            .transpose()
     }
 
     /// Numeric factorization of `matrix` (the pattern given to [`new`](Self::new)): the
@@ -233,7 +301,7 @@ impl<T: Scalar> TwoDomains<T> {
     }
 }
 
-impl<T: Scalar> SideFactor<T> {
+impl SidePlan {
     /// The submatrix of side `side` (`0` or `1`) and the separator, and its symbolic
     /// factorization in `order` restricted to it (one thread); `None` when an entry of
     /// `pattern` joins the two sides or the factorization would not eliminate the
@@ -311,36 +379,45 @@ impl<T: Scalar> SideFactor<T> {
             .collect();
         let sub = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
         let upper = sub.as_ref().transpose().to_col_major()?;
-        let factor = Factor::build(
-            upper.as_ref(),
-            Side::Upper,
-            SymmetricOrdering::Identity,
-            Par::Seq,
-        )?;
+        let symbolic = analyse(upper.as_ref(), Side::Upper, SymmetricOrdering::Identity)?;
         drop(upper);
         let s = rows.iter().filter(|&&i| side_of[i] != side).count();
         let first = m - s;
         // The separator comes last in `order`, in its own numbering; faer must keep it
         // there.
         if (0..s).any(|r| {
-            let l = factor.eliminated(first + r);
+            let l = eliminated(&symbolic, first + r);
             l >= m || side_of[rows[l]] == side || separator_index[rows[l]] != r
         }) {
             return Ok(None);
         }
-        let own_in_order = (0..first).map(|k| rows[factor.eliminated(k)]).collect();
+        let own_in_order = (0..first).map(|k| rows[eliminated(&symbolic, k)]).collect();
         Ok(Some(Self {
             rows,
             own_in_order,
-            values: vec![T::from_f64(0.0); source.len()],
             pattern: sub,
             source,
-            factor,
-            trailing: Mat::zeros(s, s),
-            schur_part: Mat::zeros(s, s),
+            symbolic,
         }))
     }
 
+    /// The side's factorization: the factor's storage written now (one thread).
+    fn into_factor<T: Scalar>(self) -> Result<SideFactor<T>, SolveError> {
+        let s = self.rows.len() - self.own_in_order.len();
+        Ok(SideFactor {
+            values: vec![T::from_f64(0.0); self.source.len()],
+            factor: Factor::with_storage(self.symbolic, Par::Seq)?,
+            rows: self.rows,
+            own_in_order: self.own_in_order,
+            pattern: self.pattern,
+            source: self.source,
+            trailing: Mat::zeros(s, s),
+            schur_part: Mat::zeros(s, s),
+        })
+    }
+}
+
+impl<T: Scalar> SideFactor<T> {
     /// Factors `M_A` from the values of `M`, then forms `T_A = L_A L_A^H` from the
     /// factor's last `|S|` columns (the separator, in its own order).
     fn factorize(&mut self, values: &[T], tolerance: f64) -> Result<(), FactorFailure> {
@@ -441,7 +518,7 @@ impl<T: Scalar> SideFactor<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solve::dissected;
+    use crate::solve::{dissected, factor_count};
     use faer::sparse::{SparseColMat, Triplet};
     use num_complex::Complex64;
 
@@ -512,6 +589,26 @@ mod tests {
             worst = r.iter().map(|z| z.norm()).fold(worst, f64::max);
         }
         worst / b.norm_max()
+    }
+
+    #[test]
+    fn the_plans_count_bounds_the_whole_factors_closely() {
+        // The exact count of the whole matrix's factor in the dissection's order, against
+        // the plan's: the sides' stored factors and the separator taken dense.
+        let m = grid(120, 0.05, true, 1);
+        let dissection = dissected(m.symbolic()).unwrap();
+        let halves = dissection.halves.expect("a split");
+        let plan = TwoDomainsPlan::new(m.symbolic(), &dissection.order, halves)
+            .unwrap()
+            .expect("the split separates");
+        let exact = factor_count(m.symbolic(), &dissection.order)
+            .unwrap()
+            .multiply_subtracts;
+        let bound = plan.multiply_subtracts_bound();
+        assert!(
+            (exact..1.1 * exact).contains(&bound),
+            "bound {bound:e}, exact {exact:e}"
+        );
     }
 
     #[test]
