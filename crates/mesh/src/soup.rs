@@ -58,6 +58,17 @@ impl PolygonSoup {
         self.indices.reserve(corners);
     }
 
+    /// Appends `other`'s positions after this soup's and its faces after this soup's,
+    /// their vertex indices as they are: they name vertices of the joined soup (the
+    /// parts of one file read at once).
+    pub(crate) fn append(&mut self, other: PolygonSoup) {
+        let base = self.indices.len();
+        self.positions.extend(other.positions);
+        self.indices.extend(other.indices);
+        self.offsets
+            .extend(other.offsets[1..].iter().map(|&offset| base + offset));
+    }
+
     /// Appends a face given by its vertex indices (any count; the builder rejects sizes
     /// other than 3 and 4 with [`crate::MeshError::UnsupportedFaceSize`]).
     pub fn push_face(&mut self, vertices: &[u32]) {

@@ -31,6 +31,7 @@ use nalgebra::{Point3, Vector2};
 
 use super::slots::OutputSlots;
 use super::{RawMesh, ReadError, VertexAttributes, WriteError};
+use crate::parallel::{available_threads, map_blocks};
 use crate::{FaceId, Mesh, PolygonSoup};
 
 /// Reads an OBJ file. See the module docs for what is kept.
@@ -267,11 +268,116 @@ fn parse_with_tobj(path: &Path, bytes: &[u8], prepared: Prepared) -> Result<RawM
 /// generality costs on large files (per-face records and a hash map of corners: 255 MB
 /// and 0.8 s for a 44 MB file of 1M triangles); the values are the same (both parse
 /// numbers with the standard library's correctly rounded parser).
+///
+/// A large file is read in parts, one per core, cut after line breaks
+/// ([`parse_plain_part`]); the parts are joined in order. A negative index after the
+/// first part needs the count of vertices listed before its part: then the whole file is
+/// read again in one part.
 fn parse_plain(bytes: &[u8]) -> Option<(PolygonSoup, Vec<u32>)> {
+    parse_plain_in_parts(bytes, &plain_parts(bytes, available_threads()))
+}
+
+/// [`parse_plain`] with `bytes` cut into `parts` (consecutive byte ranges covering it,
+/// each but the last ending with a line break), read at once.
+fn parse_plain_in_parts(
+    bytes: &[u8],
+    parts: &[std::ops::Range<usize>],
+) -> Option<(PolygonSoup, Vec<u32>)> {
+    let read = map_blocks(parts.len(), 1, parts.len(), |k| {
+        let k = k.start;
+        parse_plain_part(&bytes[parts[k].clone()], (k == 0).then_some(0))
+    });
+    let mut joined: Option<(PolygonSoup, Vec<u32>)> = None;
+    let mut lines = 0u32;
+    for part in read {
+        let part = match part {
+            PlainPart::Read(part) => part,
+            PlainPart::NotPlain => return None,
+            PlainPart::Relative => {
+                return match parse_plain_part(bytes, Some(0)) {
+                    PlainPart::Read(whole) => Some((whole.soup, whole.face_lines)),
+                    PlainPart::NotPlain | PlainPart::Relative => None,
+                };
+            }
+        };
+        let listed = joined.as_ref().map_or(0, |(soup, _)| soup.vertex_count());
+        if part.reach > listed {
+            return None;
+        }
+        let face_lines = part
+            .face_lines
+            .iter()
+            .map(|&line| line.checked_add(lines))
+            .collect::<Option<Vec<u32>>>()?;
+        lines = lines.checked_add(part.newlines)?;
+        match &mut joined {
+            None => joined = Some((part.soup, face_lines)),
+            Some((soup, all_lines)) => {
+                soup.append(part.soup);
+                all_lines.extend(face_lines);
+            }
+        }
+    }
+    joined
+}
+
+/// Bytes of a plain OBJ file per part read at once ([`parse_plain`]), at least: below,
+/// a thread costs more than it saves.
+const PLAIN_PART_BYTES: usize = 1 << 20;
+
+/// The byte ranges of the parts of `bytes` read at once: at most `threads`, each at
+/// least [`PLAIN_PART_BYTES`] long but the last, each but the last ending with a line
+/// break.
+fn plain_parts(bytes: &[u8], threads: usize) -> Vec<std::ops::Range<usize>> {
+    let count = threads.min(bytes.len() / PLAIN_PART_BYTES).max(1);
+    let mut parts = Vec::with_capacity(count);
+    let mut start = 0;
+    for k in 1..count {
+        let cut = (k * bytes.len() / count).max(start);
+        let Some(end) = bytes[cut..].iter().position(|&c| c == b'\n') else {
+            break;
+        };
+        parts.push(start..cut + end + 1);
+        start = cut + end + 1;
+    }
+    parts.push(start..bytes.len());
+    parts
+}
+
+/// How a part of a plain OBJ file read ([`parse_plain_part`]).
+enum PlainPart {
+    Read(PlainRead),
+    /// A line that is not plain, or an index that cannot name a vertex listed before it.
+    NotPlain,
+    /// A negative index in a part whose count of vertices listed before it is unknown.
+    Relative,
+}
+
+/// The content of a part of a plain OBJ file.
+struct PlainRead {
+    /// Its positions, and its faces with 0-based indices into the whole file's vertices.
+    soup: PolygonSoup,
+    /// The line of each face, counted from the part's first line (line 1).
+    face_lines: Vec<u32>,
+    /// The line breaks in the part: the first line of the next part is `newlines + 1`.
+    newlines: u32,
+    /// The most vertices that must be listed before the part for its faces to name
+    /// vertices listed before them (0 when they all name the part's own).
+    reach: usize,
+}
+
+/// Reads `bytes`, a run of whole lines of a plain OBJ file ([`parse_plain`]), with
+/// `listed_before` vertices listed before it when known (`Some(0)` for the first part):
+/// a positive index `i` names vertex `i - 1` of the file, a negative one counts back
+/// from the last vertex listed (and needs `listed_before`).
+fn parse_plain_part(bytes: &[u8], listed_before: Option<usize>) -> PlainPart {
     let mut soup = PolygonSoup::new(Vec::new());
     let mut face_lines = Vec::new();
     let mut corners: Vec<u32> = Vec::with_capacity(4);
+    let mut reach = 0;
+    let mut newlines = 0;
     for (i, line) in bytes.split(|&c| c == b'\n').enumerate() {
+        newlines = i;
         let mut tokens = line
             .split(|c| c.is_ascii_whitespace())
             .filter(|t| !t.is_empty());
@@ -281,37 +387,72 @@ fn parse_plain(bytes: &[u8]) -> Option<(PolygonSoup, Vec<u32>)> {
             Some(b"v") => {
                 let mut p = [0.0; 3];
                 for x in &mut p {
-                    *x = std::str::from_utf8(tokens.next()?).ok()?.parse().ok()?;
+                    let Some(value) = plain_number(tokens.next()) else {
+                        return PlainPart::NotPlain;
+                    };
+                    *x = value;
                 }
                 if tokens.next().is_some() {
-                    return None;
+                    return PlainPart::NotPlain;
                 }
                 soup.positions.push(Point3::new(p[0], p[1], p[2]));
             }
             Some(b"f") => {
                 corners.clear();
+                let listed = soup.positions.len();
                 for token in tokens {
-                    let index: i64 = std::str::from_utf8(token).ok()?.parse().ok()?;
-                    let listed = soup.positions.len() as i64;
-                    let index = if index > 0 && index <= listed {
-                        index - 1
-                    } else if index < 0 && -index <= listed {
-                        listed + index
-                    } else {
-                        return None;
+                    let Some(index) = plain_number::<i64>(Some(token)) else {
+                        return PlainPart::NotPlain;
                     };
-                    corners.push(u32::try_from(index).ok()?);
+                    let vertex = if index > 0 {
+                        let index = index as usize;
+                        reach = reach.max(index.saturating_sub(listed));
+                        index - 1
+                    } else if index < 0 {
+                        let Some(before) = listed_before else {
+                            return PlainPart::Relative;
+                        };
+                        match (before + listed).checked_sub(index.unsigned_abs() as usize) {
+                            Some(vertex) => vertex,
+                            None => return PlainPart::NotPlain,
+                        }
+                    } else {
+                        return PlainPart::NotPlain;
+                    };
+                    let Ok(vertex) = u32::try_from(vertex) else {
+                        return PlainPart::NotPlain;
+                    };
+                    corners.push(vertex);
                 }
                 if corners.len() < 3 {
-                    return None;
+                    return PlainPart::NotPlain;
                 }
                 soup.push_face(&corners);
-                face_lines.push(u32::try_from(i + 1).ok()?);
+                let Ok(line) = u32::try_from(i + 1) else {
+                    return PlainPart::NotPlain;
+                };
+                face_lines.push(line);
             }
-            Some(_) => return None,
+            Some(_) => return PlainPart::NotPlain,
         }
     }
-    Some((soup, face_lines))
+    if listed_before.is_some_and(|before| reach > before) {
+        return PlainPart::NotPlain;
+    }
+    let Ok(newlines) = u32::try_from(newlines) else {
+        return PlainPart::NotPlain;
+    };
+    PlainPart::Read(PlainRead {
+        soup,
+        face_lines,
+        newlines,
+        reach,
+    })
+}
+
+/// A token of a plain OBJ file read as a number (`None` when absent or not one).
+fn plain_number<T: std::str::FromStr>(token: Option<&[u8]>) -> Option<T> {
+    std::str::from_utf8(token?).ok()?.parse().ok()
 }
 
 /// tobj's errors carry no line number: find the first line that explains the error.
@@ -688,7 +829,10 @@ mod tests {
 
 #[cfg(test)]
 mod plain_tests {
-    use super::{parse, parse_plain, parse_with_tobj, prepare};
+    use super::{
+        PLAIN_PART_BYTES, PlainPart, parse, parse_plain, parse_plain_in_parts, parse_plain_part,
+        parse_with_tobj, plain_parts, prepare,
+    };
     use crate::PolygonSoup;
     use std::path::Path;
 
@@ -715,6 +859,78 @@ mod plain_tests {
         assert_eq!(raw.soup.face(1), [1, 2, 3, 4]);
         assert_eq!(raw.face_lines, Some(vec![8, 10, 11]));
         assert!(raw.corner_uvs.is_none());
+    }
+
+    /// The ranges of `bytes` cut after the line breaks at the byte positions `cuts`.
+    fn cut_after(bytes: &[u8], cuts: &[usize]) -> Vec<std::ops::Range<usize>> {
+        let mut parts = Vec::new();
+        let mut start = 0;
+        for &cut in cuts {
+            parts.push(start..cut + 1);
+            start = cut + 1;
+        }
+        parts.push(start..bytes.len());
+        parts
+    }
+
+    #[test]
+    fn a_file_read_in_parts_reads_as_in_one() {
+        let plain = "# a plain file\r\nv 0 0 0\r\nv 1.5 0 -0.0\r\n\r\n  v 1 1e0 0.25\r\nv -2.5E-1 1 0\r\nv 3 3 3\r\nf 1 2 3\r\n# quad\r\nf 1 2 3 4\r\nv 4 4 4\nf 2 3 6\nf 5 6 4\n";
+        let relative = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nv 1 1 0\nf -3 -1 -2\n";
+        let later = "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n";
+        let prefix = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        let other = format!("{prefix}f 1 2 3\nvt 0 0\n");
+        for text in [plain, relative, later, other.as_str()] {
+            let bytes = text.as_bytes();
+            let whole = parse_plain_part(bytes, Some(0));
+            let breaks: Vec<usize> = (0..bytes.len().saturating_sub(1))
+                .filter(|&i| bytes[i] == b'\n')
+                .collect();
+            let mut cuts: Vec<Vec<usize>> = breaks.iter().map(|&b| vec![b]).collect();
+            for (k, &a) in breaks.iter().enumerate() {
+                cuts.extend(breaks[k + 1..].iter().map(|&b| vec![a, b]));
+            }
+            for cut in cuts {
+                let parts = parse_plain_in_parts(bytes, &cut_after(bytes, &cut));
+                match (&whole, parts) {
+                    (PlainPart::Read(whole), Some((soup, lines))) => {
+                        assert_same(&soup, &whole.soup);
+                        assert_eq!(lines, whole.face_lines, "{text:?} cut at {cut:?}");
+                    }
+                    (PlainPart::NotPlain, None) => {}
+                    _ => panic!("{text:?} cut at {cut:?}: one part and several differ"),
+                }
+            }
+        }
+        // The plain file as one part reads as tobj reads it; the negative indices of the
+        // second file name the vertices before them, also in a later part.
+        assert_same(
+            &parse_plain(plain.as_bytes()).unwrap().0,
+            &through_tobj(plain.as_bytes()),
+        );
+        let PlainPart::Read(relative) = parse_plain_part(relative.as_bytes(), Some(0)) else {
+            panic!("a plain file");
+        };
+        assert_eq!(relative.soup.face(1), [1, 3, 2]);
+        assert_eq!(relative.face_lines, [4, 6]);
+        // A face naming a vertex listed after it is not plain, whichever part holds it.
+        assert!(matches!(
+            parse_plain_part(later.as_bytes(), Some(0)),
+            PlainPart::NotPlain
+        ));
+        assert!(matches!(
+            parse_plain_part(other.as_bytes(), Some(0)),
+            PlainPart::NotPlain
+        ));
+        // Parts cut by size end after line breaks and cover the file.
+        let long = plain.repeat(PLAIN_PART_BYTES / plain.len() * 3);
+        let parts = plain_parts(long.as_bytes(), 2);
+        assert_eq!(parts.len(), 2);
+        assert_eq!((parts[0].start, parts[0].end), (0, parts[1].start));
+        assert_eq!(parts[1].end, long.len());
+        assert_eq!(long.as_bytes()[parts[0].end - 1], b'\n');
+        assert_eq!(plain_parts(long.as_bytes(), 1).len(), 1);
+        assert_eq!(plain_parts(plain.as_bytes(), 2).len(), 1);
     }
 
     #[test]
