@@ -43,10 +43,12 @@ mod nested_dissection;
 mod normal;
 mod saddle;
 mod two_domains;
+mod vertex_graph;
 mod vertex_separator;
 
 pub use normal::normal_pattern_of_cells;
 pub use saddle::{SaddlePointSolution, SaddlePointSolver, solve_saddle_point};
+pub use vertex_graph::vertex_graph_pattern;
 
 use crate::dof::{DofMap, Scalar};
 use beltrami_mesh::VertexId;
@@ -1100,6 +1102,46 @@ impl<T: Scalar> PlannedCholesky<T> {
         Ok(Self { pattern, cholesky })
     }
 
+    /// [`PlannedCholesky::new`] with the nested-dissection order of the pattern given
+    /// (`split`, computed elsewhere: on the vertex graph while the DOF map was made,
+    /// carried over by [`SplitOrder::of_unknowns`]), judged as `new` judges its own: from
+    /// [`NESTED_DISSECTION_FROM`] rows it is taken when its factor is cheap enough, else
+    /// AMD's order is computed too and the cheaper taken; below, `split` is not used and
+    /// the order is AMD's.
+    ///
+    /// Errors: as [`PlannedCholesky::new`]; [`SolveError::InvalidOrder`] when `split`'s
+    /// order is not a permutation of the rows, [`SolveError::Length`] when its sides
+    /// are longer than the order.
+    pub fn with_dissection(
+        pattern: SymbolicSparseColMat<usize>,
+        split: SplitOrder,
+        options: SolveOptions,
+    ) -> Result<Self, SolveError> {
+        let n = pattern.nrows();
+        check_len("the column count of the pattern", n, pattern.ncols())?;
+        check_len("the length of the order", n, split.order.len())?;
+        if let Some([a, b]) = split.sides {
+            check_len("the sides of the order", n, n.max(a + b))?;
+        }
+        inverse_permutation(&split.order)?;
+        let cholesky = if n >= NESTED_DISSECTION_FROM {
+            let dissected = nested_dissection::Dissected {
+                order: split.order,
+                halves: split.sides,
+            };
+            Some(Cholesky::from_dissection(
+                pattern.as_ref(),
+                dissected,
+                options.par(),
+            )?)
+        } else if n > 0 {
+            Some(Cholesky::new(pattern.as_ref(), options.par())?)
+        } else {
+            None
+        };
+        Ok(Self { pattern, cholesky })
+    }
+
     /// The number of unknowns.
     pub fn len(&self) -> usize {
         self.pattern.nrows()
@@ -1131,6 +1173,14 @@ pub fn nested_dissection_order(
     pattern: SymbolicSparseColMatRef<'_, usize>,
 ) -> Result<Vec<usize>, SolveError> {
     dissected(pattern).map(|d| d.order)
+}
+
+/// [`nested_dissection_order`] with its first split: two sides no entry joins and their
+/// separator ([`SplitOrder`]).
+pub fn nested_dissection_split(
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+) -> Result<SplitOrder, SolveError> {
+    dissected(pattern).map(SplitOrder::from)
 }
 
 /// [`nested_dissection_order`] with its first split.
@@ -1167,6 +1217,48 @@ pub struct SplitOrder {
     /// The lengths of the two sides at the front of `order`; `None` when nothing splits
     /// the rows (then only `order` counts).
     pub sides: Option<[usize; 2]>,
+}
+
+impl SplitOrder {
+    /// This order of `dofs`' nodes (an order of the vertex graph: cheaper to order than
+    /// the unknowns' graph, and ready before the DOF map is) carried over to its reduced
+    /// unknowns: the unknowns that move one node alone take that node's place, the
+    /// unknowns shared by several nodes go last, in increasing order (with the separator
+    /// when there are sides); a fixed node has none. The sides' lengths are counted
+    /// again in unknowns.
+    ///
+    /// Errors: [`SolveError::Length`] when the order is not as long as `dofs` has nodes
+    /// or its sides are longer, [`SolveError::InvalidOrder`] for a node out of range.
+    pub fn of_unknowns<T: Scalar>(&self, dofs: &DofMap<T>) -> Result<SplitOrder, SolveError> {
+        let nodes = dofs.n_nodes();
+        check_len("the length of the order", nodes, self.order.len())?;
+        let n = dofs.reduced_len();
+        let shared: Vec<bool> = (0..n)
+            .map(|j| dofs.unknown_nodes(j).is_some_and(|nodes| nodes.count() > 1))
+            .collect();
+        let [a, b] = self.sides.unwrap_or([nodes, 0]);
+        check_len("the sides of the order", nodes, nodes.max(a + b))?;
+        let mut order = Vec::with_capacity(n);
+        let mut ends = [0; 2];
+        for (part, range) in [0..a, a..a + b, a + b..nodes].into_iter().enumerate() {
+            for (k, &v) in self.order[range.clone()].iter().enumerate() {
+                let terms = dofs.node_terms(VertexId::from_usize(v)).map_err(|_| {
+                    SolveError::InvalidOrder {
+                        index: range.start + k,
+                    }
+                })?;
+                order.extend(terms.map(|(_, t)| t.dof).filter(|&j| !shared[j]));
+            }
+            if let Some(end) = ends.get_mut(part) {
+                *end = order.len();
+            }
+        }
+        order.extend((0..n).filter(|&j| shared[j]));
+        Ok(SplitOrder {
+            order,
+            sides: self.sides.map(|_| [ends[0], ends[1] - ends[0]]),
+        })
+    }
 }
 
 impl From<nested_dissection::Dissected> for SplitOrder {

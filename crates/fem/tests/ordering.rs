@@ -2,14 +2,17 @@
 //! them.
 
 use beltrami_fem::solve::{
-    NESTED_DISSECTION_FROM, PlannedCholesky, amd_order, factor_count, fill_reducing_order,
-    first_split_order, nested_dissection_order, two_core_order,
+    NESTED_DISSECTION_FROM, PlannedCholesky, SplitOrder, amd_order, factor_count,
+    fill_reducing_order, first_split_order, nested_dissection_order, nested_dissection_split,
+    two_core_order,
 };
-use beltrami_fem::{SolveOptions, SpdSolver};
+use beltrami_fem::{DofConstraints, DofMap, SolveError, SolveOptions, SpdSolver};
+use beltrami_mesh::VertexId;
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Mat, Side};
+use num_complex::Complex64;
 
 /// The lower triangle (diagonal included) of a symmetric pattern with the given edges.
 fn pattern(n: usize, edges: &[(usize, usize)]) -> SymbolicSparseColMat<usize> {
@@ -422,4 +425,118 @@ fn a_planned_solver_solves_as_a_fresh_one() {
     solver
         .solve_in_place(Mat::<f64>::zeros(0, 1).as_mut())
         .unwrap();
+}
+
+#[test]
+fn a_dissection_given_from_outside_is_judged_and_solves() {
+    // The 330 x 330 grid (108,900 rows, from the nested-dissection size): its own
+    // dissection, given as computed elsewhere, is taken (two sides at once) and solves.
+    let k = 330;
+    let n = k * k;
+    assert!(n >= NESTED_DISSECTION_FROM);
+    let (m, rhs) = shifted_grid_laplacian(k, 0.01);
+    let split = nested_dissection_split(m.symbolic()).unwrap();
+    assert!(split.sides.is_some());
+    let pattern = m.symbolic().to_owned().unwrap();
+    let planned = PlannedCholesky::<f64>::with_dissection(
+        pattern.clone(),
+        split.clone(),
+        SolveOptions::default(),
+    )
+    .unwrap();
+    let mut solver = SpdSolver::from_planned(planned, SolveOptions::default()).unwrap();
+    assert!(solver.is_split());
+    solver.factorize(m.as_ref()).unwrap();
+    let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
+    solver.solve_in_place(x.as_mut()).unwrap();
+    let x: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    let residual = relative_residual(&m, &x, &rhs);
+    assert!(residual < 1e-9, "residual {residual:e}");
+
+    // Orders that are not the pattern's are refused.
+    let short = SplitOrder {
+        order: split.order[1..].to_vec(),
+        sides: split.sides,
+    };
+    assert!(matches!(
+        PlannedCholesky::<f64>::with_dissection(pattern.clone(), short, SolveOptions::default()),
+        Err(SolveError::Length { .. })
+    ));
+    let mut repeated = split.clone();
+    repeated.order[1] = repeated.order[0];
+    assert!(matches!(
+        PlannedCholesky::<f64>::with_dissection(pattern.clone(), repeated, SolveOptions::default()),
+        Err(SolveError::InvalidOrder { .. })
+    ));
+    let wide = SplitOrder {
+        order: split.order.clone(),
+        sides: Some([n, 1]),
+    };
+    assert!(matches!(
+        PlannedCholesky::<f64>::with_dissection(pattern, wide, SolveOptions::default()),
+        Err(SolveError::Length { .. })
+    ));
+
+    // Below the nested-dissection size the given order is not used: AMD's, whole.
+    let (small, _) = shifted_grid_laplacian(60, 0.01);
+    let split = nested_dissection_split(small.symbolic()).unwrap();
+    let planned = PlannedCholesky::<f64>::with_dissection(
+        small.symbolic().to_owned().unwrap(),
+        split,
+        SolveOptions::default(),
+    )
+    .unwrap();
+    let solver = SpdSolver::from_planned(planned, SolveOptions::default()).unwrap();
+    assert!(!solver.is_split());
+}
+
+#[test]
+fn a_vertex_order_carries_over_to_the_unknowns() {
+    // Seven vertices, one unknown each in the complex form, but vertex 2 is fixed and
+    // vertices 4 and 6 share one unknown.
+    let mut constraints = DofConstraints::new();
+    constraints.fix(VertexId::from_usize(2), Complex64::new(1.0, 0.0));
+    constraints.share(VertexId::from_usize(4), VertexId::from_usize(6));
+    let dofs = DofMap::complex(7, &constraints).unwrap();
+    assert_eq!(dofs.reduced_len(), 5);
+    let unknown = |v: usize| {
+        let mut terms = dofs.node_terms(VertexId::from_usize(v)).unwrap();
+        terms.next().map(|(_, t)| t.dof)
+    };
+    let shared = unknown(4).unwrap();
+    assert_eq!(unknown(6), Some(shared));
+    // Sides {3, 0, 4} and {1, 2}, separator {5, 6}.
+    let vertices = SplitOrder {
+        order: vec![3, 0, 4, 1, 2, 5, 6],
+        sides: Some([3, 2]),
+    };
+    let unknowns = vertices.of_unknowns(&dofs).unwrap();
+    let own = |v: usize| unknown(v).unwrap();
+    assert_eq!(unknowns.order, vec![own(3), own(0), own(1), own(5), shared]);
+    assert_eq!(unknowns.sides, Some([2, 1]));
+    // Without sides, the shared unknown still goes last.
+    let whole = SplitOrder {
+        order: vertices.order.clone(),
+        sides: None,
+    };
+    let unknowns = whole.of_unknowns(&dofs).unwrap();
+    assert_eq!(unknowns.order.last(), Some(&shared));
+    assert_eq!(unknowns.sides, None);
+    // An order of another vertex count, or naming a vertex beyond the map's, is refused.
+    let short = SplitOrder {
+        order: vec![0, 1, 2],
+        sides: None,
+    };
+    assert!(matches!(
+        short.of_unknowns(&dofs),
+        Err(SolveError::Length { .. })
+    ));
+    let beyond = SplitOrder {
+        order: vec![0, 1, 2, 3, 4, 5, 9],
+        sides: None,
+    };
+    assert!(matches!(
+        beyond.of_unknowns(&dofs),
+        Err(SolveError::InvalidOrder { index: 6 })
+    ));
 }

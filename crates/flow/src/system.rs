@@ -860,7 +860,6 @@ const TWO_SIDES_FROM: usize = 20_000;
 /// separator); below, it is [`fill_reducing_order`]'s, one whole.
 fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<SplitOrder, SolverError> {
     let nv = dofs.n_nodes();
-    let n = dofs.reduced_len();
     let mut positions = Vec::with_capacity(nv + 3 * faces.len());
     positions.extend((0..nv).map(|v| (v, v)));
     for f in faces {
@@ -878,29 +877,7 @@ fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<SplitOrder, S
             sides: None,
         }
     };
-    let shared: Vec<bool> = (0..n)
-        .map(|j| dofs.unknown_nodes(j).is_some_and(|nodes| nodes.count() > 1))
-        .collect();
-    let [a, b] = vertices.sides.unwrap_or([nv, 0]);
-    let mut order = Vec::with_capacity(n);
-    let mut ends = [0; 2];
-    for (part, range) in [0..a, a..a + b, a + b..nv].into_iter().enumerate() {
-        for &v in &vertices.order[range] {
-            for (_, t) in dofs.node_terms(VertexId::from_usize(v))? {
-                if !shared[t.dof] {
-                    order.push(t.dof);
-                }
-            }
-        }
-        if let Some(end) = ends.get_mut(part) {
-            *end = order.len();
-        }
-    }
-    order.extend((0..n).filter(|&j| shared[j]));
-    Ok(SplitOrder {
-        order,
-        sides: vertices.sides.map(|_| [ends[0], ends[1] - ends[0]]),
-    })
+    Ok(vertices.of_unknowns(dofs)?)
 }
 
 /// A vector of R^3 (three components) as the complex number of its components along

@@ -30,7 +30,10 @@ use beltrami_core::{
 use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::conformal_energy::{ConformalSystem, conformal_energy, conformal_system};
 use beltrami_fem::operators::{apply, beltrami_operator};
-use beltrami_fem::solve::{PlannedCholesky, normal_pattern_of_cells};
+use beltrami_fem::solve::{
+    NESTED_DISSECTION_FROM, PlannedCholesky, nested_dissection_split, normal_pattern_of_cells,
+    vertex_graph_pattern,
+};
 use beltrami_fem::{
     DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveError, SpdSolver,
 };
@@ -112,12 +115,12 @@ impl Solver for Lscm {
         for &(v, z) in &pinned {
             constraints.fix(v, z);
         }
-        let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
         let (map, energy, elements) = if mesh.quad_count() == 0 {
-            let map = by_sides(mesh, &dofs, settings, context, &mut report)?;
+            let map = by_sides(mesh, &constraints, settings, context, &mut report)?;
             let energy = conformal_energy(mesh, &map)?;
             (map, energy, None)
         } else {
+            let dofs = DofMap::complex(mesh.vertex_count(), &constraints)?;
             let (map, energy, elements) = by_elements(mesh, &dofs, settings, context, &mut report)?;
             (map, energy, Some(elements))
         };
@@ -148,55 +151,75 @@ impl Solver for Lscm {
 /// LSCM of a triangle mesh: the normal equations assembled face by face from the
 /// sides ([`conformal_system`]: no elements, `D_zbar` or scatter maps, so a large mesh
 /// touches far less memory), their symbolic factorization planned on another thread
-/// meanwhile.
+/// meanwhile. From the size where the order is a nested dissection
+/// ([`NESTED_DISSECTION_FROM`] unknowns), the vertex graph is dissected on another thread
+/// from the start, while the DOF map and the pattern are made, and the order carried
+/// over to the unknowns ([`SplitOrder::of_unknowns`](beltrami_fem::solve::SplitOrder::of_unknowns)).
 fn by_sides(
     mesh: &Mesh,
-    dofs: &DofMap<Complex64>,
+    constraints: &DofConstraints,
     settings: &Settings,
     context: &mut Context<'_>,
     report: &mut Report,
 ) -> Result<Vec<Complex64>, SolverError> {
     let options = solve_options(settings);
-    let faces = (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
-    let (pattern, system, solver) = context.stage("assembly", report, || {
-        let pattern = normal_pattern_of_cells(faces, dofs)?;
-        std::thread::scope(|scope| {
-            let copy = pattern.clone();
-            let planned = scope.spawn(move || PlannedCholesky::new(copy, options));
-            let system = conformal_system(mesh, dofs, pattern.as_ref());
-            // A panic in the ordering thread is a bug; pass it on as one.
-            let planned = planned
-                .join()
-                .unwrap_or_else(|p| std::panic::resume_unwind(p))?;
-            let solver = match dofs.reduced_len() {
-                0 => None,
-                _ => Some(SpdSolver::from_planned(planned, options)?),
+    std::thread::scope(|scope| {
+        let dissection = (mesh.vertex_count() >= NESTED_DISSECTION_FROM)
+            .then(|| scope.spawn(|| nested_dissection_split(vertex_graph_pattern(mesh).as_ref())));
+        let dofs = DofMap::complex(mesh.vertex_count(), constraints)?;
+        let faces = (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
+        let (pattern, system, solver) = context.stage("assembly", report, || {
+            let pattern = normal_pattern_of_cells(faces, &dofs)?;
+            let split = match dissection {
+                // A panic in the ordering thread is a bug; pass it on as one.
+                Some(thread) => Some(
+                    thread
+                        .join()
+                        .unwrap_or_else(|p| std::panic::resume_unwind(p))?
+                        .of_unknowns(&dofs)?,
+                ),
+                None => None,
             };
-            Ok((pattern, system?, solver))
+            std::thread::scope(|scope| {
+                let copy = pattern.clone();
+                let planned = scope.spawn(move || match split {
+                    Some(split) => PlannedCholesky::with_dissection(copy, split, options),
+                    None => PlannedCholesky::new(copy, options),
+                });
+                let system = conformal_system(mesh, &dofs, pattern.as_ref());
+                let planned = planned
+                    .join()
+                    .unwrap_or_else(|p| std::panic::resume_unwind(p))?;
+                let solver = match dofs.reduced_len() {
+                    0 => None,
+                    _ => Some(SpdSolver::from_planned(planned, options)?),
+                };
+                Ok((pattern, system?, solver))
+            })
+        })?;
+        context.stage("solve", report, || {
+            let ConformalSystem { values, mut rhs } = system;
+            if let Some(mut solver) = solver {
+                let singular = |index: usize, ratio: f64| SolveError::Singular {
+                    index,
+                    node: dofs.dof_node(index),
+                    ratio,
+                };
+                solver
+                    .factorize(SparseColMatRef::new(pattern.as_ref(), &values))
+                    .map_err(|e| match e {
+                        // The energy is semidefinite: a non-positive pivot is a zero one
+                        // perturbed by rounding.
+                        SolveError::NotPositiveDefinite { index } => singular(index, 0.0),
+                        SolveError::Singular { index, ratio, .. } => singular(index, ratio),
+                        other => other,
+                    })?;
+                drop(values);
+                let n = rhs.len();
+                solver.solve_in_place(MatMut::from_column_major_slice_mut(&mut rhs, n, 1))?;
+            }
+            Ok(dofs.expand(&rhs)?)
         })
-    })?;
-    context.stage("solve", report, || {
-        let ConformalSystem { values, mut rhs } = system;
-        if let Some(mut solver) = solver {
-            let singular = |index: usize, ratio: f64| SolveError::Singular {
-                index,
-                node: dofs.dof_node(index),
-                ratio,
-            };
-            solver
-                .factorize(SparseColMatRef::new(pattern.as_ref(), &values))
-                .map_err(|e| match e {
-                    // The energy is semidefinite: a non-positive pivot is a zero one
-                    // perturbed by rounding.
-                    SolveError::NotPositiveDefinite { index } => singular(index, 0.0),
-                    SolveError::Singular { index, ratio, .. } => singular(index, ratio),
-                    other => other,
-                })?;
-            drop(values);
-            let n = rhs.len();
-            solver.solve_in_place(MatMut::from_column_major_slice_mut(&mut rhs, n, 1))?;
-        }
-        Ok(dofs.expand(&rhs)?)
     })
 }
 

@@ -5,6 +5,7 @@ mod common;
 
 use beltrami_core::{Context, Pin, PlanarBoundary, Position, Problem, Solver, SolverError, Target};
 use beltrami_fem::operators::{apply, beltrami_operator};
+use beltrami_fem::solve::NESTED_DISSECTION_FROM;
 use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveOptions};
 use beltrami_init::Lscm;
 use beltrami_mesh::primitives::{Cells, icosphere, torus};
@@ -71,6 +72,31 @@ fn default_pins_give_a_similarity_of_a_planar_mesh() {
     // Far apart: the diagonal of the unit square.
     assert!(((zq - zp).norm() - 2f64.sqrt()).abs() < 1e-12);
     assert!(solution.report.notes.iter().any(|n| n.contains("pinned")));
+}
+
+#[test]
+fn a_mesh_ordered_from_its_vertex_graph_gives_the_similarity() {
+    // 103,041 vertices: from the nested-dissection size, the vertex graph is dissected
+    // while the DOF map and the pattern are made, and the order carried to the unknowns.
+    // (Jittered by 0.1 of the spacing: by 0.3, 8 of the 204,800 faces turn over, and
+    // the identity is no longer conformal.)
+    let mesh = jittered(320, Cells::Triangles, 0.1, 24);
+    assert!(mesh.vertex_count() >= NESTED_DISSECTION_FROM);
+    let solution = Lscm.solve(&free(&mesh), &mut Context::new()).unwrap();
+    let map = planar(solution.map().expect("a map"));
+    let at = |z: Complex64| mesh.vertices().find(|v| map[v.idx()] == z);
+    let (Some(p), Some(q)) = (at(Complex64::new(0.0, 0.0)), at(Complex64::new(1.0, 0.0))) else {
+        panic!("no vertex exactly at (0, 0) and (1, 0)");
+    };
+    let (zp, zq) = (own_position(&mesh, p), own_position(&mesh, q));
+    let a = 1.0 / (zq - zp);
+    let worst = mesh
+        .vertices()
+        .map(|v| (map[v.idx()] - a * (own_position(&mesh, v) - zp)).norm())
+        .fold(0.0, f64::max);
+    // Two pins leave the free-boundary system ill-conditioned: 1.4e-6 on the
+    // 1M-triangle disk (docs/benchmarks.md).
+    assert!(worst < 1e-6, "{worst:e}");
 }
 
 #[test]

@@ -5,6 +5,7 @@
 //! on every call; iterative solvers refactor the same pattern every step, so this
 //! wrapper keeps both and calls the low-level `SymbolicCholesky::factorize_numeric_llt`.
 
+use super::nested_dissection::Dissected;
 use super::two_domains::{TwoDomains, TwoDomainsPlan};
 use super::{
     Choice, NESTED_DISSECTION_FROM, SolveError, choose, dissected, inverse_permutation,
@@ -58,11 +59,21 @@ impl<T: Scalar> Cholesky<T> {
         pattern: SymbolicSparseColMatRef<'_, usize>,
         par: Par,
     ) -> Result<Self, SolveError> {
-        let n = pattern.nrows();
-        if n < NESTED_DISSECTION_FROM {
+        if pattern.nrows() < NESTED_DISSECTION_FROM {
             return Self::with_ordering(pattern, None, par);
         }
-        let dissected = dissected(pattern)?;
+        Self::from_dissection(pattern, dissected(pattern)?, par)
+    }
+
+    /// [`Cholesky::new`] with the nested-dissection order `dissected` of `pattern`
+    /// computed (at least [`NESTED_DISSECTION_FROM`] rows): the same choice between it
+    /// and AMD's order.
+    pub(super) fn from_dissection(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        dissected: Dissected,
+        par: Par,
+    ) -> Result<Self, SolveError> {
+        let n = pattern.nrows();
         let plan = match dissected.halves {
             Some(halves) => TwoDomainsPlan::new(pattern, &dissected.order, halves)?,
             None => None,
