@@ -48,7 +48,7 @@ mod vertex_separator;
 
 pub use normal::normal_pattern_of_cells;
 pub use saddle::{SaddlePointSolution, SaddlePointSolver, solve_saddle_point};
-pub use vertex_graph::vertex_graph_pattern;
+pub use vertex_graph::{pattern_of_unknowns, vertex_graph_pattern};
 
 use crate::dof::{DofMap, Scalar};
 use beltrami_mesh::VertexId;

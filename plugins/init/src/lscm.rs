@@ -32,7 +32,7 @@ use beltrami_fem::conformal_energy::{ConformalSystem, conformal_energy, conforma
 use beltrami_fem::operators::{apply, beltrami_operator};
 use beltrami_fem::solve::{
     NESTED_DISSECTION_FROM, PlannedCholesky, nested_dissection_split, normal_pattern_of_cells,
-    vertex_graph_pattern,
+    pattern_of_unknowns, vertex_graph_pattern,
 };
 use beltrami_fem::{
     DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveError, SpdSolver,
@@ -150,11 +150,13 @@ impl Solver for Lscm {
 
 /// LSCM of a triangle mesh: the normal equations assembled face by face from the
 /// sides ([`conformal_system`]: no elements, `D_zbar` or scatter maps, so a large mesh
-/// touches far less memory), their symbolic factorization planned on another thread
-/// meanwhile. From the size where the order is a nested dissection
-/// ([`NESTED_DISSECTION_FROM`] unknowns), the vertex graph is dissected on another thread
-/// from the start, while the DOF map and the pattern are made, and the order carried
-/// over to the unknowns ([`SplitOrder::of_unknowns`](beltrami_fem::solve::SplitOrder::of_unknowns)).
+/// touches far less memory) into the pattern of the vertex graph carried to the
+/// unknowns ([`pattern_of_unknowns`]), its symbolic factorization planned on another
+/// thread while the system is assembled. From the size where the order is a nested
+/// dissection ([`NESTED_DISSECTION_FROM`] unknowns), the vertex graph is dissected on
+/// another thread from the start, while the DOF map is made, and the order carried over
+/// to the unknowns
+/// ([`SplitOrder::of_unknowns`](beltrami_fem::solve::SplitOrder::of_unknowns)).
 fn by_sides(
     mesh: &Mesh,
     constraints: &DofConstraints,
@@ -163,30 +165,36 @@ fn by_sides(
     report: &mut Report,
 ) -> Result<Vec<Complex64>, SolverError> {
     let options = solve_options(settings);
+    let graph = vertex_graph_pattern(mesh);
     std::thread::scope(|scope| {
         let dissection = (mesh.vertex_count() >= NESTED_DISSECTION_FROM)
-            .then(|| scope.spawn(|| nested_dissection_split(vertex_graph_pattern(mesh).as_ref())));
+            .then(|| scope.spawn(|| nested_dissection_split(graph.as_ref())));
         let dofs = DofMap::complex(mesh.vertex_count(), constraints)?;
-        let faces = (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
         let (pattern, system, solver) = context.stage("assembly", report, || {
-            let pattern = normal_pattern_of_cells(faces, &dofs)?;
-            let split = match dissection {
-                // A panic in the ordering thread is a bug; pass it on as one.
-                Some(thread) => Some(
-                    thread
-                        .join()
-                        .unwrap_or_else(|p| std::panic::resume_unwind(p))?
-                        .of_unknowns(&dofs)?,
-                ),
-                None => None,
+            let pattern = match pattern_of_unknowns(graph.as_ref(), &dofs) {
+                Some(pattern) => pattern,
+                None => {
+                    let faces = (0..mesh.face_count())
+                        .map(|f| mesh.face_vertices(FaceId::from_usize(f)));
+                    normal_pattern_of_cells(faces, &dofs)?
+                }
             };
-            std::thread::scope(|scope| {
+            // The symbolic factorization on another thread while the system is assembled.
+            std::thread::scope(|inner| {
                 let copy = pattern.clone();
-                let planned = scope.spawn(move || match split {
-                    Some(split) => PlannedCholesky::with_dissection(copy, split, options),
+                let dofs = &dofs;
+                let planned = inner.spawn(move || match dissection {
+                    Some(thread) => {
+                        // A panic in the ordering thread is a bug; pass it on as one.
+                        let split = thread
+                            .join()
+                            .unwrap_or_else(|p| std::panic::resume_unwind(p))?
+                            .of_unknowns(dofs)?;
+                        PlannedCholesky::with_dissection(copy, split, options)
+                    }
                     None => PlannedCholesky::new(copy, options),
                 });
-                let system = conformal_system(mesh, &dofs, pattern.as_ref());
+                let system = conformal_system(mesh, dofs, pattern.as_ref());
                 let planned = planned
                     .join()
                     .unwrap_or_else(|p| std::panic::resume_unwind(p))?;
@@ -194,7 +202,7 @@ fn by_sides(
                     0 => None,
                     _ => Some(SpdSolver::from_planned(planned, options)?),
                 };
-                Ok((pattern, system?, solver))
+                Ok::<_, SolverError>((pattern, system?, solver))
             })
         })?;
         context.stage("solve", report, || {

@@ -1,8 +1,9 @@
 //! The pattern of a mesh's vertex graph, for ordering a factorization before the
 //! unknowns are known.
 
+use crate::dof::{DofMap, Scalar};
 use beltrami_mesh::{Mesh, VertexId};
-use faer::sparse::SymbolicSparseColMat;
+use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 /// The lower triangle (diagonal included, each column's rows increasing) of the
 /// symmetric pattern of `mesh`'s vertex graph: `(v, v)` for every vertex and `(w, v)`,
@@ -30,6 +31,59 @@ pub fn vertex_graph_pattern(mesh: &Mesh) -> SymbolicSparseColMat<usize> {
         col_ptr.push(rows.len());
     }
     SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows)
+}
+
+/// `vertex_graph` (the lower triangle of a pattern of `dofs`' nodes, as
+/// [`vertex_graph_pattern`] gives it) carried over to `dofs`' reduced unknowns, when each
+/// node has at most one unknown and the unknowns are numbered in the order of their
+/// nodes, each once (the complex form with fixed nodes: a fixed node's row and column
+/// are dropped, the others renumbered, their order kept); `None` otherwise, and when
+/// the pattern is not of `dofs`' nodes. On a triangle mesh this is the pattern
+/// [`normal_pattern_of_cells`](super::normal_pattern_of_cells) gives from the faces, in
+/// one pass over the graph.
+pub fn pattern_of_unknowns<T: Scalar>(
+    vertex_graph: SymbolicSparseColMatRef<'_, usize>,
+    dofs: &DofMap<T>,
+) -> Option<SymbolicSparseColMat<usize>> {
+    let nodes = dofs.n_nodes();
+    if vertex_graph.nrows() != nodes || vertex_graph.ncols() != nodes {
+        return None;
+    }
+    let mut unknown = vec![usize::MAX; nodes];
+    let mut next = 0;
+    for (v, slot) in unknown.iter_mut().enumerate() {
+        let mut terms = dofs.node_terms(VertexId::from_usize(v)).ok()?;
+        if let Some((_, term)) = terms.next() {
+            if term.dof != next || terms.next().is_some() {
+                return None;
+            }
+            *slot = next;
+            next += 1;
+        }
+    }
+    let n = dofs.reduced_len();
+    if next != n {
+        return None;
+    }
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut rows = Vec::with_capacity(vertex_graph.row_idx().len());
+    col_ptr.push(0);
+    for v in (0..nodes).filter(|&v| unknown[v] != usize::MAX) {
+        let start = rows.len();
+        rows.extend(
+            vertex_graph
+                .row_idx_of_col(v)
+                .map(|w| unknown.get(w).copied().unwrap_or(usize::MAX))
+                .filter(|&c| c != usize::MAX),
+        );
+        // Sorted in, sorted out (the renumbering keeps the order); a pattern given
+        // with unsorted rows is declined.
+        if !rows[start..].is_sorted_by(|a, b| a < b) {
+            return None;
+        }
+        col_ptr.push(rows.len());
+    }
+    Some(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows))
 }
 
 #[cfg(test)]
@@ -60,5 +114,31 @@ mod tests {
                 "column {v}: {column:?}"
             );
         }
+    }
+
+    #[test]
+    fn carried_to_the_unknowns_the_graph_is_the_faces_pattern() {
+        use crate::dof::DofConstraints;
+        use crate::solve::normal_pattern_of_cells;
+        use beltrami_mesh::FaceId;
+        use num_complex::Complex64;
+        let mesh = Mesh::from_soup(&grid(9, 7, Cells::Triangles)).unwrap();
+        let mut constraints = DofConstraints::new();
+        constraints.fix(VertexId::from_usize(0), Complex64::new(0.0, 0.0));
+        constraints.fix(VertexId::from_usize(33), Complex64::new(1.0, 0.0));
+        let dofs = DofMap::complex(mesh.vertex_count(), &constraints).unwrap();
+        let graph = vertex_graph_pattern(&mesh);
+        let carried = pattern_of_unknowns(graph.as_ref(), &dofs).expect("one unknown per node");
+        let faces = (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
+        let from_faces = normal_pattern_of_cells(faces, &dofs).unwrap();
+        assert_eq!(carried.col_ptr(), from_faces.col_ptr());
+        assert_eq!(carried.row_idx(), from_faces.row_idx());
+        // Two nodes sharing an unknown, or a graph of other nodes: declined.
+        let mut shared = DofConstraints::new();
+        shared.share(VertexId::from_usize(1), VertexId::from_usize(2));
+        let shared = DofMap::complex(mesh.vertex_count(), &shared).unwrap();
+        assert!(pattern_of_unknowns(graph.as_ref(), &shared).is_none());
+        let other = DofMap::<Complex64>::complex(10, &DofConstraints::new()).unwrap();
+        assert!(pattern_of_unknowns(graph.as_ref(), &other).is_none());
     }
 }
