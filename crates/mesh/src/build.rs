@@ -12,10 +12,12 @@
 //!    boundary loops, and check that the faces around every vertex form one fan.
 
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 use nalgebra::Point3;
 
 use crate::mesh::{Mesh, MeshData};
+use crate::parallel::in_turns;
 use crate::vertex_map::NO_VERTEX;
 use crate::{ComponentId, EdgeId, HalfedgeId, MeshError, PolygonSoup, VertexId, VertexMap};
 
@@ -235,57 +237,99 @@ fn group_edges(
     }
     drop(fill);
 
-    let mut corner_edge = vec![NONE; nc];
-    let mut corner_twin = vec![NONE; nc];
+    // The buckets in ranges of vertices, one per thread (sorting them and matching their
+    // corners is most of the grouping): first each range's buckets sorted and its edges
+    // counted, then its edges numbered after the earlier ranges' and its corners
+    // matched. Each corner is in one bucket, so the ranges write disjoint corners.
+    let ranges = bucket_ranges(&start, vertex_count, nc);
+    let mut parts: Vec<(std::ops::Range<usize>, &mut [u32])> = Vec::with_capacity(ranges.len());
+    let mut rest = by_lo.as_mut_slice();
+    for range in &ranges {
+        let (part, tail) = rest.split_at_mut((start[range.end] - start[range.start]) as usize);
+        parts.push((range.clone(), part));
+        rest = tail;
+    }
+    let by_hi = |c: &u32| ends(*c as usize).1;
+    let threads = parts.len();
+    let counts = in_turns(parts.iter_mut().collect(), threads, |(range, part)| {
+        let base = start[range.start] as usize;
+        let mut edges = 0;
+        for v in range.clone() {
+            let bucket = &mut part[start[v] as usize - base..start[v + 1] as usize - base];
+            bucket.sort_unstable_by_key(by_hi);
+            edges += bucket.chunk_by(|a, b| by_hi(a) == by_hi(b)).count();
+        }
+        edges
+    });
+    let corner_edge: Vec<AtomicU32> = (0..nc).map(|_| AtomicU32::new(NONE)).collect();
+    let corner_twin: Vec<AtomicU32> = (0..nc).map(|_| AtomicU32::new(NONE)).collect();
+    let mut first_edge = Vec::with_capacity(counts.len());
     let mut edge_count = 0usize;
-    let mut duplicates = Vec::new();
-    for v in 0..vertex_count {
-        let bucket = &mut by_lo[start[v] as usize..start[v + 1] as usize];
-        bucket.sort_unstable_by_key(|&c| ends(c as usize).1);
-        for group in bucket.chunk_by(|&a, &b| ends(a as usize).1 == ends(b as usize).1) {
-            let e = edge_count as u32;
-            edge_count += 1;
-            for &c in group {
-                corner_edge[c as usize] = e;
-            }
-            if group.len() == 1 {
-                continue;
-            }
-            let mut found_duplicate = false;
-            for (i, &a) in group.iter().enumerate() {
-                let fa = corner_face[a as usize] as usize;
-                for &b in &group[i + 1..] {
-                    let fb = corner_face[b as usize] as usize;
-                    if vertex_set(faces.face(fa)) == vertex_set(faces.face(fb)) {
-                        found_duplicate = true;
-                        duplicates.push((fa.max(fb), fa.min(fb)));
+    for count in &counts {
+        first_edge.push(edge_count);
+        edge_count += count;
+    }
+    let mut numbered: Vec<_> = parts.into_iter().zip(first_edge).collect();
+    let matched = in_turns(
+        numbered.iter_mut().collect(),
+        threads,
+        |((range, part), first)| {
+            let base = start[range.start] as usize;
+            let mut e = *first as u32;
+            let mut duplicates = Vec::new();
+            for v in range.clone() {
+                let bucket = &part[start[v] as usize - base..start[v + 1] as usize - base];
+                for group in bucket.chunk_by(|a, b| by_hi(a) == by_hi(b)) {
+                    for &c in group {
+                        corner_edge[c as usize].store(e, Ordering::Relaxed);
                     }
+                    e += 1;
+                    if group.len() == 1 {
+                        continue;
+                    }
+                    let mut found_duplicate = false;
+                    for (i, &a) in group.iter().enumerate() {
+                        let fa = corner_face[a as usize] as usize;
+                        for &b in &group[i + 1..] {
+                            let fb = corner_face[b as usize] as usize;
+                            if vertex_set(faces.face(fa)) == vertex_set(faces.face(fb)) {
+                                found_duplicate = true;
+                                duplicates.push((fa.max(fb), fa.min(fb)));
+                            }
+                        }
+                    }
+                    if found_duplicate {
+                        continue;
+                    }
+                    if group.len() > 2 {
+                        let (a, b) = ends(group[0] as usize);
+                        let mut on_edge: Vec<usize> = group
+                            .iter()
+                            .map(|&c| faces.input[corner_face[c as usize] as usize] as usize)
+                            .collect();
+                        on_edge.sort_unstable();
+                        return Err(MeshError::NonManifoldEdge {
+                            a: a as usize,
+                            b: b as usize,
+                            faces: on_edge,
+                        });
+                    }
+                    corner_twin[group[0] as usize].store(group[1], Ordering::Relaxed);
+                    corner_twin[group[1] as usize].store(group[0], Ordering::Relaxed);
                 }
             }
-            if found_duplicate {
-                continue;
-            }
-            if group.len() > 2 {
-                let (a, b) = ends(group[0] as usize);
-                let mut on_edge: Vec<usize> = group
-                    .iter()
-                    .map(|&c| faces.input[corner_face[c as usize] as usize] as usize)
-                    .collect();
-                on_edge.sort_unstable();
-                return Err(MeshError::NonManifoldEdge {
-                    a: a as usize,
-                    b: b as usize,
-                    faces: on_edge,
-                });
-            }
-            corner_twin[group[0] as usize] = group[1];
-            corner_twin[group[1] as usize] = group[0];
-        }
+            Ok(duplicates)
+        },
+    );
+    // The first non-manifold edge in vertex order, as one pass over the buckets finds.
+    let mut duplicates = Vec::new();
+    for part in matched {
+        duplicates.extend(part?);
     }
     if duplicates.is_empty() {
         Ok(Grouping::Edges(EdgeGroups {
-            corner_edge,
-            corner_twin,
+            corner_edge: corner_edge.into_iter().map(AtomicU32::into_inner).collect(),
+            corner_twin: corner_twin.into_iter().map(AtomicU32::into_inner).collect(),
             edge_count,
         }))
     } else {
@@ -293,6 +337,36 @@ fn group_edges(
         duplicates.dedup();
         Ok(Grouping::Duplicates(duplicates))
     }
+}
+
+/// Corners from which [`group_edges`] matches buckets on several threads.
+const PARALLEL_GROUPING_FROM: usize = 1 << 16;
+
+/// Consecutive ranges of the vertices `0..vertex_count`, one per thread (one below
+/// [`PARALLEL_GROUPING_FROM`] corners), holding about as many corners each: `start[v]`
+/// is the first corner of vertex `v`'s bucket.
+fn bucket_ranges(
+    start: &[u32],
+    vertex_count: usize,
+    corners: usize,
+) -> Vec<std::ops::Range<usize>> {
+    let threads = if corners < PARALLEL_GROUPING_FROM {
+        1
+    } else {
+        crate::parallel::available_threads()
+    };
+    let mut ranges = Vec::with_capacity(threads);
+    let mut begin = 0;
+    for k in 1..threads {
+        let target = (k * corners / threads) as u32;
+        let end = start[..=vertex_count]
+            .partition_point(|&s| s < target)
+            .clamp(begin, vertex_count);
+        ranges.push(begin..end);
+        begin = end;
+    }
+    ranges.push(begin..vertex_count);
+    ranges
 }
 
 /// Orientation of every face relative to its component's majority, and components.

@@ -57,7 +57,7 @@ pub fn join<A: Send, B: Send>(
 
 /// Runs `work` on every item of `chunks` (in turns, on the calling thread and
 /// `threads - 1` scoped threads) and returns the results in the order of `chunks`.
-fn in_turns<C: Send, R: Send>(
+pub(crate) fn in_turns<C: Send, R: Send>(
     chunks: Vec<C>,
     threads: usize,
     work: impl Fn(C) -> R + Sync,

@@ -957,3 +957,72 @@ fn merging_unreferenced_coincident_vertices_keeps_them_unreferenced() {
     assert_eq!(mesh.vertex_map().unreferenced().len(), 2);
     assert!(mesh.vertex_map().is_order_preserving());
 }
+
+#[test]
+fn large_meshes_group_their_edges_in_ranges_as_in_one() {
+    // 240,000 corners: the edges are grouped in ranges of vertices on several threads.
+    let g = primitives::grid(200, 200, Cells::Triangles);
+    let (nv, nf) = (g.vertex_count(), g.face_count());
+    let (mesh, _) = build(&g).unwrap();
+    // A disk: V - E + F = 1.
+    assert_eq!(mesh.edge_count(), nv + nf - 1);
+    for h in mesh.halfedges() {
+        assert_eq!(mesh.twin(mesh.twin(h)), h);
+        assert_eq!(mesh.origin(mesh.twin(h)), mesh.origin(mesh.next(h)));
+    }
+    let last = (nv - 1) as u32;
+    // Two more faces on a boundary edge at each end of the vertex numbering: the first
+    // in vertex order is reported, as one pass over the vertices finds it.
+    let with = |extra: &[[u32; 3]]| {
+        let mut positions = g.positions.clone();
+        for k in 0..extra.len() {
+            positions.push(p(-1.0 - k as f64, -1.0, 1.0 + k as f64));
+        }
+        let mut s = PolygonSoup::new(positions);
+        for f in g.faces() {
+            s.push_face(f);
+        }
+        for f in extra {
+            s.push_face(f);
+        }
+        s
+    };
+    let n = nv as u32;
+    let both = with(&[
+        [last - 1, last, n],
+        [last, last - 1, n + 1],
+        [0, 1, n + 2],
+        [1, 0, n + 3],
+    ]);
+    match build_err(&both) {
+        MeshError::NonManifoldEdge { a, b, faces } => {
+            assert_eq!((a, b), (0, 1));
+            assert_eq!(faces.len(), 3);
+        }
+        e => panic!("{e}"),
+    }
+    let high = with(&[[last - 1, last, n], [last, last - 1, n + 1]]);
+    match build_err(&high) {
+        MeshError::NonManifoldEdge { a, b, .. } => {
+            assert_eq!((a, b), (last as usize - 1, last as usize))
+        }
+        e => panic!("{e}"),
+    }
+    // A duplicate of the first face with a non-manifold edge at the far end: the edge,
+    // as one pass finds it after the duplicate; the duplicate alone is named.
+    let mut dup = high.clone();
+    dup.push_face(g.face(0));
+    assert!(matches!(build_err(&dup), MeshError::NonManifoldEdge { .. }));
+    let mut only = PolygonSoup::new(g.positions.clone());
+    for f in g.faces() {
+        only.push_face(f);
+    }
+    only.push_face(g.face(nf - 1));
+    assert_eq!(
+        build_err(&only),
+        MeshError::DuplicateFace {
+            face: nf,
+            first: nf - 1
+        }
+    );
+}

@@ -174,8 +174,8 @@ fn by_sides(
             let pattern = match pattern_of_unknowns(graph.as_ref(), &dofs) {
                 Some(pattern) => pattern,
                 None => {
-                    let faces = (0..mesh.face_count())
-                        .map(|f| mesh.face_vertices(FaceId::from_usize(f)));
+                    let faces =
+                        (0..mesh.face_count()).map(|f| mesh.face_vertices(FaceId::from_usize(f)));
                     normal_pattern_of_cells(faces, &dofs)?
                 }
             };
