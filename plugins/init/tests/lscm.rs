@@ -46,30 +46,36 @@ fn reproduces_a_planar_mesh_pinned_at_its_own_positions() {
     }
 }
 
+/// The pinned vertices of a map with default pins (exactly at 0 and 1) and the largest
+/// distance of the map from the similarity `z -> (z - z_p) / (z_q - z_p)` through them.
+fn similarity_error(
+    mesh: &Mesh,
+    map: &[Complex64],
+) -> (beltrami_mesh::VertexId, beltrami_mesh::VertexId, f64) {
+    let at = |z: Complex64| mesh.vertices().find(|v| map[v.idx()] == z);
+    let (Some(p), Some(q)) = (at(Complex64::new(0.0, 0.0)), at(Complex64::new(1.0, 0.0))) else {
+        panic!("no vertex exactly at (0, 0) and (1, 0)");
+    };
+    let (zp, zq) = (own_position(mesh, p), own_position(mesh, q));
+    let a = 1.0 / (zq - zp);
+    let worst = mesh
+        .vertices()
+        .map(|v| (map[v.idx()] - a * (own_position(mesh, v) - zp)).norm())
+        .fold(0.0, f64::max);
+    (p, q, worst)
+}
+
 #[test]
 fn default_pins_give_a_similarity_of_a_planar_mesh() {
     let mesh = jittered(12, Cells::Triangles, 0.3, 23);
     let solution = Lscm.solve(&free(&mesh), &mut Context::new()).unwrap();
     let map = planar(solution.map().expect("a map"));
     // The pinned vertices are exactly at 0 and 1; the map is z -> a z + b through them.
-    let a_vertex = mesh
-        .vertices()
-        .find(|v| map[v.idx()] == Complex64::new(0.0, 0.0));
-    let b_vertex = mesh
-        .vertices()
-        .find(|v| map[v.idx()] == Complex64::new(1.0, 0.0));
-    let (Some(p), Some(q)) = (a_vertex, b_vertex) else {
-        panic!("no vertex exactly at (0, 0) and (1, 0)");
-    };
+    let (p, q, worst) = similarity_error(&mesh, &map);
     assert!(mesh.is_boundary_vertex(p) && mesh.is_boundary_vertex(q));
-    let (zp, zq) = (own_position(&mesh, p), own_position(&mesh, q));
-    let a = 1.0 / (zq - zp);
-    let worst = mesh
-        .vertices()
-        .map(|v| (map[v.idx()] - a * (own_position(&mesh, v) - zp)).norm())
-        .fold(0.0, f64::max);
     assert!(worst < 1e-9, "{worst:e}");
     // Far apart: the diagonal of the unit square.
+    let (zp, zq) = (own_position(&mesh, p), own_position(&mesh, q));
     assert!(((zq - zp).norm() - 2f64.sqrt()).abs() < 1e-12);
     assert!(solution.report.notes.iter().any(|n| n.contains("pinned")));
 }
@@ -83,17 +89,7 @@ fn a_mesh_ordered_from_its_vertex_graph_gives_the_similarity() {
     let mesh = jittered(320, Cells::Triangles, 0.1, 24);
     assert!(mesh.vertex_count() >= NESTED_DISSECTION_FROM);
     let solution = Lscm.solve(&free(&mesh), &mut Context::new()).unwrap();
-    let map = planar(solution.map().expect("a map"));
-    let at = |z: Complex64| mesh.vertices().find(|v| map[v.idx()] == z);
-    let (Some(p), Some(q)) = (at(Complex64::new(0.0, 0.0)), at(Complex64::new(1.0, 0.0))) else {
-        panic!("no vertex exactly at (0, 0) and (1, 0)");
-    };
-    let (zp, zq) = (own_position(&mesh, p), own_position(&mesh, q));
-    let a = 1.0 / (zq - zp);
-    let worst = mesh
-        .vertices()
-        .map(|v| (map[v.idx()] - a * (own_position(&mesh, v) - zp)).norm())
-        .fold(0.0, f64::max);
+    let (_, _, worst) = similarity_error(&mesh, &planar(solution.map().expect("a map")));
     // Two pins leave the free-boundary system ill-conditioned: 1.4e-6 on the
     // 1M-triangle disk (docs/benchmarks.md).
     assert!(worst < 1e-6, "{worst:e}");

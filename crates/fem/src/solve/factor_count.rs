@@ -118,6 +118,9 @@ pub(super) fn stored_multiply_subtracts(symbolic: &SymbolicCholesky<usize>, colu
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solve::vertex_graph_pattern;
+    use beltrami_mesh::Mesh;
+    use beltrami_mesh::primitives::{self, Cells};
     use faer::Side;
     use faer::perm::PermRef;
     use faer::sparse::SymbolicSparseColMat;
@@ -187,24 +190,9 @@ mod tests {
     fn the_stored_count_is_exact_for_simplicial_factors_and_bounds_supernodal_ones() {
         // A 30 x 30 grid with diagonals in a scattered order (plenty of fill, supernodes
         // of varied structure for faer's relaxation to merge).
-        let k = 30;
-        let id = |i: usize, j: usize| i + k * j;
-        let mut edges = Vec::new();
-        for j in 0..k {
-            for i in 0..k {
-                if i + 1 < k {
-                    edges.push((id(i, j), id(i + 1, j)));
-                }
-                if j + 1 < k {
-                    edges.push((id(i, j), id(i, j + 1)));
-                }
-                if i + 1 < k && j + 1 < k {
-                    edges.push((id(i, j), id(i + 1, j + 1)));
-                }
-            }
-        }
-        let n = k * k;
-        let grid = pattern(n, &edges);
+        let mesh = Mesh::from_soup(&primitives::grid(29, 29, Cells::Triangles)).unwrap();
+        let grid = vertex_graph_pattern(&mesh);
+        let n = grid.nrows();
         let order: Vec<usize> = (0..n).map(|i| (i * 37) % n).collect();
         let exact = factor_count(grid.as_ref(), &order)
             .unwrap()
