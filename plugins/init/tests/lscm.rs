@@ -71,7 +71,7 @@ fn default_pins_give_a_similarity_of_a_planar_mesh() {
     let solution = Lscm.solve(&free(&mesh), &mut Context::new()).unwrap();
     let map = planar(solution.map().expect("a map"));
     // The pinned vertices are exactly at 0 and 1; the map is z -> a z + b through them.
-    let (p, q, worst) = similarity_error(&mesh, &map);
+    let (p, q, worst) = similarity_error(&mesh, map);
     assert!(mesh.is_boundary_vertex(p) && mesh.is_boundary_vertex(q));
     assert!(worst < 1e-9, "{worst:e}");
     // Far apart: the diagonal of the unit square.
@@ -89,7 +89,7 @@ fn a_mesh_ordered_from_its_vertex_graph_gives_the_similarity() {
     let mesh = jittered(320, Cells::Triangles, 0.1, 24);
     assert!(mesh.vertex_count() >= NESTED_DISSECTION_FROM);
     let solution = Lscm.solve(&free(&mesh), &mut Context::new()).unwrap();
-    let (_, _, worst) = similarity_error(&mesh, &planar(solution.map().expect("a map")));
+    let (_, _, worst) = similarity_error(&mesh, planar(solution.map().expect("a map")));
     // Two pins leave the free-boundary system ill-conditioned: 1.4e-6 on the
     // 1M-triangle disk (docs/benchmarks.md).
     assert!(worst < 1e-6, "{worst:e}");
