@@ -84,7 +84,7 @@ struct SidePlan {
     rows: Vec<usize>,
     own_in_order: Vec<usize>,
     pattern: SymbolicSparseColMat<usize>,
-    source: Vec<(usize, bool)>,
+    source: Vec<u32>,
     symbolic: SymbolicCholesky<usize>,
 }
 
@@ -98,9 +98,10 @@ struct SideFactor<T: Scalar> {
     /// factor eliminates these first, then the separator in its own numbering.
     own_in_order: Vec<usize>,
     pattern: SymbolicSparseColMat<usize>,
-    /// For each stored value of `M_A`, its position among the values of `M` and whether
-    /// it is that value's conjugate (read above the diagonal in this numbering).
-    source: Vec<(usize, bool)>,
+    /// For each stored value of `M_A`, its position among the values of `M`, with
+    /// [`CONJUGATED`] set when it is that value's conjugate (read above the diagonal in
+    /// this numbering).
+    source: Vec<u32>,
     values: Vec<T>,
     factor: Factor<T>,
     /// `L_A`, the factor's last `|S|` rows and columns (lower triangular, separator
@@ -110,6 +111,9 @@ struct SideFactor<T: Scalar> {
     /// successful factorization.
     schur_part: Mat<T>,
 }
+
+/// The bit of a [`SideFactor`]'s source position that marks a conjugated value.
+const CONJUGATED: u32 = 1 << 31;
 
 /// Which side a row of `M` is on, [`SEPARATOR`] for the separator.
 const SEPARATOR: u8 = 2;
@@ -331,8 +335,9 @@ impl SidePlan {
             local[i] = l;
         }
         let m = rows.len();
-        // The entries (column, row, position among M's values, conjugated) of the lower
-        // triangle in the local numbering, placed column by column.
+        // The entries (column, row, source: the position among M's values, with
+        // CONJUGATED) of the lower triangle in the local numbering, placed column by
+        // column.
         let mut entries = Vec::new();
         for &j in &rows {
             for p in pattern.col_range(j) {
@@ -349,10 +354,18 @@ impl SidePlan {
                     continue;
                 }
                 let (a, b) = (local[i], local[j]);
+                // Positions from CONJUGATED on cannot be packed (matrices of more than
+                // 2^31 stored values): the caller factors the whole.
+                let Ok(p) = u32::try_from(p) else {
+                    return Ok(None);
+                };
+                if p >= CONJUGATED {
+                    return Ok(None);
+                }
                 entries.push(if a >= b {
-                    (b, a, p, false)
+                    (b, a, p)
                 } else {
-                    (a, b, p, true)
+                    (a, b, p | CONJUGATED)
                 });
             }
         }
@@ -364,19 +377,16 @@ impl SidePlan {
             col_ptr[c + 1] += col_ptr[c];
         }
         let mut next = col_ptr[..m].to_vec();
-        let mut cells = vec![(0usize, 0usize, false); entries.len()];
-        for (c, r, p, conjugated) in entries {
-            cells[next[c]] = (r, p, conjugated);
+        let mut cells = vec![(0usize, 0u32); entries.len()];
+        for (c, r, source) in entries {
+            cells[next[c]] = (r, source);
             next[c] += 1;
         }
         for c in 0..m {
-            cells[col_ptr[c]..col_ptr[c + 1]].sort_unstable_by_key(|&(r, ..)| r);
+            cells[col_ptr[c]..col_ptr[c + 1]].sort_unstable_by_key(|&(r, _)| r);
         }
-        let row_idx = cells.iter().map(|&(r, ..)| r).collect();
-        let source: Vec<(usize, bool)> = cells
-            .iter()
-            .map(|&(_, p, conjugated)| (p, conjugated))
-            .collect();
+        let row_idx = cells.iter().map(|&(r, _)| r).collect();
+        let source: Vec<u32> = cells.iter().map(|&(_, source)| source).collect();
         let sub = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
         let upper = sub.as_ref().transpose().to_col_major()?;
         let symbolic = analyse(upper.as_ref(), Side::Upper, SymmetricOrdering::Identity)?;
@@ -421,11 +431,12 @@ impl<T: Scalar> SideFactor<T> {
     /// Factors `M_A` from the values of `M`, then forms `T_A = L_A L_A^H` from the
     /// factor's last `|S|` columns (the separator, in its own order).
     fn factorize(&mut self, values: &[T], tolerance: f64) -> Result<(), FactorFailure> {
-        for (v, &(p, conjugated)) in self.values.iter_mut().zip(&self.source) {
-            *v = if conjugated {
-                values[p].conjugate()
+        for (v, &source) in self.values.iter_mut().zip(&self.source) {
+            let value = values[(source & !CONJUGATED) as usize];
+            *v = if source & CONJUGATED != 0 {
+                value.conjugate()
             } else {
-                values[p]
+                value
             };
         }
         let matrix = SparseColMatRef::new(self.pattern.as_ref(), &self.values);
