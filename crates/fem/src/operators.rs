@@ -267,6 +267,21 @@ pub fn apply(m: &SparseColMat<usize, Complex64>, x: &[Complex64]) -> Vec<Complex
     y
 }
 
+/// The weighted squared residual `sum_q w_q |(A x)_q|^2 = |W^(1/2) A x|^2` of an
+/// operator with a row per quadrature point (`weights[q]` the point's weight): the
+/// least-squares energy of LSCM (`A = D_zbar`) and of a QC map (`A = D_zbar - mu D_z`).
+pub fn weighted_residual(
+    m: &SparseColMat<usize, Complex64>,
+    x: &[Complex64],
+    weights: &[f64],
+) -> f64 {
+    apply(m, x)
+        .iter()
+        .zip(weights)
+        .map(|(r, w)| w * r.norm_sqr())
+        .sum()
+}
+
 /// The operator `A = D_zbar - diag(mu_q) D_z` (quadrature points x vertices) of the
 /// elements, `mu_q = mu[f]` at every quadrature point of face `f`: `(A x)_q` is
 /// `f_zbar(q) - mu_f f_z(q)` of the map with vertex values `x`, in the elements' frame.

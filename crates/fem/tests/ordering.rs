@@ -200,6 +200,21 @@ fn shifted_grid_laplacian(k: usize, shift: f64) -> (SparseColMat<usize, f64>, Ve
     (m, rhs)
 }
 
+/// Factors `m` with `solver`, solves `m x = rhs` and returns its
+/// [`relative_residual`].
+fn factored_residual(
+    solver: &mut SpdSolver<f64>,
+    m: &SparseColMat<usize, f64>,
+    rhs: &[f64],
+) -> f64 {
+    let n = rhs.len();
+    solver.factorize(m.as_ref()).unwrap();
+    let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
+    solver.solve_in_place(x.as_mut()).unwrap();
+    let x: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    relative_residual(m, &x, rhs)
+}
+
 /// `max |M x - b|` over `max |b|` for `M` given by its lower triangle.
 fn relative_residual(m: &SparseColMat<usize, f64>, x: &[f64], b: &[f64]) -> f64 {
     let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
@@ -241,18 +256,13 @@ fn a_large_solver_refactors_correctly_in_nested_dissection_order() {
     // the block touched while the dissection was computed. Two matrices with one pattern
     // through one solver: both solutions satisfy their systems.
     let k = 700;
-    let n = k * k;
     for (round, shift) in [0.01, 1.0].into_iter().enumerate() {
         let (m, rhs) = shifted_grid_laplacian(k, shift);
         let mut solver = SpdSolver::new(m.symbolic(), SolveOptions::default()).unwrap();
         // Taken from the count of the two sides' stored factors, without the exact one.
         assert!(solver.is_split());
         for pass in 0..2 {
-            solver.factorize(m.as_ref()).unwrap();
-            let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
-            solver.solve_in_place(x.as_mut()).unwrap();
-            let x: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
-            let residual = relative_residual(&m, &x, &rhs);
+            let residual = factored_residual(&mut solver, &m, &rhs);
             assert!(
                 residual < 1e-9,
                 "round {round}, pass {pass}: residual {residual:e}"
@@ -411,11 +421,7 @@ fn a_planned_solver_solves_as_a_fresh_one() {
         let mut solver = SpdSolver::from_planned(planned, SolveOptions::default()).unwrap();
         assert_eq!(solver.is_split(), n >= NESTED_DISSECTION_FROM);
         assert_eq!(solver.pattern().col_ptr(), m.symbolic().col_ptr());
-        solver.factorize(m.as_ref()).unwrap();
-        let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
-        solver.solve_in_place(x.as_mut()).unwrap();
-        let x: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
-        let residual = relative_residual(&m, &x, &rhs);
+        let residual = factored_residual(&mut solver, &m, &rhs);
         assert!(residual < 1e-9, "k = {k}: residual {residual:e}");
     }
     let empty = SymbolicSparseColMat::new_checked(0, 0, vec![0], None, Vec::new());
@@ -446,11 +452,7 @@ fn a_dissection_given_from_outside_is_judged_and_solves() {
     .unwrap();
     let mut solver = SpdSolver::from_planned(planned, SolveOptions::default()).unwrap();
     assert!(solver.is_split());
-    solver.factorize(m.as_ref()).unwrap();
-    let mut x = Mat::from_fn(n, 1, |i, _| rhs[i]);
-    solver.solve_in_place(x.as_mut()).unwrap();
-    let x: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
-    let residual = relative_residual(&m, &x, &rhs);
+    let residual = factored_residual(&mut solver, &m, &rhs);
     assert!(residual < 1e-9, "residual {residual:e}");
 
     // Orders that are not the pattern's are refused.

@@ -29,7 +29,7 @@ use beltrami_core::{
 };
 use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::conformal_energy::{ConformalSystem, conformal_energy, conformal_system};
-use beltrami_fem::operators::{apply, beltrami_operator};
+use beltrami_fem::operators::{beltrami_operator, weighted_residual};
 use beltrami_fem::solve::{
     NESTED_DISSECTION_FROM, PlannedCholesky, nested_dissection_split, normal_pattern_of_cells,
     pattern_of_unknowns, vertex_graph_pattern,
@@ -280,11 +280,7 @@ fn by_elements(
         let zero = vec![Complex64::new(0.0, 0.0); dzbar.nrows()];
         Ok(solver.solve(dzbar.as_ref(), Some(&weights), &zero)?)
     })?;
-    let energy = apply(&dzbar, &map)
-        .iter()
-        .zip(&weights)
-        .map(|(r, w)| w * r.norm_sqr())
-        .sum();
+    let energy = weighted_residual(&dzbar, &map, &weights);
     Ok((map, energy, elements))
 }
 

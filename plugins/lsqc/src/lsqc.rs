@@ -9,7 +9,7 @@ use beltrami_core::{
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::boundary::{self, BoundaryError};
 use beltrami_fem::element::check_planar;
-use beltrami_fem::operators::{apply, beltrami_operator};
+use beltrami_fem::operators::{beltrami_operator, weighted_residual};
 use beltrami_fem::{
     BeltramiField, Distortion, DofConstraints, DofMap, Elements, FemError, Frame,
     LeastSquaresSolver, MuError, SolveOptions,
@@ -131,11 +131,7 @@ impl Solver for Lsqc {
             let zero = vec![Complex64::new(0.0, 0.0); operator.nrows()];
             Ok(solver.solve(operator.as_ref(), Some(&weights), &zero)?)
         })?;
-        let energy = apply(&operator, &map)
-            .iter()
-            .zip(&weights)
-            .map(|(r, w)| w * r.norm_sqr())
-            .sum();
+        let energy = weighted_residual(&operator, &map, &weights);
         metrics.energy_history.push(energy);
 
         let distortion = context.stage("distortion", &mut report, || {

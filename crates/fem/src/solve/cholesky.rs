@@ -88,13 +88,9 @@ impl<T: Scalar> Cholesky<T> {
         };
         match (choice, plan) {
             (Choice::Nested(_), Some(plan)) => Ok(Self::Halves(Box::new(plan.into_factors()?))),
-            (Choice::Nested(dissected), None) => {
-                let inverse = inverse_permutation(&dissected.order)?;
-                Self::with_ordering(pattern, Some((&dissected.order, &inverse)), par)
-            }
-            (Choice::Amd(order), _) => {
-                let inverse = inverse_permutation(&order)?;
-                Self::with_ordering(pattern, Some((&order, &inverse)), par)
+            // The order whole: the dissection whose sides could not be planned, or AMD's.
+            (Choice::Nested(Dissected { order, .. }) | Choice::Amd(order), _) => {
+                Self::split(pattern, &order, None, par)
             }
         }
     }

@@ -78,12 +78,16 @@ pub fn factor_count(
         entries: counts.iter().sum(),
         multiply_subtracts: counts
             .iter()
-            .map(|&c| {
-                let below = c.saturating_sub(1) as f64;
-                below * (below + 1.0) / 2.0
-            })
+            .map(|&c| column_multiply_subtracts(c.saturating_sub(1)))
             .sum(),
     })
+}
+
+/// The multiply-subtracts of eliminating a column with `below` entries under its
+/// diagonal: `r (r + 1) / 2`, the lower triangle of an `r x r` update.
+pub(super) fn column_multiply_subtracts(below: usize) -> f64 {
+    let below = below as f64;
+    below * (below + 1.0) / 2.0
 }
 
 /// The multiply-subtract count (`sum_j r_j (r_j + 1) / 2`, as in [`FactorCount`]) of
@@ -92,14 +96,10 @@ pub fn factor_count(
 /// union of their rows, so where faer's relaxation merged columns of different
 /// structure the zeros it stores count too, and the result is at least the exact count.
 pub(super) fn stored_multiply_subtracts(symbolic: &SymbolicCholesky<usize>, columns: usize) -> f64 {
-    let term = |below: usize| {
-        let below = below as f64;
-        below * (below + 1.0) / 2.0
-    };
     match symbolic.raw() {
         SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr()[..=columns.min(s.nrows())]
             .windows(2)
-            .map(|w| term(w[1] - w[0] - 1))
+            .map(|w| column_multiply_subtracts(w[1] - w[0] - 1))
             .sum(),
         SymbolicCholeskyRaw::Supernodal(s) => (0..s.n_supernodes())
             .map(|node| {
@@ -108,7 +108,7 @@ pub(super) fn stored_multiply_subtracts(symbolic: &SymbolicCholesky<usize>, colu
                 // Column `begin + k` stores the rest of the diagonal block and the
                 // supernode's rows below it.
                 (begin..end.min(columns))
-                    .map(|j| term(end - 1 - j + below_block))
+                    .map(|j| column_multiply_subtracts(end - 1 - j + below_block))
                     .sum::<f64>()
             })
             .sum(),

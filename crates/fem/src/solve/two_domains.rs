@@ -41,7 +41,7 @@
 
 use super::SolveError;
 use super::cholesky::{Factor, FactorFailure, analyse, eliminated};
-use super::factor_count::stored_multiply_subtracts;
+use super::factor_count::{column_multiply_subtracts, stored_multiply_subtracts};
 use crate::dof::Scalar;
 use beltrami_mesh::parallel::join;
 use faer::linalg::cholesky::llt::factor::LltError;
@@ -178,7 +178,7 @@ impl TwoDomainsPlan {
             .map(|side| stored_multiply_subtracts(&side.symbolic, side.own_in_order.len()))
             .sum();
         let dense: f64 = (0..self.separator.len())
-            .map(|r| (r * (r + 1) / 2) as f64)
+            .map(column_multiply_subtracts)
             .sum();
         sides + dense
     }
