@@ -19,6 +19,9 @@
 //! | `teichmueller_bound` | the least `sup \|mu\|` of any map homotopic to the result, when known (a registration between tori, from their conformal moduli) |
 //! | `factorizations`, `cg_iterations` | numeric factorizations, and conjugate-gradient iterations of steps that reused one |
 //! | `annulus_radius` | the free inner radius of an annulus target |
+//! | `landmarks` | a registration's landmarks: `[{index, vertex, distance}]`, the distance from each landmark's image to its target (0 to rounding on exit 0) |
+//! | `landmark_max` | the largest of those distances (`null` without landmarks) |
+//! | `route` | the road a registration took, in words |
 //! | `energy_history`, `step_sizes` | per iteration |
 //! | `seconds_per_step` | [`seconds_per_step`] |
 //! | `timings` | `[{stage, seconds}]` in the order they happened |
@@ -79,6 +82,11 @@ pub fn solution_json(solution: &Solution) -> JsonMap<String, Value> {
         "factorizations": m.factorizations,
         "cg_iterations": m.cg_iterations,
         "annulus_radius": x.annulus_radius.map(|a| a.radius),
+        "landmarks": x.landmarks.iter().map(|l| json!({
+            "index": l.index, "vertex": l.vertex.idx(), "distance": l.distance,
+        })).collect::<Vec<_>>(),
+        "landmark_max": x.landmarks.iter().map(|l| l.distance).reduce(f64::max),
+        "route": x.route,
         "energy_history": m.energy_history,
         "step_sizes": m.step_sizes,
         "seconds_per_step": seconds_per_step(solution),

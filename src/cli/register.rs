@@ -45,6 +45,11 @@ pub struct RegisterArgs {
     /// notes); without it such a registration fails, naming them, and writes nothing.
     #[arg(long = "allow-flips")]
     pub allow_flips: bool,
+    /// Write the map even if some landmarks are not exact (their distances are in the
+    /// report); without it such a registration fails, naming the farthest, and writes
+    /// nothing.
+    #[arg(long = "allow-missed-landmarks")]
+    pub allow_missed_landmarks: bool,
     /// Output mesh: the source's vertices and faces, every vertex at its image on the
     /// target (so `beltrami distortion SOURCE OUT` measures the map).
     #[arg(short, long)]
@@ -105,6 +110,12 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
                 args.allow_flips.then_some(OptionValue::Bool(true)),
                 None,
             ),
+            (
+                "allow-missed-landmarks",
+                args.allow_missed_landmarks
+                    .then_some(OptionValue::Bool(true)),
+                None,
+            ),
         ],
         &args.common,
     );
@@ -122,10 +133,20 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     let mut report = mapping::report_json(&args.source, &args.output, &solution, seconds);
     report.insert("target".into(), json!(args.target.display().to_string()));
     let per_step = report::seconds_per_step(&solution).unwrap_or(0.0);
-    let extra = vec![format!(
+    let mut extra = vec![format!(
         "iterations      {} ({per_step:.3} s per step)",
         solution.metrics.iterations
     )];
+    let marks = &solution.extras.landmarks;
+    if let Some(worst) = marks.iter().map(|m| m.distance).reduce(f64::max) {
+        extra.push(format!(
+            "landmarks       {} (largest distance to its target {worst:.3e})",
+            marks.len()
+        ));
+    }
+    if let Some(route) = &solution.extras.route {
+        extra.push(format!("route           {route}"));
+    }
     mapping::finish(
         report,
         args.common.report.as_deref(),

@@ -248,6 +248,9 @@ impl Renumbered {
             if let Some(phi) = &mut solution.extras.quadratic_differential {
                 phi.values = n.face_values_to_old(&phi.values);
             }
+            for mark in &mut solution.extras.landmarks {
+                mark.vertex = n.old_vertex(mark.vertex);
+            }
         }
         solution
     }

@@ -4,7 +4,7 @@
 //! and prose notes).
 
 use beltrami_fem::{BeltramiField, DistortionStats, Frame, MuError};
-use beltrami_mesh::{Mesh, SurfacePoint};
+use beltrami_mesh::{Mesh, SurfacePoint, VertexId};
 use num_complex::Complex64;
 
 use crate::{Map, Report};
@@ -128,6 +128,19 @@ pub struct QuadraticDifferential {
     pub values: Vec<Complex64>,
 }
 
+/// How far a landmark's image ended from its target: `|f(v) - p|` for the landmark on
+/// source vertex `vertex` with target point `p` (on a target mesh, the closest point of
+/// the target to the given point).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LandmarkResidual {
+    /// The landmark's index among the problem's landmarks.
+    pub index: usize,
+    /// Its source vertex.
+    pub vertex: VertexId,
+    /// The distance, in the target's units.
+    pub distance: f64,
+}
+
 /// What some solvers compute beside the map, typed.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Extras {
@@ -137,6 +150,12 @@ pub struct Extras {
     pub circles: Option<Vec<Circle>>,
     /// The quadratic differential of an extremal map.
     pub quadratic_differential: Option<QuadraticDifferential>,
+    /// Each landmark's residual, in the order of the problem's landmarks (a
+    /// registration).
+    pub landmarks: Vec<LandmarkResidual>,
+    /// The road a registration took, in words: the common domain, where the landmarks
+    /// were matched and why.
+    pub route: Option<String>,
 }
 
 /// The result of a solve.

@@ -1,7 +1,7 @@
 //! Errors of the initial bijection.
 
 use beltrami_core::SolverError;
-use beltrami_fem::{BoundaryError, FemError, SolveError, WeightError};
+use beltrami_fem::{BoundaryError, DofError, FemError, SolveError, WeightError};
 use beltrami_mesh::{CutError, MeshError, VertexId};
 use beltrami_spatial::SpatialError;
 use thiserror::Error;
@@ -112,6 +112,14 @@ pub enum RegisterError {
         /// The solve error.
         error: SolveError,
     },
+    /// The fixed vertices of a landmark-matching map could not be laid out as unknowns.
+    #[error("unknowns of the {side}: {error}")]
+    Dofs {
+        /// Which mesh.
+        side: Side,
+        /// The DOF error.
+        error: DofError,
+    },
     /// The spherical initialization failed.
     #[error("sphere map of the {side}: {error}")]
     Sphere {
@@ -142,6 +150,37 @@ pub enum RegisterError {
     /// Measuring the initial map failed (a degenerate source face).
     #[error("measuring the initial map: {0}")]
     Measure(#[from] FemError),
+    /// The landmark-matching map in a parameter domain still folds faces after its
+    /// smoothing steps.
+    #[error(
+        "matching the landmarks on the {domain}: {flipped} source faces still fold after {steps} smoothing steps; landmarks that are close to one another on one mesh and far apart on the other, or in another order around each other, cannot be matched without folds at this resolution: check them, or refine the source around them"
+    )]
+    LandmarkFolds {
+        /// The parameter domain.
+        domain: &'static str,
+        /// Faces still flipped.
+        flipped: usize,
+        /// Steps taken.
+        steps: usize,
+    },
+    /// Landmarks whose images are not at their targets at the end.
+    #[error(
+        "{count} of {total} landmarks are not exact: the farthest, landmark {index} (source vertex {vertex}), ends {distance:.4e} from its target ({relative:.2e} of the target's size). Check that the landmarks can be matched by a bijection (same order around each other on both meshes), or keep the map with `--allow-missed-landmarks` (option `allow-missed-landmarks`)"
+    )]
+    LandmarksMissed {
+        /// Landmarks missed.
+        count: usize,
+        /// Landmarks given.
+        total: usize,
+        /// The farthest one's index.
+        index: usize,
+        /// Its source vertex (input index).
+        vertex: usize,
+        /// Its distance from its target.
+        distance: f64,
+        /// That distance relative to the target's bounding-box diagonal.
+        relative: f64,
+    },
     /// Two feature curves that meet on one mesh and not on the other.
     #[error(
         "feature curves {first} and {second} meet at {side} vertex {vertex} but not on the {other}: a bijection maps meeting curves to meeting curves"

@@ -40,6 +40,7 @@ mod compose;
 mod consistency;
 mod disk;
 mod error;
+mod landmark_match;
 mod landmarks;
 mod modulus;
 mod param;
@@ -83,6 +84,8 @@ pub struct InitialMap {
     /// against or orthogonal to it). No flips for a bijective map between well-shaped
     /// meshes.
     pub distortion: DistortionStats,
+    /// The road taken, in words: the common domain, where the landmarks are matched.
+    pub route: String,
     /// The smallest `sup |mu|` of any map homotopic to this one, when known: between
     /// two tori, from their conformal moduli in the markings the map pairs
     /// ([`teichmueller_bound`]).
@@ -119,6 +122,7 @@ pub fn initial_map(
     let marks = landmarks::resolve(source, target, &target_index, landmarks)?;
     let mut notes = Vec::new();
     let mut teichmueller_bound = None;
+    let route = route(topology, marks.len());
     let (mut points, honoured) = match topology {
         Topology::Disk => disk::map(source, target, &marks, &mut notes)?,
         Topology::Sphere => sphere::map(source, target, &target_index, &marks, &mut notes)?,
@@ -170,8 +174,30 @@ pub fn initial_map(
         topology,
         notes,
         distortion,
+        route,
         teichmueller_bound,
     })
+}
+
+/// The road of [`initial_map`] for `topology` with `landmarks` landmarks, in words.
+fn route(topology: Topology, landmarks: usize) -> String {
+    let matched = "every landmark matched in the domain";
+    let pulled = "landmarks the domain does not place are pulled by the flow on the target";
+    match topology {
+        Topology::Sphere if landmarks > 0 => format!(
+            "sphere: both meshes conformally onto the unit sphere, {matched} (a landmark-matching quasiconformal map in a stereographic chart), composed with the target's sphere map; the flow on the target mesh polishes with every landmark held"
+        ),
+        Topology::Sphere => "sphere: both meshes onto the unit sphere, aligned by a rotation from a rough spatial match, composed with the target's sphere map; then the flow on the target mesh".to_string(),
+        Topology::Disk => format!(
+            "disk: both meshes onto the target's Tutte disk, the boundary turned by a boundary landmark or a rough spatial match; then the flow on the target mesh ({pulled})"
+        ),
+        Topology::Torus => format!(
+            "torus: both meshes onto the square glued periodically, a symmetry of the square chosen by the landmarks or a rough spatial match; then the flow on the target mesh ({pulled})"
+        ),
+        Topology::MultiplyConnected | Topology::HigherGenus => format!(
+            "polygon: both meshes cut along matched cut graphs into one polygon, its corners placed by the landmarks or in space; then the flow on the target mesh ({pulled})"
+        ),
+    }
 }
 
 /// Adds [`Register`] to `registry`.

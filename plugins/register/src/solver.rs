@@ -3,8 +3,9 @@
 use std::sync::LazyLock;
 
 use beltrami_core::{
-    Accepts, ConstraintKind, Context, Element, GoalKind, Map, OptionKind, OptionSpec, Position,
-    Problem, Report, Settings, Solution, Solver, SolverError, Target, TargetKind, solve_renumbered,
+    Accepts, ConstraintKind, Context, Element, GoalKind, LandmarkResidual, Map, OptionKind,
+    OptionSpec, Position, Problem, Report, Settings, Solution, Solver, SolverError, Target,
+    TargetKind, solve_renumbered,
 };
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
@@ -49,7 +50,7 @@ const ACCEPTS: Accepts = Accepts {
     constraints: &[ConstraintKind::Landmark, ConstraintKind::OpenCurve],
 };
 
-/// The flow's options and `allow-flips`.
+/// The flow's options, `allow-flips` and `allow-missed-landmarks`.
 static OPTIONS: LazyLock<Vec<OptionSpec>> = LazyLock::new(|| {
     let mut options = beltrami_flow_engine::OPTIONS.to_vec();
     options.push(OptionSpec {
@@ -57,8 +58,17 @@ static OPTIONS: LazyLock<Vec<OptionSpec>> = LazyLock::new(|| {
         kind: OptionKind::Bool { default: false },
         help: "keep a map that still has flipped faces after the flow (they are named in the notes) instead of failing",
     });
+    options.push(OptionSpec {
+        name: "allow-missed-landmarks",
+        kind: OptionKind::Bool { default: false },
+        help: "keep a map whose landmarks are not all exact (their distances are in the report) instead of failing",
+    });
     options
 });
+
+/// A landmark is exact when its image is within this of its target, relative to the
+/// target's bounding-box diagonal (rounding of barycentric coordinates is ~1e-16).
+pub const LANDMARK_TOLERANCE: f64 = 1e-9;
 
 /// A registration error as a solver error.
 fn plugin(error: RegisterError) -> SolverError {
@@ -132,6 +142,65 @@ fn judge_flips(
         report
             .notes
             .push(format!("kept as asked (allow-flips): {error}"));
+        Ok(())
+    } else {
+        Err(error)
+    }
+}
+
+/// The distance from each landmark's image to its target (the closest point of the
+/// target to the landmark's point), in the order of the problem's landmarks.
+fn landmark_residuals(
+    problem: &Problem<'_>,
+    index: &SurfaceIndex<'_>,
+    positions: &[Point3<f64>],
+) -> Result<Vec<LandmarkResidual>, RegisterError> {
+    problem
+        .constraints
+        .landmarks()
+        .enumerate()
+        .map(|(i, mark)| {
+            let goal = index.locate(&mark.position.to_point())?.position;
+            Ok(LandmarkResidual {
+                index: i,
+                vertex: mark.vertex,
+                distance: (positions[mark.vertex.idx()] - goal).norm(),
+            })
+        })
+        .collect()
+}
+
+/// The landmarks farther than [`LANDMARK_TOLERANCE`] from their targets, as an error,
+/// or as a note when `allowed`.
+fn judge_landmarks(
+    source: &Mesh,
+    residuals: &[LandmarkResidual],
+    diagonal: f64,
+    allowed: bool,
+    report: &mut Report,
+) -> Result<(), RegisterError> {
+    let missed: Vec<&LandmarkResidual> = residuals
+        .iter()
+        .filter(|r| !(r.distance <= LANDMARK_TOLERANCE * diagonal))
+        .collect();
+    let Some(worst) = missed
+        .iter()
+        .max_by(|a, b| a.distance.total_cmp(&b.distance))
+    else {
+        return Ok(());
+    };
+    let error = RegisterError::LandmarksMissed {
+        count: missed.len(),
+        total: residuals.len(),
+        index: worst.index,
+        vertex: source.vertex_map().to_input(worst.vertex),
+        distance: worst.distance,
+        relative: worst.distance / diagonal,
+    };
+    if allowed {
+        report
+            .notes
+            .push(format!("kept as asked (allow-missed-landmarks): {error}"));
         Ok(())
     } else {
         Err(error)
@@ -243,11 +312,22 @@ pub(crate) fn register(
     // distortion --target` and of the flow), when the initial map was built.
     solution.metrics.initial_distortion = Some(initial.distortion);
     solution.metrics.teichmueller_bound = initial.teichmueller_bound;
-    if solution.metrics.flipped().unwrap_or(0) > 0
-        && let Some(Map::OnMesh(points)) = solution.map().cloned()
-    {
-        let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
-        let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
+    solution.extras.route = Some(initial.route);
+    let Some(Map::OnMesh(points)) = solution.map().cloned() else {
+        return Ok(solution);
+    };
+    let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
+    let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
+    solution.extras.landmarks = landmark_residuals(problem, &index, &positions).map_err(plugin)?;
+    judge_landmarks(
+        source,
+        &solution.extras.landmarks,
+        target.bounding_box().diagonal(),
+        settings.flag("allow-missed-landmarks"),
+        &mut solution.report,
+    )
+    .map_err(plugin)?;
+    if solution.metrics.flipped().unwrap_or(0) > 0 {
         judge_flips(
             source,
             &index,

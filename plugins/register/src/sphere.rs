@@ -15,15 +15,30 @@
 //! - two or more: the Moebius transformation taking the first three landmarks' images
 //!   onto their targets' (exact); with two, the third pair is the poles of the great
 //!   circles through the two, so the transformation fixes the pole and slides along
-//!   the circle. Further landmarks are left to the flow (their distances are noted).
+//!   the circle.
+//!
+//! With landmarks, both sphere maps are the conformal start of the `sphere` solver and
+//! every landmark is matched on the sphere itself ([`match_on_sphere`]): after the
+//! Moebius transformation of the three landmarks that brings all of them nearest their
+//! targets, the source minus the face farthest from every landmark is mapped into the
+//! stereographic chart from that face's direction by the landmark-matching
+//! quasiconformal map of [`crate::landmark_match`] (the face's corners held where the
+//! transformation put them, each landmark at its target's chart point), and lifted back
+//! onto the sphere. The map is exact at every landmark and, with no flipped face in the
+//! chart, a bijection of the sphere.
 
 use beltrami_core::{Context, Map, Problem, Solver, SolverError, Target};
+use beltrami_fem::Frame;
 use beltrami_init::Sphere;
-use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3};
+use beltrami_mesh::{
+    BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Repair, SurfacePoint, Vector3,
+};
 use beltrami_spatial::SurfaceIndex;
+use num_complex::Complex64;
 
 use crate::compose;
 use crate::error::{RegisterError, Side};
+use crate::landmark_match::match_landmarks;
 use crate::landmarks::{
     Moebius, Resolved, SpatialMatch, best_rotation, interpolate, rotation_between,
 };
@@ -31,6 +46,9 @@ use crate::param::{domain_mesh, each_mesh};
 
 /// Source vertices used by the rotation fit at most.
 const FIT_SAMPLES: usize = 4096;
+
+/// Triples of landmarks tried for the Moebius transformation at most.
+const MOEBIUS_TRIALS: usize = 200;
 
 /// The source's images on the target and the landmarks honoured exactly (indices into
 /// `marks`).
@@ -41,8 +59,18 @@ pub(crate) fn map(
     marks: &[Resolved],
     notes: &mut Vec<String>,
 ) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
+    // The Tutte start, which the flow from a map without landmarks was tuned from; with
+    // landmarks the matching is done on the sphere, where the conformal start makes the
+    // composition nearly conformal by itself.
+    let start = if marks.is_empty() {
+        "tutte"
+    } else {
+        "conformal"
+    };
     // The two sphere maps are independent: computed at once, on two cores.
-    let (source_sphere, target_sphere) = each_mesh(source, target, notes, sphere)?;
+    let (source_sphere, target_sphere) = each_mesh(source, target, notes, |mesh, side, notes| {
+        sphere(mesh, side, start, notes)
+    })?;
     let target_at =
         |p: &SurfacePoint| -> Vector3<f64> { interpolate(target, &target_sphere, p).normalize() };
 
@@ -57,67 +85,48 @@ pub(crate) fn map(
         Ok(best_rotation(&pairs))
     };
 
-    let (images, honoured): (Vec<Vector3<f64>>, Vec<usize>) = match marks {
+    let s: Vec<Vector3<f64>> = marks
+        .iter()
+        .map(|m| source_sphere[m.source.idx()])
+        .collect();
+    let t: Vec<Vector3<f64>> = marks.iter().map(|m| target_at(&m.target)).collect();
+    let aligned: Vec<Vector3<f64>> = match marks {
         [] => {
             let r = fit()?;
             notes.push(
                 "sphere: no landmark; source sphere rotated to match a rough spatial correspondence (centroids and sizes)"
                     .to_string(),
             );
-            (source_sphere.iter().map(|s| r * s).collect(), Vec::new())
+            source_sphere.iter().map(|s| r * s).collect()
         }
         [mark] => {
             let r0 = fit()?;
-            let r = rotation_between(
-                &(r0 * source_sphere[mark.source.idx()]),
-                &target_at(&mark.target),
-            ) * r0;
+            let r = rotation_between(&(r0 * s[0]), &t[0]) * r0;
             notes.push(format!(
                 "sphere: rotated so that landmark {} lands on its target, the rest by a rough spatial correspondence",
                 mark.index
             ));
-            (source_sphere.iter().map(|s| r * s).collect(), vec![0])
+            source_sphere.iter().map(|s| r * s).collect()
         }
         _ => {
-            let s: Vec<Vector3<f64>> = marks
-                .iter()
-                .map(|m| source_sphere[m.source.idx()])
-                .collect();
-            let t: Vec<Vector3<f64>> = marks.iter().map(|m| target_at(&m.target)).collect();
-            let (from, to, used) = if marks.len() == 2 {
-                let pole = |a: &Vector3<f64>, b: &Vector3<f64>| {
-                    let c = a.cross(b);
-                    if c.norm() > 0.0 { c.normalize() } else { c }
-                };
-                (
-                    [s[0], s[1], pole(&s[0], &s[1])],
-                    [t[0], t[1], pole(&t[0], &t[1])],
-                    2,
-                )
-            } else {
-                ([s[0], s[1], s[2]], [t[0], t[1], t[2]], 3)
-            };
-            let moebius = Moebius::through(from, to).ok_or_else(|| RegisterError::Landmark {
-                index: marks[1].index,
-                vertex: marks[1].source,
-                reason: "its position on the sphere coincides with (or is opposite to) another landmark's, so no Moebius transformation takes the landmarks onto their targets".to_string(),
-            })?;
+            let (moebius, used) = best_moebius(marks, &s, &t)?;
             notes.push(format!(
                 "sphere: Moebius transformation taking landmarks {} onto their targets",
-                marks[..used]
-                    .iter()
-                    .map(|m| m.index.to_string())
+                used.iter()
+                    .map(|&k| marks[k].index.to_string())
                     .collect::<Vec<_>>()
                     .join(", ")
             ));
-            (
-                source_sphere
-                    .iter()
-                    .map(|p| moebius.apply(p).normalize())
-                    .collect(),
-                (0..used).collect(),
-            )
+            source_sphere
+                .iter()
+                .map(|p| moebius.apply(p).normalize())
+                .collect()
         }
+    };
+    let images = if marks.is_empty() {
+        aligned
+    } else {
+        match_on_sphere(source, &aligned, marks, &t, notes)?
     };
 
     let domain = domain_mesh(
@@ -132,20 +141,212 @@ pub(crate) fn map(
             "sphere: {fallbacks} source images were located by closest point instead of along the ray (quads or a target sphere map with inward faces)"
         ));
     }
-    Ok((located, honoured))
+    Ok((located, (0..marks.len()).collect()))
 }
 
-/// The `sphere` initialization of `mesh` as unit vectors, its notes added to `notes`.
+/// The Moebius transformation through three of the landmarks (from their source
+/// sphere positions `s` to their targets' `t`) that brings all of them nearest their
+/// targets (least sum of squared chordal distances), and the three (indices into
+/// `marks`). With two landmarks the third pair is the poles of the great circles through
+/// them, so the transformation fixes the pole and slides along the circle. Triples are
+/// tried in order (all of them for up to 11 landmarks, else [`MOEBIUS_TRIALS`] spread
+/// ones).
+fn best_moebius(
+    marks: &[Resolved],
+    s: &[Vector3<f64>],
+    t: &[Vector3<f64>],
+) -> Result<(Moebius, Vec<usize>), RegisterError> {
+    if let [_, _] = marks {
+        let pole = |a: &Vector3<f64>, b: &Vector3<f64>| {
+            let c = a.cross(b);
+            if c.norm() > 0.0 { c.normalize() } else { c }
+        };
+        let moebius = Moebius::through(
+            [s[0], s[1], pole(&s[0], &s[1])],
+            [t[0], t[1], pole(&t[0], &t[1])],
+        )
+        .ok_or_else(|| coincident(&marks[1]))?;
+        return Ok((moebius, vec![0, 1]));
+    }
+    let n = marks.len();
+    let total = n * (n - 1) * (n - 2) / 6;
+    let stride = total.div_ceil(MOEBIUS_TRIALS).max(1);
+    let mut best: Option<(f64, Moebius, [usize; 3])> = None;
+    let mut counter = 0usize;
+    for a in 0..n {
+        for b in a + 1..n {
+            for c in b + 1..n {
+                counter += 1;
+                if (counter - 1) % stride != 0 {
+                    continue;
+                }
+                let Some(m) = Moebius::through([s[a], s[b], s[c]], [t[a], t[b], t[c]]) else {
+                    continue;
+                };
+                let cost: f64 = s
+                    .iter()
+                    .zip(t)
+                    .map(|(p, q)| (m.apply(p).normalize() - q).norm_squared())
+                    .sum();
+                if cost.is_finite() && best.as_ref().is_none_or(|(c0, _, _)| cost < *c0) {
+                    best = Some((cost, m, [a, b, c]));
+                }
+            }
+        }
+    }
+    best.map(|(_, m, used)| (m, used.to_vec()))
+        .ok_or_else(|| coincident(&marks[1]))
+}
+
+fn coincident(mark: &Resolved) -> RegisterError {
+    RegisterError::Landmark {
+        index: mark.index,
+        vertex: mark.source,
+        reason: "its position on the sphere coincides with (or is opposite to) another landmark's, so no Moebius transformation takes the landmarks onto their targets".to_string(),
+    }
+}
+
+/// Every landmark matched on the sphere (module docs): `aligned` the source's sphere
+/// positions after the alignment, `targets` the landmarks' targets on the sphere. The
+/// returned positions are on the unit sphere, each landmark exactly at its target.
+///
+/// # Errors
+/// [`RegisterError::LandmarkFolds`] when the landmark-matching map still folds faces
+/// after its steps; the errors of [`match_landmarks`].
+fn match_on_sphere(
+    source: &Mesh,
+    aligned: &[Vector3<f64>],
+    marks: &[Resolved],
+    targets: &[Vector3<f64>],
+    notes: &mut Vec<String>,
+) -> Result<Vec<Vector3<f64>>, RegisterError> {
+    let pole = pole_face(source, aligned, marks, targets);
+    let (corners, degree) = source.face_vertex_array(pole);
+    let centre: Vector3<f64> = corners[..degree]
+        .iter()
+        .map(|v| aligned[v.idx()])
+        .sum::<Vector3<f64>>()
+        .normalize();
+    let r = rotation_between(&centre, &Vector3::z());
+    // Stereographic projection from the north pole, conjugated so that a face turning
+    // counter-clockwise about the outward normal turns counter-clockwise in the chart.
+    let chart = |p: &Vector3<f64>| {
+        let q = r * p;
+        Complex64::new(q.x, -q.y) / (1.0 - q.z)
+    };
+    // The cap about the pole within half the pole's clearance from the landmarks stays
+    // where the alignment put it: the chart is bounded there, and the punctured face's
+    // neighbourhood (where a chart blows up) is not solved for.
+    let clearance = marks
+        .iter()
+        .map(|m| aligned[m.source.idx()])
+        .chain(targets.iter().copied())
+        .map(|p| (p - centre).norm())
+        .fold(2.0, f64::min);
+    let mut fixed: Vec<_> = source
+        .vertices()
+        .filter(|v| (aligned[v.idx()] - centre).norm() <= 0.5 * clearance)
+        .chain(corners[..degree].iter().copied())
+        .map(|v| (v, chart(&aligned[v.idx()])))
+        .collect();
+    fixed.sort_by_key(|(v, _)| *v);
+    fixed.dedup_by_key(|(v, _)| *v);
+    fixed.extend(marks.iter().zip(targets).map(|(m, t)| (m.source, chart(t))));
+    let punctured = puncture(source, pole)?;
+    let initial: Vec<Complex64> = aligned.iter().map(chart).collect();
+    let matched = match_landmarks(&punctured, Frame::Face, &initial, &fixed, Side::Source)?;
+    if matched.flipped > 0 {
+        return Err(RegisterError::LandmarkFolds {
+            domain: "sphere",
+            flipped: matched.flipped,
+            steps: matched.steps,
+        });
+    }
+    notes.push(format!(
+        "sphere: every landmark matched on the sphere in the chart from source face {} (mean |mu| of the matching {:.4}, {} smoothing steps)",
+        source.face_to_input(pole),
+        matched.mean_mu,
+        matched.steps
+    ));
+    let back = r.transpose();
+    Ok(matched
+        .map
+        .iter()
+        .map(|f| {
+            let w = f.conj();
+            let n = w.norm_sqr();
+            back * Vector3::new(2.0 * w.re, 2.0 * w.im, n - 1.0) / (n + 1.0)
+        })
+        .collect())
+}
+
+/// The face whose sphere centroid is farthest from every landmark and every landmark
+/// target (chordal distance), among the faces with no landmark corner.
+fn pole_face(
+    source: &Mesh,
+    aligned: &[Vector3<f64>],
+    marks: &[Resolved],
+    targets: &[Vector3<f64>],
+) -> FaceId {
+    let mut is_mark = vec![false; source.vertex_count()];
+    for m in marks {
+        is_mark[m.source.idx()] = true;
+    }
+    let points: Vec<Vector3<f64>> = marks
+        .iter()
+        .map(|m| aligned[m.source.idx()])
+        .chain(targets.iter().copied())
+        .collect();
+    let clearance = |f: FaceId| {
+        let (vs, degree) = source.face_vertex_array(f);
+        if vs[..degree].iter().any(|v| is_mark[v.idx()]) {
+            return f64::NEG_INFINITY;
+        }
+        let c: Vector3<f64> = vs[..degree].iter().map(|v| aligned[v.idx()]).sum();
+        let c = c.normalize();
+        points
+            .iter()
+            .map(|p| (p - c).norm_squared())
+            .fold(f64::INFINITY, f64::min)
+    };
+    source
+        .faces()
+        .max_by(|&a, &b| clearance(a).total_cmp(&clearance(b)))
+        .unwrap_or(FaceId(0))
+}
+
+/// `mesh` without face `removed`: a disk when `mesh` is a closed genus-0 surface, with
+/// the same vertices (ids and positions).
+fn puncture(mesh: &Mesh, removed: FaceId) -> Result<Mesh, RegisterError> {
+    let mut soup = PolygonSoup::new(mesh.positions().to_vec());
+    let mut buf = Vec::with_capacity(4);
+    for f in mesh.faces().filter(|&f| f != removed) {
+        buf.clear();
+        buf.extend(mesh.face_vertices(f).map(|v| v.0));
+        soup.push_face(&buf);
+    }
+    let options = BuildOptions {
+        degenerate_area_tolerance: -1.0,
+        repair: Repair::NONE,
+    };
+    let (punctured, _) = Mesh::build(&soup, &options).map_err(|error| RegisterError::Mesh {
+        side: Side::Source,
+        error,
+    })?;
+    debug_assert!(punctured.vertex_map().is_identity());
+    Ok(punctured)
+}
+
+/// The `sphere` initialization of `mesh` from `start` (`tutte` or `conformal`) as unit
+/// vectors, its notes added to `notes`.
 fn sphere(
     mesh: &Mesh,
     side: Side,
+    start: &str,
     notes: &mut Vec<String>,
 ) -> Result<Vec<Vector3<f64>>, RegisterError> {
     let mut problem = Problem::new(mesh, Target::Sphere);
-    // The Tutte start, which the registration was tuned from: the sphere solver's default
-    // conformal start gives a near-conformal initial map, from which the flow's
-    // objective no longer halves mean |mu| (issue 12; switching is a separate change).
-    problem.options.set_text("start", "tutte");
+    problem.options.set_text("start", start);
     let solution = Sphere
         .solve(&problem, &mut Context::new())
         .map_err(|error| RegisterError::Sphere { side, error })?;

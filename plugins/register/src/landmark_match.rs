@@ -1,0 +1,370 @@
+//! A map of a mesh into the plane that takes given vertices exactly to given points and
+//! flips no face: the landmark-matching quasiconformal map of Lam and Lui (K. C. Lam,
+//! L. M. Lui, "Landmark- and intensity-based registration with large deformations via
+//! quasi-conformal maps", SIAM J. Imaging Sci. 7, 2014, section 4, algorithm 1).
+//!
+//! Each step solves the linear Beltrami equation `f_zbar = nu f_z` in the least-squares
+//! sense, `min sum_q w_q |f_zbar(q) - nu_q f_z(q)|^2` with the fixed vertices as
+//! Dirichlet values (`beltrami_fem::operators::beltrami_operator`, one symbolic
+//! factorization for all steps). The first step takes the coefficient of a given
+//! initial map (a conformal parameterization, whose `mu` is its discretization error):
+//! with every fixed vertex where the initial map puts it, the equation holds exactly on
+//! every face and the solution is the initial map itself; moved fixed vertices bend it
+//! as little as the least-squares sense allows. While faces are flipped, the coefficient of the map just
+//! found is smoothed (each face averaged with its edge neighbours, weighted by area, the
+//! neighbours' values carried into the face's frame) and cut to `|nu| <= K_MAX`, and the
+//! equation solved again: a map with `|mu| < 1` on every face is a local homeomorphism,
+//! and with its boundary fixed a bijection. The first map without flips is returned.
+//!
+//! Coefficients live in each face's own frame ([`Frame::Face`]) or in the plane's
+//! ([`Frame::Global`]); across an edge a neighbour's value is rotated into the face's
+//! frame by `mu e^{-2 i theta}` (Gruber-Aulisa 2022, Lemma 3.4), `theta` the angle
+//! between the two frames' real axes once the faces are unfolded about the edge.
+
+use beltrami_fem::beltrami::{face_mu, flipped_faces, planar_map, point_mu};
+use beltrami_fem::operators::beltrami_operator;
+use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveOptions};
+use beltrami_mesh::{FaceId, Mesh, VertexId};
+use num_complex::Complex64;
+
+use crate::error::{RegisterError, Side};
+
+/// The largest `|nu|` a step solves for: below 1 with a margin, so that the least-squares
+/// solution (which only approximates `nu`) stays orientation-preserving.
+const K_MAX: f64 = 0.8;
+
+/// Steps after the first at most.
+const MAX_STEPS: usize = 60;
+
+/// Smoothing passes applied to the coefficient between two steps.
+const SMOOTHING_PASSES: usize = 2;
+
+/// A landmark-matching map and how it was found.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Matched {
+    /// The image of every vertex; fixed vertices exactly at their values.
+    pub map: Vec<Complex64>,
+    /// Solves of the Beltrami equation after the first (0: the conformal one had no flip).
+    pub steps: usize,
+    /// Faces with a free corner flipped in `map` (0 unless the steps ran out); faces
+    /// whose corners are all fixed are not counted: the map cannot change them.
+    pub flipped: usize,
+    /// Area-weighted mean `|mu|` of `map`.
+    pub mean_mu: f64,
+}
+
+/// The landmark-matching map of `mesh` bent from `initial` (one value per vertex) so
+/// that the vertices of `fixed` are at their values (module docs). Faces whose corners
+/// are all fixed are left as they are, flipped or not. `side` names the mesh in errors.
+///
+/// # Errors
+/// [`RegisterError::Elements`] for a degenerate face, [`RegisterError::Measure`] for an
+/// initial map of the wrong length or with a non-finite value, [`RegisterError::Solve`]
+/// when the fixed vertices leave the system singular (a part of the mesh with no fixed
+/// vertex).
+pub(crate) fn match_landmarks(
+    mesh: &Mesh,
+    frame: Frame,
+    initial: &[Complex64],
+    fixed: &[(VertexId, Complex64)],
+    side: Side,
+) -> Result<Matched, RegisterError> {
+    let elements =
+        Elements::new(mesh, frame).map_err(|error| RegisterError::Elements { side, error })?;
+    let initial_derivatives =
+        planar_map(&elements, mesh.vertex_count(), initial).map_err(RegisterError::Measure)?;
+    let initial_nu = face_mu(&elements, &point_mu(&initial_derivatives));
+    let mut constraints = DofConstraints::new();
+    let mut is_fixed = vec![false; mesh.vertex_count()];
+    for &(v, z) in fixed {
+        constraints.fix(v, z);
+        if let Some(slot) = is_fixed.get_mut(v.idx()) {
+            *slot = true;
+        }
+    }
+    // A face with every corner fixed is the caller's: the map cannot change it.
+    let solved: Vec<bool> = mesh
+        .faces()
+        .map(|f| mesh.face_vertices(f).any(|v| !is_fixed[v.idx()]))
+        .collect();
+    let solve_error = |error| RegisterError::Solve { side, error };
+    let dofs = DofMap::complex(mesh.vertex_count(), &constraints)
+        .map_err(|error| RegisterError::Dofs { side, error })?;
+    let operator =
+        beltrami_operator(mesh, &elements, &initial_nu).map_err(RegisterError::Measure)?;
+    let mut solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, SolveOptions::default())
+        .map_err(solve_error)?;
+    let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
+    let rhs = vec![Complex64::new(0.0, 0.0); operator.nrows()];
+    let areas = elements.face_areas();
+    let neighbours = FaceNeighbours::new(mesh, &elements);
+
+    let mut map = solver
+        .solve(operator.as_ref(), Some(&weights), &rhs)
+        .map_err(solve_error)?;
+    let mut steps = 0;
+    loop {
+        let derivatives =
+            planar_map(&elements, mesh.vertex_count(), &map).map_err(RegisterError::Measure)?;
+        let flipped = flipped_faces(&elements, &derivatives)
+            .iter()
+            .zip(&solved)
+            .filter(|&(&f, &s)| f && s)
+            .count();
+        let mu = face_mu(&elements, &point_mu(&derivatives));
+        if flipped == 0 || steps == MAX_STEPS {
+            let total: f64 = areas.iter().sum();
+            let mean_mu = mu
+                .iter()
+                .zip(&areas)
+                .map(|(m, a)| m.norm().min(1.0) * a)
+                .sum::<f64>()
+                / total.max(f64::MIN_POSITIVE);
+            return Ok(Matched {
+                map,
+                steps,
+                flipped,
+                mean_mu,
+            });
+        }
+        let mut nu = mu;
+        for _ in 0..SMOOTHING_PASSES {
+            nu = neighbours.smooth(&nu, &areas);
+        }
+        for m in &mut nu {
+            let r = m.norm();
+            if r > K_MAX {
+                *m *= K_MAX / r;
+            }
+        }
+        let operator = beltrami_operator(mesh, &elements, &nu).map_err(RegisterError::Measure)?;
+        map = solver
+            .solve(operator.as_ref(), Some(&weights), &rhs)
+            .map_err(solve_error)?;
+        steps += 1;
+    }
+}
+
+/// The edge neighbours of every face with the factor `e^{-2 i theta}` that carries a
+/// neighbour's coefficient into the face's frame (module docs).
+struct FaceNeighbours {
+    /// `start[f]..start[f + 1]` indexes `faces` and `carry` for face `f`.
+    start: Vec<usize>,
+    faces: Vec<FaceId>,
+    carry: Vec<Complex64>,
+}
+
+impl FaceNeighbours {
+    fn new(mesh: &Mesh, elements: &Elements) -> Self {
+        let mut start = Vec::with_capacity(mesh.face_count() + 1);
+        let (mut faces, mut carry) = (Vec::new(), Vec::new());
+        let unit = |s: nalgebra::Vector2<f64>| Complex64::new(s.x, s.y) / s.norm();
+        for f in mesh.faces() {
+            start.push(faces.len());
+            for (k, h) in mesh.face_halfedges(f).enumerate() {
+                let twin = mesh.twin(h);
+                let Some(g) = mesh.face(twin) else {
+                    continue;
+                };
+                let Some(j) = mesh.face_halfedges(g).position(|x| x == twin) else {
+                    continue;
+                };
+                // The shared edge in each frame, in f's direction.
+                let in_f = unit(elements.sides(f)[k]);
+                let in_g = -unit(elements.sides(g)[j]);
+                let turn = in_f * in_g.conj();
+                faces.push(g);
+                carry.push(turn * turn);
+            }
+        }
+        start.push(faces.len());
+        Self {
+            start,
+            faces,
+            carry,
+        }
+    }
+
+    /// Each face's value averaged with its neighbours', weighted by area.
+    fn smooth(&self, nu: &[Complex64], areas: &[f64]) -> Vec<Complex64> {
+        (0..nu.len())
+            .map(|f| {
+                let mut sum = nu[f] * areas[f];
+                let mut weight = areas[f];
+                for i in self.start[f]..self.start[f + 1] {
+                    let g = self.faces[i].idx();
+                    sum += nu[g] * self.carry[i] * areas[g];
+                    weight += areas[g];
+                }
+                sum / weight
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use beltrami_mesh::primitives;
+
+    /// A grid of `n x n` squares on `[0, 1]^2`, each cut into two triangles.
+    fn square(n: usize) -> Mesh {
+        Mesh::from_soup(&primitives::grid(n, n, primitives::Cells::Triangles)).unwrap()
+    }
+
+    fn boundary_fixed(mesh: &Mesh) -> Vec<(VertexId, Complex64)> {
+        mesh.vertices()
+            .filter(|&v| mesh.is_boundary_vertex(v))
+            .map(|v| {
+                let p = mesh.position(v);
+                (v, Complex64::new(p.x, p.y))
+            })
+            .collect()
+    }
+
+    fn identity(mesh: &Mesh) -> Vec<Complex64> {
+        mesh.positions()
+            .iter()
+            .map(|p| Complex64::new(p.x, p.y))
+            .collect()
+    }
+
+    fn vertex_at(mesh: &Mesh, x: f64, y: f64) -> VertexId {
+        mesh.vertices()
+            .min_by(|&a, &b| {
+                let d = |v: VertexId| {
+                    let p = mesh.position(v);
+                    (p.x - x).powi(2) + (p.y - y).powi(2)
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    }
+
+    #[test]
+    fn fixed_values_of_an_affine_map_give_that_map() {
+        // Every boundary vertex and one interior vertex at the image of an affine map
+        // with mu = (a_zbar / a_z): the conformal step does not reproduce it (mu = 0),
+        // but nothing is flipped, so it is returned as it is; and the map is exact at
+        // every fixed vertex.
+        let mesh = square(12);
+        let affine =
+            |z: Complex64| Complex64::new(1.3, 0.2) * z + Complex64::new(0.1, 0.0) * z.conj();
+        let mut fixed: Vec<_> = boundary_fixed(&mesh)
+            .into_iter()
+            .map(|(v, z)| (v, affine(z)))
+            .collect();
+        let inner = vertex_at(&mesh, 0.5, 0.5);
+        let p = mesh.position(inner);
+        fixed.push((inner, affine(Complex64::new(p.x, p.y))));
+        let matched =
+            match_landmarks(&mesh, Frame::Global, &identity(&mesh), &fixed, Side::Source).unwrap();
+        assert_eq!(matched.flipped, 0);
+        assert_eq!(matched.steps, 0);
+        for &(v, z) in &fixed {
+            assert_eq!(matched.map[v.idx()], z, "vertex {v}");
+        }
+        // The least-squares map with these values is the affine map itself: its
+        // coefficient is constant and the conformal energy's minimizer with an affine
+        // boundary is affine (the Euler-Lagrange equation is Laplace's, solved exactly by
+        // P1 on any mesh for linear data).
+        for v in mesh.vertices() {
+            let p = mesh.position(v);
+            let want = affine(Complex64::new(p.x, p.y));
+            assert!((matched.map[v.idx()] - want).norm() < 1e-12, "vertex {v}");
+        }
+    }
+
+    #[test]
+    fn a_landmark_moved_far_is_matched_without_flips() {
+        // The boundary held, an interior landmark moved by 0.3 of the square: the
+        // conformal map through it folds the faces next to the landmark (the
+        // conformal energy's minimizer has a point singularity there), and the smoothed
+        // coefficients of Lam-Lui's iteration unfold them.
+        let mesh = square(24);
+        let mut fixed = boundary_fixed(&mesh);
+        let a = vertex_at(&mesh, 0.35, 0.5);
+        let b = vertex_at(&mesh, 0.7, 0.5);
+        fixed.push((a, Complex64::new(0.65, 0.5)));
+        fixed.push((b, Complex64::new(0.85, 0.45)));
+        let matched =
+            match_landmarks(&mesh, Frame::Global, &identity(&mesh), &fixed, Side::Source).unwrap();
+        assert_eq!(matched.flipped, 0);
+        assert!(matched.steps > 0, "the conformal step alone folds");
+        for &(v, z) in &fixed {
+            assert_eq!(matched.map[v.idx()], z, "vertex {v}");
+        }
+        // Every triangle keeps its orientation.
+        for f in mesh.faces() {
+            let [p, q, r] = {
+                let (vs, _) = mesh.face_vertex_array(f);
+                [vs[0], vs[1], vs[2]].map(|v| matched.map[v.idx()])
+            };
+            let area = ((q - p).conj() * (r - p)).im;
+            assert!(area > 0.0, "face {f} has area {area}");
+        }
+        assert!(matched.mean_mu < 0.5, "{}", matched.mean_mu);
+    }
+
+    #[test]
+    fn fixed_vertices_where_the_initial_map_puts_them_give_the_initial_map() {
+        // A smooth map that is neither conformal nor affine, on a jittered grid: with the
+        // boundary and two interior vertices at its values, the solution is the map
+        // itself (its own coefficient solves the equation exactly on every face).
+        let mesh = Mesh::from_soup(&primitives::jittered_grid(
+            16,
+            16,
+            primitives::Cells::Triangles,
+            0.2,
+            7,
+        ))
+        .unwrap();
+        let bend = |z: Complex64| z + 0.15 * z * z + 0.1 * z.conj() * z.conj() * z;
+        let initial: Vec<Complex64> = identity(&mesh).into_iter().map(bend).collect();
+        let mut fixed: Vec<_> = boundary_fixed(&mesh)
+            .into_iter()
+            .map(|(v, _)| (v, initial[v.idx()]))
+            .collect();
+        for (x, y) in [(0.3, 0.4), (0.7, 0.6)] {
+            let v = vertex_at(&mesh, x, y);
+            fixed.push((v, initial[v.idx()]));
+        }
+        let matched = match_landmarks(&mesh, Frame::Face, &initial, &fixed, Side::Source).unwrap();
+        assert_eq!((matched.flipped, matched.steps), (0, 0));
+        for v in mesh.vertices() {
+            let d = (matched.map[v.idx()] - initial[v.idx()]).norm();
+            assert!(d < 1e-12, "vertex {v}: {d}");
+        }
+        assert!(matched.mean_mu > 0.05, "the bend is not conformal");
+    }
+
+    #[test]
+    fn coefficients_are_carried_between_face_frames() {
+        // On a bent strip (two faces on either side of a crease), a constant coefficient
+        // in the plane's frame, read in each face's frame, is the same field: carried
+        // across the edge it must agree with the neighbour's own value.
+        let mesh = square(3);
+        let global = Elements::new(&mesh, Frame::Global).unwrap();
+        let local = Elements::new(&mesh, Frame::Face).unwrap();
+        let neighbours = FaceNeighbours::new(&mesh, &local);
+        let mu = Complex64::new(0.3, -0.2);
+        // The face frame's real axis makes angle theta with the plane's x axis: mu in
+        // the face frame is mu e^{-2 i theta}.
+        let in_face: Vec<Complex64> = mesh
+            .faces()
+            .map(|f| {
+                let s = local.sides(f)[0];
+                let g = global.sides(f)[0];
+                let theta = g.y.atan2(g.x) - s.y.atan2(s.x);
+                mu * Complex64::from_polar(1.0, -2.0 * theta)
+            })
+            .collect();
+        for f in mesh.faces() {
+            for i in neighbours.start[f.idx()]..neighbours.start[f.idx() + 1] {
+                let g = neighbours.faces[i];
+                let carried = in_face[g.idx()] * neighbours.carry[i];
+                assert!((carried - in_face[f.idx()]).norm() < 1e-12, "{g} into {f}");
+            }
+        }
+    }
+}
