@@ -11,11 +11,15 @@
 //! composition of a bijection with the inverse of one, and every source point lands
 //! inside `D` (at distance 0 from the target's parameter mesh).
 //!
-//! `delta` is the boundary alignment: given by the first landmark whose source vertex is
-//! on the boundary (its target must be on the target's boundary, and it lands there
-//! exactly), otherwise the one of 720 equally spaced rotations that brings the source's
-//! boundary vertices closest, in the sum of squared distances, to their images on the
-//! target's boundary after the rough spatial match of [`SpatialMatch`].
+//! `delta` is the boundary alignment without boundary landmarks: the one of 720 equally
+//! spaced rotations that brings the source's boundary vertices closest, in the sum of
+//! squared distances, to their images on the target's boundary after the rough spatial
+//! match of [`SpatialMatch`]. With boundary landmarks (each target on the target's
+//! boundary, in the same cyclic order on both loops) each lands on its target and the
+//! vertices between two of them are spread by arc length over the stretch between their
+//! targets. Interior landmarks are then matched in the disk by the landmark-matching
+//! quasiconformal map of [`crate::landmark_match`] bent from the source's Tutte map, the
+//! whole boundary held: every landmark lands exactly on its target.
 //!
 //! A source *ear* (a face with two boundary edges, `u -> m -> w` along the loop)
 //! collapses onto a segment when no target boundary vertex lies strictly between the
@@ -25,12 +29,13 @@
 
 use std::f64::consts::TAU;
 
-use beltrami_fem::BoundaryMap;
+use beltrami_fem::{BoundaryMap, Frame};
 use beltrami_mesh::{BoundaryLoopId, Mesh, Point3, SurfacePoint, VertexId, parallel};
 use num_complex::Complex64;
 
 use crate::compose;
 use crate::error::{RegisterError, Side};
+use crate::landmark_match::match_landmarks;
 use crate::landmarks::{Resolved, SpatialMatch, interpolate};
 use crate::param::{arc_fractions, domain_mesh, planar_points, tutte};
 
@@ -116,28 +121,28 @@ pub(crate) fn map(
     }
     let sigma = arc_fractions(source, &source_loop);
 
-    // A landmark with one end on the boundary and the other inside is refused before
-    // either Tutte map is computed.
-    let pinned = boundary_landmark(source, target, &outline, marks, &loop_index)?;
+    // A landmark with one end on the boundary and the other inside, or boundary
+    // landmarks in another cyclic order on the two loops, are refused before either
+    // Tutte map is computed.
+    let pinned = boundary_landmarks(source, target, &outline, marks, &loop_index)?;
 
-    let delta = match pinned {
-        Some((m, i, tau)) => {
-            notes.push(format!(
-                "disk: boundary rotated so that landmark {} (source vertex {}) lands on its target",
-                marks[m].index,
-                source.vertex_map().to_input(marks[m].source)
-            ));
-            tau - sigma[i]
-        }
-        None => {
-            let delta = best_rotation(source, target, &source_loop, &sigma, &outline);
-            notes.push(format!(
-                "disk: no boundary landmark; boundary rotated by {delta:.4} turns, the best of {ROTATIONS} for a rough spatial match (centroids and sizes)"
-            ));
-            delta
-        }
+    let tau: Vec<f64> = if pinned.is_empty() {
+        let delta = best_rotation(source, target, &source_loop, &sigma, &outline);
+        notes.push(format!(
+            "disk: no boundary landmark; boundary rotated by {delta:.4} turns, the best of {ROTATIONS} for a rough spatial match (centroids and sizes)"
+        ));
+        sigma.iter().map(|s| s + delta).collect()
+    } else {
+        notes.push(format!(
+            "disk: boundary laid so that landmarks {} land on their targets, by arc length between them",
+            pinned
+                .iter()
+                .map(|p| marks[p.0].index.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        between_landmarks(&sigma, &pinned)
     };
-    let tau: Vec<f64> = sigma.iter().map(|s| s + delta).collect();
     let collapsed = collapsed_ears(source, &source_loop, &tau, &outline);
     if collapsed > 0 {
         notes.push(format!(
@@ -145,27 +150,55 @@ pub(crate) fn map(
         ));
     }
     let mut source_boundary = BoundaryMap {
-        vertices: source_loop,
+        vertices: source_loop.clone(),
         positions: tau.iter().map(|&t| outline.image(t)).collect(),
     };
-    let (target_param, source_param) = match pinned {
-        // The two Tutte maps are independent: both at once, on two cores.
-        None => {
-            let (target_param, source_param) = parallel::join(
-                || tutte(target, &target_boundary, Side::Target),
-                || tutte(source, &source_boundary, Side::Source),
-            );
-            (target_param?, source_param?)
+    // The two Tutte maps are independent: both at once, on two cores.
+    let (target_param, source_param) = parallel::join(
+        || tutte(target, &target_boundary, Side::Target),
+        || tutte(source, &source_boundary, Side::Source),
+    );
+    let target_param = target_param?;
+    let mut source_param = source_param?;
+    // Each landmark's source vertex goes where its target lies in the target's map.
+    let mut fixed = Vec::with_capacity(source_loop.len() + marks.len());
+    for &(m, i, _) in &pinned {
+        source_boundary.positions[i] = interpolate(target, &target_param, &marks[m].target);
+    }
+    fixed.extend(
+        source_boundary
+            .vertices
+            .iter()
+            .copied()
+            .zip(source_boundary.positions.iter().copied()),
+    );
+    let interior: Vec<usize> = (0..marks.len())
+        .filter(|&m| !source.is_boundary_vertex(marks[m].source))
+        .collect();
+    fixed.extend(interior.iter().map(|&m| {
+        (
+            marks[m].source,
+            interpolate(target, &target_param, &marks[m].target),
+        )
+    }));
+    if !marks.is_empty() {
+        let matched = match_landmarks(source, Frame::Face, &source_param, &fixed, Side::Source)?;
+        if matched.flipped > 0 {
+            return Err(RegisterError::LandmarkFolds {
+                domain: "disk",
+                flipped: matched.flipped,
+                steps: matched.steps,
+            });
         }
-        // The pinned landmark's source vertex goes where its target lies in the
-        // target's map.
-        Some((m, i, _)) => {
-            let target_param = tutte(target, &target_boundary, Side::Target)?;
-            source_boundary.positions[i] = interpolate(target, &target_param, &marks[m].target);
-            let source_param = tutte(source, &source_boundary, Side::Source)?;
-            (target_param, source_param)
+        if !interior.is_empty() {
+            notes.push(format!(
+                "disk: {} interior landmarks matched in the disk ({} smoothing steps)",
+                interior.len(),
+                matched.steps
+            ));
         }
-    };
+        source_param = matched.map;
+    }
     let domain = domain_mesh(target, planar_points(&target_param), Side::Target)?;
     let (points, gap) = compose::locate(&domain, &planar_points(&source_param))?;
     if gap > 1e-12 {
@@ -173,29 +206,68 @@ pub(crate) fn map(
             "disk: the farthest source image was {gap:.3e} outside the target's disk and was moved onto it"
         ));
     }
-    Ok((points, pinned.map(|p| vec![p.0]).unwrap_or_default()))
+    Ok((points, (0..marks.len()).collect()))
 }
 
-/// The first landmark whose source vertex is on the boundary, as `(index into marks,
+/// The boundary fractions of the source's loop vertices (arc-length fractions `sigma`)
+/// laid between the boundary landmarks `pinned` (`(mark, position in the loop, target
+/// fraction)`): each landmark at its target's fraction, the vertices between two
+/// landmarks spread by arc length over the target's stretch between them. Unwrapped:
+/// increasing along the loop.
+fn between_landmarks(sigma: &[f64], pinned: &[(usize, usize, f64)]) -> Vec<f64> {
+    let mut order: Vec<(usize, f64)> = pinned.iter().map(|&(_, i, t)| (i, t)).collect();
+    order.sort_by_key(|&(i, _)| i);
+    let n = order.len();
+    let mut tau = vec![0.0; sigma.len()];
+    for k in 0..n {
+        let (i0, t0) = order[k];
+        let (i1, t1) = order[(k + 1) % n];
+        let source_span = if n == 1 {
+            1.0
+        } else {
+            (sigma[i1] - sigma[i0]).rem_euclid(1.0)
+        };
+        let target_span = if n == 1 {
+            1.0
+        } else {
+            (t1 - t0).rem_euclid(1.0)
+        };
+        let mut i = i0;
+        loop {
+            let along = (sigma[i] - sigma[i0]).rem_euclid(1.0);
+            tau[i] = t0 + target_span * along / source_span;
+            i = (i + 1) % sigma.len();
+            if i == i1 {
+                break;
+            }
+        }
+    }
+    for i in 1..tau.len() {
+        while tau[i] < tau[i - 1] {
+            tau[i] += 1.0;
+        }
+    }
+    tau
+}
+
+/// The landmarks whose source vertex is on the boundary, as `(index into marks,
 /// position in the source's loop, fraction of its target along the target's loop)`;
-/// an error names a landmark with one end on the boundary and the other inside.
-fn boundary_landmark(
+/// an error names a landmark with one end on the boundary and the other inside, and a
+/// landmark that breaks the cyclic order of the boundary landmarks (an
+/// orientation-preserving map keeps the order of points along the boundary).
+fn boundary_landmarks(
     source: &Mesh,
     target: &Mesh,
     outline: &Outline,
     marks: &[Resolved],
     loop_index: &[usize],
-) -> Result<Option<(usize, usize, f64)>, RegisterError> {
-    let mut pinned = None;
+) -> Result<Vec<(usize, usize, f64)>, RegisterError> {
+    let mut pinned = Vec::new();
     for (m, mark) in marks.iter().enumerate() {
         let on_source = source.is_boundary_vertex(mark.source);
         let on_target = boundary_fraction(target, outline, mark)?;
         match (on_source, on_target) {
-            (true, Some(tau)) => {
-                if pinned.is_none() {
-                    pinned = Some((m, loop_index[mark.source.idx()], tau));
-                }
-            }
+            (true, Some(tau)) => pinned.push((m, loop_index[mark.source.idx()], tau)),
             (false, None) => {}
             (true, None) => {
                 return Err(RegisterError::Landmark {
@@ -209,6 +281,27 @@ fn boundary_landmark(
                     index: mark.index,
                     vertex: mark.source,
                     reason: "the source vertex is inside the disk but its target is on the boundary: a disk map takes the boundary onto the boundary".to_string(),
+                });
+            }
+        }
+    }
+    // Along the source's loop the targets' fractions must turn once around the
+    // target's loop: their steps (mod 1) add up to one turn exactly when the cyclic
+    // orders agree.
+    let mut order = pinned.clone();
+    order.sort_by_key(|p| p.1);
+    let n = order.len();
+    if n >= 3 {
+        let mut turned = 0.0;
+        for k in 0..n {
+            let step = (order[(k + 1) % n].2 - order[k].2).rem_euclid(1.0);
+            turned += step;
+            if turned > 1.0 + 1e-9 || step == 0.0 {
+                let mark = &marks[order[(k + 1) % n].0];
+                return Err(RegisterError::Landmark {
+                    index: mark.index,
+                    vertex: mark.source,
+                    reason: "its target breaks the order of the boundary landmarks: along the two boundary loops they come in different cyclic orders (or two share a target), and an orientation-preserving map keeps the order along the boundary".to_string(),
                 });
             }
         }

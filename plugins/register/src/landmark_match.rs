@@ -46,8 +46,8 @@ pub(crate) struct Matched {
     pub map: Vec<Complex64>,
     /// Solves of the Beltrami equation after the first (0: the conformal one had no flip).
     pub steps: usize,
-    /// Faces with a free corner flipped in `map` (0 unless the steps ran out); faces
-    /// whose corners are all fixed are not counted: the map cannot change them.
+    /// Faces flipped in `map` that were not flipped in the initial map and have a free
+    /// corner (0 unless the steps ran out).
     pub flipped: usize,
     /// Area-weighted mean `|mu|` of `map`.
     pub mean_mu: f64,
@@ -55,7 +55,8 @@ pub(crate) struct Matched {
 
 /// The landmark-matching map of `mesh` bent from `initial` (one value per vertex) so
 /// that the vertices of `fixed` are at their values (module docs). Faces whose corners
-/// are all fixed are left as they are, flipped or not. `side` names the mesh in errors.
+/// are all fixed, and faces the initial map flips, are not judged: the steps mend only
+/// the flips the matching makes. `side` names the mesh in errors.
 ///
 /// # Errors
 /// [`RegisterError::Elements`] for a degenerate face, [`RegisterError::Measure`] for an
@@ -82,10 +83,12 @@ pub(crate) fn match_landmarks(
             *slot = true;
         }
     }
-    // A face with every corner fixed is the caller's: the map cannot change it.
+    // A face with every corner fixed is the caller's: the map cannot change it; nor are
+    // the initial map's own flips the matching's to mend (they stay with the map).
+    let flipped_before = flipped_faces(&elements, &initial_derivatives);
     let solved: Vec<bool> = mesh
         .faces()
-        .map(|f| mesh.face_vertices(f).any(|v| !is_fixed[v.idx()]))
+        .map(|f| !flipped_before[f.idx()] && mesh.face_vertices(f).any(|v| !is_fixed[v.idx()]))
         .collect();
     let solve_error = |error| RegisterError::Solve { side, error };
     let dofs = DofMap::complex(mesh.vertex_count(), &constraints)
