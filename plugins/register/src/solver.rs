@@ -181,7 +181,7 @@ fn judge_landmarks(
 ) -> Result<(), RegisterError> {
     let missed: Vec<&LandmarkResidual> = residuals
         .iter()
-        .filter(|r| !(r.distance <= LANDMARK_TOLERANCE * diagonal))
+        .filter(|r| r.distance.is_nan() || r.distance > LANDMARK_TOLERANCE * diagonal)
         .collect();
     let Some(worst) = missed
         .iter()

@@ -177,7 +177,7 @@ fn best_moebius(
         for b in a + 1..n {
             for c in b + 1..n {
                 counter += 1;
-                if (counter - 1) % stride != 0 {
+                if !(counter - 1).is_multiple_of(stride) {
                     continue;
                 }
                 let Some(m) = Moebius::through([s[a], s[b], s[c]], [t[a], t[b], t[c]]) else {
