@@ -531,6 +531,7 @@ def register(
     max_iters: Optional[int] = None,
     threads: Optional[int] = None,
     allow_flips: bool = False,
+    allow_missed_landmarks: bool = False,
     options: Optional[Dict[str, Any]] = None,
     progress: Optional[Progress] = None,
     info: bool = False,
@@ -541,7 +542,9 @@ def register(
     ``L^p`` norm of mu) or with the Beltrami coefficient ``mu`` (face frames): an initial
     bijection through a common parameter domain, then the Beltrami flow on the target
     (Wong-Zhao 2014). ``landmarks`` is a landmarks file (``v``, ``p`` and ``c`` lines) or
-    pairs ``(src, tgt)`` / ``(src, (x, y, z))``.
+    pairs ``(src, tgt)`` / ``(src, (x, y, z))``; every landmark is exact, or the call
+    raises naming the farthest (``allow_missed_landmarks=True`` keeps the map; the
+    report's ``landmarks`` lists each distance).
 
     Returns ``(P, face, bary)``: the image of every vertex ``(n, 3)``, the row of ``TF``
     it lies in and its barycentric coordinates there (``(n, 3)``, ``(n, 4)`` on quads).
@@ -556,6 +559,7 @@ def register(
             max_iters=max_iters,
             threads=threads,
             allow_flips=True if allow_flips else None,
+            allow_missed_landmarks=True if allow_missed_landmarks else None,
         ),
         "defaults": {"tolerance": "1e-05", "max-iters": "100"},
     }
