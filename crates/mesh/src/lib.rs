@@ -40,6 +40,7 @@ pub mod io;
 mod mesh;
 pub mod parallel;
 pub mod primitives;
+mod puncture;
 pub mod renumber;
 mod soup;
 pub mod subdivision;

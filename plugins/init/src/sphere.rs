@@ -126,7 +126,7 @@ use beltrami_core::{
 use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
 use beltrami_fem::{BoundaryMap, EdgeWeights, WeightError, WeightedMeanSystem};
-use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Vector3, VertexId};
+use beltrami_mesh::{FaceId, Mesh, Point3, Vector3, VertexId};
 use nalgebra::Matrix3;
 use num_complex::Complex64;
 
@@ -551,20 +551,7 @@ fn removed_face(mesh: &Mesh) -> FaceId {
 
 /// The mesh without face `removed`, with the same vertex ids.
 fn puncture(mesh: &Mesh, removed: FaceId) -> Result<Mesh, SolverError> {
-    let mut soup = PolygonSoup::new(mesh.positions().to_vec());
-    soup.reserve(mesh.face_count() - 1, 4 * mesh.face_count());
-    let mut corners = Vec::with_capacity(4);
-    for f in mesh.faces().filter(|&f| f != removed) {
-        corners.clear();
-        corners.extend(mesh.face_vertices(f).map(|v| v.0));
-        soup.push_face(&corners);
-    }
-    // The source mesh was validated already; accept any face it accepted.
-    let options = BuildOptions {
-        degenerate_area_tolerance: 0.0,
-        ..BuildOptions::default()
-    };
-    let (punctured, _) = Mesh::build(&soup, &options)?;
+    let punctured = mesh.punctured(removed)?;
     let map = punctured.vertex_map();
     if let Some(v) = mesh
         .vertices()

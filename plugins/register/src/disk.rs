@@ -149,7 +149,7 @@ pub(crate) fn map(
             "disk: {collapsed} source ears (faces with two boundary edges) have all three vertices on one boundary edge of the target and collapse onto it (refine the target's boundary)"
         ));
     }
-    let mut source_boundary = BoundaryMap {
+    let source_boundary = BoundaryMap {
         vertices: source_loop.clone(),
         positions: tau.iter().map(|&t| outline.image(t)).collect(),
     };
@@ -160,28 +160,25 @@ pub(crate) fn map(
     );
     let target_param = target_param?;
     let mut source_param = source_param?;
-    // Each landmark's source vertex goes where its target lies in the target's map.
-    let mut fixed = Vec::with_capacity(source_loop.len() + marks.len());
-    for &(m, i, _) in &pinned {
-        source_boundary.positions[i] = interpolate(target, &target_param, &marks[m].target);
+    // Each landmark's source vertex goes where its target lies in the target's map: on
+    // the boundary at once, inside through the matching in the disk.
+    for &(m, _, _) in &pinned {
+        source_param[marks[m].source.idx()] = interpolate(target, &target_param, &marks[m].target);
     }
-    fixed.extend(
-        source_boundary
-            .vertices
-            .iter()
-            .copied()
-            .zip(source_boundary.positions.iter().copied()),
-    );
     let interior: Vec<usize> = (0..marks.len())
         .filter(|&m| !source.is_boundary_vertex(marks[m].source))
         .collect();
-    fixed.extend(interior.iter().map(|&m| {
-        (
-            marks[m].source,
-            interpolate(target, &target_param, &marks[m].target),
-        )
-    }));
-    if !marks.is_empty() {
+    if !interior.is_empty() {
+        let fixed: Vec<(VertexId, Complex64)> = source_loop
+            .iter()
+            .map(|&v| (v, source_param[v.idx()]))
+            .chain(interior.iter().map(|&m| {
+                (
+                    marks[m].source,
+                    interpolate(target, &target_param, &marks[m].target),
+                )
+            }))
+            .collect();
         let matched = match_landmarks(source, Frame::Face, &source_param, &fixed, Side::Source)?;
         if matched.flipped > 0 {
             return Err(RegisterError::LandmarkFolds {
@@ -190,13 +187,11 @@ pub(crate) fn map(
                 steps: matched.steps,
             });
         }
-        if !interior.is_empty() {
-            notes.push(format!(
-                "disk: {} interior landmarks matched in the disk ({} smoothing steps)",
-                interior.len(),
-                matched.steps
-            ));
-        }
+        notes.push(format!(
+            "disk: {} interior landmarks matched in the disk ({} smoothing steps)",
+            interior.len(),
+            matched.steps
+        ));
         source_param = matched.map;
     }
     let domain = domain_mesh(target, planar_points(&target_param), Side::Target)?;

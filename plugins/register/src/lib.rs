@@ -72,6 +72,9 @@ pub struct InitialMap {
     pub points: Vec<SurfacePoint>,
     /// The same images as positions: `points[i].position(target)`.
     pub positions: Vec<Point3<f64>>,
+    /// Where each landmark goes, in the order given: its target vertex, or the closest
+    /// point of the target to its point.
+    pub landmark_targets: Vec<Point3<f64>>,
     /// The shared topology.
     pub topology: Topology,
     /// What was done, in words: the loops cut along (per mesh, lengths and input vertex
@@ -146,9 +149,11 @@ pub fn initial_map(
         exact[m] = true;
     }
     let positions: Vec<Point3<f64>> = points.iter().map(|p| p.position(target)).collect();
-    for (mark, &exact) in marks.iter().zip(&exact) {
+    let landmark_targets: Vec<Point3<f64>> =
+        marks.iter().map(|m| m.target.position(target)).collect();
+    for ((mark, &exact), goal) in marks.iter().zip(&exact).zip(&landmark_targets) {
         if !exact {
-            let distance = (positions[mark.source.idx()] - mark.target.position(target)).norm();
+            let distance = (positions[mark.source.idx()] - goal).norm();
             notes.push(format!(
                 "landmark {} (source vertex {}) is not enforced by the initial map: its image is {distance:.4e} from its target (left to the flow)",
                 mark.index,
@@ -171,6 +176,7 @@ pub fn initial_map(
     Ok(InitialMap {
         points,
         positions,
+        landmark_targets,
         topology,
         notes,
         distortion,

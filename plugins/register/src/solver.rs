@@ -138,34 +138,43 @@ fn judge_flips(
         faces: format!("{}{more}", names.join(", ")),
         why,
     };
-    if allowed {
-        report
-            .notes
-            .push(format!("kept as asked (allow-flips): {error}"));
-        Ok(())
-    } else {
-        Err(error)
+    keep_or_fail(error, allowed.then_some("allow-flips"), report)
+}
+
+/// `error` as a note naming the `option` that keeps the map when it is set, else as
+/// the error.
+fn keep_or_fail(
+    error: RegisterError,
+    option: Option<&str>,
+    report: &mut Report,
+) -> Result<(), RegisterError> {
+    match option {
+        Some(option) => {
+            report
+                .notes
+                .push(format!("kept as asked ({option}): {error}"));
+            Ok(())
+        }
+        None => Err(error),
     }
 }
 
-/// The distance from each landmark's image to its target (the closest point of the
-/// target to the landmark's point), in the order of the problem's landmarks.
+/// The distance from each landmark's image to its target (`targets`, in the order of
+/// the problem's landmarks: the target vertex or the closest point of the target).
 fn landmark_residuals(
     problem: &Problem<'_>,
-    index: &SurfaceIndex<'_>,
+    targets: &[Point3<f64>],
     positions: &[Point3<f64>],
-) -> Result<Vec<LandmarkResidual>, RegisterError> {
+) -> Vec<LandmarkResidual> {
     problem
         .constraints
         .landmarks()
+        .zip(targets)
         .enumerate()
-        .map(|(i, mark)| {
-            let goal = index.locate(&mark.position.to_point())?.position;
-            Ok(LandmarkResidual {
-                index: i,
-                vertex: mark.vertex,
-                distance: (positions[mark.vertex.idx()] - goal).norm(),
-            })
+        .map(|(i, (mark, goal))| LandmarkResidual {
+            index: i,
+            vertex: mark.vertex,
+            distance: (positions[mark.vertex.idx()] - goal).norm(),
         })
         .collect()
 }
@@ -197,14 +206,7 @@ fn judge_landmarks(
         distance: worst.distance,
         relative: worst.distance / diagonal,
     };
-    if allowed {
-        report
-            .notes
-            .push(format!("kept as asked (allow-missed-landmarks): {error}"));
-        Ok(())
-    } else {
-        Err(error)
-    }
+    keep_or_fail(error, allowed.then_some("allow-missed-landmarks"), report)
 }
 
 /// Corners whose target normals differ by more than this lie across a fold.
@@ -309,11 +311,14 @@ pub(crate) fn register(
     // closest point of the target to the given point (the flow would pull a vertex
     // towards the given point itself, off the surface).
     let mut held = Constraints::new();
+    let mut goals = initial.landmark_targets.iter();
     for constraint in problem.constraints.iter() {
         held.push(match constraint {
             Constraint::Landmark(mark) => Constraint::Landmark(beltrami_core::Landmark {
                 vertex: mark.vertex,
-                position: Position::Spatial(initial.positions[mark.vertex.idx()]),
+                position: goals
+                    .next()
+                    .map_or(mark.position, |goal| Position::Spatial(*goal)),
             }),
             other => other.clone(),
         });
@@ -330,9 +335,8 @@ pub(crate) fn register(
     let Some(Map::OnMesh(points)) = solution.map().cloned() else {
         return Ok(solution);
     };
-    let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
     let positions: Vec<_> = points.iter().map(|p| p.position(target)).collect();
-    solution.extras.landmarks = landmark_residuals(problem, &index, &positions).map_err(plugin)?;
+    solution.extras.landmarks = landmark_residuals(problem, &initial.landmark_targets, &positions);
     judge_landmarks(
         source,
         &solution.extras.landmarks,
@@ -342,6 +346,7 @@ pub(crate) fn register(
     )
     .map_err(plugin)?;
     if solution.metrics.flipped().unwrap_or(0) > 0 {
+        let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
         judge_flips(
             source,
             &index,

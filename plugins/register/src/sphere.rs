@@ -30,9 +30,7 @@
 use beltrami_core::{Context, Map, Problem, Solver, SolverError, Target};
 use beltrami_fem::Frame;
 use beltrami_init::Sphere;
-use beltrami_mesh::{
-    BuildOptions, FaceId, Mesh, Point3, PolygonSoup, Repair, SurfacePoint, Vector3,
-};
+use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
@@ -220,13 +218,12 @@ fn match_on_sphere(
     targets: &[Vector3<f64>],
     notes: &mut Vec<String>,
 ) -> Result<Vec<Vector3<f64>>, RegisterError> {
-    let pole = pole_face(source, aligned, marks, targets);
+    let Pole {
+        face: pole,
+        centre,
+        clearance,
+    } = pole_face(source, aligned, marks, targets);
     let (corners, degree) = source.face_vertex_array(pole);
-    let centre: Vector3<f64> = corners[..degree]
-        .iter()
-        .map(|v| aligned[v.idx()])
-        .sum::<Vector3<f64>>()
-        .normalize();
     let r = rotation_between(&centre, &Vector3::z());
     // Stereographic projection from the north pole, conjugated so that a face turning
     // counter-clockwise about the outward normal turns counter-clockwise in the chart.
@@ -237,12 +234,6 @@ fn match_on_sphere(
     // The cap about the pole within half the pole's clearance from the landmarks stays
     // where the alignment put it: the chart is bounded there, and the punctured face's
     // neighbourhood (where a chart blows up) is not solved for.
-    let clearance = marks
-        .iter()
-        .map(|m| aligned[m.source.idx()])
-        .chain(targets.iter().copied())
-        .map(|p| (p - centre).norm())
-        .fold(2.0, f64::min);
     let mut fixed: Vec<_> = source
         .vertices()
         .filter(|v| (aligned[v.idx()] - centre).norm() <= 0.5 * clearance)
@@ -252,7 +243,14 @@ fn match_on_sphere(
     fixed.sort_by_key(|(v, _)| *v);
     fixed.dedup_by_key(|(v, _)| *v);
     fixed.extend(marks.iter().zip(targets).map(|(m, t)| (m.source, chart(t))));
-    let punctured = puncture(source, pole)?;
+    let punctured = source
+        .punctured(pole)
+        .map_err(|error| RegisterError::Mesh {
+            side: Side::Source,
+            error,
+        })?;
+    // Every vertex of a closed surface has other faces: the ids are kept.
+    debug_assert!(punctured.vertex_map().is_identity());
     let initial: Vec<Complex64> = aligned.iter().map(chart).collect();
     let matched = match_landmarks(&punctured, Frame::Face, &initial, &fixed, Side::Source)?;
     if matched.flipped > 0 {
@@ -280,14 +278,23 @@ fn match_on_sphere(
         .collect())
 }
 
+/// The face of a stereographic chart: its centroid direction on the sphere and the
+/// chordal distance from there to the nearest landmark or landmark target.
+struct Pole {
+    face: FaceId,
+    centre: Vector3<f64>,
+    clearance: f64,
+}
+
 /// The face whose sphere centroid is farthest from every landmark and every landmark
-/// target (chordal distance), among the faces with no landmark corner.
+/// target (chordal distance), among the faces with no landmark corner (the last of
+/// equals).
 fn pole_face(
     source: &Mesh,
     aligned: &[Vector3<f64>],
     marks: &[Resolved],
     targets: &[Vector3<f64>],
-) -> FaceId {
+) -> Pole {
     let mut is_mark = vec![false; source.vertex_count()];
     for m in marks {
         is_mark[m.source.idx()] = true;
@@ -297,44 +304,28 @@ fn pole_face(
         .map(|m| aligned[m.source.idx()])
         .chain(targets.iter().copied())
         .collect();
-    let clearance = |f: FaceId| {
+    let mut best = (FaceId(0), Vector3::z(), f64::NEG_INFINITY);
+    for f in source.faces() {
         let (vs, degree) = source.face_vertex_array(f);
-        if vs[..degree].iter().any(|v| is_mark[v.idx()]) {
-            return f64::NEG_INFINITY;
-        }
         let c: Vector3<f64> = vs[..degree].iter().map(|v| aligned[v.idx()]).sum();
         let c = c.normalize();
-        points
-            .iter()
-            .map(|p| (p - c).norm_squared())
-            .fold(f64::INFINITY, f64::min)
-    };
-    source
-        .faces()
-        .max_by(|&a, &b| clearance(a).total_cmp(&clearance(b)))
-        .unwrap_or(FaceId(0))
-}
-
-/// `mesh` without face `removed`: a disk when `mesh` is a closed genus-0 surface, with
-/// the same vertices (ids and positions).
-fn puncture(mesh: &Mesh, removed: FaceId) -> Result<Mesh, RegisterError> {
-    let mut soup = PolygonSoup::new(mesh.positions().to_vec());
-    let mut buf = Vec::with_capacity(4);
-    for f in mesh.faces().filter(|&f| f != removed) {
-        buf.clear();
-        buf.extend(mesh.face_vertices(f).map(|v| v.0));
-        soup.push_face(&buf);
+        let squared = if vs[..degree].iter().any(|v| is_mark[v.idx()]) {
+            f64::NEG_INFINITY
+        } else {
+            points
+                .iter()
+                .map(|p| (p - c).norm_squared())
+                .fold(f64::INFINITY, f64::min)
+        };
+        if squared >= best.2 {
+            best = (f, c, squared);
+        }
     }
-    let options = BuildOptions {
-        degenerate_area_tolerance: -1.0,
-        repair: Repair::NONE,
-    };
-    let (punctured, _) = Mesh::build(&soup, &options).map_err(|error| RegisterError::Mesh {
-        side: Side::Source,
-        error,
-    })?;
-    debug_assert!(punctured.vertex_map().is_identity());
-    Ok(punctured)
+    Pole {
+        face: best.0,
+        centre: best.1,
+        clearance: best.2.max(0.0).sqrt().min(2.0),
+    }
 }
 
 /// The `sphere` initialization of `mesh` from `start` (`tutte` or `conformal`) as unit
