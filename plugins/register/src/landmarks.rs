@@ -88,7 +88,14 @@ pub(crate) fn resolve(
                 if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
                     return Err(fail(format!("the target point {p:?} is not finite")));
                 }
-                (target_index.locate(&p)?.point, None)
+                let point = target_index.locate(&p)?.point;
+                // A point at a vertex (a `v SRC TGT` landmark arrives as the vertex's
+                // position) is that vertex, whichever of its faces the location chose:
+                // a boundary vertex stays on the boundary.
+                match at_corner(target, &point) {
+                    Some(v) => (SurfacePoint::at_vertex(target, v), Some(v)),
+                    None => (point, None),
+                }
             }
         };
         out.push(Resolved {
@@ -100,6 +107,19 @@ pub(crate) fn resolve(
     }
     Ok(out)
 }
+
+/// The vertex of `point`'s face that `point` is at (a coordinate within
+/// [`AT_CORNER`] of 1), if any.
+fn at_corner(mesh: &Mesh, point: &SurfacePoint) -> Option<VertexId> {
+    let (vertices, degree) = mesh.face_vertex_array(point.face);
+    (0..degree)
+        .find(|&k| point.coords[k] >= 1.0 - AT_CORNER)
+        .map(|k| vertices[k])
+}
+
+/// Barycentric coordinates this close to 1 put a point at a corner (rounding of the
+/// closest-point computation at a vertex is ~1e-16).
+const AT_CORNER: f64 = 1e-12;
 
 /// The value of a per-vertex parameterization at a surface point: the coordinates
 /// applied to the values of the face's vertices in `mesh` (the target, or its cut).
@@ -322,6 +342,40 @@ fn cross_ratio_map(points: [Vector3<f64>; 3]) -> Option<[[Complex64; 2]; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use beltrami_mesh::primitives;
+
+    #[test]
+    fn a_point_at_a_target_vertex_is_that_vertex() {
+        // Every vertex of a bumpy disk, boundary ones included, given by its position:
+        // whichever face the location picks, the landmark keeps the vertex (so a
+        // boundary vertex stays on the boundary).
+        let mut soup = primitives::disk(3);
+        for p in &mut soup.positions {
+            p.z = 0.2 * (3.0 * p.x).sin() * p.y;
+        }
+        let target = Mesh::from_soup(&soup).unwrap();
+        let source = Mesh::from_soup(&primitives::disk(2)).unwrap();
+        let index = SurfaceIndex::new(&target).unwrap();
+        for v in target.vertices() {
+            let marks = [Landmark {
+                source: VertexId(0),
+                target: LandmarkTarget::Point(target.position(v)),
+            }];
+            let resolved = resolve(&source, &target, &index, &marks).unwrap();
+            assert_eq!(resolved[0].vertex, Some(v));
+            assert_eq!(resolved[0].target.position(&target), target.position(v));
+        }
+        // A point inside a face stays a point.
+        let f = target.faces().next().unwrap();
+        let inside = [Landmark {
+            source: VertexId(0),
+            target: LandmarkTarget::Point(target.face_centroid(f)),
+        }];
+        assert_eq!(
+            resolve(&source, &target, &index, &inside).unwrap()[0].vertex,
+            None
+        );
+    }
 
     #[test]
     fn the_fitted_similarity_recovers_a_rotation_scale_and_shift() {

@@ -153,6 +153,75 @@ fn disk_boundary_landmark_lands_exactly() {
     ));
 }
 
+/// The `k`-th of `n` boundary vertices spread along the loop of `mesh`.
+fn along_boundary(mesh: &Mesh, k: usize, n: usize) -> VertexId {
+    let lp: Vec<VertexId> = mesh
+        .loop_vertices(beltrami_mesh::BoundaryLoopId(0))
+        .collect();
+    lp[k * lp.len() / n]
+}
+
+#[test]
+fn every_disk_landmark_lands_exactly_and_boundary_order_is_kept() {
+    let source = jittered_disk(4, 0.01, 5);
+    let target = jittered_disk(5, 0.005, 6);
+    // Three boundary landmarks given as the positions of target boundary vertices (as
+    // a `v SRC TGT` line arrives), each moved a little along the loop, and four interior
+    // ones onto points a tenth of the disk away from where the plain map puts them.
+    let plain = initial_map(&source, &target, &[]).unwrap();
+    let mut landmarks: Vec<Landmark> = (0..3)
+        .map(|k| Landmark {
+            source: along_boundary(&source, k, 3),
+            target: LandmarkTarget::Point(target.position(along_boundary(&target, 3 * k + 1, 9))),
+        })
+        .collect();
+    let interior: Vec<VertexId> = source
+        .vertices()
+        .filter(|&v| !source.is_boundary_vertex(v))
+        .step_by(37)
+        .take(4)
+        .collect();
+    for (k, &v) in interior.iter().enumerate() {
+        let angle = k as f64 * std::f64::consts::FRAC_PI_2;
+        let p = plain.positions[v.idx()];
+        landmarks.push(Landmark {
+            source: v,
+            target: LandmarkTarget::Point(Point3::new(
+                p.x + 0.1 * angle.cos(),
+                p.y + 0.1 * angle.sin(),
+                p.z,
+            )),
+        });
+    }
+    let map = initial_map(&source, &target, &landmarks).unwrap();
+    check_on_target(&source, &target, &map);
+    assert_eq!(map.flipped(), 0, "{:?}", map.notes);
+    let index = SurfaceIndex::new(&target).unwrap();
+    let scale = target.bounding_box().diagonal();
+    for (k, mark) in landmarks.iter().enumerate() {
+        let LandmarkTarget::Point(p) = mark.target else {
+            unreachable!()
+        };
+        let goal = index.locate(&p).unwrap().position;
+        let d = (map.positions[mark.source.idx()] - goal).norm();
+        assert!(d <= 1e-12 * scale, "landmark {k}: {d:e}");
+    }
+    // The boundary landmarks in the other turn of the target's loop: refused, naming
+    // the one that breaks the order.
+    let reversed: Vec<Landmark> = (0..3)
+        .map(|k| Landmark {
+            source: along_boundary(&source, k, 3),
+            target: LandmarkTarget::Vertex(along_boundary(&target, (3 - k) % 3, 3)),
+        })
+        .collect();
+    match initial_map(&source, &target, &reversed) {
+        Err(RegisterError::Landmark { reason, .. }) => {
+            assert!(reason.contains("order"), "{reason}")
+        }
+        other => panic!("reversed boundary landmarks: {other:?}"),
+    }
+}
+
 #[test]
 fn disk_onto_itself_is_the_identity() {
     let m = jittered_disk(4, 0.01, 5);
