@@ -179,7 +179,14 @@ pub(crate) fn map(
                 )
             }))
             .collect();
-        let matched = match_landmarks(source, Frame::Face, &source_param, &fixed, Side::Source)?;
+        let matched = match_landmarks(
+            source,
+            Frame::Face,
+            &source_param,
+            &fixed,
+            &[],
+            Side::Source,
+        )?;
         if matched.flipped > 0 {
             return Err(RegisterError::LandmarkFolds {
                 domain: "disk",

@@ -23,7 +23,9 @@
 
 use beltrami_fem::beltrami::{face_mu, flipped_faces, planar_map, point_mu};
 use beltrami_fem::operators::beltrami_operator;
-use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveOptions};
+use beltrami_fem::{
+    DofBuilder, DofError, DofMap, Elements, Frame, LeastSquaresSolver, SolveOptions,
+};
 use beltrami_mesh::{FaceId, Mesh, VertexId};
 use num_complex::Complex64;
 
@@ -38,6 +40,16 @@ const MAX_STEPS: usize = 60;
 
 /// Smoothing passes applied to the coefficient between two steps.
 const SMOOTHING_PASSES: usize = 2;
+
+/// Two vertices that move as one up to a translation: `x_b = x_a + offset`. The two
+/// copies of a seam vertex of a torus cut into its square, in the universal cover
+/// `R^2` of `R^2 / Z^2`, differ by a lattice vector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Glue {
+    pub a: VertexId,
+    pub b: VertexId,
+    pub offset: Complex64,
+}
 
 /// A landmark-matching map and how it was found.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,9 +66,10 @@ pub(crate) struct Matched {
 }
 
 /// The landmark-matching map of `mesh` bent from `initial` (one value per vertex) so
-/// that the vertices of `fixed` are at their values (module docs). Faces whose corners
-/// are all fixed, and faces the initial map flips, are not judged: the steps mend only
-/// the flips the matching makes. `side` names the mesh in errors.
+/// that the vertices of `fixed` are at their values (module docs), each pair of `glued`
+/// moving as one (a fixed vertex fixes its glued partners at their offsets). Faces whose
+/// corners are all fixed, and faces the initial map flips, are not judged: the steps
+/// mend only the flips the matching makes. `side` names the mesh in errors.
 ///
 /// # Errors
 /// [`RegisterError::Elements`] for a degenerate face, [`RegisterError::Measure`] for an
@@ -68,6 +81,7 @@ pub(crate) fn match_landmarks(
     frame: Frame,
     initial: &[Complex64],
     fixed: &[(VertexId, Complex64)],
+    glued: &[Glue],
     side: Side,
 ) -> Result<Matched, RegisterError> {
     let elements =
@@ -75,14 +89,8 @@ pub(crate) fn match_landmarks(
     let initial_derivatives =
         planar_map(&elements, mesh.vertex_count(), initial).map_err(RegisterError::Measure)?;
     let initial_nu = face_mu(&elements, &point_mu(&initial_derivatives));
-    let mut constraints = DofConstraints::new();
-    let mut is_fixed = vec![false; mesh.vertex_count()];
-    for &(v, z) in fixed {
-        constraints.fix(v, z);
-        if let Some(slot) = is_fixed.get_mut(v.idx()) {
-            *slot = true;
-        }
-    }
+    let (dofs, is_fixed) = glued_dofs(mesh.vertex_count(), fixed, glued)
+        .map_err(|error| RegisterError::Dofs { side, error })?;
     // A face with every corner fixed is the caller's: the map cannot change it; nor are
     // the initial map's own flips the matching's to mend (they stay with the map).
     let flipped_before = flipped_faces(&elements, &initial_derivatives);
@@ -91,8 +99,6 @@ pub(crate) fn match_landmarks(
         .map(|f| !flipped_before[f.idx()] && mesh.face_vertices(f).any(|v| !is_fixed[v.idx()]))
         .collect();
     let solve_error = |error| RegisterError::Solve { side, error };
-    let dofs = DofMap::complex(mesh.vertex_count(), &constraints)
-        .map_err(|error| RegisterError::Dofs { side, error })?;
     let operator =
         beltrami_operator(mesh, &elements, &initial_nu).map_err(RegisterError::Measure)?;
     let mut solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, SolveOptions::default())
@@ -146,6 +152,75 @@ pub(crate) fn match_landmarks(
             .map_err(solve_error)?;
         steps += 1;
     }
+}
+
+/// The unknowns of a matching: vertices joined by `glued` form groups, each group one
+/// unknown moving all its vertices alike (every vertex at its offset from the group's
+/// first), or no unknown when one of its vertices is in `fixed`; and which vertices are
+/// fixed. Vertices out of range are [`DofError`]s.
+fn glued_dofs(
+    n: usize,
+    fixed: &[(VertexId, Complex64)],
+    glued: &[Glue],
+) -> Result<(DofMap<Complex64>, Vec<bool>), DofError> {
+    let mut builder = DofBuilder::<Complex64>::new(n, 1)?;
+    let mut partners: Vec<Vec<(usize, Complex64)>> = vec![Vec::new(); n];
+    for g in glued {
+        for (v, w, offset) in [(g.a, g.b, g.offset), (g.b, g.a, -g.offset)] {
+            let slot = partners.get_mut(v.idx()).ok_or(DofError::NodeOutOfRange {
+                node: v,
+                n_nodes: n,
+            })?;
+            slot.push((w.idx(), offset));
+        }
+    }
+    // Each group by a walk from its smallest vertex, with every vertex's offset from it.
+    let mut group = vec![usize::MAX; n];
+    let mut offset = vec![Complex64::new(0.0, 0.0); n];
+    let mut members: Vec<Vec<usize>> = Vec::new();
+    for start in 0..n {
+        if group[start] != usize::MAX {
+            continue;
+        }
+        let g = members.len();
+        group[start] = g;
+        let mut list = vec![start];
+        let mut k = 0;
+        while let Some(&v) = list.get(k) {
+            for &(w, step) in &partners[v] {
+                if group[w] == usize::MAX {
+                    group[w] = g;
+                    offset[w] = offset[v] + step;
+                    list.push(w);
+                }
+            }
+            k += 1;
+        }
+        members.push(list);
+    }
+    let mut value: Vec<Option<Complex64>> = vec![None; members.len()];
+    for &(v, z) in fixed {
+        let g = *group.get(v.idx()).ok_or(DofError::NodeOutOfRange {
+            node: v,
+            n_nodes: n,
+        })?;
+        value[g] = Some(z - offset[v.idx()]);
+    }
+    let mut is_fixed = vec![false; n];
+    for (list, value) in members.iter().zip(&value) {
+        for &v in list {
+            let node = VertexId::from_usize(v);
+            builder.origin(node, &[value.unwrap_or_default() + offset[v]])?;
+            is_fixed[v] = value.is_some();
+        }
+        if value.is_none() {
+            builder.unknown(
+                list.iter()
+                    .map(|&v| (VertexId::from_usize(v), [Complex64::new(1.0, 0.0)])),
+            )?;
+        }
+    }
+    Ok((builder.build()?, is_fixed))
 }
 
 /// The edge neighbours of every face with the factor `e^{-2 i theta}` that carries a
@@ -260,8 +335,15 @@ mod tests {
         let inner = vertex_at(&mesh, 0.5, 0.5);
         let p = mesh.position(inner);
         fixed.push((inner, affine(Complex64::new(p.x, p.y))));
-        let matched =
-            match_landmarks(&mesh, Frame::Global, &identity(&mesh), &fixed, Side::Source).unwrap();
+        let matched = match_landmarks(
+            &mesh,
+            Frame::Global,
+            &identity(&mesh),
+            &fixed,
+            &[],
+            Side::Source,
+        )
+        .unwrap();
         assert_eq!(matched.flipped, 0);
         assert_eq!(matched.steps, 0);
         for &(v, z) in &fixed {
@@ -290,8 +372,15 @@ mod tests {
         let b = vertex_at(&mesh, 0.7, 0.5);
         fixed.push((a, Complex64::new(0.65, 0.5)));
         fixed.push((b, Complex64::new(0.85, 0.45)));
-        let matched =
-            match_landmarks(&mesh, Frame::Global, &identity(&mesh), &fixed, Side::Source).unwrap();
+        let matched = match_landmarks(
+            &mesh,
+            Frame::Global,
+            &identity(&mesh),
+            &fixed,
+            &[],
+            Side::Source,
+        )
+        .unwrap();
         assert_eq!(matched.flipped, 0);
         assert!(matched.steps > 0, "the conformal step alone folds");
         for &(v, z) in &fixed {
@@ -332,7 +421,8 @@ mod tests {
             let v = vertex_at(&mesh, x, y);
             fixed.push((v, initial[v.idx()]));
         }
-        let matched = match_landmarks(&mesh, Frame::Face, &initial, &fixed, Side::Source).unwrap();
+        let matched =
+            match_landmarks(&mesh, Frame::Face, &initial, &fixed, &[], Side::Source).unwrap();
         assert_eq!((matched.flipped, matched.steps), (0, 0));
         for v in mesh.vertices() {
             let d = (matched.map[v.idx()] - initial[v.idx()]).norm();

@@ -105,7 +105,41 @@ pub(crate) fn resolve(
             vertex,
         });
     }
+    one_target_each(target, landmarks, &out)?;
     Ok(out)
+}
+
+/// Refuses two landmarks whose targets coincide (within `1e-12` of the target's
+/// diagonal): a bijection cannot send two source vertices onto one point.
+fn one_target_each(
+    target: &Mesh,
+    landmarks: &[Landmark],
+    resolved: &[Resolved],
+) -> Result<(), RegisterError> {
+    let tolerance = 1e-12 * target.bounding_box().diagonal();
+    let at: Vec<Point3<f64>> = resolved.iter().map(|m| m.target.position(target)).collect();
+    // Sorted by x, each point compared with those within the tolerance in x.
+    let mut order: Vec<usize> = (0..at.len()).collect();
+    order.sort_by(|&a, &b| at[a].x.total_cmp(&at[b].x));
+    for (k, &a) in order.iter().enumerate() {
+        for &b in order[k + 1..]
+            .iter()
+            .take_while(|&&b| at[b].x - at[a].x <= tolerance)
+        {
+            if (at[a] - at[b]).norm() <= tolerance {
+                let (first, second) = (a.min(b), a.max(b));
+                return Err(RegisterError::Landmark {
+                    index: second,
+                    vertex: landmarks[second].source,
+                    reason: format!(
+                        "its target is the target of landmark {first} (source vertex {}): a bijection cannot map two vertices onto one point",
+                        landmarks[first].source
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The vertex of `point`'s face that `point` is at (a coordinate within

@@ -135,7 +135,7 @@ pub fn initial_map(
             (torus.points, torus.honoured)
         }
         Topology::MultiplyConnected | Topology::HigherGenus => {
-            let cut = polygon::map(source, target, &target_index, &marks, &mut notes);
+            let cut = polygon::map_with_points(source, target, &target_index, &marks, &mut notes);
             if marks.is_empty() && target.boundary_loop_count() == 0 {
                 projection::better(source, target, &target_index, cut, &mut notes)?
             } else {
@@ -188,21 +188,21 @@ pub fn initial_map(
 /// The road of [`initial_map`] for `topology` with `landmarks` landmarks, in words.
 fn route(topology: Topology, landmarks: usize) -> String {
     let matched = "every landmark matched in the domain";
-    let pulled = "landmarks the domain does not place are pulled by the flow on the target";
     match topology {
         Topology::Sphere if landmarks > 0 => format!(
             "sphere: both meshes conformally onto the unit sphere, {matched} (a landmark-matching quasiconformal map in a stereographic chart), composed with the target's sphere map; the flow on the target mesh polishes with every landmark held"
         ),
         Topology::Sphere => "sphere: both meshes onto the unit sphere, aligned by a rotation from a rough spatial match, composed with the target's sphere map; then the flow on the target mesh".to_string(),
-        Topology::Disk => format!(
-            "disk: both meshes onto the target's Tutte disk, the boundary turned by a boundary landmark or a rough spatial match; then the flow on the target mesh ({pulled})"
+        Topology::Disk if landmarks > 0 => format!(
+            "disk: both meshes onto the target's Tutte disk, the boundary laid between the boundary landmarks, {matched} with the boundary held; then the flow on the target mesh polishes with every landmark held"
         ),
-        Topology::Torus => format!(
-            "torus: both meshes onto the square glued periodically, a symmetry of the square chosen by the landmarks or a rough spatial match; then the flow on the target mesh ({pulled})"
+        Topology::Disk => "disk: both meshes onto the target's Tutte disk, the boundary turned by a rough spatial match; then the flow on the target mesh".to_string(),
+        Topology::Torus if landmarks > 0 => format!(
+            "torus: both meshes onto the square glued periodically, a symmetry of the square and a translation chosen by the landmarks, {matched} (a landmark-matching quasiconformal map on the torus, the seams glued); then the flow on the target mesh polishes with every landmark held"
         ),
-        Topology::MultiplyConnected | Topology::HigherGenus => format!(
-            "polygon: both meshes cut along matched cut graphs into one polygon, its corners placed by the landmarks or in space; then the flow on the target mesh ({pulled})"
-        ),
+        Topology::Torus => "torus: both meshes onto the square glued periodically, a symmetry of the square chosen by a rough spatial match; then the flow on the target mesh".to_string(),
+        Topology::MultiplyConnected | Topology::HigherGenus if landmarks > 0 => "polygon: both meshes cut along matched cut graphs into one polygon, every landmark a corner of it (drawn on the target at its vertex, or at the vertex nearest to its point and moved onto the point); then the flow on the target mesh polishes with every landmark held".to_string(),
+        Topology::MultiplyConnected | Topology::HigherGenus => "polygon: both meshes cut along matched cut graphs into one polygon, placed in space; then the flow on the target mesh".to_string(),
     }
 }
 

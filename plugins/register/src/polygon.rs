@@ -44,9 +44,79 @@ use crate::param::{arc_fractions, domain_mesh, path_fractions, planar_points, tu
 use crate::routing::{Drawing, Loops, Pin, forward_pins, pair_loops, placement};
 use crate::skeleton::{Skeleton, Word, with_slits};
 
+/// [`map`] with every landmark's target point inside a target face made a vertex of
+/// the target first ([`Mesh::with_points_inserted`]): the cut graphs are drawn through
+/// it, so the landmark is a corner of the polygon at its very target; the images are
+/// then read back on the target as given.
+pub(crate) fn map_with_points(
+    source: &Mesh,
+    target: &Mesh,
+    target_index: &SurfaceIndex<'_>,
+    marks: &[Resolved],
+    notes: &mut Vec<String>,
+) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
+    let inside: Vec<SurfacePoint> = marks
+        .iter()
+        .filter(|m| m.vertex.is_none())
+        .map(|m| m.target)
+        .collect();
+    if inside.is_empty() {
+        return map(source, target, target_index, marks, notes);
+    }
+    let refined = target
+        .with_points_inserted(&inside)
+        .map_err(|error| RegisterError::Mesh {
+            side: Side::Target,
+            error,
+        })?;
+    let original = marks;
+    let mut inserted = refined.vertices.iter();
+    let marks: Vec<Resolved> = marks
+        .iter()
+        .map(|m| {
+            let vertex = if m.vertex.is_none() {
+                inserted.next().copied().flatten()
+            } else {
+                m.vertex
+            };
+            match vertex {
+                Some(v) if m.vertex.is_none() => Resolved {
+                    target: SurfacePoint::at_vertex(&refined.mesh, v),
+                    vertex: Some(v),
+                    ..*m
+                },
+                _ => *m,
+            }
+        })
+        .collect();
+    let added = refined.mesh.vertex_count() - target.vertex_count();
+    let index = SurfaceIndex::new(&refined.mesh)?;
+    let mut tried = Vec::new();
+    match map(source, &refined.mesh, &index, &marks, &mut tried) {
+        Ok((points, honoured)) => {
+            notes.push(format!(
+                "cut graphs: {added} landmark target points inside target faces made vertices of the target for the cuts"
+            ));
+            notes.append(&mut tried);
+            let points = points.iter().map(|p| refined.to_original(p)).collect();
+            Ok((points, honoured))
+        }
+        // An inserted vertex has three neighbours: a cut graph with a node of more arcs
+        // there cannot be drawn; the nearest vertices take the points instead.
+        Err(RegisterError::Seams { reason }) => {
+            notes.push(format!(
+                "cut graphs: drawn through the landmark target points made vertices, {reason}; drawn through the target vertices nearest to them instead"
+            ));
+            map(source, target, target_index, original, notes)
+        }
+        Err(error) => Err(error),
+    }
+}
+
 /// The source's images on the target and the landmarks honoured exactly (indices into
-/// `marks`): every one whose target is a target vertex (each landmark is a corner of
-/// the polygon).
+/// `marks`): each landmark is a corner of the polygon, drawn on the target at its
+/// target vertex or at the vertex nearest to its target point; the image is then moved
+/// onto a target point next to it.
 pub(crate) fn map(
     source: &Mesh,
     target: &Mesh,
@@ -178,23 +248,21 @@ pub(crate) fn map(
             "cut graphs: the farthest source image was {gap:.3e} outside the target's polygon and was moved onto it"
         ));
     }
-    // A landmark on a boundary loop whose source vertex and target are nodes paired by
-    // the cuts lands there exactly.
-    let tolerance = 1e-9 * target.bounding_box().diagonal();
+    // Every landmark is a node of the cut graphs: on the target at its own vertex, or
+    // for a point inside a face at the nearest vertex. A point target is then taken
+    // exactly when the vertex is a corner of a face next to the point's (the move stays
+    // within the image's star; the flow mends a fold it makes); a landmark drawn
+    // elsewhere is left to the flow, and the registration fails if it is missed.
+    let near = |a: &SurfacePoint, b: &SurfacePoint| {
+        a.face == b.face
+            || target
+                .face_vertices(a.face)
+                .any(|v| target.face_vertices(b.face).any(|w| w == v))
+    };
     let honoured = marks
         .iter()
         .enumerate()
-        .filter(|(_, mark)| {
-            source_skeleton
-                .nodes
-                .iter()
-                .position(|&v| v == mark.source)
-                .is_some_and(|n| {
-                    (target.position(target_skeleton.nodes[n]) - mark.target.position(target))
-                        .norm()
-                        <= tolerance
-                })
-        })
+        .filter(|(_, mark)| near(&points[mark.source.idx()], &mark.target))
         .map(|(k, _)| k)
         .collect();
     Ok((points, honoured))

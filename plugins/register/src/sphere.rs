@@ -252,7 +252,7 @@ fn match_on_sphere(
     // Every vertex of a closed surface has other faces: the ids are kept.
     debug_assert!(punctured.vertex_map().is_identity());
     let initial: Vec<Complex64> = aligned.iter().map(chart).collect();
-    let matched = match_landmarks(&punctured, Frame::Face, &initial, &fixed, Side::Source)?;
+    let matched = match_landmarks(&punctured, Frame::Face, &initial, &fixed, &[], Side::Source)?;
     if matched.flipped > 0 {
         return Err(RegisterError::LandmarkFolds {
             domain: "sphere",

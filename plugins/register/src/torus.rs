@@ -43,13 +43,14 @@
 //!
 //! The notes give the pairing, both moduli and the bound of the class taken.
 
-use beltrami_fem::BoundaryMap;
+use beltrami_fem::{BoundaryMap, Frame};
 use beltrami_mesh::{CutMesh, Mesh, Point3, SurfacePoint, VertexId, cut_to_disk, parallel};
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
 use crate::compose;
 use crate::error::{RegisterError, Side};
+use crate::landmark_match::{Glue, Matched, match_landmarks};
 use crate::landmarks::{Resolved, SpatialMatch, interpolate};
 use crate::modulus::{TorusPeriods, periods, teichmueller_bound};
 use crate::param::{domain_mesh, each_mesh, input_indices, path_fractions, planar_points, tutte};
@@ -126,6 +127,11 @@ pub(crate) fn map(
     let (source_periods, target_periods) = (source_periods?, target_periods?);
     let tau = source_periods.tau();
 
+    // Each landmark's target in the target's square.
+    let t: Vec<Complex64> = marks
+        .iter()
+        .map(|m| interpolate(&target_square.cut.mesh, &target_square.param, &m.target))
+        .collect();
     let (map, honoured) = if marks.is_empty() {
         let (candidates, identity) = least_distortion_classes(tau, &target_periods);
         let map = best_by_space(source, target, &domain, s_param, &candidates)?;
@@ -142,10 +148,6 @@ pub(crate) fn map(
         ));
         (map, Vec::new())
     } else {
-        let t: Vec<Complex64> = marks
-            .iter()
-            .map(|m| interpolate(&target_square.cut.mesh, &target_square.param, &m.target))
-            .collect();
         let s: Vec<Complex64> = marks.iter().map(|m| s_param[m.source.idx()]).collect();
         let turns: &[u8] = if marks.len() == 1 {
             &[0]
@@ -185,7 +187,21 @@ pub(crate) fn map(
         ));
         (map, honoured)
     };
-    let images: Vec<Complex64> = s_param.iter().map(|&x| map.apply(x)).collect();
+    let (images, honoured): (Vec<Complex64>, Vec<usize>) = if honoured.len() < marks.len() {
+        let matched = match_on_torus(&source_square, source.vertex_count(), &map, marks, &t)?;
+        notes.push(format!(
+            "torus: {} landmarks not placed by the symmetry matched on the torus ({} smoothing steps)",
+            marks.len() - honoured.len(),
+            matched.steps
+        ));
+        let wrapped = matched.map[..source.vertex_count()]
+            .iter()
+            .map(|z| Complex64::new(z.re.rem_euclid(1.0), z.im.rem_euclid(1.0)))
+            .collect();
+        (wrapped, (0..marks.len()).collect())
+    } else {
+        (s_param.iter().map(|&x| map.apply(x)).collect(), honoured)
+    };
     let (points, gap) = compose::locate(&domain, &planar_points(&images))?;
     if gap > 1e-12 {
         notes.push(format!(
@@ -203,6 +219,68 @@ pub(crate) fn map(
         honoured,
         teichmueller_bound: bound,
     })
+}
+
+/// The source's square bent so that every landmark lands on its target `targets[k]`
+/// (points of the target's square), on the torus itself: the map `x -> L x + s` of
+/// `map` unwrapped on the source's cut mesh (no reduction mod 1), the two copies of
+/// every seam vertex glued at their lattice offset, each landmark fixed at the lattice
+/// translate of its target nearest to its image, and the landmark-matching map of
+/// module `landmark_match` solved with these unknowns. The map returned is on the
+/// cut mesh, unwrapped; `n` is the source's vertex count (the cut mesh's first `n`
+/// vertices are the source's).
+///
+/// # Errors
+/// [`RegisterError::LandmarkFolds`] when the matching leaves flipped faces; the errors
+/// of [`match_landmarks`].
+fn match_on_torus(
+    square: &Square,
+    n: usize,
+    map: &SquareMap,
+    marks: &[Resolved],
+    targets: &[Complex64],
+) -> Result<Matched, RegisterError> {
+    let unwrapped: Vec<Complex64> = square
+        .param
+        .iter()
+        .map(|&x| map.turn(x) + map.shift)
+        .collect();
+    let lattice = |z: Complex64| Complex64::new(z.re.round(), z.im.round());
+    let glued: Vec<Glue> = square
+        .cut
+        .mesh
+        .vertices()
+        .skip(n)
+        .map(|copy| {
+            let original = square.cut.original_vertex(copy);
+            Glue {
+                a: original,
+                b: copy,
+                offset: lattice(unwrapped[copy.idx()] - unwrapped[original.idx()]),
+            }
+        })
+        .collect();
+    let fixed: Vec<(VertexId, Complex64)> = marks
+        .iter()
+        .zip(targets)
+        .map(|(m, &t)| (m.source, t + lattice(unwrapped[m.source.idx()] - t)))
+        .collect();
+    let matched = match_landmarks(
+        &square.cut.mesh,
+        Frame::Face,
+        &unwrapped,
+        &fixed,
+        &glued,
+        Side::Source,
+    )?;
+    if matched.flipped > 0 {
+        return Err(RegisterError::LandmarkFolds {
+            domain: "torus",
+            flipped: matched.flipped,
+            steps: matched.steps,
+        });
+    }
+    Ok(matched)
 }
 
 /// The homotopy classes a map without landmarks chooses from, and the Teichmueller

@@ -2,6 +2,7 @@
 //! valid surface points, landmarks, the identity, topology errors and the torus loops.
 //! The shared meshes (`../shared/meshes`) are skipped with a message when absent.
 
+use std::f64::consts::TAU;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -416,6 +417,43 @@ fn torus_landmarks_and_identity() {
 }
 
 #[test]
+fn every_torus_landmark_lands_exactly_under_a_twist() {
+    // A torus onto a finer mesh of the same torus, six landmarks along a twist of the
+    // tube (up to two target edges off the rotation that places the first): no
+    // symmetry of the square places them all, the matching on the torus does.
+    let (nu, nv) = (40, 16);
+    let source = torus(nu, nv);
+    let target = torus(60, 24);
+    let marks: Vec<Landmark> = [(0, 0), (7, 3), (13, 8), (20, 12), (27, 5), (33, 14)]
+        .iter()
+        .map(|&(i, j): &(usize, usize)| {
+            let twist = 2.0 * (TAU * j as f64 / nv as f64).sin();
+            let ti = (1.5 * i as f64 + twist).round().rem_euclid(60.0) as usize;
+            let tj = (1.5 * j as f64).round() as usize % 24;
+            Landmark {
+                source: VertexId::from_usize(i * nv + j),
+                target: LandmarkTarget::Vertex(VertexId::from_usize(ti * 24 + tj)),
+            }
+        })
+        .collect();
+    let map = initial_map(&source, &target, &marks).unwrap();
+    check_on_target(&source, &target, &map);
+    assert_eq!(map.flipped(), 0, "{:?}", map.notes);
+    assert!(
+        map.notes.iter().any(|n| n.contains("matched on the torus")),
+        "{:?}",
+        map.notes
+    );
+    for mark in &marks {
+        let LandmarkTarget::Vertex(v) = mark.target else {
+            unreachable!()
+        };
+        let miss = (map.positions[mark.source.idx()] - target.position(v)).norm();
+        assert!(miss < 1e-12, "landmark {}: {miss:.3e}", mark.source);
+    }
+}
+
+#[test]
 fn kitten_onto_modified_tori() {
     let Some(source) = shared("g1_kitten.obj") else {
         return;
@@ -514,6 +552,27 @@ fn bad_landmarks_name_their_index() {
         initial_map(&sphere, &sphere, &repeated),
         Err(RegisterError::Landmark { index: 1, .. })
     ));
+    // Two source vertices onto one target, once as a vertex and once as its position.
+    let one_point = [
+        Landmark {
+            source: VertexId(3),
+            target: LandmarkTarget::Vertex(VertexId(7)),
+        },
+        Landmark {
+            source: VertexId(5),
+            target: LandmarkTarget::Vertex(VertexId(9)),
+        },
+        Landmark {
+            source: VertexId(4),
+            target: LandmarkTarget::Point(sphere.position(VertexId(7))),
+        },
+    ];
+    let err = initial_map(&sphere, &sphere, &one_point).unwrap_err();
+    assert!(
+        matches!(err, RegisterError::Landmark { index: 2, .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("landmark 0"), "{err}");
 }
 
 #[test]
