@@ -9,6 +9,11 @@ fsaverage5 template (10,242 vertices, 20,480 triangles), `OUT_DIR/fs5_{hemi}_{su
 Within one hemisphere vertex i of every surface is the same point of the cortex, so a
 registration of one surface onto another has a known answer: vertex i goes to vertex i.
 
+It also writes the per-vertex fields of each hemisphere, `OUT_DIR/fs5_{hemi}_{field}.txt`
+(one value per line, in vertex order): `sulc` (sulcal depth) and `curv` (curvature of the
+white surface), for `beltrami register SRC TGT --features F F` (vertex i of every surface
+has the same value, the fields agree under the true correspondence).
+
 With `--landmarks N` it also writes `OUT_DIR/fs5_landmarks_N.txt`: N landmarks `v I I`
 spread over the white surface by farthest-point sampling (geodesic distance along
 edges), for `beltrami register SRC TGT --landmarks`.
@@ -40,7 +45,15 @@ SURFACES = {
 }
 
 
-def wheel():
+FIELDS = {
+    "sulc": "sulc_{h}.gii.gz",
+    "curv": "curv_{h}.gii.gz",
+}
+
+
+def wheel(given):
+    if given:
+        return given
     folder = tempfile.mkdtemp()
     subprocess.run(
         [sys.executable, "-m", "pip", "download", "--quiet", "--no-deps", "nilearn", "-d", folder],
@@ -118,10 +131,19 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("out")
     parser.add_argument("--landmarks", type=int, default=0)
+    parser.add_argument("--wheel", help="a nilearn wheel already downloaded")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
-    with zipfile.ZipFile(wheel()) as z:
+    with zipfile.ZipFile(wheel(args.wheel)) as z:
         for hemi in ("left", "right"):
+            for name, pattern in FIELDS.items():
+                member = "nilearn/datasets/data/fsaverage5/" + pattern.format(h=hemi)
+                values = data_arrays(z.read(member))[0][1]
+                path = os.path.join(args.out, f"fs5_{hemi}_{name}.txt")
+                with open(path, "w") as f:
+                    f.write(f"# FreeSurfer fsaverage5 {name}, {hemi} hemisphere, one value per vertex\n")
+                    f.writelines(f"{x!r}\n" for x in values)
+                print(f"{path}: {len(values)} values")
             for name, pattern in SURFACES.items():
                 member = "nilearn/datasets/data/fsaverage5/" + pattern.format(h=hemi)
                 positions, faces = surface(z.read(member))

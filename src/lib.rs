@@ -56,6 +56,7 @@ pub mod landmarks;
 pub mod map_file;
 pub mod mapped;
 pub mod report;
+pub mod vertex_field;
 
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;

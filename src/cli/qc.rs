@@ -381,6 +381,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             Goal::Conformal { p } => format!("conformal L^{p}"),
             Goal::Prescribed(_) => "prescribed mu".into(),
             Goal::Extremal => "extremal".into(),
+            Goal::Features(_) => "features".into(),
         }),
     );
     report.extend(beltrami::report::mu_error_keys(error.as_ref()));

@@ -6,8 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use beltrami::landmarks::Landmarks;
-use beltrami::{correspondence, map_file, report};
-use beltrami_core::{Goal, Map, OptionValue, Problem, Target};
+use beltrami::{correspondence, map_file, report, vertex_field};
+use beltrami_core::{Features, Goal, Map, OptionValue, Problem, Target};
 use beltrami_fem::BeltramiField;
 use clap::Args;
 use serde_json::json;
@@ -31,6 +31,11 @@ pub struct RegisterArgs {
     /// Landmarks and feature curves (`v SRC TGT`, `p SRC x y z`, `c SRC,.. TGT,..`).
     #[arg(long)]
     pub landmarks: Option<PathBuf>,
+    /// Match a scalar field given on both meshes (one value per vertex per line, or the
+    /// computed `mean-curvature`): the conformal registration bent in the common domain
+    /// until the fields agree, landmarks held (disks and closed genus-0 surfaces).
+    #[arg(long, num_args = 2, value_names = ["SOURCE_FIELD", "TARGET_FIELD"])]
+    pub features: Option<Vec<PathBuf>>,
     /// Most flow iterations [default: 100].
     #[arg(long = "max-iters")]
     pub max_iters: Option<usize>,
@@ -76,12 +81,24 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     let target = &target_loaded.mesh.mesh;
 
     let mut problem = Problem::new(source, Target::Mesh(target));
-    problem.goal = match (&args.mu, args.p) {
-        (Some(_), Some(_)) => {
+    problem.goal = match (&args.mu, args.p, args.features.as_deref()) {
+        (Some(_), Some(_), _) => {
             bail!("--p is the exponent of the conformal goal; a prescribed --mu has no exponent")
         }
-        (Some(path), None) => Goal::Prescribed(BeltramiField::read(path, source.face_count())?),
-        (None, p) => Goal::Conformal {
+        (_, Some(_), Some(_)) | (Some(_), _, Some(_)) => {
+            bail!(
+                "--features matches fields with the least-squares conformal map as its start; it takes neither --p nor --mu"
+            )
+        }
+        (None, None, Some([source_field, target_field])) => Goal::Features(Features {
+            source: vertex_field::read(source_field, source)?,
+            target: vertex_field::read(target_field, target)?,
+        }),
+        (None, None, Some(_)) => bail!("--features takes two fields: SOURCE_FIELD TARGET_FIELD"),
+        (Some(path), None, None) => {
+            Goal::Prescribed(BeltramiField::read(path, source.face_count())?)
+        }
+        (None, p, None) => Goal::Conformal {
             p: p.unwrap_or(2.0),
         },
     };

@@ -172,6 +172,8 @@ pub enum GoalKind {
     Prescribed,
     /// `Extremal`.
     Extremal,
+    /// `Features(fields)`.
+    Features,
 }
 
 impl GoalKind {
@@ -182,6 +184,7 @@ impl GoalKind {
             Goal::Conformal { .. } => GoalKind::ConformalLp,
             Goal::Prescribed(_) => GoalKind::Prescribed,
             Goal::Extremal => GoalKind::Extremal,
+            Goal::Features(_) => GoalKind::Features,
         }
     }
 
@@ -192,6 +195,7 @@ impl GoalKind {
             GoalKind::ConformalLp => "conformal-lp",
             GoalKind::Prescribed => "prescribed-mu",
             GoalKind::Extremal => "extremal",
+            GoalKind::Features => "features",
         }
     }
 }

@@ -71,6 +71,7 @@
 mod accepts;
 mod constraint;
 mod error;
+mod features;
 mod map;
 mod options;
 mod problem;
@@ -87,6 +88,7 @@ pub use constraint::{
     LoopMatch, Pin, Slide,
 };
 pub use error::SolverError;
+pub use features::Features;
 pub use map::{Map, SurfacePoint};
 pub use options::{OptionError, OptionKind, OptionSpec, OptionValue, Options, Settings, THREADS};
 pub use problem::{Goal, PlanarBoundary, Position, Problem, Target};

@@ -84,6 +84,10 @@ pub enum Goal {
     Prescribed(BeltramiField),
     /// The extremal (Teichmueller) map for the boundary condition.
     Extremal,
+    /// A registration that matches scalar fields given on both meshes (the
+    /// landmark-and-intensity registration of Lam and Lui, SIAM J. Imaging Sci. 2014),
+    /// as conformal as the match allows.
+    Features(crate::Features),
 }
 
 impl Default for Goal {

@@ -183,6 +183,10 @@ impl Renumbered {
                 field.mu = n.face_values_to_new(&field.mu);
                 Goal::Prescribed(field)
             }
+            (Goal::Features(features), _) => Goal::Features(crate::Features {
+                source: vertices_to_new(source_numbering, &features.source),
+                target: vertices_to_new(target_numbering, &features.target),
+            }),
             (goal, _) => goal.clone(),
         };
         let initial = problem.initial.as_ref().map(|map| match map {

@@ -28,6 +28,7 @@ pub mod element;
 mod error;
 pub mod expr;
 pub mod field;
+pub mod mean_curvature;
 pub mod operators;
 pub mod quaternion;
 pub mod quaternionic_lsqc;

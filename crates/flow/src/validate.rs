@@ -211,6 +211,9 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
         Goal::Extremal => Err(unsupported(
             "extremal (Teichmueller) maps come with their own solver",
         )),
+        Goal::Features(_) => Err(unsupported(
+            "features are matched by register, in the parameter domain",
+        )),
     }
 }
 

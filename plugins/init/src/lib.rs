@@ -105,6 +105,11 @@ fn check_goal_and_curves(solver: &'static str, problem: &Problem<'_>) -> Result<
                 "{solver} computes a map of its own and cannot follow a prescribed Beltrami coefficient; use lsqc"
             ));
         }
+        Goal::Features(_) => {
+            return unsupported(format!(
+                "{solver} matches no features; features are matched by register"
+            ));
+        }
         Goal::Extremal => {
             return unsupported(format!(
                 "{solver} does not compute extremal (Teichmueller) maps; use teichmuller"

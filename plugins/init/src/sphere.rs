@@ -503,6 +503,12 @@ fn weights(problem: &Problem<'_>, settings: &Settings) -> Result<Weights, Solver
                     .to_string(),
             );
         }
+        Goal::Features(_) => {
+            return unsupported(
+                "sphere computes a fixed initial map and matches no features; features are matched by register"
+                    .to_string(),
+            );
+        }
         Goal::Extremal => {
             return unsupported(
                 "sphere computes a fixed initial map, not an extremal (Teichmueller) map; use teichmuller"

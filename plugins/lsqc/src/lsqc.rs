@@ -209,6 +209,12 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
                     .to_string(),
             ));
         }
+        Goal::Features(_) => {
+            return Err(unsupported(
+                "lsqc follows a prescribed Beltrami coefficient; features are matched by register"
+                    .to_string(),
+            ));
+        }
     };
     if problem.constraints.curves().next().is_some() {
         return Err(unsupported(

@@ -58,6 +58,12 @@ pub(crate) fn setup(problem: &Problem<'_>) -> Result<SpaceSetup, SolverError> {
                     .to_string(),
             ));
         }
+        Goal::Features(_) => {
+            return Err(unsupported(
+                "lsqc follows a prescribed Beltrami coefficient; features are matched by register"
+                    .to_string(),
+            ));
+        }
     };
     if problem.constraints.curves().next().is_some() {
         return Err(unsupported(

@@ -271,6 +271,12 @@ fn setup(
                         .to_string(),
             });
         }
+        Goal::Features(_) => {
+            return Err(SolverError::Unsupported {
+                solver: NAME,
+                message: "qcmc follows a prescribed Beltrami coefficient or mu = 0; features are matched by register".to_string(),
+            });
+        }
     };
     if !matches!(
         Topology::of(mesh),

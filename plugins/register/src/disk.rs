@@ -27,14 +27,17 @@
 //! `m`'s image. Such ears are counted in the notes (they count as flipped); a target
 //! boundary at least as fine as the source's avoids them.
 
+use beltrami_core::Features;
 use std::f64::consts::TAU;
 
 use beltrami_fem::{BoundaryMap, Frame};
 use beltrami_mesh::{BoundaryLoopId, Mesh, Point3, SurfacePoint, VertexId, parallel};
 use num_complex::Complex64;
 
+use crate::Routed;
 use crate::compose;
 use crate::error::{RegisterError, Side};
+use crate::feature_match::match_features;
 use crate::landmark_match::match_landmarks;
 use crate::landmarks::{Resolved, SpatialMatch, interpolate};
 use crate::param::{arc_fractions, domain_mesh, planar_points, tutte};
@@ -89,14 +92,14 @@ impl Outline {
     }
 }
 
-/// The source's images on the target and the landmarks honoured exactly (indices into
-/// `marks`).
+/// The source's images on the target, the landmarks honoured exactly (indices into
+/// `marks`) and the target's disk (its Tutte map, per target vertex).
 pub(crate) fn map(
     source: &Mesh,
     target: &Mesh,
     marks: &[Resolved],
     notes: &mut Vec<String>,
-) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
+) -> Result<Routed<Vec<Complex64>>, RegisterError> {
     let target_loop: Vec<VertexId> = target.loop_vertices(BoundaryLoopId(0)).collect();
     let fractions = arc_fractions(target, &target_loop);
     let images: Vec<Complex64> = fractions
@@ -208,7 +211,51 @@ pub(crate) fn map(
             "disk: the farthest source image was {gap:.3e} outside the target's disk and was moved onto it"
         ));
     }
-    Ok((points, (0..marks.len()).collect()))
+    Ok(Routed {
+        points,
+        honoured: (0..marks.len()).collect(),
+        domain: target_param,
+    })
+}
+
+/// The registration `points` (a bijection of the disks, the landmarks exact) bent in the
+/// target's disk `target_param` so that `features` match (module `feature_match`), its
+/// boundary and landmarks held.
+pub(crate) fn match_features_after(
+    source: &Mesh,
+    target: &Mesh,
+    target_param: &[Complex64],
+    points: &[SurfacePoint],
+    marks: &[Resolved],
+    features: &Features,
+    notes: &mut Vec<String>,
+) -> Result<Vec<SurfacePoint>, RegisterError> {
+    let chart: Vec<Complex64> = points
+        .iter()
+        .map(|p| interpolate(target, target_param, p))
+        .collect();
+    let fixed: Vec<(VertexId, Complex64)> = source
+        .vertices()
+        .filter(|&v| source.is_boundary_vertex(v))
+        .chain(marks.iter().map(|m| m.source))
+        .map(|v| (v, chart[v.idx()]))
+        .collect();
+    let domain = domain_mesh(target, planar_points(target_param), Side::Target)?;
+    let matched = match_features(
+        source,
+        &chart,
+        &fixed,
+        &features.source,
+        &domain,
+        &features.target,
+        Side::Source,
+    )?;
+    notes.push(format!(
+        "disk: features matched in the target's disk with the boundary and the landmarks held: mismatch {:.4} -> {:.4} (mean squared difference of the standardized fields) in {} steps",
+        matched.before, matched.after, matched.steps
+    ));
+    let (located, _) = compose::locate(&domain, &planar_points(&matched.map))?;
+    Ok(located)
 }
 
 /// The boundary fractions of the source's loop vertices (arc-length fractions `sigma`)

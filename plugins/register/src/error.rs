@@ -52,6 +52,13 @@ pub enum RegisterError {
         /// What it is.
         shape: Shape,
     },
+    /// Features that cannot be matched: on a topology whose road does not match them,
+    /// or fields that do not fit the meshes.
+    #[error("features: {reason}")]
+    Features {
+        /// Why.
+        reason: String,
+    },
     /// A landmark that cannot be honoured or names a vertex that does not exist.
     #[error("landmark {index} (source vertex {vertex}): {reason}")]
     Landmark {

@@ -84,51 +84,14 @@ pub(crate) fn match_landmarks(
     glued: &[Glue],
     side: Side,
 ) -> Result<Matched, RegisterError> {
-    let elements =
-        Elements::new(mesh, frame).map_err(|error| RegisterError::Elements { side, error })?;
-    let initial_derivatives =
-        planar_map(&elements, mesh.vertex_count(), initial).map_err(RegisterError::Measure)?;
-    let initial_nu = face_mu(&elements, &point_mu(&initial_derivatives));
-    let (dofs, is_fixed) = glued_dofs(mesh.vertex_count(), fixed, glued)
-        .map_err(|error| RegisterError::Dofs { side, error })?;
-    // A face with every corner fixed is the caller's: the map cannot change it; nor are
-    // the initial map's own flips the matching's to mend (they stay with the map).
-    let flipped_before = flipped_faces(&elements, &initial_derivatives);
-    let solved: Vec<bool> = mesh
-        .faces()
-        .map(|f| !flipped_before[f.idx()] && mesh.face_vertices(f).any(|v| !is_fixed[v.idx()]))
-        .collect();
-    let solve_error = |error| RegisterError::Solve { side, error };
-    let operator =
-        beltrami_operator(mesh, &elements, &initial_nu).map_err(RegisterError::Measure)?;
-    let mut solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, SolveOptions::default())
-        .map_err(solve_error)?;
-    let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
-    let rhs = vec![Complex64::new(0.0, 0.0); operator.nrows()];
-    let areas = elements.face_areas();
-    let neighbours = FaceNeighbours::new(mesh, &elements);
-
-    let mut map = solver
-        .solve(operator.as_ref(), Some(&weights), &rhs)
-        .map_err(solve_error)?;
+    let (mut reconstruction, initial_nu) =
+        Reconstruction::new(mesh, frame, initial, fixed, glued, side)?;
+    let mut map = reconstruction.solve(&initial_nu)?;
     let mut steps = 0;
     loop {
-        let derivatives =
-            planar_map(&elements, mesh.vertex_count(), &map).map_err(RegisterError::Measure)?;
-        let flipped = flipped_faces(&elements, &derivatives)
-            .iter()
-            .zip(&solved)
-            .filter(|&(&f, &s)| f && s)
-            .count();
-        let mu = face_mu(&elements, &point_mu(&derivatives));
+        let (mu, flipped) = reconstruction.measure(&map)?;
         if flipped == 0 || steps == MAX_STEPS {
-            let total: f64 = areas.iter().sum();
-            let mean_mu = mu
-                .iter()
-                .zip(&areas)
-                .map(|(m, a)| m.norm().min(1.0) * a)
-                .sum::<f64>()
-                / total.max(f64::MIN_POSITIVE);
+            let mean_mu = reconstruction.mean_mu(&mu);
             return Ok(Matched {
                 map,
                 steps,
@@ -136,9 +99,113 @@ pub(crate) fn match_landmarks(
                 mean_mu,
             });
         }
+        map = reconstruction.solve(&reconstruction.regularized(mu, SMOOTHING_PASSES))?;
+        steps += 1;
+    }
+}
+
+/// Planar maps of a mesh rebuilt from Beltrami coefficients with some vertices held:
+/// the least-squares solution of `f_zbar = nu f_z` (module docs) for any `nu`, one
+/// symbolic factorization for all.
+pub(crate) struct Reconstruction<'m> {
+    mesh: &'m Mesh,
+    elements: Elements,
+    solver: LeastSquaresSolver<Complex64>,
+    weights: Vec<f64>,
+    rhs: Vec<Complex64>,
+    /// Faces judged for flips: not flipped by the initial map, with a free corner.
+    solved: Vec<bool>,
+    areas: Vec<f64>,
+    neighbours: FaceNeighbours,
+    side: Side,
+}
+
+impl<'m> Reconstruction<'m> {
+    /// The reconstruction with the vertices of `fixed` at their values and those of
+    /// `glued` moving as one, and the coefficient of `initial` (per face). Faces whose
+    /// corners are all fixed, and faces `initial` flips, are not judged by
+    /// [`Self::measure`].
+    ///
+    /// # Errors
+    /// As [`match_landmarks`].
+    pub(crate) fn new(
+        mesh: &'m Mesh,
+        frame: Frame,
+        initial: &[Complex64],
+        fixed: &[(VertexId, Complex64)],
+        glued: &[Glue],
+        side: Side,
+    ) -> Result<(Self, Vec<Complex64>), RegisterError> {
+        let elements =
+            Elements::new(mesh, frame).map_err(|error| RegisterError::Elements { side, error })?;
+        let initial_derivatives =
+            planar_map(&elements, mesh.vertex_count(), initial).map_err(RegisterError::Measure)?;
+        let initial_nu = face_mu(&elements, &point_mu(&initial_derivatives));
+        let (dofs, is_fixed) = glued_dofs(mesh.vertex_count(), fixed, glued)
+            .map_err(|error| RegisterError::Dofs { side, error })?;
+        // A face with every corner fixed is the caller's: the map cannot change it; nor
+        // are the initial map's own flips the matching's to mend (they stay with it).
+        let flipped_before = flipped_faces(&elements, &initial_derivatives);
+        let solved: Vec<bool> = mesh
+            .faces()
+            .map(|f| !flipped_before[f.idx()] && mesh.face_vertices(f).any(|v| !is_fixed[v.idx()]))
+            .collect();
+        let operator =
+            beltrami_operator(mesh, &elements, &initial_nu).map_err(RegisterError::Measure)?;
+        let solver = LeastSquaresSolver::new(operator.symbolic(), &dofs, SolveOptions::default())
+            .map_err(|error| RegisterError::Solve { side, error })?;
+        let weights: Vec<f64> = elements.points().iter().map(|q| q.weight).collect();
+        let rhs = vec![Complex64::new(0.0, 0.0); operator.nrows()];
+        let areas = elements.face_areas();
+        let neighbours = FaceNeighbours::new(mesh, &elements);
+        Ok((
+            Self {
+                mesh,
+                elements,
+                solver,
+                weights,
+                rhs,
+                solved,
+                areas,
+                neighbours,
+                side,
+            },
+            initial_nu,
+        ))
+    }
+
+    /// The map whose coefficient is `nu` (per face) in the least-squares sense, with the
+    /// held vertices at their values.
+    pub(crate) fn solve(&mut self, nu: &[Complex64]) -> Result<Vec<Complex64>, RegisterError> {
+        let operator =
+            beltrami_operator(self.mesh, &self.elements, nu).map_err(RegisterError::Measure)?;
+        let side = self.side;
+        self.solver
+            .solve(operator.as_ref(), Some(&self.weights), &self.rhs)
+            .map_err(|error| RegisterError::Solve { side, error })
+    }
+
+    /// The coefficient of `map` per face and the number of judged faces it flips.
+    pub(crate) fn measure(
+        &self,
+        map: &[Complex64],
+    ) -> Result<(Vec<Complex64>, usize), RegisterError> {
+        let derivatives = planar_map(&self.elements, self.mesh.vertex_count(), map)
+            .map_err(RegisterError::Measure)?;
+        let flipped = flipped_faces(&self.elements, &derivatives)
+            .iter()
+            .zip(&self.solved)
+            .filter(|&(&f, &s)| f && s)
+            .count();
+        Ok((face_mu(&self.elements, &point_mu(&derivatives)), flipped))
+    }
+
+    /// `mu` smoothed over edge neighbours (`passes` times) and cut to `|nu| <= K_MAX`
+    /// (module docs): a coefficient whose map is a local homeomorphism.
+    pub(crate) fn regularized(&self, mu: Vec<Complex64>, passes: usize) -> Vec<Complex64> {
         let mut nu = mu;
-        for _ in 0..SMOOTHING_PASSES {
-            nu = neighbours.smooth(&nu, &areas);
+        for _ in 0..passes {
+            nu = self.neighbours.smooth(&nu, &self.areas);
         }
         for m in &mut nu {
             let r = m.norm();
@@ -146,11 +213,17 @@ pub(crate) fn match_landmarks(
                 *m *= K_MAX / r;
             }
         }
-        let operator = beltrami_operator(mesh, &elements, &nu).map_err(RegisterError::Measure)?;
-        map = solver
-            .solve(operator.as_ref(), Some(&weights), &rhs)
-            .map_err(solve_error)?;
-        steps += 1;
+        nu
+    }
+
+    /// The area-weighted mean of `|mu|` (each face's value capped at 1).
+    pub(crate) fn mean_mu(&self, mu: &[Complex64]) -> f64 {
+        let total: f64 = self.areas.iter().sum();
+        mu.iter()
+            .zip(&self.areas)
+            .map(|(m, a)| m.norm().min(1.0) * a)
+            .sum::<f64>()
+            / total.max(f64::MIN_POSITIVE)
     }
 }
 

@@ -40,6 +40,7 @@ mod compose;
 mod consistency;
 mod disk;
 mod error;
+mod feature_match;
 mod landmark_match;
 mod landmarks;
 mod modulus;
@@ -54,9 +55,12 @@ mod square_map;
 mod topology;
 mod torus;
 
+use beltrami_core::Features;
 use beltrami_fem::DistortionStats;
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
+
+use crate::landmarks::Resolved;
 
 pub use error::{RegisterError, Side};
 pub use landmarks::{Landmark, LandmarkTarget};
@@ -93,6 +97,10 @@ pub struct InitialMap {
     /// two tori, from their conformal moduli in the markings the map pairs
     /// ([`teichmueller_bound`]).
     pub teichmueller_bound: Option<f64>,
+    /// The target's parameterization, for a feature match after the flow.
+    pub(crate) domain: TargetDomain,
+    /// The landmarks as resolved on the target.
+    pub(crate) marks: Vec<Resolved>,
 }
 
 impl InitialMap {
@@ -120,15 +128,42 @@ pub fn initial_map(
     target: &Mesh,
     landmarks: &[Landmark],
 ) -> Result<InitialMap, RegisterError> {
+    initial_map_for(source, target, landmarks, false)
+}
+
+/// [`initial_map`], with both sphere maps conformal when `conformal_sphere` (the
+/// start of a feature match on the sphere) even without landmarks.
+pub(crate) fn initial_map_for(
+    source: &Mesh,
+    target: &Mesh,
+    landmarks: &[Landmark],
+    conformal_sphere: bool,
+) -> Result<InitialMap, RegisterError> {
     let topology = check_topology(source, target)?;
     let target_index = SurfaceIndex::new(target)?;
     let marks = landmarks::resolve(source, target, &target_index, landmarks)?;
     let mut notes = Vec::new();
     let mut teichmueller_bound = None;
     let route = route(topology, marks.len());
+    let mut domain = TargetDomain::Other;
     let (mut points, honoured) = match topology {
-        Topology::Disk => disk::map(source, target, &marks, &mut notes)?,
-        Topology::Sphere => sphere::map(source, target, &target_index, &marks, &mut notes)?,
+        Topology::Disk => {
+            let routed = disk::map(source, target, &marks, &mut notes)?;
+            domain = TargetDomain::Disk(routed.domain);
+            (routed.points, routed.honoured)
+        }
+        Topology::Sphere => {
+            let routed = sphere::map(
+                source,
+                target,
+                &target_index,
+                &marks,
+                conformal_sphere,
+                &mut notes,
+            )?;
+            domain = TargetDomain::Sphere(routed.domain);
+            (routed.points, routed.honoured)
+        }
         Topology::Torus => {
             let torus = torus::map(source, target, &marks, &mut notes)?;
             teichmueller_bound = Some(torus.teichmueller_bound);
@@ -182,7 +217,77 @@ pub fn initial_map(
         distortion,
         route,
         teichmueller_bound,
+        domain,
+        marks,
     })
+}
+
+/// What a road of [`initial_map`] gives: the source's images on the target, the
+/// landmarks it honours exactly (indices into the resolved landmarks) and the target's
+/// parameterization it composed with.
+pub(crate) struct Routed<D> {
+    pub points: Vec<SurfacePoint>,
+    pub honoured: Vec<usize>,
+    pub domain: D,
+}
+
+/// The target's parameterization an initial map composed with, kept for a later
+/// feature match.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum TargetDomain {
+    /// The target's disk, per target vertex.
+    Disk(Vec<num_complex::Complex64>),
+    /// The target's sphere map, per target vertex.
+    Sphere(Vec<beltrami_mesh::Vector3<f64>>),
+    /// A road that keeps none.
+    Other,
+}
+
+/// The registration `points` bent in the common domain of `initial` so that `features`
+/// match, the landmarks held: on the disk and the sphere (see [`check_features`]).
+///
+/// # Errors
+/// [`RegisterError::Features`] on another road; the errors of the matching.
+pub(crate) fn match_features_after(
+    source: &Mesh,
+    target: &Mesh,
+    initial: &InitialMap,
+    points: &[SurfacePoint],
+    features: &Features,
+    notes: &mut Vec<String>,
+) -> Result<Vec<SurfacePoint>, RegisterError> {
+    let marks = &initial.marks;
+    match &initial.domain {
+        TargetDomain::Disk(param) => {
+            disk::match_features_after(source, target, param, points, marks, features, notes)
+        }
+        TargetDomain::Sphere(sphere) => {
+            sphere::match_features_after(source, target, sphere, points, marks, features, notes)
+        }
+        TargetDomain::Other => Err(RegisterError::Features {
+            reason: "they are matched on disks and closed genus-0 surfaces".to_string(),
+        }),
+    }
+}
+
+/// Refuses features on a topology whose road does not match them, or fields that do
+/// not fit the meshes ([`Features::check`]).
+pub(crate) fn check_features(
+    topology: Topology,
+    features: &Features,
+    source: &Mesh,
+    target: &Mesh,
+) -> Result<(), RegisterError> {
+    if !matches!(topology, Topology::Disk | Topology::Sphere) {
+        return Err(RegisterError::Features {
+            reason: format!(
+                "they are matched on disks and closed genus-0 surfaces; these meshes are {topology}"
+            ),
+        });
+    }
+    features
+        .check(source, target)
+        .map_err(|reason| RegisterError::Features { reason })
 }
 
 /// The road of [`initial_map`] for `topology` with `landmarks` landmarks, in words.

@@ -3,21 +3,26 @@
 use std::sync::LazyLock;
 
 use beltrami_core::{
-    Accepts, Constraint, ConstraintKind, Constraints, Context, Element, GoalKind, LandmarkResidual,
-    Map, OptionKind, OptionSpec, Position, Problem, Report, Settings, Solution, Solver,
-    SolverError, Target, TargetKind, solve_renumbered,
+    Accepts, Constraint, ConstraintKind, Constraints, Context, Element, Features, Goal, GoalKind,
+    LandmarkResidual, Map, OptionKind, OptionSpec, OptionValue, Position, Problem, Report,
+    Settings, Solution, Solver, SolverError, Target, TargetKind, solve_renumbered,
 };
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::compose::flipped_faces;
-use crate::{Landmark, LandmarkTarget, RegisterError, check_topology, initial_map};
+use crate::{
+    InitialMap, Landmark, LandmarkTarget, RegisterError, check_topology, initial_map_for,
+    match_features_after,
+};
 
 /// Surface registration: the initial bijection of [`initial_map`] (through a common
 /// parameter domain chosen by the topology, aligned by the landmarks), then the discrete
 /// Beltrami flow on the target mesh ([`beltrami_flow_engine::solve`] with `Target::Mesh`).
 ///
-/// Reads: `target` (`Mesh` only), `goal` (`Conformal { p >= 2 }` or `Prescribed`),
+/// Reads: `target` (`Mesh` only), `goal` (`Conformal { p >= 2 }`, `Prescribed`, or
+/// `Features`: fields matched in the common domain, then no flow, which would pull the
+/// map back towards conformal),
 /// landmarks (each with a `Position::Spatial` on the target; the vertex is pulled there
 /// and held), open curves (feature curves: a source chain onto a target chain, ends
 /// fixed, sliding between), and the flow's options. The map is `Map::OnMesh`. The
@@ -46,6 +51,7 @@ const ACCEPTS: Accepts = Accepts {
         GoalKind::Conformal,
         GoalKind::ConformalLp,
         GoalKind::Prescribed,
+        GoalKind::Features,
     ],
     constraints: &[ConstraintKind::Landmark, ConstraintKind::OpenCurve],
 };
@@ -273,6 +279,15 @@ impl Solver for Register {
             }
         }
         landmarks(problem)?;
+        if let Goal::Features(features) = &problem.goal {
+            if problem.constraints.curves().next().is_some() {
+                return Err(unsupported(
+                    "feature curves and feature fields together are not matched yet: give landmarks along the curves instead",
+                ));
+            }
+            let topology = check_topology(problem.source, target).map_err(plugin)?;
+            crate::check_features(topology, features, problem.source, target).map_err(plugin)?;
+        }
         crate::consistency::check(problem, target).map_err(|error| SolverError::Plugin {
             solver: NAME,
             error: Box::new(error),
@@ -290,6 +305,45 @@ impl Solver for Register {
     }
 }
 
+/// The conformal registration `solution` of `flow` bent in the common domain so that
+/// `features` match (module `feature_match`), then measured by the flow engine with no
+/// step (a step would pull it back towards conformal).
+fn after_features(
+    flow: &Problem<'_>,
+    initial: &InitialMap,
+    features: &Features,
+    solution: Solution,
+    context: &mut Context<'_>,
+) -> Result<Solution, SolverError> {
+    let Target::Mesh(target) = flow.target else {
+        return Err(unsupported("register maps onto a target mesh"));
+    };
+    let Some(Map::OnMesh(points)) = solution.map() else {
+        return Ok(solution);
+    };
+    let mut report = solution.report.clone();
+    let mut notes = Vec::new();
+    let matched = context.stage("feature match", &mut report, || {
+        match_features_after(flow.source, target, initial, points, features, &mut notes)
+            .map_err(plugin)
+    })?;
+    report.notes.extend(notes);
+    let mut measure = flow.clone();
+    let positions = matched.iter().map(|p| p.position(target)).collect();
+    measure.initial = Some(Map::OnMesh(matched));
+    measure.options.set("max-iters", OptionValue::Int(0));
+    let measure_settings =
+        Settings::resolve(NAME, &OPTIONS, &measure.options).map_err(SolverError::from)?;
+    let mut measured =
+        beltrami_flow_engine::solve(&measure, &measure_settings, positions, report, context)?;
+    // The measuring run took no step by design: its stop is not news.
+    measured
+        .report
+        .notes
+        .retain(|n| !n.starts_with("stopped at the iteration limit (0)"));
+    Ok(measured)
+}
+
 /// The registration of `problem`, in the numbering of its meshes ([`Register`]).
 pub(crate) fn register(
     problem: &Problem<'_>,
@@ -302,11 +356,20 @@ pub(crate) fn register(
     let source = problem.source;
     let marks = landmarks(problem)?;
     let mut report = Report::new(NAME);
+    let features = match &problem.goal {
+        Goal::Features(features) => Some(features),
+        _ => None,
+    };
     let initial = context.stage("initial map", &mut report, || {
-        initial_map(source, target, &marks).map_err(plugin)
+        initial_map_for(source, target, &marks, features.is_some()).map_err(plugin)
     })?;
     report.notes.extend(initial.notes.iter().cloned());
     let mut flow = problem.clone();
+    // With features the flow gives the conformal registration they start from.
+    flow.goal = match &problem.goal {
+        Goal::Features(_) => Goal::default(),
+        goal => goal.clone(),
+    };
     // The flow holds each landmark where the initial map put it, on its target: the
     // closest point of the target to the given point (the flow would pull a vertex
     // towards the given point itself, off the surface).
@@ -324,9 +387,12 @@ pub(crate) fn register(
         });
     }
     flow.constraints = held;
-    flow.initial = Some(Map::OnMesh(initial.points));
+    flow.initial = Some(Map::OnMesh(initial.points.clone()));
     let mut solution =
-        beltrami_flow_engine::solve(&flow, settings, initial.positions, report, context)?;
+        beltrami_flow_engine::solve(&flow, settings, initial.positions.clone(), report, context)?;
+    if let Some(features) = features {
+        solution = after_features(&flow, &initial, features, solution, context)?;
+    }
     // Judged against the target's normals at the images (the rule of `beltrami
     // distortion --target` and of the flow), when the initial map was built.
     solution.metrics.initial_distortion = Some(initial.distortion);

@@ -27,20 +27,22 @@
 //! onto the sphere. The map is exact at every landmark and, with no flipped face in the
 //! chart, a bijection of the sphere.
 
-use beltrami_core::{Context, Map, Problem, Solver, SolverError, Target};
+use beltrami_core::{Context, Features, Map, Problem, Solver, SolverError, Target};
 use beltrami_fem::Frame;
 use beltrami_init::Sphere;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
+use crate::Routed;
 use crate::compose;
 use crate::error::{RegisterError, Side};
+use crate::feature_match::match_features;
 use crate::landmark_match::match_landmarks;
 use crate::landmarks::{
     Moebius, Resolved, SpatialMatch, best_rotation, interpolate, rotation_between,
 };
-use crate::param::{domain_mesh, each_mesh};
+use crate::param::{domain_mesh, each_mesh, planar_points};
 
 /// Source vertices used by the rotation fit at most.
 const FIT_SAMPLES: usize = 4096;
@@ -48,19 +50,20 @@ const FIT_SAMPLES: usize = 4096;
 /// Triples of landmarks tried for the Moebius transformation at most.
 const MOEBIUS_TRIALS: usize = 200;
 
-/// The source's images on the target and the landmarks honoured exactly (indices into
-/// `marks`).
+/// The source's images on the target, the landmarks honoured exactly (indices into
+/// `marks`) and the target's sphere map (per target vertex).
 pub(crate) fn map(
     source: &Mesh,
     target: &Mesh,
     target_index: &SurfaceIndex<'_>,
     marks: &[Resolved],
+    conformal: bool,
     notes: &mut Vec<String>,
-) -> Result<(Vec<SurfacePoint>, Vec<usize>), RegisterError> {
+) -> Result<Routed<Vec<Vector3<f64>>>, RegisterError> {
     // The Tutte start, which the flow from a map without landmarks was tuned from; with
     // landmarks the matching is done on the sphere, where the conformal start makes the
-    // composition nearly conformal by itself.
-    let start = if marks.is_empty() {
+    // composition nearly conformal by itself (asked for by `conformal` as well).
+    let start = if marks.is_empty() && !conformal {
         "tutte"
     } else {
         "conformal"
@@ -124,7 +127,7 @@ pub(crate) fn map(
     let images = if marks.is_empty() {
         aligned
     } else {
-        match_on_sphere(source, &aligned, marks, &t, notes)?
+        match_on_sphere(source, &aligned, marks, &t, None, notes)?
     };
 
     let domain = domain_mesh(
@@ -139,7 +142,43 @@ pub(crate) fn map(
             "sphere: {fallbacks} source images were located by closest point instead of along the ray (quads or a target sphere map with inward faces)"
         ));
     }
-    Ok((located, (0..marks.len()).collect()))
+    Ok(Routed {
+        points: located,
+        honoured: (0..marks.len()).collect(),
+        domain: target_sphere,
+    })
+}
+
+/// The registration `points` (a bijection of the spheres, the landmarks exact) bent on
+/// the sphere so that `features` match (module `feature_match`): in the stereographic
+/// chart of [`match_on_sphere`], with the landmarks held; `target_sphere` is the
+/// target's sphere map.
+pub(crate) fn match_features_after(
+    source: &Mesh,
+    target: &Mesh,
+    target_sphere: &[Vector3<f64>],
+    points: &[SurfacePoint],
+    marks: &[Resolved],
+    features: &Features,
+    notes: &mut Vec<String>,
+) -> Result<Vec<SurfacePoint>, RegisterError> {
+    let on_sphere = |p: &SurfacePoint| interpolate(target, target_sphere, p).normalize();
+    let aligned: Vec<Vector3<f64>> = points.iter().map(on_sphere).collect();
+    let targets: Vec<Vector3<f64>> = marks.iter().map(|m| on_sphere(&m.target)).collect();
+    let fields = SphereFields {
+        features,
+        target,
+        target_sphere,
+    };
+    let images = match_on_sphere(source, &aligned, marks, &targets, Some(fields), notes)?;
+    let domain = domain_mesh(
+        target,
+        target_sphere.iter().map(|v| Point3::from(*v)).collect(),
+        Side::Target,
+    )?;
+    let images: Vec<Point3<f64>> = images.iter().map(|v| Point3::from(*v)).collect();
+    let (located, _) = compose::locate_radial(&domain, &images)?;
+    Ok(located)
 }
 
 /// The Moebius transformation through three of the landmarks (from their source
@@ -216,6 +255,7 @@ fn match_on_sphere(
     aligned: &[Vector3<f64>],
     marks: &[Resolved],
     targets: &[Vector3<f64>],
+    fields: Option<SphereFields<'_>>,
     notes: &mut Vec<String>,
 ) -> Result<Vec<Vector3<f64>>, RegisterError> {
     let Pole {
@@ -252,23 +292,73 @@ fn match_on_sphere(
     // Every vertex of a closed surface has other faces: the ids are kept.
     debug_assert!(punctured.vertex_map().is_identity());
     let initial: Vec<Complex64> = aligned.iter().map(chart).collect();
-    let matched = match_landmarks(&punctured, Frame::Face, &initial, &fixed, &[], Side::Source)?;
-    if matched.flipped > 0 {
-        return Err(RegisterError::LandmarkFolds {
-            domain: "sphere",
-            flipped: matched.flipped,
-            steps: matched.steps,
-        });
+    let mut map = if marks.is_empty() {
+        initial
+    } else {
+        let matched =
+            match_landmarks(&punctured, Frame::Face, &initial, &fixed, &[], Side::Source)?;
+        if matched.flipped > 0 {
+            return Err(RegisterError::LandmarkFolds {
+                domain: "sphere",
+                flipped: matched.flipped,
+                steps: matched.steps,
+            });
+        }
+        notes.push(format!(
+            "sphere: every landmark matched on the sphere in the chart from source face {} (mean |mu| of the matching {:.4}, {} smoothing steps)",
+            source.face_to_input(pole),
+            matched.mean_mu,
+            matched.steps
+        ));
+        matched.map
+    };
+    if let Some(fields) = fields {
+        // The target in the same chart, punctured at the face the pole falls in.
+        let sphere_mesh = domain_mesh(
+            fields.target,
+            fields
+                .target_sphere
+                .iter()
+                .map(|v| Point3::from(*v))
+                .collect(),
+            Side::Target,
+        )?;
+        let (at_pole, _) = compose::locate_radial(&sphere_mesh, &[Point3::from(centre)])?;
+        let pole_face = at_pole.first().map_or(FaceId(0), |p| p.face);
+        let punctured_target =
+            fields
+                .target
+                .punctured(pole_face)
+                .map_err(|error| RegisterError::Mesh {
+                    side: Side::Target,
+                    error,
+                })?;
+        let chart_target: Vec<Complex64> = fields.target_sphere.iter().map(chart).collect();
+        let domain = domain_mesh(
+            &punctured_target,
+            planar_points(&chart_target),
+            Side::Target,
+        )?;
+        let matched = match_features(
+            &punctured,
+            &map,
+            &fixed,
+            &fields.features.source,
+            &domain,
+            &fields.features.target,
+            Side::Source,
+        )?;
+        notes.push(format!(
+            "sphere: features matched in the chart from source face {}: mismatch {:.4} -> {:.4} (mean squared difference of the standardized fields) in {} steps",
+            source.face_to_input(pole),
+            matched.before,
+            matched.after,
+            matched.steps
+        ));
+        map = matched.map;
     }
-    notes.push(format!(
-        "sphere: every landmark matched on the sphere in the chart from source face {} (mean |mu| of the matching {:.4}, {} smoothing steps)",
-        source.face_to_input(pole),
-        matched.mean_mu,
-        matched.steps
-    ));
     let back = r.transpose();
-    Ok(matched
-        .map
+    Ok(map
         .iter()
         .map(|f| {
             let w = f.conj();
@@ -276,6 +366,14 @@ fn match_on_sphere(
             back * Vector3::new(2.0 * w.re, 2.0 * w.im, n - 1.0) / (n + 1.0)
         })
         .collect())
+}
+
+/// The fields of a feature match on the sphere: the features and the target with its
+/// sphere map.
+struct SphereFields<'a> {
+    features: &'a Features,
+    target: &'a Mesh,
+    target_sphere: &'a [Vector3<f64>],
 }
 
 /// The face of a stereographic chart: its centroid direction on the sphere and the

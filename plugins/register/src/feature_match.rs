@@ -1,0 +1,473 @@
+//! Scalar fields matched in a planar parameter domain: the intensity part of the
+//! landmark- and intensity-based registration of Lam and Lui (K. C. Lam, L. M. Lui,
+//! SIAM J. Imaging Sci. 7, 2014, section 5), with bijectivity kept through the Beltrami
+//! coefficient.
+//!
+//! The source mesh has a bijective map `f` into the plane (its chart of the common
+//! domain) and a field `I` per source vertex; the target's chart is a planar mesh with a
+//! field `J` per vertex, linear on each triangle. The mismatch is
+//! `E(f) = sum_i a_i (I_i - J(f(v_i)))^2 / sum_i a_i` (`a_i` a third of the area of the
+//! source faces around `v_i`), both fields standardized first (mean 0, standard
+//! deviation 1 over their vertices), so that they may come in different units.
+//!
+//! Each step moves every free vertex by the demons force of Thirion (Med. Image Anal.
+//! 2, 1998), the step of Lam and Lui's intensity term:
+//! `u_i = r_i g_i / (|g_i|^2 + alpha^2 r_i^2)` with `r_i = I_i - J(f(v_i))` and
+//! `g_i = grad J` at `f(v_i)`, so `|u_i| <= 1 / (2 alpha)`: `alpha` is set so that no
+//! vertex moves more than the median edge of the chart in one step. The force is
+//! smoothed over vertex neighbours (a Gaussian-like regularization of the
+//! displacement), the moved map's Beltrami coefficient smoothed and cut to
+//! `|nu| <= 0.8`, and the map rebuilt from it with the held vertices in place
+//! ([`Reconstruction`]): a map with `|mu| < 1` everywhere, so no fold. A step is kept
+//! when it lowers `E` and flips nothing; otherwise the step length is halved. The steps
+//! end when `E` falls by less than `1e-3` of its first value, after `MAX_STEPS`, or
+//! when the step length is below `1/8`.
+
+use beltrami_fem::Frame;
+use beltrami_mesh::{FaceId, Mesh, SurfacePoint, VertexId};
+use beltrami_spatial::SurfaceIndex;
+use num_complex::Complex64;
+
+use crate::error::{RegisterError, Side};
+use crate::landmark_match::Reconstruction;
+use crate::param::planar_points;
+
+/// Steps at most.
+const MAX_STEPS: usize = 200;
+
+/// Passes of neighbour averaging of both fields, coarse to fine: each scale's match
+/// starts from the last, so that features farther apart than the fine fields' reach are
+/// brought together first.
+const SCALES: [usize; 3] = [32, 8, 0];
+
+/// Passes of edge-neighbour averaging applied to the moved map's coefficient.
+const MU_SMOOTHING: usize = 8;
+
+/// Passes of neighbour averaging applied to the force.
+const FORCE_SMOOTHING: usize = 16;
+
+/// A step that lowers the mismatch by less than this fraction of the first value ends
+/// the matching.
+const STALL: f64 = 1e-4;
+
+/// The smallest step length tried.
+const MIN_STEP: f64 = 0.125;
+
+/// A map that matches the fields and how far it got.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FeatureMatch {
+    /// The image of every source vertex in the chart; held vertices at their values.
+    pub map: Vec<Complex64>,
+    /// Steps kept.
+    pub steps: usize,
+    /// The mismatch `E` (module docs) of the given map and of the returned one.
+    pub before: f64,
+    pub after: f64,
+}
+
+/// The source's chart map `initial` (bijective, one value per vertex of `mesh`) bent so
+/// that `source_values` (per vertex of `mesh`) matches `domain_values` (per vertex of
+/// the planar mesh `domain`, the target's chart) with the vertices of `fixed` held
+/// (module docs).
+///
+/// # Errors
+/// The errors of [`Reconstruction`]; [`RegisterError::Spatial`] when the chart cannot be
+/// searched.
+pub(crate) fn match_features(
+    mesh: &Mesh,
+    initial: &[Complex64],
+    fixed: &[(VertexId, Complex64)],
+    source_values: &[f64],
+    domain: &Mesh,
+    domain_values: &[f64],
+    side: Side,
+) -> Result<FeatureMatch, RegisterError> {
+    let weights = vertex_areas(mesh);
+    let mut held = vec![false; mesh.vertex_count()];
+    for &(v, _) in fixed {
+        if let Some(h) = held.get_mut(v.idx()) {
+            *h = true;
+        }
+    }
+    let neighbours = vertex_neighbours(mesh);
+    let domain_neighbours = vertex_neighbours(domain);
+    // Smoothing passes on the target that give the same scale as on the source: the
+    // reach of `k` passes grows as `h sqrt(k)`, with `h^2` about the area per vertex.
+    let ratio = domain.vertex_count() as f64 / mesh.vertex_count().max(1) as f64;
+    let alpha = 0.5 / median_edge(mesh, initial).max(f64::MIN_POSITIVE);
+    let (mut reconstruction, _) =
+        Reconstruction::new(mesh, Frame::Face, initial, fixed, &[], side)?;
+    let exact_source = standardized(source_values);
+    let index = SurfaceIndex::new(domain)?;
+    let exact_target = TargetField::new(&index, domain, &standardized(domain_values));
+    let start = exact_target.probe(initial, None)?;
+    let before = mismatch(&exact_source, &start.values, &weights);
+
+    let mut map = initial.to_vec();
+    let mut steps = 0;
+    for passes in SCALES {
+        let target_passes = (passes as f64 * ratio).round() as usize;
+        let source_field = standardized(&smoothed(&neighbours, source_values, passes));
+        let target_field = TargetField::new(
+            &index,
+            domain,
+            &standardized(&smoothed(&domain_neighbours, domain_values, target_passes)),
+        );
+        let mut probe = target_field.probe(&map, Some(&start))?;
+        let mut energy = mismatch(&source_field, &probe.values, &weights);
+        let first = energy;
+        let mut length = 1.0;
+        let mut level_steps = 0;
+        while level_steps < MAX_STEPS && length >= MIN_STEP {
+            let force: Vec<Complex64> = (0..map.len())
+                .map(|i| {
+                    if held[i] {
+                        return Complex64::new(0.0, 0.0);
+                    }
+                    let r = source_field[i] - probe.values[i];
+                    let g = probe.gradients[i];
+                    let denominator = g.norm_sqr() + alpha * alpha * r * r;
+                    if denominator > 0.0 {
+                        g * (r / denominator)
+                    } else {
+                        Complex64::new(0.0, 0.0)
+                    }
+                })
+                .collect();
+            let force = smoothed_held(&neighbours, &held, force, FORCE_SMOOTHING);
+            let moved: Vec<Complex64> = map
+                .iter()
+                .zip(&force)
+                .map(|(z, u)| z + u * length)
+                .collect();
+            let (mu, _) = reconstruction.measure(&moved)?;
+            let nu = reconstruction.regularized(mu, MU_SMOOTHING);
+            let rebuilt = reconstruction.solve(&nu)?;
+            let (_, flipped) = reconstruction.measure(&rebuilt)?;
+            let trial = target_field.probe(&rebuilt, Some(&probe))?;
+            let trial_energy = mismatch(&source_field, &trial.values, &weights);
+            if flipped > 0 || trial_energy >= energy {
+                length *= 0.5;
+                continue;
+            }
+            let decrease = energy - trial_energy;
+            map = rebuilt;
+            probe = trial;
+            energy = trial_energy;
+            level_steps += 1;
+            if decrease < STALL * first {
+                break;
+            }
+        }
+        steps += level_steps;
+    }
+    let after = mismatch(
+        &exact_source,
+        &exact_target.probe(&map, Some(&start))?.values,
+        &weights,
+    );
+    Ok(FeatureMatch {
+        map,
+        steps,
+        before,
+        after,
+    })
+}
+
+/// The neighbours of every vertex, by index.
+fn vertex_neighbours(mesh: &Mesh) -> Vec<Vec<usize>> {
+    mesh.vertices()
+        .map(|v| mesh.vertex_neighbors(v).map(|w| w.idx()).collect())
+        .collect()
+}
+
+/// `values` after `passes` of averaging each vertex with its neighbours.
+fn smoothed(neighbours: &[Vec<usize>], values: &[f64], passes: usize) -> Vec<f64> {
+    let mut values = values.to_vec();
+    for _ in 0..passes {
+        values = (0..values.len())
+            .map(|i| {
+                let sum: f64 = neighbours[i].iter().map(|&j| values[j]).sum();
+                (values[i] + sum) / (1 + neighbours[i].len()) as f64
+            })
+            .collect();
+    }
+    values
+}
+
+/// `values` after `passes` of neighbour averaging, the `held` vertices kept.
+fn smoothed_held(
+    neighbours: &[Vec<usize>],
+    held: &[bool],
+    mut values: Vec<Complex64>,
+    passes: usize,
+) -> Vec<Complex64> {
+    for _ in 0..passes {
+        values = (0..values.len())
+            .map(|i| {
+                if held[i] {
+                    return values[i];
+                }
+                let sum: Complex64 = neighbours[i].iter().map(|&j| values[j]).sum();
+                (values[i] + sum) / (1 + neighbours[i].len()) as f64
+            })
+            .collect();
+    }
+    values
+}
+
+/// `values` with their mean subtracted, divided by their standard deviation (left
+/// centred when it is 0).
+fn standardized(values: &[f64]) -> Vec<f64> {
+    let n = values.len().max(1) as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let deviation = (values.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt();
+    let scale = if deviation > 0.0 {
+        1.0 / deviation
+    } else {
+        1.0
+    };
+    values.iter().map(|x| (x - mean) * scale).collect()
+}
+
+/// A third of the area of the faces around each vertex.
+fn vertex_areas(mesh: &Mesh) -> Vec<f64> {
+    let mut areas = vec![0.0; mesh.vertex_count()];
+    for f in mesh.faces() {
+        let third = mesh.face_area(f) / mesh.face_degree(f) as f64;
+        for v in mesh.face_vertices(f) {
+            areas[v.idx()] += third;
+        }
+    }
+    areas
+}
+
+/// The median length of the edges of `mesh` under the planar map `map`.
+fn median_edge(mesh: &Mesh, map: &[Complex64]) -> f64 {
+    let mut lengths: Vec<f64> = mesh
+        .edges()
+        .map(|e| {
+            let [a, b] = mesh.edge_vertices(e);
+            (map[a.idx()] - map[b.idx()]).norm()
+        })
+        .collect();
+    if lengths.is_empty() {
+        return 0.0;
+    }
+    let middle = lengths.len() / 2;
+    *lengths.select_nth_unstable_by(middle, f64::total_cmp).1
+}
+
+/// The area-weighted mean squared difference of two fields.
+fn mismatch(source: &[f64], at_images: &[f64], weights: &[f64]) -> f64 {
+    let total: f64 = weights.iter().sum();
+    source
+        .iter()
+        .zip(at_images)
+        .zip(weights)
+        .map(|((a, b), w)| w * (a - b).powi(2))
+        .sum::<f64>()
+        / total.max(f64::MIN_POSITIVE)
+}
+
+/// The target's field on its chart: values at the vertices, linear on each triangle.
+struct TargetField<'d> {
+    index: &'d SurfaceIndex<'d>,
+    domain: &'d Mesh,
+    values: Vec<f64>,
+    /// The gradient of the linear interpolant on each face, as `d/dx + i d/dy`.
+    gradients: Vec<Complex64>,
+}
+
+/// The target's field and its gradient at the images of the source's vertices, and the
+/// faces the images are in.
+struct Probe {
+    values: Vec<f64>,
+    gradients: Vec<Complex64>,
+    faces: Vec<FaceId>,
+}
+
+impl<'d> TargetField<'d> {
+    fn new(index: &'d SurfaceIndex<'d>, domain: &'d Mesh, values: &[f64]) -> Self {
+        let gradients = domain
+            .faces()
+            .map(|f| {
+                let (vs, _) = domain.face_vertex_array(f);
+                let p = |k: usize| domain.position(vs[k]);
+                let (a, b, c) = (p(0), p(1), p(2));
+                let (e1, e2) = (b - a, c - a);
+                let (d1, d2) = (
+                    values[vs[1].idx()] - values[vs[0].idx()],
+                    values[vs[2].idx()] - values[vs[0].idx()],
+                );
+                // [e1; e2] g = [d1; d2] by Cramer's rule.
+                let det = e1.x * e2.y - e1.y * e2.x;
+                if det == 0.0 {
+                    return Complex64::new(0.0, 0.0);
+                }
+                Complex64::new((d1 * e2.y - d2 * e1.y) / det, (e1.x * d2 - e2.x * d1) / det)
+            })
+            .collect();
+        Self {
+            index,
+            domain,
+            values: values.to_vec(),
+            gradients,
+        }
+    }
+
+    /// The field and its gradient at the images `map`: each image found by a walk from
+    /// its face in `near` (the last probe's, when given), or by the index.
+    fn probe(&self, map: &[Complex64], near: Option<&Probe>) -> Result<Probe, RegisterError> {
+        let walked: Vec<Option<SurfacePoint>> = match near {
+            Some(near) => map
+                .iter()
+                .zip(&near.faces)
+                .map(|(&z, &face)| walk(self.domain, z, face))
+                .collect(),
+            None => vec![None; map.len()],
+        };
+        let lost: Vec<usize> = (0..map.len()).filter(|&i| walked[i].is_none()).collect();
+        let found = self.index.locate_all(&planar_points(
+            &lost.iter().map(|&i| map[i]).collect::<Vec<_>>(),
+        ))?;
+        let mut points = walked;
+        for (&i, l) in lost.iter().zip(found) {
+            points[i] = Some(l.point);
+        }
+        let mut probe = Probe {
+            values: Vec::with_capacity(map.len()),
+            gradients: Vec::with_capacity(map.len()),
+            faces: Vec::with_capacity(map.len()),
+        };
+        for point in points.into_iter().flatten() {
+            let (vs, degree) = self.domain.face_vertex_array(point.face);
+            probe.values.push(
+                (0..degree)
+                    .map(|k| point.coords[k] * self.values[vs[k].idx()])
+                    .sum(),
+            );
+            probe.gradients.push(self.gradients[point.face.idx()]);
+            probe.faces.push(point.face);
+        }
+        Ok(probe)
+    }
+}
+
+/// Faces a walk crosses at most before the index takes over.
+const MAX_WALK: usize = 64;
+
+/// The point `z` of the planar triangle mesh `domain`, found by walking from face
+/// `start` across the edge opposite the most negative barycentric coordinate; `None`
+/// when the walk leaves the mesh or does not end.
+fn walk(domain: &Mesh, z: Complex64, start: FaceId) -> Option<SurfacePoint> {
+    let mut face = start;
+    for _ in 0..MAX_WALK {
+        let (vs, degree) = domain.face_vertex_array(face);
+        if degree != 3 {
+            return None;
+        }
+        let p: Vec<Complex64> = vs[..3]
+            .iter()
+            .map(|&v| {
+                let q = domain.position(v);
+                Complex64::new(q.x, q.y)
+            })
+            .collect();
+        let cross = |a: Complex64, b: Complex64| (a.conj() * b).im;
+        let area = cross(p[1] - p[0], p[2] - p[0]);
+        if area == 0.0 {
+            return None;
+        }
+        let l = [
+            cross(p[1] - z, p[2] - z) / area,
+            cross(p[2] - z, p[0] - z) / area,
+            cross(p[0] - z, p[1] - z) / area,
+        ];
+        let k = (0..3).min_by(|&a, &b| l[a].total_cmp(&l[b]))?;
+        if l[k] >= -1e-12 {
+            let clamped = l.map(|x| x.max(0.0));
+            let sum: f64 = clamped.iter().sum();
+            return Some(SurfacePoint::in_triangle(face, clamped.map(|x| x / sum)));
+        }
+        // The edge opposite corner k runs from corner k + 1 to corner k + 2.
+        let from = vs[(k + 1) % 3];
+        let h = domain
+            .face_halfedges(face)
+            .find(|&h| domain.origin(h) == from)?;
+        face = domain.face(domain.twin(h))?;
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use beltrami_mesh::primitives::{Cells, grid};
+
+    #[test]
+    fn a_shifted_bump_is_moved_onto_its_target() {
+        // The source is the unit square with a bump centred at (0.45, 0.5); the
+        // target's chart is the same square with the bump at (0.55, 0.5). With the
+        // boundary held, the matching moves the bump's centre towards (0.55, 0.5) and
+        // lowers the mismatch by most of it, with no fold.
+        let square = Mesh::from_soup(&grid(24, 24, Cells::Triangles)).unwrap();
+        let bump = |x: f64, y: f64, cx: f64| (-((x - cx).powi(2) + (y - 0.5).powi(2)) / 0.02).exp();
+        let identity: Vec<Complex64> = square
+            .positions()
+            .iter()
+            .map(|p| Complex64::new(p.x, p.y))
+            .collect();
+        let source: Vec<f64> = square
+            .positions()
+            .iter()
+            .map(|p| bump(p.x, p.y, 0.45))
+            .collect();
+        let target: Vec<f64> = square
+            .positions()
+            .iter()
+            .map(|p| bump(p.x, p.y, 0.55))
+            .collect();
+        let fixed: Vec<(VertexId, Complex64)> = square
+            .vertices()
+            .filter(|&v| square.is_boundary_vertex(v))
+            .map(|v| (v, identity[v.idx()]))
+            .collect();
+        let matched = match_features(
+            &square,
+            &identity,
+            &fixed,
+            &source,
+            &square,
+            &target,
+            Side::Source,
+        )
+        .unwrap();
+        assert!(matched.steps > 0);
+        assert!(
+            matched.after < 0.2 * matched.before,
+            "{} -> {}",
+            matched.before,
+            matched.after
+        );
+        let centre = square
+            .vertices()
+            .min_by(|&a, &b| {
+                let d = |v: VertexId| {
+                    let p = square.position(v);
+                    (p.x - 0.45).powi(2) + (p.y - 0.5).powi(2)
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap();
+        let image = matched.map[centre.idx()];
+        assert!(
+            (image - Complex64::new(0.55, 0.5)).norm() < 0.03,
+            "the bump's centre went to {image}"
+        );
+        let (reconstruction, _) =
+            Reconstruction::new(&square, Frame::Face, &identity, &fixed, &[], Side::Source)
+                .unwrap();
+        assert_eq!(reconstruction.measure(&matched.map).unwrap().1, 0);
+    }
+}
