@@ -527,6 +527,7 @@ def register(
     landmarks: Any = None,
     mu: Optional[ArrayLike] = None,
     p: Optional[float] = None,
+    features: Optional[Tuple[Any, Any]] = None,
     tolerance: Optional[float] = None,
     max_iters: Optional[int] = None,
     threads: Optional[int] = None,
@@ -544,14 +545,34 @@ def register(
     (Wong-Zhao 2014). ``landmarks`` is a landmarks file (``v``, ``p`` and ``c`` lines) or
     pairs ``(src, tgt)`` / ``(src, (x, y, z))``; every landmark is exact, or the call
     raises naming the farthest (``allow_missed_landmarks=True`` keeps the map; the
-    report's ``landmarks`` lists each distance).
+    report's ``landmarks`` lists each distance). ``features=(fs, ft)`` matches a scalar
+    field given on both meshes (arrays with one value per row of ``V`` and of ``TV``, or
+    ``"mean-curvature"``): the conformal registration is bent in the common domain until
+    the fields agree, the landmarks held (disks and closed genus-0 surfaces).
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/spot.obj")
+    >>> P, face, bary = beltrami.register(V, F, V, F, features=(V[:, 2], V[:, 2]))
+    >>> bool(np.abs(P - V).max() < 1e-6)
+    True
 
     Returns ``(P, face, bary)``: the image of every vertex ``(n, 3)``, the row of ``TF``
     it lies in and its barycentric coordinates there (``(n, 3)``, ``(n, 4)`` on quads).
     ``beltrami register`` (with ``--correspondence``)."""
+    if features is not None:
+        if mu is not None or p is not None:
+            raise OptionError("features start from the least-squares conformal map: give neither mu nor p")
+        try:
+            fs, ft = features
+        except (TypeError, ValueError):
+            raise OptionError("features=(source_field, target_field): two fields") from None
+        field = lambda x: x if isinstance(x, str) else [float(v) for v in np.asarray(x, dtype=float).ravel()]
+        goal = {"kind": "features", "source": field(fs), "target": field(ft)}
+    else:
+        goal = {"kind": "mu", "frame": "face"} if mu is not None else _goal(None, None, None, p)
     spec = {
         "target": "mesh",
-        "goal": {"kind": "mu", "frame": "face"} if mu is not None else _goal(None, None, None, p),
+        "goal": goal,
         "landmarks": _landmarks(landmarks),
         "options": _options(
             options,

@@ -11,7 +11,7 @@
 //! | `target` | `plane`, `disk`, `annulus`, `sphere`, `space`, `circle-domain`, `mesh` |
 //! | `boundary` | `plane`: `circle`, `square`, `free`, `keep` or `given` (`boundary_map`) |
 //! | `free_radius` | `annulus`: let the inner radius move (else the input's is kept) |
-//! | `goal` | `{"kind": "conformal", "p": P}`, `{"kind": "mu", "frame": F}` (`mu`), `{"kind": "mu_expr", "expr": E}`, `{"kind": "extremal"}` |
+//! | `goal` | `{"kind": "conformal", "p": P}`, `{"kind": "mu", "frame": F}` (`mu`), `{"kind": "mu_expr", "expr": E}`, `{"kind": "extremal"}`, `{"kind": "features", "source": S, "target": T}` (each a list of numbers per vertex row or `"mean-curvature"`) |
 //! | `pins` | input vertex indices held where the solver puts them |
 //! | `normal_constraint` | `space`: the weight of the normal constraint |
 //! | `area_constraint` | `space`: `true` keeps the area to first order |
@@ -31,8 +31,8 @@ use std::time::Instant;
 use beltrami::landmarks::Landmarks;
 use beltrami::map_file::{self, Image};
 use beltrami_core::{
-    Constraint, Context, Goal, Landmark, Map, Pin, PlanarBoundary, Position, Problem, Progress,
-    Solution, Target,
+    Constraint, Context, Features, Goal, Landmark, Map, Pin, PlanarBoundary, Position, Problem,
+    Progress, Solution, Target,
 };
 use beltrami_fem::{BeltramiField, Expr, Frame};
 use beltrami_mesh::Mesh;
@@ -113,7 +113,12 @@ fn target<'a>(
 }
 
 /// The goal of the description (the problem's default, the conformal map, without one).
-fn goal(spec: &JsonMap<String, Value>, mesh: &Mesh, inputs: &Inputs<'_>) -> PyResult<Option<Goal>> {
+fn goal(
+    spec: &JsonMap<String, Value>,
+    mesh: &Mesh,
+    target_mesh: Option<&Mesh>,
+    inputs: &Inputs<'_>,
+) -> PyResult<Option<Goal>> {
     let Some(goal) = spec.get("goal").and_then(Value::as_object) else {
         return Ok(None);
     };
@@ -161,8 +166,58 @@ fn goal(spec: &JsonMap<String, Value>, mesh: &Mesh, inputs: &Inputs<'_>) -> PyRe
             };
             Goal::Prescribed(field)
         }
+        Some("features") => {
+            let Some(target_mesh) = target_mesh else {
+                return Err(option_error(
+                    "features need the target mesh (TV, TF)".into(),
+                ));
+            };
+            Goal::Features(Features {
+                source: vertex_field(goal.get("source"), mesh, "source")?,
+                target: vertex_field(goal.get("target"), target_mesh, "target")?,
+            })
+        }
         other => return Err(option_error(format!("goal {other:?} is not a goal"))),
     }))
+}
+
+/// A field of `features=(source, target)`: `"mean-curvature"` or one number per row of
+/// the mesh's vertex array, returned per mesh vertex.
+fn vertex_field(value: Option<&Value>, mesh: &Mesh, side: &str) -> PyResult<Vec<f64>> {
+    let field_error = |message: String| errors::raise(Kind::Field, message);
+    match value {
+        Some(Value::String(name)) if name == "mean-curvature" => {
+            beltrami_fem::mean_curvature::mean_curvature(mesh)
+                .map_err(|e| field_error(format!("the {side} mean curvature: {e}")))
+        }
+        Some(Value::Array(values)) => {
+            let expected = mesh.vertex_map().input_len();
+            if values.len() != expected {
+                return Err(field_error(format!(
+                    "features: the {side} field has {} values, but its vertex array has {expected} rows",
+                    values.len()
+                )));
+            }
+            let numbers: Vec<f64> = values
+                .iter()
+                .enumerate()
+                .map(|(i, x)| {
+                    x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
+                        field_error(format!(
+                            "features: the {side} field's value {i} is not a finite number"
+                        ))
+                    })
+                })
+                .collect::<PyResult<_>>()?;
+            Ok(mesh
+                .vertices()
+                .map(|v| numbers[mesh.vertex_map().to_input(v)])
+                .collect())
+        }
+        _ => Err(field_error(format!(
+            "features: the {side} field is an array with one number per vertex, or 'mean-curvature'"
+        ))),
+    }
 }
 
 /// The constraints of the description: pins, the normal and area constraints, the held
@@ -365,7 +420,7 @@ pub fn solve<'py>(
     };
 
     let mut problem = Problem::new(&mesh, target(&spec, &mesh, target_mesh.as_ref(), &inputs)?);
-    if let Some(goal) = goal(&spec, &mesh, &inputs)? {
+    if let Some(goal) = goal(&spec, &mesh, target_mesh.as_ref(), &inputs)? {
         problem.goal = goal;
     }
     if let Some(initial) = &inputs.initial {

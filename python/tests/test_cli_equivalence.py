@@ -178,6 +178,39 @@ def test_register_matches_the_command_with_its_correspondence(cli, tmp_path):
     close(np.einsum("ij,ijk->ik", bary, TV[TF[face]]), P, 1e-12)
 
 
+def test_register_with_features_matches_the_command(cli, tmp_path):
+    # A field per vertex (a file for the command, an array in Python) and the computed
+    # mean curvature: the same map both ways, the fields' match reported.
+    source, target = MESHES / "spot.obj", MESHES / "blob.obj"
+    V, F = beltrami.read_mesh(source)
+    TV, TF = beltrami.read_mesh(target)
+    fs, ft = tmp_path / "fs.txt", tmp_path / "ft.txt"
+    fs.write_text("".join(f"{z!r}\n" for z in V[:, 2]))
+    ft.write_text("".join(f"{z!r}\n" for z in TV[:, 2]))
+    landmarks = tmp_path / "marks.txt"
+    landmarks.write_text("v 0 0\nv 700 300\nv 1500 900\n")
+    out = tmp_path / "out.obj"
+    cli("register", source, target, "--landmarks", landmarks, "--max-iters", "3",
+        "--features", fs, ft, "-o", out)
+    marks = [(0, 0), (700, 300), (1500, 900)]
+    P, face, bary, info = beltrami.register(V, F, TV, TF, landmarks=marks, max_iters=3,
+                                            features=(V[:, 2], TV[:, 2]), info=True)
+    close(P, positions_of(out))
+    assert any("features matched" in note for note in info["notes"])
+    assert info["flipped"] == 0
+    for (s, t) in marks:
+        close(P[s], TV[t], 1e-12)
+    out = tmp_path / "curvature.obj"
+    cli("register", source, target, "--max-iters", "3", "--features", "mean-curvature",
+        "mean-curvature", "-o", out)
+    P = beltrami.register(V, F, TV, TF, max_iters=3, features=("mean-curvature", "mean-curvature"))[0]
+    close(P, positions_of(out))
+    with pytest.raises(beltrami.FieldError, match="3 values"):
+        beltrami.register(V, F, TV, TF, features=([1.0, 2.0, 3.0], TV[:, 2]))
+    with pytest.raises(beltrami.OptionError, match="neither mu nor p"):
+        beltrami.register(V, F, TV, TF, p=4, features=(V[:, 2], TV[:, 2]))
+
+
 def test_register_of_a_multiply_connected_pair_matches_the_command(cli, generated, tmp_path):
     # Genus 0 with two boundary loops: the matched cut graphs of the initial map.
     source = generated("annulus", "1")

@@ -16,12 +16,20 @@
 //! `g_i = grad J` at `f(v_i)`, so `|u_i| <= 1 / (2 alpha)`: `alpha` is set so that no
 //! vertex moves more than the median edge of the chart in one step. The force is
 //! smoothed over vertex neighbours (a Gaussian-like regularization of the
-//! displacement), the moved map's Beltrami coefficient smoothed and cut to
-//! `|nu| <= 0.8`, and the map rebuilt from it with the held vertices in place
-//! ([`Reconstruction`]): a map with `|mu| < 1` everywhere, so no fold. A step is kept
-//! when it lowers `E` and flips nothing; otherwise the step length is halved. The steps
-//! end when `E` falls by less than `1e-3` of its first value, after `MAX_STEPS`, or
-//! when the step length is below `1/8`.
+//! displacement), the change of the Beltrami coefficient it makes smoothed and added to
+//! the map's own (each face cut to `|nu| <= 0.8`), and the map rebuilt from it with the
+//! held vertices in place ([`Reconstruction`]): a map with `|mu| < 1` everywhere, so
+//! no fold. A step is kept when it lowers `E` and flips nothing; otherwise the step
+//! length is halved.
+//!
+//! The fields are matched coarse to fine: first both smoothed (`SCALES`, passes of
+//! neighbour averaging, as many more on the target as it has more vertices per area),
+//! then less, then as given, each scale starting from the last's map. A scale ends when
+//! a step lowers its mismatch by less than `1e-4` of its first value, after
+//! `MAX_STEPS` steps, or when the step length falls below `1/8`.
+//!
+//! Figures (docs/benchmarks.md): fsaverage5 pial onto white with 24 landmarks and the
+//! sulcal depth on both, 2.75 mm -> 0.70 mm mean distance to the true correspondence.
 
 use beltrami_fem::Frame;
 use beltrami_mesh::{FaceId, Mesh, SurfacePoint, VertexId};
@@ -32,15 +40,15 @@ use crate::error::{RegisterError, Side};
 use crate::landmark_match::Reconstruction;
 use crate::param::planar_points;
 
-/// Steps at most.
-const MAX_STEPS: usize = 200;
+/// Steps per scale at most.
+const MAX_STEPS: usize = 60;
 
 /// Passes of neighbour averaging of both fields, coarse to fine: each scale's match
 /// starts from the last, so that features farther apart than the fine fields' reach are
 /// brought together first.
 const SCALES: [usize; 3] = [32, 8, 0];
 
-/// Passes of edge-neighbour averaging applied to the moved map's coefficient.
+/// Passes of edge-neighbour averaging applied to a step's change of coefficient.
 const MU_SMOOTHING: usize = 8;
 
 /// Passes of neighbour averaging applied to the force.
@@ -104,6 +112,7 @@ pub(crate) fn match_features(
     let before = mismatch(&exact_source, &start.values, &weights);
 
     let mut map = initial.to_vec();
+    let mut current_mu = reconstruction.measure(&map)?.0;
     let mut steps = 0;
     for passes in SCALES {
         let target_passes = (passes as f64 * ratio).round() as usize;
@@ -141,16 +150,20 @@ pub(crate) fn match_features(
                 .map(|(z, u)| z + u * length)
                 .collect();
             let (mu, _) = reconstruction.measure(&moved)?;
-            let nu = reconstruction.regularized(mu, MU_SMOOTHING);
+            let nu = reconstruction.regularized_step(&current_mu, &mu, MU_SMOOTHING);
             let rebuilt = reconstruction.solve(&nu)?;
             let (_, flipped) = reconstruction.measure(&rebuilt)?;
             let trial = target_field.probe(&rebuilt, Some(&probe))?;
             let trial_energy = mismatch(&source_field, &trial.values, &weights);
+            eprintln!(
+                "level {passes} len {length} flipped {flipped} e {energy:.4} -> {trial_energy:.4}"
+            );
             if flipped > 0 || trial_energy >= energy {
                 length *= 0.5;
                 continue;
             }
             let decrease = energy - trial_energy;
+            current_mu = reconstruction.measure(&rebuilt)?.0;
             map = rebuilt;
             probe = trial;
             energy = trial_energy;

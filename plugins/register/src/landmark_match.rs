@@ -216,6 +216,32 @@ impl<'m> Reconstruction<'m> {
         nu
     }
 
+    /// The coefficient of a step from a map with coefficient `current` towards one with
+    /// `moved`: the change smoothed over edge neighbours (`passes` times) and added to
+    /// `current`, each face cut to `|nu| <= K_MAX`. Only the change is smoothed: the
+    /// map's own fine structure (a folded surface's conformal map has much) is kept, and
+    /// a step of zero gives `current` back wherever `|current| <= K_MAX`.
+    pub(crate) fn regularized_step(
+        &self,
+        current: &[Complex64],
+        moved: &[Complex64],
+        passes: usize,
+    ) -> Vec<Complex64> {
+        let mut change: Vec<Complex64> = moved.iter().zip(current).map(|(m, c)| m - c).collect();
+        for _ in 0..passes {
+            change = self.neighbours.smooth(&change, &self.areas);
+        }
+        current
+            .iter()
+            .zip(change)
+            .map(|(&c, d)| {
+                let nu = c + d;
+                let r = nu.norm();
+                if r > K_MAX { nu * (K_MAX / r) } else { nu }
+            })
+            .collect()
+    }
+
     /// The area-weighted mean of `|mu|` (each face's value capped at 1).
     pub(crate) fn mean_mu(&self, mu: &[Complex64]) -> f64 {
         let total: f64 = self.areas.iter().sum();

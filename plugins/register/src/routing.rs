@@ -810,13 +810,16 @@ impl Drawing<'_> {
                 break;
             }
             let Some(dropped) = legs.pop() else {
+                let middle = arc.vertices[arc.vertices.len() / 2];
                 return Err(self.seams(format!(
-                    "no path on the other mesh for the cut graph's arc from vertex {} to vertex {} of the {} that avoids the arcs drawn before it",
+                    "no path on the other mesh for the cut graph's arc from vertex {} to vertex {} of the {} that avoids the arcs drawn before it (the arc goes round a handle or a hole the placement did not pair: a landmark at {} vertex {}, the arc's middle, with its partner on the other mesh ties that handle down)",
                     self.from.vertex_map().to_input(arc.vertices[0]),
                     self.from
                         .vertex_map()
                         .to_input(*arc.vertices.last().unwrap_or(&arc.vertices[0])),
-                    self.from_side
+                    self.from_side,
+                    self.from_side,
+                    self.from.vertex_map().to_input(middle),
                 )));
             };
             self.take(&dropped, &mut blocked, &mut used_edge, false);
