@@ -17,17 +17,15 @@
 //!   ([`crate::routing::check_boundary_landmarks`]).
 
 use beltrami_core::Problem;
-use beltrami_mesh::{Mesh, Point3, VertexId};
+use beltrami_mesh::{Mesh, VertexId};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::error::RegisterError;
+use crate::landmarks::SAME_POINT;
 
 /// The largest distance of a landmark point from the target, relative to the target's
 /// bounding-box diagonal.
 pub(crate) const FAR_OFF: f64 = 0.05;
-
-/// Two landmark points closer than this (relative to the diagonal) are one point.
-const SAME_POINT: f64 = 1e-9;
 
 /// Checks that the problem's landmarks and curves can be honoured together by a
 /// bijection onto `target` (module docs).
@@ -57,21 +55,16 @@ pub(crate) fn check(problem: &Problem<'_>, target: &Mesh) -> Result<(), Register
                 });
             }
             let q = found.position;
-            if let Some(j) = located
-                .iter()
-                .position(|other: &Point3<f64>| (other - q).norm() <= SAME_POINT * diagonal)
-            {
-                return Err(RegisterError::Landmark {
-                    index: i,
-                    vertex: mark.vertex,
-                    reason: format!(
-                        "it goes to the same target point as landmark {j} (source vertex {}): a bijection cannot map two vertices onto one point",
-                        marks[j].vertex
-                    ),
-                });
-            }
             located.push(q);
             points.push(found.point);
+        }
+        if let Some((j, i)) = crate::landmarks::coincident(&located, SAME_POINT * diagonal) {
+            return Err(crate::landmarks::same_point(
+                i,
+                marks[i].vertex,
+                j,
+                marks[j].vertex,
+            ));
         }
         if matches!(
             crate::Shape::of(problem.source).topology(),

@@ -109,37 +109,67 @@ pub(crate) fn resolve(
     Ok(out)
 }
 
-/// Refuses two landmarks whose targets coincide (within `1e-12` of the target's
-/// diagonal): a bijection cannot send two source vertices onto one point.
+/// Refuses two landmarks whose targets coincide (within `1e-9` of the target's
+/// diagonal, [`coincident`]): a bijection cannot send two source vertices onto one
+/// point.
 fn one_target_each(
     target: &Mesh,
     landmarks: &[Landmark],
     resolved: &[Resolved],
 ) -> Result<(), RegisterError> {
-    let tolerance = 1e-12 * target.bounding_box().diagonal();
     let at: Vec<Point3<f64>> = resolved.iter().map(|m| m.target.position(target)).collect();
-    // Sorted by x, each point compared with those within the tolerance in x.
-    let mut order: Vec<usize> = (0..at.len()).collect();
-    order.sort_by(|&a, &b| at[a].x.total_cmp(&at[b].x));
+    match coincident(&at, SAME_POINT * target.bounding_box().diagonal()) {
+        Some((first, second)) => Err(same_point(
+            second,
+            landmarks[second].source,
+            first,
+            landmarks[first].source,
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Two landmark targets closer than this (relative to the target's diagonal) are one
+/// point.
+pub(crate) const SAME_POINT: f64 = 1e-9;
+
+/// The first pair `(j, i)`, `j < i`, of `points` within `tolerance` of each other, by a
+/// sweep in `x`.
+pub(crate) fn coincident(points: &[Point3<f64>], tolerance: f64) -> Option<(usize, usize)> {
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| points[a].x.total_cmp(&points[b].x));
+    let mut best: Option<(usize, usize)> = None;
     for (k, &a) in order.iter().enumerate() {
         for &b in order[k + 1..]
             .iter()
-            .take_while(|&&b| at[b].x - at[a].x <= tolerance)
+            .take_while(|&&b| points[b].x - points[a].x <= tolerance)
         {
-            if (at[a] - at[b]).norm() <= tolerance {
-                let (first, second) = (a.min(b), a.max(b));
-                return Err(RegisterError::Landmark {
-                    index: second,
-                    vertex: landmarks[second].source,
-                    reason: format!(
-                        "its target is the target of landmark {first} (source vertex {}): a bijection cannot map two vertices onto one point",
-                        landmarks[first].source
-                    ),
-                });
+            if (points[a] - points[b]).norm() <= tolerance {
+                let pair = (a.min(b), a.max(b));
+                if best.is_none_or(|p| (pair.1, pair.0) < (p.1, p.0)) {
+                    best = Some(pair);
+                }
             }
         }
     }
-    Ok(())
+    best
+}
+
+/// The error of landmark `index` (source vertex `vertex`) going where landmark `first`
+/// (source vertex `first_vertex`) goes.
+pub(crate) fn same_point(
+    index: usize,
+    vertex: VertexId,
+    first: usize,
+    first_vertex: VertexId,
+) -> RegisterError {
+    RegisterError::Landmark {
+        index,
+        vertex,
+        reason: format!(
+            "it goes to the same target point as landmark {first} (source vertex {first_vertex}): a bijection cannot map two vertices onto one point"
+        ),
+    }
 }
 
 /// The vertex of `point`'s face that `point` is at (a coordinate within
