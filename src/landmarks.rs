@@ -354,6 +354,34 @@ impl Landmarks {
         Ok(out)
     }
 
+    /// The same landmarks for the registration the other way (target onto source):
+    /// each `v` line and `c` line with its two sides exchanged. A `p` line has no vertex
+    /// on the target to start from: its 1-based line number is the error.
+    pub fn reversed(&self) -> Result<Self, usize> {
+        let points = self
+            .points
+            .iter()
+            .map(|l| match l.goal {
+                LandmarkGoal::Vertex(w) => Ok(LandmarkLine {
+                    line: l.line,
+                    source: w,
+                    goal: LandmarkGoal::Vertex(l.source),
+                }),
+                LandmarkGoal::Point(_) => Err(l.line),
+            })
+            .collect::<Result<_, _>>()?;
+        let curves = self
+            .curves
+            .iter()
+            .map(|c| CurveLine {
+                line: c.line,
+                source: c.target.clone(),
+                target: c.source.clone(),
+            })
+            .collect();
+        Ok(Self { points, curves })
+    }
+
     /// The constraints of the file for a map onto `target` (the mesh it was parsed
     /// against), in file order: a [`Constraint::Landmark`] per `v` line (at the target
     /// vertex's position) and `p` line (at its point; the solver moves the vertex to the

@@ -1237,3 +1237,51 @@ fn modified_tori_stay_within_0_05_of_the_bound_the_report_computes() {
         );
     }
 }
+
+#[test]
+fn inverse_consistency_is_zero_for_a_mesh_onto_itself_and_reported_for_a_pair() {
+    // Spot onto itself both ways is the identity both ways: the round trip is exact.
+    // Spot onto blob with three `v` landmarks: both ways run, the round trip is
+    // reported; a `p` landmark has no vertex to start back from and is refused.
+    let spot = Path::new("meshes/spot.obj");
+    let (_, r) = register(spot, spot, &["--inverse-consistency"], f64::INFINITY);
+    let trip = &r["inverse_consistency"];
+    assert!(trip["relative_max"].as_f64().unwrap() < 1e-9, "{trip}");
+    let dir = tempfile::tempdir().unwrap();
+    let marks = dir.path().join("marks.txt");
+    std::fs::write(&marks, "v 0 0\nv 700 300\nv 1500 900\n").unwrap();
+    let blob = Path::new("meshes/blob.obj");
+    let (_, r) = register(
+        spot,
+        blob,
+        &["--landmarks", s(&marks), "--inverse-consistency"],
+        f64::INFINITY,
+    );
+    let trip = &r["inverse_consistency"];
+    let (mean, max) = (
+        trip["mean"].as_f64().unwrap(),
+        trip["max"].as_f64().unwrap(),
+    );
+    assert!(mean > 0.0 && mean <= max, "{trip}");
+    assert!(trip["relative_mean"].as_f64().unwrap() < 0.05, "{trip}");
+    let q = read(blob).position(VertexId(300));
+    std::fs::write(&marks, format!("v 0 0\np 700 {} {} {}\n", q.x, q.y, q.z)).unwrap();
+    let out = dir.path().join("out.obj");
+    let run = beltrami(&[
+        "register",
+        s(spot),
+        s(blob),
+        "--landmarks",
+        s(&marks),
+        "--inverse-consistency",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("line 2 is a `p` line"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!out.exists());
+}

@@ -9,6 +9,7 @@ use beltrami::landmarks::Landmarks;
 use beltrami::{correspondence, map_file, report, vertex_field};
 use beltrami_core::{Features, Goal, Map, OptionValue, Problem, Target};
 use beltrami_fem::BeltramiField;
+use beltrami_register::{InverseConsistency, inverse_consistency};
 use clap::Args;
 use serde_json::json;
 
@@ -55,6 +56,11 @@ pub struct RegisterArgs {
     /// nothing.
     #[arg(long = "allow-missed-landmarks")]
     pub allow_missed_landmarks: bool,
+    /// Also register TARGET onto SOURCE (the landmarks' `v` and `c` lines reversed, the
+    /// features exchanged) and report how far the two maps are from inverses: each
+    /// source vertex carried there and back, its distance from where it started.
+    #[arg(long = "inverse-consistency")]
+    pub inverse_consistency: bool,
     /// Output mesh: the source's vertices and faces, every vertex at its image on the
     /// target (so `beltrami distortion SOURCE OUT` measures the map).
     #[arg(short, long)]
@@ -102,12 +108,13 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
             p: p.unwrap_or(2.0),
         },
     };
-    if let Some(path) = &args.landmarks {
-        let marks = Landmarks::read(path, source, target)?;
-        problem
-            .constraints
-            .extend(marks.constraints(target).iter().cloned());
-    }
+    let marks = match &args.landmarks {
+        Some(path) => Landmarks::read(path, source, target)?,
+        None => Landmarks::default(),
+    };
+    problem
+        .constraints
+        .extend(marks.constraints(target).iter().cloned());
     problem.options = mapping::solver_options(
         solver,
         &[
@@ -138,6 +145,15 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     );
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
+    // The way back runs before anything is written: a failure there writes nothing.
+    let round_trip = if args.inverse_consistency {
+        let Some(Map::OnMesh(points)) = solution.map() else {
+            bail!("the register solver did not give points on the target mesh");
+        };
+        Some(round_trip(args, &problem, &marks, points, quiet)?)
+    } else {
+        None
+    };
     map_file::write(&args.output, source, &solution, Some(target), None)?;
     if let Some(path) = &args.correspondence {
         let Some(Map::OnMesh(points)) = solution.map() else {
@@ -164,6 +180,26 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     if let Some(route) = &solution.extras.route {
         extra.push(format!("route           {route}"));
     }
+    if let Some(trip) = round_trip {
+        let size = source.bounding_box().diagonal().max(f64::MIN_POSITIVE);
+        report.insert(
+            "inverse_consistency".into(),
+            json!({
+                "mean": trip.mean,
+                "max": trip.max,
+                "worst_vertex": source.vertex_map().to_input(beltrami_mesh::VertexId::from_usize(trip.worst)),
+                "relative_mean": trip.mean / size,
+                "relative_max": trip.max / size,
+            }),
+        );
+        extra.push(format!(
+            "inverse consistency mean {:.4e} max {:.4e} ({:.2e} / {:.2e} of the source's size)",
+            trip.mean,
+            trip.max,
+            trip.mean / size,
+            trip.max / size
+        ));
+    }
     mapping::finish(
         report,
         args.common.report.as_deref(),
@@ -172,4 +208,50 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         (&args.source, &args.output, &solution, seconds),
         &extra,
     )
+}
+
+/// The registration of TARGET onto SOURCE with `problem`'s options, landmarks reversed
+/// and features exchanged, measured against `forward` ([`inverse_consistency`]).
+fn round_trip(
+    args: &RegisterArgs,
+    problem: &Problem<'_>,
+    marks: &Landmarks,
+    forward: &[beltrami_core::SurfacePoint],
+    quiet: bool,
+) -> anyhow::Result<InverseConsistency> {
+    let Target::Mesh(target) = problem.target else {
+        bail!("register maps onto a target mesh");
+    };
+    let source = problem.source;
+    let mut reverse = Problem::new(target, Target::Mesh(source));
+    reverse.goal = match &problem.goal {
+        Goal::Features(f) => Goal::Features(Features {
+            source: f.target.clone(),
+            target: f.source.clone(),
+        }),
+        Goal::Prescribed(_) => {
+            bail!(
+                "--inverse-consistency: a prescribed --mu is per source face and has no inverse to run"
+            )
+        }
+        goal => goal.clone(),
+    };
+    let reversed = marks.reversed().map_err(|line| {
+        anyhow::anyhow!(
+            "--inverse-consistency: landmarks line {line} is a `p` line, which has no target vertex to start the registration back from; give `v SRC TGT` lines"
+        )
+    })?;
+    reverse
+        .constraints
+        .extend(reversed.constraints(source).iter().cloned());
+    reverse.options = problem.options.clone();
+    let registry = beltrami::registry();
+    let solver = registry.get("register")?;
+    let (back, _) = mapping::solve(solver, &reverse, args.common.progress(quiet))?;
+    let Some(Map::OnMesh(points)) = back.map() else {
+        bail!("the register solver did not give points on the source mesh");
+    };
+    let positions: Vec<_> = points.iter().map(|p| p.position(source)).collect();
+    inverse_consistency(source, target, forward, &positions)
+        .ok_or_else(|| anyhow::anyhow!("the two registrations do not fit the meshes"))
 }

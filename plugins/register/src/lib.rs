@@ -41,6 +41,7 @@ mod consistency;
 mod disk;
 mod error;
 mod feature_match;
+mod inverse_consistency;
 mod landmark_match;
 mod landmarks;
 mod modulus;
@@ -63,6 +64,7 @@ use beltrami_spatial::SurfaceIndex;
 use crate::landmarks::Resolved;
 
 pub use error::{RegisterError, Side};
+pub use inverse_consistency::{InverseConsistency, inverse_consistency};
 pub use landmarks::{Landmark, LandmarkTarget};
 pub use modulus::{TorusPeriods, teichmueller_bound};
 pub use solver::Register;
