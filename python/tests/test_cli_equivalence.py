@@ -185,8 +185,8 @@ def test_register_with_features_matches_the_command(cli, tmp_path):
     V, F = beltrami.read_mesh(source)
     TV, TF = beltrami.read_mesh(target)
     fs, ft = tmp_path / "fs.txt", tmp_path / "ft.txt"
-    fs.write_text("".join(f"{z!r}\n" for z in V[:, 2]))
-    ft.write_text("".join(f"{z!r}\n" for z in TV[:, 2]))
+    fs.write_text("".join(f"{float(z)!r}\n" for z in V[:, 2]))
+    ft.write_text("".join(f"{float(z)!r}\n" for z in TV[:, 2]))
     landmarks = tmp_path / "marks.txt"
     landmarks.write_text("v 0 0\nv 700 300\nv 1500 900\n")
     out = tmp_path / "out.obj"

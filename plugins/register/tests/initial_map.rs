@@ -359,6 +359,17 @@ fn spot_onto_bunny() {
     );
 }
 
+/// Every landmark (all onto target vertices) lands on its vertex to rounding.
+fn assert_vertex_landmarks_exact(map: &InitialMap, target: &Mesh, marks: &[Landmark]) {
+    for mark in marks {
+        let LandmarkTarget::Vertex(v) = mark.target else {
+            panic!("landmark {} is not onto a vertex", mark.source);
+        };
+        let miss = (map.positions[mark.source.idx()] - target.position(v)).norm();
+        assert!(miss < 1e-12, "landmark {}: {miss:.3e}", mark.source);
+    }
+}
+
 fn torus(nu: usize, nv: usize) -> Mesh {
     mesh(&primitives::torus(nu, nv, 3.0, 1.0, Cells::Triangles))
 }
@@ -444,13 +455,7 @@ fn every_torus_landmark_lands_exactly_under_a_twist() {
         "{:?}",
         map.notes
     );
-    for mark in &marks {
-        let LandmarkTarget::Vertex(v) = mark.target else {
-            unreachable!()
-        };
-        let miss = (map.positions[mark.source.idx()] - target.position(v)).norm();
-        assert!(miss < 1e-12, "landmark {}: {miss:.3e}", mark.source);
-    }
+    assert_vertex_landmarks_exact(&map, &target, &marks);
 }
 
 #[test]
@@ -605,11 +610,5 @@ fn genus_two_onto_a_turned_copy_through_matched_cuts() {
         "{:?}",
         map.notes
     );
-    for mark in &marks {
-        let LandmarkTarget::Vertex(v) = mark.target else {
-            unreachable!()
-        };
-        let miss = (map.positions[mark.source.idx()] - target.position(v)).norm();
-        assert!(miss < 1e-12, "landmark {}: {miss:.3e}", mark.source);
-    }
+    assert_vertex_landmarks_exact(&map, &target, &marks);
 }
