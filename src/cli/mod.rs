@@ -48,8 +48,9 @@ pub enum Command {
     /// one (lsqc, beltrami-flow) onto the plane, a disk, an annulus or the sphere.
     Qc(qc::QcArgs),
     /// Map one mesh onto another of the same topology (any genus, any number of boundary loops),
-    /// bijectively and as conformally as the constraints allow, with landmarks and
-    /// feature curves: an initial bijection, then the Beltrami flow on the target.
+    /// bijectively and as conformally as the constraints allow, with landmarks, feature
+    /// curves and fields matched on both meshes: an initial bijection, then the Beltrami
+    /// flow on the target.
     Register(register::RegisterArgs),
     /// Write a generated mesh: the disk, sphere, annulus and square of the paper
     /// reproductions.
