@@ -152,18 +152,15 @@ pub(crate) fn match_features(
             let (mu, _) = reconstruction.measure(&moved)?;
             let nu = reconstruction.regularized_step(&current_mu, &mu, MU_SMOOTHING);
             let rebuilt = reconstruction.solve(&nu)?;
-            let (_, flipped) = reconstruction.measure(&rebuilt)?;
+            let (rebuilt_mu, flipped) = reconstruction.measure(&rebuilt)?;
             let trial = target_field.probe(&rebuilt, Some(&probe))?;
             let trial_energy = mismatch(&source_field, &trial.values, &weights);
-            eprintln!(
-                "level {passes} len {length} flipped {flipped} e {energy:.4} -> {trial_energy:.4}"
-            );
             if flipped > 0 || trial_energy >= energy {
                 length *= 0.5;
                 continue;
             }
             let decrease = energy - trial_energy;
-            current_mu = reconstruction.measure(&rebuilt)?.0;
+            current_mu = rebuilt_mu;
             map = rebuilt;
             probe = trial;
             energy = trial_energy;
