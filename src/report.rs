@@ -22,6 +22,7 @@
 //! | `landmarks` | a registration's landmarks: `[{index, vertex, distance}]`, the distance from each landmark's image to its target (0 to rounding on exit 0) |
 //! | `landmark_max` | the largest of those distances (`null` without landmarks) |
 //! | `route` | the road a registration took, in words |
+//! | `features` | a registration's feature match: `{before, after, steps}`, the mean squared difference of the standardized fields at the conformal start and at the result |
 //! | `energy_history`, `step_sizes` | per iteration |
 //! | `seconds_per_step` | [`seconds_per_step`] |
 //! | `timings` | `[{stage, seconds}]` in the order they happened |
@@ -87,6 +88,9 @@ pub fn solution_json(solution: &Solution) -> JsonMap<String, Value> {
         })).collect::<Vec<_>>(),
         "landmark_max": x.landmarks.iter().map(|l| l.distance).reduce(f64::max),
         "route": x.route,
+        "features": x.features.map(|f| json!({
+            "before": f.before, "after": f.after, "steps": f.steps,
+        })),
         "energy_history": m.energy_history,
         "step_sizes": m.step_sizes,
         "seconds_per_step": seconds_per_step(solution),

@@ -197,6 +197,7 @@ def test_register_with_features_matches_the_command(cli, tmp_path):
                                             features=(V[:, 2], TV[:, 2]), info=True)
     close(P, positions_of(out))
     assert any("features matched" in note for note in info["notes"])
+    assert info["features"]["after"] <= info["features"]["before"]
     assert info["flipped"] == 0
     for (s, t) in marks:
         close(P[s], TV[t], 1e-12)

@@ -96,7 +96,7 @@ pub use registry::Registry;
 pub use renumbered::{Renumbered, SCATTERED_SPREAD, solve_renumbered};
 pub use report::Report;
 pub use solution::{
-    AnnulusRadius, Circle, Extras, LandmarkResidual, Metrics, Output, QuadraticDifferential,
-    Remeshed, Solution, Stop,
+    AnnulusRadius, Circle, Extras, FeatureMismatch, LandmarkResidual, Metrics, Output,
+    QuadraticDifferential, Remeshed, Solution, Stop,
 };
 pub use solver::{Context, Progress, Solver};

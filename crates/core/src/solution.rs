@@ -141,6 +141,19 @@ pub struct LandmarkResidual {
     pub distance: f64,
 }
 
+/// How far a registration's feature match brought the fields together: the mean squared
+/// difference of the standardized fields (source field minus the target field at each
+/// image, area-weighted) before and after, and the steps kept.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FeatureMismatch {
+    /// At the conformal registration the match started from.
+    pub before: f64,
+    /// At the result.
+    pub after: f64,
+    /// Steps kept.
+    pub steps: usize,
+}
+
 /// What some solvers compute beside the map, typed.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Extras {
@@ -156,6 +169,8 @@ pub struct Extras {
     /// The road a registration took, in words: the common domain, where the landmarks
     /// were matched and why.
     pub route: Option<String>,
+    /// A registration's feature match (`Goal::Features`).
+    pub features: Option<FeatureMismatch>,
 }
 
 /// The result of a solve.

@@ -27,7 +27,7 @@
 //! `m`'s image. Such ears are counted in the notes (they count as flipped); a target
 //! boundary at least as fine as the source's avoids them.
 
-use beltrami_core::Features;
+use beltrami_core::{FeatureMismatch, Features};
 use std::f64::consts::TAU;
 
 use beltrami_fem::{BoundaryMap, Frame};
@@ -229,7 +229,7 @@ pub(crate) fn match_features_after(
     marks: &[Resolved],
     features: &Features,
     notes: &mut Vec<String>,
-) -> Result<Vec<SurfacePoint>, RegisterError> {
+) -> Result<(Vec<SurfacePoint>, FeatureMismatch), RegisterError> {
     let chart: Vec<Complex64> = points
         .iter()
         .map(|p| interpolate(target, target_param, p))
@@ -255,7 +255,12 @@ pub(crate) fn match_features_after(
         matched.before, matched.after, matched.steps
     ));
     let (located, _) = compose::locate(&domain, &planar_points(&matched.map))?;
-    Ok(located)
+    let mismatch = FeatureMismatch {
+        before: matched.before,
+        after: matched.after,
+        steps: matched.steps,
+    };
+    Ok((located, mismatch))
 }
 
 /// The boundary fractions of the source's loop vertices (arc-length fractions `sigma`)

@@ -246,7 +246,8 @@ pub(crate) enum TargetDomain {
 }
 
 /// The registration `points` bent in the common domain of `initial` so that `features`
-/// match, the landmarks held: on the disk and the sphere (see [`check_features`]).
+/// match, the landmarks held: on the disk and the sphere (see [`check_features`]); and
+/// the fields' mismatch before and after.
 ///
 /// # Errors
 /// [`RegisterError::Features`] on another road; the errors of the matching.
@@ -257,7 +258,7 @@ pub(crate) fn match_features_after(
     points: &[SurfacePoint],
     features: &Features,
     notes: &mut Vec<String>,
-) -> Result<Vec<SurfacePoint>, RegisterError> {
+) -> Result<(Vec<SurfacePoint>, beltrami_core::FeatureMismatch), RegisterError> {
     let marks = &initial.marks;
     match &initial.domain {
         TargetDomain::Disk(param) => {

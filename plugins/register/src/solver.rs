@@ -323,7 +323,7 @@ fn after_features(
     };
     let mut report = solution.report.clone();
     let mut notes = Vec::new();
-    let matched = context.stage("feature match", &mut report, || {
+    let (matched, mismatch) = context.stage("feature match", &mut report, || {
         match_features_after(flow.source, target, initial, points, features, &mut notes)
             .map_err(plugin)
     })?;
@@ -341,6 +341,7 @@ fn after_features(
         .report
         .notes
         .retain(|n| !n.starts_with("stopped at the iteration limit (0)"));
+    measured.extras.features = Some(mismatch);
     Ok(measured)
 }
 

@@ -27,7 +27,9 @@
 //! onto the sphere. The map is exact at every landmark and, with no flipped face in the
 //! chart, a bijection of the sphere.
 
-use beltrami_core::{Context, Features, Map, Problem, Solver, SolverError, Target};
+use beltrami_core::{
+    Context, FeatureMismatch, Features, Map, Problem, Solver, SolverError, Target,
+};
 use beltrami_fem::Frame;
 use beltrami_init::Sphere;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3};
@@ -127,7 +129,7 @@ pub(crate) fn map(
     let images = if marks.is_empty() {
         aligned
     } else {
-        match_on_sphere(source, &aligned, marks, &t, None, notes)?
+        match_on_sphere(source, &aligned, marks, &t, None, notes)?.0
     };
 
     let domain = domain_mesh(
@@ -161,7 +163,7 @@ pub(crate) fn match_features_after(
     marks: &[Resolved],
     features: &Features,
     notes: &mut Vec<String>,
-) -> Result<Vec<SurfacePoint>, RegisterError> {
+) -> Result<(Vec<SurfacePoint>, FeatureMismatch), RegisterError> {
     let on_sphere = |p: &SurfacePoint| interpolate(target, target_sphere, p).normalize();
     let aligned: Vec<Vector3<f64>> = points.iter().map(on_sphere).collect();
     let targets: Vec<Vector3<f64>> = marks.iter().map(|m| on_sphere(&m.target)).collect();
@@ -170,7 +172,8 @@ pub(crate) fn match_features_after(
         target,
         target_sphere,
     };
-    let images = match_on_sphere(source, &aligned, marks, &targets, Some(fields), notes)?;
+    let (images, mismatch) =
+        match_on_sphere(source, &aligned, marks, &targets, Some(fields), notes)?;
     let domain = domain_mesh(
         target,
         target_sphere.iter().map(|v| Point3::from(*v)).collect(),
@@ -178,7 +181,10 @@ pub(crate) fn match_features_after(
     )?;
     let images: Vec<Point3<f64>> = images.iter().map(|v| Point3::from(*v)).collect();
     let (located, _) = compose::locate_radial(&domain, &images)?;
-    Ok(located)
+    let mismatch = mismatch.ok_or_else(|| RegisterError::Features {
+        reason: "the match on the sphere gave no mismatch".to_string(),
+    })?;
+    Ok((located, mismatch))
 }
 
 /// The Moebius transformation through three of the landmarks (from their source
@@ -245,7 +251,9 @@ fn coincident(mark: &Resolved) -> RegisterError {
 
 /// Every landmark matched on the sphere (module docs): `aligned` the source's sphere
 /// positions after the alignment, `targets` the landmarks' targets on the sphere. The
-/// returned positions are on the unit sphere, each landmark exactly at its target.
+/// returned positions are on the unit sphere, each landmark exactly at its target; with
+/// `fields`, the features are matched in the same chart after the landmarks, and how
+/// far is returned too.
 ///
 /// # Errors
 /// [`RegisterError::LandmarkFolds`] when the landmark-matching map still folds faces
@@ -257,7 +265,7 @@ fn match_on_sphere(
     targets: &[Vector3<f64>],
     fields: Option<SphereFields<'_>>,
     notes: &mut Vec<String>,
-) -> Result<Vec<Vector3<f64>>, RegisterError> {
+) -> Result<(Vec<Vector3<f64>>, Option<FeatureMismatch>), RegisterError> {
     let Pole {
         face: pole,
         centre,
@@ -312,6 +320,7 @@ fn match_on_sphere(
         ));
         matched.map
     };
+    let mut mismatch = None;
     if let Some(fields) = fields {
         // The target in the same chart, punctured at the face the pole falls in.
         let sphere_mesh = domain_mesh(
@@ -355,17 +364,23 @@ fn match_on_sphere(
             matched.after,
             matched.steps
         ));
+        mismatch = Some(FeatureMismatch {
+            before: matched.before,
+            after: matched.after,
+            steps: matched.steps,
+        });
         map = matched.map;
     }
     let back = r.transpose();
-    Ok(map
+    let images = map
         .iter()
         .map(|f| {
             let w = f.conj();
             let n = w.norm_sqr();
             back * Vector3::new(2.0 * w.re, 2.0 * w.im, n - 1.0) / (n + 1.0)
         })
-        .collect())
+        .collect();
+    Ok((images, mismatch))
 }
 
 /// The fields of a feature match on the sphere: the features and the target with its
