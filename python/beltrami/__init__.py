@@ -518,6 +518,26 @@ def _landmarks(landmarks: Any) -> Optional[str]:
     return "\n".join(lines) + "\n"
 
 
+def _reversed_landmarks(text: Optional[str]) -> Optional[str]:
+    """The landmarks of the registration back: each ``v`` and ``c`` line with its two
+    sides exchanged; a ``p`` line has no target vertex to start back from."""
+    if text is None:
+        return None
+    lines = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        fields = raw.split("#", 1)[0].split()
+        if not fields:
+            continue
+        if fields[0] in ("v", "c") and len(fields) == 3:
+            lines.append(f"{fields[0]} {fields[2]} {fields[1]}")
+        else:
+            raise ConstraintError(
+                f"inverse_consistency: landmarks line {number} is not a `v` or `c` line; "
+                "a point has no target vertex to start the registration back from"
+            )
+    return "\n".join(lines) + "\n"
+
+
 def register(
     V: ArrayLike,
     F: ArrayLike,
@@ -533,6 +553,7 @@ def register(
     threads: Optional[int] = None,
     allow_flips: bool = False,
     allow_missed_landmarks: bool = False,
+    inverse_consistency: bool = False,
     options: Optional[Dict[str, Any]] = None,
     progress: Optional[Progress] = None,
     info: bool = False,
@@ -549,6 +570,10 @@ def register(
     field given on both meshes (arrays with one value per row of ``V`` and of ``TV``, or
     ``"mean-curvature"``): the conformal registration is bent in the common domain until
     the fields agree, the landmarks held (disks and closed genus-0 surfaces).
+    ``inverse_consistency=True`` also registers ``TV, TF`` onto ``V, F`` (landmark
+    pairs reversed, features exchanged) and puts how far each vertex lands from where it
+    started, carried there and back, in the report (``info=True``):
+    ``inverse_consistency: {mean, max, worst_vertex, relative_mean, relative_max}``.
 
     >>> import numpy as np, beltrami
     >>> V, F = beltrami.read_mesh("meshes/spot.obj")
@@ -586,7 +611,26 @@ def register(
     }
     if mu is not None and p is not None:
         raise OptionError("p is the exponent of the conformal goal; a prescribed mu has no exponent")
+    if inverse_consistency:
+        if mu is not None:
+            raise OptionError("inverse_consistency: a prescribed mu is per source face and has no inverse to run")
+        back_spec = dict(spec, landmarks=_reversed_landmarks(spec["landmarks"]))
     out = _solve("register", V, F, spec, mu=mu, target=(TV, TF), progress=progress)
+    if inverse_consistency:
+        if goal.get("kind") == "features":
+            back_spec["goal"] = dict(goal, source=goal["target"], target=goal["source"])
+        back = _solve("register", TV, TF, back_spec, target=(V, F), progress=progress)
+        start = np.asarray(V, dtype=float)
+        there_and_back = np.einsum("ij,ijk->ik", out["bary"], back["image"][np.asarray(TF)[out["face"]]])
+        d = np.linalg.norm(there_and_back - start, axis=1)
+        size = max(float(np.linalg.norm(start.max(axis=0) - start.min(axis=0))), np.finfo(float).tiny)
+        out["report"]["inverse_consistency"] = {
+            "mean": float(d.mean()),
+            "max": float(d.max()),
+            "worst_vertex": int(d.argmax()),
+            "relative_mean": float(d.mean()) / size,
+            "relative_max": float(d.max()) / size,
+        }
     result = (out["image"], out["face"], out["bary"])
     return (*result, out["report"]) if info else result
 

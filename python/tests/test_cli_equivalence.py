@@ -212,6 +212,26 @@ def test_register_with_features_matches_the_command(cli, tmp_path):
         beltrami.register(V, F, TV, TF, p=4, features=(V[:, 2], TV[:, 2]))
 
 
+def test_register_inverse_consistency_matches_the_command(cli, tmp_path):
+    source, target = MESHES / "spot.obj", MESHES / "blob.obj"
+    landmarks = tmp_path / "marks.txt"
+    landmarks.write_text("v 0 0\nv 700 300\nv 1500 900\n")
+    out, report = tmp_path / "out.obj", tmp_path / "r.json"
+    cli("register", source, target, "--landmarks", landmarks, "--max-iters", "3",
+        "--inverse-consistency", "--report", report, "-o", out)
+    V, F = beltrami.read_mesh(source)
+    TV, TF = beltrami.read_mesh(target)
+    info = beltrami.register(V, F, TV, TF, landmarks=[(0, 0), (700, 300), (1500, 900)],
+                             max_iters=3, inverse_consistency=True, info=True)[-1]
+    want = report_of(report)["inverse_consistency"]
+    got = info["inverse_consistency"]
+    assert got["worst_vertex"] == want["worst_vertex"]
+    for key in ("mean", "max", "relative_mean", "relative_max"):
+        assert abs(got[key] - want[key]) <= 1e-9 * max(1.0, abs(want[key])), key
+    with pytest.raises(beltrami.ConstraintError, match="line 1"):
+        beltrami.register(V, F, TV, TF, landmarks=[(0, tuple(TV[0]))], inverse_consistency=True)
+
+
 def test_register_of_a_multiply_connected_pair_matches_the_command(cli, generated, tmp_path):
     # Genus 0 with two boundary loops: the matched cut graphs of the initial map.
     source = generated("annulus", "1")
