@@ -14,6 +14,12 @@ It also writes the per-vertex fields of each hemisphere, `OUT_DIR/fs5_{hemi}_{fi
 white surface), for `beltrami register SRC TGT --features F F` (vertex i of every surface
 has the same value, the fields agree under the true correspondence).
 
+With `--subdivide` it also writes every surface and field split once 1-to-4 at edge
+midpoints, `OUT_DIR/fs5s_{hemi}_{name}.obj` and `.txt` (40,962 vertices, 81,920 faces:
+the same piecewise-flat surface, midpoints numbered alike on every surface of a
+hemisphere, so vertex i still corresponds to vertex i; a midpoint's field value is the
+mean of its edge's), for the issue's 65K-face goal.
+
 With `--landmarks N` it also writes `OUT_DIR/fs5_landmarks_N.txt`: N landmarks `v I I`
 spread over the white surface by farthest-point sampling (geodesic distance along
 edges), for `beltrami register SRC TGT --landmarks`.
@@ -102,6 +108,33 @@ def write_obj(path, positions, faces, source):
             f.write(f"f {a + 1} {b + 1} {c + 1}\n")
 
 
+def midpoints(faces):
+    """The edges split by a 1-to-4 subdivision, numbered after the vertices in the order
+    they are met, and the new faces (corners, then the three edge midpoints)."""
+    index, new_faces = {}, []
+    def mid(a, b):
+        return index.setdefault((min(a, b), max(a, b)), len(index))
+    for a, b, c in faces:
+        ab, bc, ca = mid(a, b), mid(b, c), mid(c, a)
+        new_faces.append((a, b, c, ab, bc, ca))
+    return index, new_faces
+
+
+def subdivided(values, faces, n):
+    """Per-vertex `values` (tuples or numbers) of a mesh with `n` vertices and its
+    1-to-4 subdivision's faces."""
+    index, new_faces = midpoints(faces)
+    out = list(values)
+    for (a, b), _ in sorted(index.items(), key=lambda item: item[1]):
+        va, vb = values[a], values[b]
+        out.append(tuple((x + y) / 2 for x, y in zip(va, vb)) if isinstance(va, tuple) else (va + vb) / 2)
+    tri = []
+    for a, b, c, ab, bc, ca in new_faces:
+        ab, bc, ca = n + ab, n + bc, n + ca
+        tri += [(a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca)]
+    return out, tri
+
+
 def farthest_points(positions, faces, n):
     neighbours = [[] for _ in positions]
     for face in faces:
@@ -132,6 +165,7 @@ def main():
     parser.add_argument("out")
     parser.add_argument("--landmarks", type=int, default=0)
     parser.add_argument("--wheel", help="a nilearn wheel already downloaded")
+    parser.add_argument("--subdivide", action="store_true", help="also write the 1-to-4 subdivided surfaces and fields")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
     with zipfile.ZipFile(wheel(args.wheel)) as z:
@@ -144,12 +178,25 @@ def main():
                     f.write(f"# FreeSurfer fsaverage5 {name}, {hemi} hemisphere, one value per vertex\n")
                     f.writelines(f"{x!r}\n" for x in values)
                 print(f"{path}: {len(values)} values")
+                if args.subdivide:
+                    _, faces = surface(z.read("nilearn/datasets/data/fsaverage5/" + SURFACES["white"].format(h=hemi)))
+                    fine, _ = subdivided(list(values), faces, len(values))
+                    path = os.path.join(args.out, f"fs5s_{hemi}_{name}.txt")
+                    with open(path, "w") as f:
+                        f.write(f"# fsaverage5 {name}, {hemi} hemisphere, subdivided 1-to-4 (midpoints: edge means)\n")
+                        f.writelines(f"{x!r}\n" for x in fine)
+                    print(f"{path}: {len(fine)} values")
             for name, pattern in SURFACES.items():
                 member = "nilearn/datasets/data/fsaverage5/" + pattern.format(h=hemi)
                 positions, faces = surface(z.read(member))
                 path = os.path.join(args.out, f"fs5_{hemi}_{name}.obj")
                 write_obj(path, positions, faces, f"{name}, {hemi} hemisphere")
                 print(f"{path}: {len(positions)} vertices, {len(faces)} faces")
+                if args.subdivide:
+                    fine, fine_faces = subdivided([tuple(p) for p in positions], faces, len(positions))
+                    path = os.path.join(args.out, f"fs5s_{hemi}_{name}.obj")
+                    write_obj(path, fine, fine_faces, f"{name}, {hemi} hemisphere, subdivided 1-to-4")
+                    print(f"{path}: {len(fine)} vertices, {len(fine_faces)} faces")
                 if name == "white" and hemi == "left" and args.landmarks:
                     marks = farthest_points(positions, faces, args.landmarks)
                     lm = os.path.join(args.out, f"fs5_landmarks_{args.landmarks}.txt")
