@@ -95,7 +95,10 @@ fn a_twisted_sphere_is_found_by_its_field() {
             target: target_field,
         }),
     );
-    let mismatch = solution.extras.features.expect("the feature match is reported");
+    let mismatch = solution
+        .extras
+        .features
+        .expect("the feature match is reported");
     assert!(
         mismatch.steps > 0 && mismatch.after < 0.5 * mismatch.before,
         "{mismatch:?}"
