@@ -19,8 +19,9 @@
 //! displacement), the change of the Beltrami coefficient it makes smoothed and added to
 //! the map's own (each face cut to `|nu| <= 0.8`), and the map rebuilt from it with the
 //! held vertices in place ([`Reconstruction`]): a map with `|mu| < 1` everywhere, so
-//! no fold. A step is kept when it lowers `E` and flips nothing; otherwise the step
-//! length is halved.
+//! no fold. Where the discrete rebuild still folds a few faces, its own coefficient is
+//! smoothed, cut and the map rebuilt again (up to `MENDING` times). A step is kept when
+//! it lowers `E` and flips nothing; otherwise the step length is halved.
 //!
 //! The fields are matched coarse to fine: first both smoothed (`SCALES`, passes of
 //! neighbour averaging, as many more on the target as it has more vertices per area),
@@ -57,6 +58,9 @@ const FORCE_SMOOTHING: usize = 16;
 /// A step that lowers the mismatch by less than this fraction of the first value ends
 /// the matching.
 const STALL: f64 = 1e-4;
+
+/// Rebuilds of a step that folds a few faces, at most.
+const MENDING: usize = 3;
 
 /// The smallest step length tried.
 const MIN_STEP: f64 = 0.125;
@@ -151,8 +155,17 @@ pub(crate) fn match_features(
                 .collect();
             let (mu, _) = reconstruction.measure(&moved)?;
             let nu = reconstruction.regularized_step(&current_mu, &mu, MU_SMOOTHING);
-            let rebuilt = reconstruction.solve(&nu)?;
-            let (rebuilt_mu, flipped) = reconstruction.measure(&rebuilt)?;
+            let mut rebuilt = reconstruction.solve(&nu)?;
+            let (mut rebuilt_mu, mut flipped) = reconstruction.measure(&rebuilt)?;
+            // Where the discrete rebuild still folds a few faces, its own coefficient is
+            // smoothed and cut and the map rebuilt again (the landmark matching's mending).
+            for _ in 0..MENDING {
+                if flipped == 0 {
+                    break;
+                }
+                rebuilt = reconstruction.solve(&reconstruction.regularized(rebuilt_mu, 2))?;
+                (rebuilt_mu, flipped) = reconstruction.measure(&rebuilt)?;
+            }
             let trial = target_field.probe(&rebuilt, Some(&probe))?;
             let trial_energy = mismatch(&source_field, &trial.values, &weights);
             if flipped > 0 || trial_energy >= energy {
