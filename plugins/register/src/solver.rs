@@ -268,7 +268,8 @@ impl Solver for Register {
         let Target::Mesh(target) = &problem.target else {
             return Err(unsupported("register maps onto a target mesh"));
         };
-        check_topology(problem.source, target).map_err(|e| unsupported(e.to_string()))?;
+        let topology =
+            check_topology(problem.source, target).map_err(|e| unsupported(e.to_string()))?;
         for (side, mesh) in [("source", problem.source), ("target", *target)] {
             if let Some(f) = mesh.faces().find(|&f| mesh.face_degree(f) != 3) {
                 return Err(unsupported(format!(
@@ -285,13 +286,9 @@ impl Solver for Register {
                     "feature curves and feature fields together are not matched yet: give landmarks along the curves instead",
                 ));
             }
-            let topology = check_topology(problem.source, target).map_err(plugin)?;
             crate::check_features(topology, features, problem.source, target).map_err(plugin)?;
         }
-        crate::consistency::check(problem, target).map_err(|error| SolverError::Plugin {
-            solver: NAME,
-            error: Box::new(error),
-        })?;
+        crate::consistency::check(problem, target).map_err(plugin)?;
         Ok(())
     }
 
