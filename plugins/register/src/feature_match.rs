@@ -120,11 +120,17 @@ pub(crate) fn match_features(
     let mut steps = 0;
     for passes in SCALES {
         let target_passes = (passes as f64 * ratio).round() as usize;
-        let source_field = standardized(&smoothed(&neighbours, source_values, passes));
+        let source_field =
+            standardized(&smoothed(&neighbours, None, source_values.to_vec(), passes));
         let target_field = TargetField::new(
             &index,
             domain,
-            &standardized(&smoothed(&domain_neighbours, domain_values, target_passes)),
+            &standardized(&smoothed(
+                &domain_neighbours,
+                None,
+                domain_values.to_vec(),
+                target_passes,
+            )),
         );
         let mut probe = target_field.probe(&map, Some(&start))?;
         let mut energy = mismatch(&source_field, &probe.values, &weights);
@@ -147,7 +153,7 @@ pub(crate) fn match_features(
                     }
                 })
                 .collect();
-            let force = smoothed_held(&neighbours, &held, force, FORCE_SMOOTHING);
+            let force = smoothed(&neighbours, Some(&held), force, FORCE_SMOOTHING);
             let moved: Vec<Complex64> = map
                 .iter()
                 .zip(&force)
@@ -204,34 +210,24 @@ fn vertex_neighbours(mesh: &Mesh) -> Vec<Vec<usize>> {
         .collect()
 }
 
-/// `values` after `passes` of averaging each vertex with its neighbours.
-fn smoothed(neighbours: &[Vec<usize>], values: &[f64], passes: usize) -> Vec<f64> {
-    let mut values = values.to_vec();
-    for _ in 0..passes {
-        values = (0..values.len())
-            .map(|i| {
-                let sum: f64 = neighbours[i].iter().map(|&j| values[j]).sum();
-                (values[i] + sum) / (1 + neighbours[i].len()) as f64
-            })
-            .collect();
-    }
-    values
-}
-
-/// `values` after `passes` of neighbour averaging, the `held` vertices kept.
-fn smoothed_held(
+/// `values` after `passes` of averaging each vertex with its neighbours, the vertices
+/// marked in `held` (when given) kept as they are.
+fn smoothed<T>(
     neighbours: &[Vec<usize>],
-    held: &[bool],
-    mut values: Vec<Complex64>,
+    held: Option<&[bool]>,
+    mut values: Vec<T>,
     passes: usize,
-) -> Vec<Complex64> {
+) -> Vec<T>
+where
+    T: Copy + std::iter::Sum + std::ops::Add<Output = T> + std::ops::Div<f64, Output = T>,
+{
     for _ in 0..passes {
         values = (0..values.len())
             .map(|i| {
-                if held[i] {
+                if held.is_some_and(|h| h[i]) {
                     return values[i];
                 }
-                let sum: Complex64 = neighbours[i].iter().map(|&j| values[j]).sum();
+                let sum: T = neighbours[i].iter().map(|&j| values[j]).sum();
                 (values[i] + sum) / (1 + neighbours[i].len()) as f64
             })
             .collect();

@@ -167,18 +167,19 @@ pub(crate) fn match_features_after(
     let on_sphere = |p: &SurfacePoint| interpolate(target, target_sphere, p).normalize();
     let aligned: Vec<Vector3<f64>> = points.iter().map(on_sphere).collect();
     let targets: Vec<Vector3<f64>> = marks.iter().map(|m| on_sphere(&m.target)).collect();
-    let fields = SphereFields {
-        features,
-        target,
-        target_sphere,
-    };
-    let (images, mismatch) =
-        match_on_sphere(source, &aligned, marks, &targets, Some(fields), notes)?;
     let domain = domain_mesh(
         target,
         target_sphere.iter().map(|v| Point3::from(*v)).collect(),
         Side::Target,
     )?;
+    let fields = SphereFields {
+        features,
+        target,
+        target_sphere,
+        sphere_mesh: &domain,
+    };
+    let (images, mismatch) =
+        match_on_sphere(source, &aligned, marks, &targets, Some(fields), notes)?;
     let images: Vec<Point3<f64>> = images.iter().map(|v| Point3::from(*v)).collect();
     let (located, _) = compose::locate_radial(&domain, &images)?;
     let mismatch = mismatch.ok_or_else(|| RegisterError::Features {
@@ -323,16 +324,7 @@ fn match_on_sphere(
     let mut mismatch = None;
     if let Some(fields) = fields {
         // The target in the same chart, punctured at the face the pole falls in.
-        let sphere_mesh = domain_mesh(
-            fields.target,
-            fields
-                .target_sphere
-                .iter()
-                .map(|v| Point3::from(*v))
-                .collect(),
-            Side::Target,
-        )?;
-        let (at_pole, _) = compose::locate_radial(&sphere_mesh, &[Point3::from(centre)])?;
+        let (at_pole, _) = compose::locate_radial(fields.sphere_mesh, &[Point3::from(centre)])?;
         let pole_face = at_pole.first().map_or(FaceId(0), |p| p.face);
         let punctured_target =
             fields
@@ -389,6 +381,8 @@ struct SphereFields<'a> {
     features: &'a Features,
     target: &'a Mesh,
     target_sphere: &'a [Vector3<f64>],
+    /// The target's sphere polyhedron (its faces over `target_sphere`).
+    sphere_mesh: &'a Mesh,
 }
 
 /// The face of a stereographic chart: its centroid direction on the sphere and the
