@@ -91,6 +91,7 @@ pub fn solution_json(solution: &Solution) -> JsonMap<String, Value> {
         "features": x.features.map(|f| json!({
             "before": f.before, "after": f.after, "steps": f.steps,
         })),
+        "shape": x.shape.map(|s| json!({"before": s.before, "after": s.after})),
         "energy_history": m.energy_history,
         "step_sizes": m.step_sizes,
         "seconds_per_step": seconds_per_step(solution),

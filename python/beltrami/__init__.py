@@ -553,6 +553,7 @@ def register(
     threads: Optional[int] = None,
     allow_flips: bool = False,
     allow_missed_landmarks: bool = False,
+    match_shape: bool = False,
     inverse_consistency: bool = False,
     options: Optional[Dict[str, Any]] = None,
     progress: Optional[Progress] = None,
@@ -570,7 +571,10 @@ def register(
     field given on both meshes (arrays with one value per row of ``V`` and of ``TV``, or
     ``"mean-curvature"``): the conformal registration is bent in the common domain until
     the fields agree, the landmarks held (disks and closed genus-0 surfaces).
-    ``inverse_consistency=True`` also registers ``TV, TF`` onto ``V, F`` (landmark
+    ``match_shape=True`` pulls each image towards where the source, placed on the
+    target by an affine closest-point fit, lies (a non-rigid ICP that stays a
+    bijection; disks and closed genus-0 surfaces; the report's ``shape`` has the mean
+    distance before and after). ``inverse_consistency=True`` also registers ``TV, TF`` onto ``V, F`` (landmark
     pairs reversed, features exchanged) and puts how far each vertex lands from where it
     started, carried there and back, in the report (``info=True``):
     ``inverse_consistency: {mean, max, worst_vertex, relative_mean, relative_max}``.
@@ -606,6 +610,7 @@ def register(
             threads=threads,
             allow_flips=True if allow_flips else None,
             allow_missed_landmarks=True if allow_missed_landmarks else None,
+            match_shape=True if match_shape else None,
         ),
         "defaults": {"tolerance": "1e-05", "max-iters": "100"},
     }

@@ -212,6 +212,19 @@ def test_register_with_features_matches_the_command(cli, tmp_path):
         beltrami.register(V, F, TV, TF, p=4, features=(V[:, 2], TV[:, 2]))
 
 
+def test_register_match_shape_matches_the_command(cli, tmp_path):
+    # The shape matched both ways gives the same map, its distances reported.
+    source, target = MESHES / "spot.obj", MESHES / "blob.obj"
+    V, F = beltrami.read_mesh(source)
+    TV, TF = beltrami.read_mesh(target)
+    out = tmp_path / "out.obj"
+    cli("register", source, target, "--max-iters", "3", "--match-shape", "-o", out)
+    P, face, bary, info = beltrami.register(V, F, TV, TF, max_iters=3, match_shape=True,
+                                            info=True)
+    close(P, positions_of(out))
+    assert info["shape"]["after"] < info["shape"]["before"]
+
+
 def test_register_inverse_consistency_matches_the_command(cli, tmp_path):
     source, target = MESHES / "spot.obj", MESHES / "blob.obj"
     landmarks = tmp_path / "marks.txt"

@@ -37,6 +37,13 @@ pub struct RegisterArgs {
     /// until the fields agree, landmarks held (disks and closed genus-0 surfaces).
     #[arg(long, num_args = 2, value_names = ["SOURCE_FIELD", "TARGET_FIELD"])]
     pub features: Option<Vec<PathBuf>>,
+    /// Match the shapes: after the conformal registration, pull each image towards where
+    /// the source, placed on the target by the similarity that best fits the map, lies
+    /// (a non-rigid ICP that stays a bijection; disks and closed genus-0 surfaces). For
+    /// surfaces that overlap in space once aligned, such as two scans or two cortical
+    /// surfaces of one subject. With --features, both are matched together.
+    #[arg(long = "match-shape")]
+    pub match_shape: bool,
     /// Most flow iterations [default: 100].
     #[arg(long = "max-iters")]
     pub max_iters: Option<usize>,
@@ -138,6 +145,11 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
                 "allow-missed-landmarks",
                 args.allow_missed_landmarks
                     .then_some(OptionValue::Bool(true)),
+                None,
+            ),
+            (
+                "match-shape",
+                args.match_shape.then_some(OptionValue::Bool(true)),
                 None,
             ),
         ],

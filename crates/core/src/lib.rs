@@ -97,6 +97,6 @@ pub use renumbered::{Renumbered, SCATTERED_SPREAD, solve_renumbered};
 pub use report::Report;
 pub use solution::{
     AnnulusRadius, Circle, Extras, FeatureMismatch, LandmarkResidual, Metrics, Output,
-    QuadraticDifferential, Remeshed, Solution, Stop,
+    QuadraticDifferential, Remeshed, ShapeDistance, Solution, Stop,
 };
 pub use solver::{Context, Progress, Solver};

@@ -154,6 +154,17 @@ pub struct FeatureMismatch {
     pub steps: usize,
 }
 
+/// How far a registration's shape match brought the source onto the target: the mean
+/// distance from each source vertex, placed by the similarity that best carries the
+/// source onto its images, to its image, in the target's units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeDistance {
+    /// At the conformal registration the match started from.
+    pub before: f64,
+    /// At the result.
+    pub after: f64,
+}
+
 /// What some solvers compute beside the map, typed.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Extras {
@@ -169,8 +180,11 @@ pub struct Extras {
     /// The road a registration took, in words: the common domain, where the landmarks
     /// were matched and why.
     pub route: Option<String>,
-    /// A registration's feature match (`Goal::Features`).
+    /// A registration's feature match (`Goal::Features`, and the shape's coordinates
+    /// when it is matched).
     pub features: Option<FeatureMismatch>,
+    /// A registration's shape match (its option `match-shape`).
+    pub shape: Option<ShapeDistance>,
 }
 
 /// The result of a solve.

@@ -27,7 +27,7 @@
 //! `m`'s image. Such ears are counted in the notes (they count as flipped); a target
 //! boundary at least as fine as the source's avoids them.
 
-use beltrami_core::{FeatureMismatch, Features};
+use beltrami_core::FeatureMismatch;
 use std::f64::consts::TAU;
 
 use beltrami_fem::{BoundaryMap, Frame};
@@ -37,7 +37,7 @@ use num_complex::Complex64;
 use crate::Routed;
 use crate::compose;
 use crate::error::{RegisterError, Side};
-use crate::feature_match::match_features;
+use crate::feature_match::{Channel, match_features};
 use crate::landmark_match::match_landmarks;
 use crate::landmarks::{Resolved, SpatialMatch, interpolate};
 use crate::param::{arc_fractions, domain_mesh, planar_points, tutte};
@@ -227,7 +227,7 @@ pub(crate) fn match_features_after(
     target_param: &[Complex64],
     points: &[SurfacePoint],
     marks: &[Resolved],
-    features: &Features,
+    channels: &[Channel],
     notes: &mut Vec<String>,
 ) -> Result<(Vec<SurfacePoint>, FeatureMismatch), RegisterError> {
     let chart: Vec<Complex64> = points
@@ -241,17 +241,9 @@ pub(crate) fn match_features_after(
         .map(|v| (v, chart[v.idx()]))
         .collect();
     let domain = domain_mesh(target, planar_points(target_param), Side::Target)?;
-    let matched = match_features(
-        source,
-        &chart,
-        &fixed,
-        &features.source,
-        &domain,
-        &features.target,
-        Side::Source,
-    )?;
+    let matched = match_features(source, &chart, &fixed, channels, &domain, Side::Source)?;
     notes.push(format!(
-        "disk: features matched in the target's disk with the boundary and the landmarks held: mismatch {:.4} -> {:.4} (mean squared difference of the standardized fields) in {} steps",
+        "disk: features matched in the target's disk with the boundary and the landmarks held: mismatch {:.4} -> {:.4} (mean squared difference of the fields) in {} steps",
         matched.before, matched.after, matched.steps
     ));
     let (located, _) = compose::locate(&domain, &planar_points(&matched.map))?;

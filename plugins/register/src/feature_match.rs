@@ -65,6 +65,38 @@ const MENDING: usize = 3;
 /// The smallest step length tried.
 const MIN_STEP: f64 = 0.125;
 
+/// One field to match: its values at the source's vertices and at the chart's.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Channel {
+    /// Per vertex of the source.
+    pub source: Vec<f64>,
+    /// Per vertex of the target's chart.
+    pub target: Vec<f64>,
+    /// Standardized on each side at each scale (a scalar feature, in any unit), or
+    /// taken as given (coordinates of both sides in one unit, module `shape`).
+    pub standardize: bool,
+}
+
+impl Channel {
+    /// Both sides after `passes` of neighbour averaging (`target_passes` on the target),
+    /// standardized when the channel asks for it.
+    fn at_scale(
+        &self,
+        neighbours: &[Vec<usize>],
+        domain_neighbours: &[Vec<usize>],
+        passes: usize,
+        target_passes: usize,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let source = smoothed(neighbours, None, self.source.clone(), passes);
+        let target = smoothed(domain_neighbours, None, self.target.clone(), target_passes);
+        if self.standardize {
+            (standardized(&source), standardized(&target))
+        } else {
+            (source, target)
+        }
+    }
+}
+
 /// A map that matches the fields and how far it got.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FeatureMatch {
@@ -78,9 +110,8 @@ pub(crate) struct FeatureMatch {
 }
 
 /// The source's chart map `initial` (bijective, one value per vertex of `mesh`) bent so
-/// that `source_values` (per vertex of `mesh`) matches `domain_values` (per vertex of
-/// the planar mesh `domain`, the target's chart) with the vertices of `fixed` held
-/// (module docs).
+/// that every channel's source values match its values on the planar mesh `domain`
+/// (the target's chart) with the vertices of `fixed` held (module docs).
 ///
 /// # Errors
 /// The errors of [`Reconstruction`]; [`RegisterError::Spatial`] when the chart cannot be
@@ -89,9 +120,8 @@ pub(crate) fn match_features(
     mesh: &Mesh,
     initial: &[Complex64],
     fixed: &[(VertexId, Complex64)],
-    source_values: &[f64],
+    channels: &[Channel],
     domain: &Mesh,
-    domain_values: &[f64],
     side: Side,
 ) -> Result<FeatureMatch, RegisterError> {
     let weights = vertex_areas(mesh);
@@ -109,9 +139,12 @@ pub(crate) fn match_features(
     let alpha = 0.5 / median_edge(mesh, initial).max(f64::MIN_POSITIVE);
     let (mut reconstruction, _) =
         Reconstruction::new(mesh, Frame::Face, initial, fixed, &[], side)?;
-    let exact_source = standardized(source_values);
     let index = SurfaceIndex::new(domain)?;
-    let exact_target = TargetField::new(&index, domain, &standardized(domain_values));
+    let (exact_source, exact_target): (Vec<_>, Vec<_>) = channels
+        .iter()
+        .map(|c| c.at_scale(&neighbours, &domain_neighbours, 0, 0))
+        .unzip();
+    let exact_target = TargetField::new(&index, domain, &exact_target);
     let start = exact_target.probe(initial, None)?;
     let before = mismatch(&exact_source, &start.values, &weights);
 
@@ -120,20 +153,13 @@ pub(crate) fn match_features(
     let mut steps = 0;
     for passes in SCALES {
         let target_passes = (passes as f64 * ratio).round() as usize;
-        let source_field =
-            standardized(&smoothed(&neighbours, None, source_values.to_vec(), passes));
-        let target_field = TargetField::new(
-            &index,
-            domain,
-            &standardized(&smoothed(
-                &domain_neighbours,
-                None,
-                domain_values.to_vec(),
-                target_passes,
-            )),
-        );
+        let (source_fields, target_fields): (Vec<_>, Vec<_>) = channels
+            .iter()
+            .map(|c| c.at_scale(&neighbours, &domain_neighbours, passes, target_passes))
+            .unzip();
+        let target_field = TargetField::new(&index, domain, &target_fields);
         let mut probe = target_field.probe(&map, Some(&start))?;
-        let mut energy = mismatch(&source_field, &probe.values, &weights);
+        let mut energy = mismatch(&source_fields, &probe.values, &weights);
         let first = energy;
         let mut length = 1.0;
         let mut level_steps = 0;
@@ -143,11 +169,18 @@ pub(crate) fn match_features(
                     if held[i] {
                         return Complex64::new(0.0, 0.0);
                     }
-                    let r = source_field[i] - probe.values[i];
-                    let g = probe.gradients[i];
-                    let denominator = g.norm_sqr() + alpha * alpha * r * r;
+                    let mut pull = Complex64::new(0.0, 0.0);
+                    let (mut slope, mut residual) = (0.0, 0.0);
+                    for (c, field) in source_fields.iter().enumerate() {
+                        let r = field[i] - probe.values[c][i];
+                        let g = probe.gradients[c][i];
+                        pull += g * r;
+                        slope += g.norm_sqr();
+                        residual += r * r;
+                    }
+                    let denominator = slope + alpha * alpha * residual;
                     if denominator > 0.0 {
-                        g * (r / denominator)
+                        pull / denominator
                     } else {
                         Complex64::new(0.0, 0.0)
                     }
@@ -173,7 +206,7 @@ pub(crate) fn match_features(
                 (rebuilt_mu, flipped) = reconstruction.measure(&rebuilt)?;
             }
             let trial = target_field.probe(&rebuilt, Some(&probe))?;
-            let trial_energy = mismatch(&source_field, &trial.values, &weights);
+            let trial_energy = mismatch(&source_fields, &trial.values, &weights);
             if flipped > 0 || trial_energy >= energy {
                 length *= 0.5;
                 continue;
@@ -277,66 +310,60 @@ fn median_edge(mesh: &Mesh, map: &[Complex64]) -> f64 {
     *lengths.select_nth_unstable_by(middle, f64::total_cmp).1
 }
 
-/// The area-weighted mean squared difference of two fields.
-fn mismatch(source: &[f64], at_images: &[f64], weights: &[f64]) -> f64 {
+/// The area-weighted mean squared difference of the channels' fields, summed over
+/// the channels.
+fn mismatch(source: &[Vec<f64>], at_images: &[Vec<f64>], weights: &[f64]) -> f64 {
     let total: f64 = weights.iter().sum();
     source
         .iter()
         .zip(at_images)
-        .zip(weights)
-        .map(|((a, b), w)| w * (a - b).powi(2))
+        .map(|(field, at)| {
+            field
+                .iter()
+                .zip(at)
+                .zip(weights)
+                .map(|((a, b), w)| w * (a - b).powi(2))
+                .sum::<f64>()
+        })
         .sum::<f64>()
         / total.max(f64::MIN_POSITIVE)
 }
 
-/// The target's field on its chart: values at the vertices, linear on each triangle.
+/// The target's fields on its chart: values at the vertices, linear on each triangle.
 struct TargetField<'d> {
     index: &'d SurfaceIndex<'d>,
     domain: &'d Mesh,
-    values: Vec<f64>,
-    /// The gradient of the linear interpolant on each face, as `d/dx + i d/dy`.
-    gradients: Vec<Complex64>,
+    /// Per channel, per vertex.
+    values: Vec<Vec<f64>>,
+    /// Per channel, the gradient of the linear interpolant on each face, as
+    /// `d/dx + i d/dy`.
+    gradients: Vec<Vec<Complex64>>,
 }
 
-/// The target's field and its gradient at the images of the source's vertices, and the
-/// faces the images are in.
+/// The target's fields and their gradients at the images of the source's vertices (per
+/// channel, per vertex), and the faces the images are in.
 struct Probe {
-    values: Vec<f64>,
-    gradients: Vec<Complex64>,
+    values: Vec<Vec<f64>>,
+    gradients: Vec<Vec<Complex64>>,
     faces: Vec<FaceId>,
 }
 
 impl<'d> TargetField<'d> {
-    fn new(index: &'d SurfaceIndex<'d>, domain: &'d Mesh, values: &[f64]) -> Self {
-        let gradients = domain
-            .faces()
-            .map(|f| {
-                let (vs, _) = domain.face_vertex_array(f);
-                let p = |k: usize| domain.position(vs[k]);
-                let (a, b, c) = (p(0), p(1), p(2));
-                let (e1, e2) = (b - a, c - a);
-                let (d1, d2) = (
-                    values[vs[1].idx()] - values[vs[0].idx()],
-                    values[vs[2].idx()] - values[vs[0].idx()],
-                );
-                // [e1; e2] g = [d1; d2] by Cramer's rule.
-                let det = e1.x * e2.y - e1.y * e2.x;
-                if det == 0.0 {
-                    return Complex64::new(0.0, 0.0);
-                }
-                Complex64::new((d1 * e2.y - d2 * e1.y) / det, (e1.x * d2 - e2.x * d1) / det)
-            })
+    fn new(index: &'d SurfaceIndex<'d>, domain: &'d Mesh, channels: &[Vec<f64>]) -> Self {
+        let gradients = channels
+            .iter()
+            .map(|values| face_gradients(domain, values))
             .collect();
         Self {
             index,
             domain,
-            values: values.to_vec(),
+            values: channels.to_vec(),
             gradients,
         }
     }
 
-    /// The field and its gradient at the images `map`: each image found by a walk from
-    /// its face in `near` (the last probe's, when given), or by the index.
+    /// The fields and their gradients at the images `map`: each image found by a walk
+    /// from its face in `near` (the last probe's, when given), or by the index.
     fn probe(&self, map: &[Complex64], near: Option<&Probe>) -> Result<Probe, RegisterError> {
         let walked: Vec<Option<SurfacePoint>> = match near {
             Some(near) => map
@@ -354,23 +381,50 @@ impl<'d> TargetField<'d> {
         for (&i, l) in lost.iter().zip(found) {
             points[i] = Some(l.point);
         }
+        let channels = self.values.len();
         let mut probe = Probe {
-            values: Vec::with_capacity(map.len()),
-            gradients: Vec::with_capacity(map.len()),
+            values: vec![Vec::with_capacity(map.len()); channels],
+            gradients: vec![Vec::with_capacity(map.len()); channels],
             faces: Vec::with_capacity(map.len()),
         };
         for point in points.into_iter().flatten() {
             let (vs, degree) = self.domain.face_vertex_array(point.face);
-            probe.values.push(
-                (0..degree)
-                    .map(|k| point.coords[k] * self.values[vs[k].idx()])
-                    .sum(),
-            );
-            probe.gradients.push(self.gradients[point.face.idx()]);
+            for c in 0..channels {
+                probe.values[c].push(
+                    (0..degree)
+                        .map(|k| point.coords[k] * self.values[c][vs[k].idx()])
+                        .sum(),
+                );
+                probe.gradients[c].push(self.gradients[c][point.face.idx()]);
+            }
             probe.faces.push(point.face);
         }
         Ok(probe)
     }
+}
+
+/// The gradient of the linear interpolant of `values` (per vertex) on each face of the
+/// planar mesh `domain`, as `d/dx + i d/dy` (0 on a face of zero area).
+fn face_gradients(domain: &Mesh, values: &[f64]) -> Vec<Complex64> {
+    domain
+        .faces()
+        .map(|f| {
+            let (vs, _) = domain.face_vertex_array(f);
+            let p = |k: usize| domain.position(vs[k]);
+            let (a, b, c) = (p(0), p(1), p(2));
+            let (e1, e2) = (b - a, c - a);
+            let (d1, d2) = (
+                values[vs[1].idx()] - values[vs[0].idx()],
+                values[vs[2].idx()] - values[vs[0].idx()],
+            );
+            // [e1; e2] g = [d1; d2] by Cramer's rule.
+            let det = e1.x * e2.y - e1.y * e2.x;
+            if det == 0.0 {
+                return Complex64::new(0.0, 0.0);
+            }
+            Complex64::new((d1 * e2.y - d2 * e1.y) / det, (e1.x * d2 - e2.x * d1) / det)
+        })
+        .collect()
 }
 
 /// Faces a walk crosses at most before the index takes over.
@@ -452,13 +506,17 @@ mod tests {
             .filter(|&v| square.is_boundary_vertex(v))
             .map(|v| (v, identity[v.idx()]))
             .collect();
+        let channel = Channel {
+            source,
+            target,
+            standardize: true,
+        };
         let matched = match_features(
             &square,
             &identity,
             &fixed,
-            &source,
+            &[channel],
             &square,
-            &target,
             Side::Source,
         )
         .unwrap();

@@ -5,7 +5,7 @@
 
 use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3, VertexId};
 use beltrami_spatial::SurfaceIndex;
-use nalgebra::{Matrix3, Rotation3, Unit};
+use nalgebra::{Matrix3, Matrix3x4, Rotation3, Unit};
 use num_complex::Complex64;
 
 use crate::error::RegisterError;
@@ -267,6 +267,21 @@ impl SpatialMatch {
             scale,
             rotation,
         })
+    }
+
+    /// The scale factor `s`.
+    pub(crate) fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// The similarity as an affine map `p -> M (p, 1)`.
+    pub(crate) fn as_affine(&self) -> Matrix3x4<f64> {
+        let linear = self.rotation * self.scale;
+        let shift = self.target_center.coords - linear * self.source_center.coords;
+        let mut m = Matrix3x4::zeros();
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&linear);
+        m.set_column(3, &shift);
+        m
     }
 
     /// A source position moved into the target's frame.

@@ -49,9 +49,11 @@ mod param;
 mod polygon;
 mod projection;
 mod routing;
+mod shape;
 mod skeleton;
 mod solver;
 mod sphere;
+mod sphere_alignment;
 mod square_map;
 mod topology;
 mod torus;
@@ -61,6 +63,7 @@ use beltrami_fem::DistortionStats;
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
 
+use crate::feature_match::Channel;
 use crate::landmarks::Resolved;
 
 pub use error::{RegisterError, Side};
@@ -134,7 +137,7 @@ pub fn initial_map(
 }
 
 /// [`initial_map`], with both sphere maps conformal when `conformal_sphere` (the
-/// start of a feature match on the sphere) even without landmarks.
+/// start of a shape or feature match on the sphere) even without landmarks.
 pub(crate) fn initial_map_for(
     source: &Mesh,
     target: &Mesh,
@@ -256,16 +259,16 @@ pub(crate) fn match_features_after(
     target: &Mesh,
     initial: &InitialMap,
     points: &[SurfacePoint],
-    features: &Features,
+    channels: &[Channel],
     notes: &mut Vec<String>,
 ) -> Result<(Vec<SurfacePoint>, beltrami_core::FeatureMismatch), RegisterError> {
     let marks = &initial.marks;
     match &initial.domain {
         TargetDomain::Disk(param) => {
-            disk::match_features_after(source, target, param, points, marks, features, notes)
+            disk::match_features_after(source, target, param, points, marks, channels, notes)
         }
         TargetDomain::Sphere(sphere) => {
-            sphere::match_features_after(source, target, sphere, points, marks, features, notes)
+            sphere::match_features_after(source, target, sphere, points, marks, channels, notes)
         }
         TargetDomain::Other => Err(RegisterError::Features {
             reason: "they are matched on disks and closed genus-0 surfaces".to_string(),
@@ -273,24 +276,34 @@ pub(crate) fn match_features_after(
     }
 }
 
-/// Refuses features on a topology whose road does not match them, or fields that do
-/// not fit the meshes ([`Features::check`]).
+/// Refuses fields to match (`features`, and the shape when `shape`) on a topology whose
+/// road does not match them, or features that do not fit the meshes
+/// ([`Features::check`]).
 pub(crate) fn check_features(
     topology: Topology,
-    features: &Features,
+    features: Option<&Features>,
+    shape: bool,
     source: &Mesh,
     target: &Mesh,
 ) -> Result<(), RegisterError> {
-    if !matches!(topology, Topology::Disk | Topology::Sphere) {
+    if (features.is_some() || shape) && !matches!(topology, Topology::Disk | Topology::Sphere) {
+        let what = if features.is_some() {
+            "they are"
+        } else {
+            "the shape (match-shape) is"
+        };
         return Err(RegisterError::Features {
             reason: format!(
-                "they are matched on disks and closed genus-0 surfaces; these meshes are {topology}"
+                "{what} matched on disks and closed genus-0 surfaces; these meshes are {topology}"
             ),
         });
     }
-    features
-        .check(source, target)
-        .map_err(|reason| RegisterError::Features { reason })
+    match features {
+        Some(features) => features
+            .check(source, target)
+            .map_err(|reason| RegisterError::Features { reason }),
+        None => Ok(()),
+    }
 }
 
 /// The road of [`initial_map`] for `topology` with `landmarks` landmarks, in words.

@@ -5,12 +5,14 @@ use std::sync::LazyLock;
 use beltrami_core::{
     Accepts, Constraint, ConstraintKind, Constraints, Context, Element, Features, Goal, GoalKind,
     LandmarkResidual, Map, OptionKind, OptionSpec, OptionValue, Position, Problem, Report,
-    Settings, Solution, Solver, SolverError, Target, TargetKind, solve_renumbered,
+    Settings, ShapeDistance, Solution, Solver, SolverError, Target, TargetKind, solve_renumbered,
 };
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::compose::flipped_faces;
+use crate::feature_match::Channel;
+use crate::shape::Shape;
 use crate::{
     InitialMap, Landmark, LandmarkTarget, RegisterError, check_topology, initial_map_for,
     match_features_after,
@@ -56,13 +58,18 @@ const ACCEPTS: Accepts = Accepts {
     constraints: &[ConstraintKind::Landmark, ConstraintKind::OpenCurve],
 };
 
-/// The flow's options, `allow-flips` and `allow-missed-landmarks`.
+/// The flow's options, `allow-flips`, `match-shape` and `allow-missed-landmarks`.
 static OPTIONS: LazyLock<Vec<OptionSpec>> = LazyLock::new(|| {
     let mut options = beltrami_flow_engine::OPTIONS.to_vec();
     options.push(OptionSpec {
         name: "allow-flips",
         kind: OptionKind::Bool { default: false },
         help: "keep a map that still has flipped faces after the flow (they are named in the notes) instead of failing",
+    });
+    options.push(OptionSpec {
+        name: "match-shape",
+        kind: OptionKind::Bool { default: false },
+        help: "after the conformal registration, pull each image towards where the source, aligned by a similarity, lies on the target (a bijective non-rigid ICP; disks and closed genus-0 surfaces)",
     });
     options.push(OptionSpec {
         name: "allow-missed-landmarks",
@@ -260,11 +267,7 @@ impl Solver for Register {
         &OPTIONS
     }
 
-    fn check_problem(
-        &self,
-        problem: &Problem<'_>,
-        _settings: &Settings,
-    ) -> Result<(), SolverError> {
+    fn check_problem(&self, problem: &Problem<'_>, settings: &Settings) -> Result<(), SolverError> {
         let Target::Mesh(target) = &problem.target else {
             return Err(unsupported("register maps onto a target mesh"));
         };
@@ -280,14 +283,17 @@ impl Solver for Register {
             }
         }
         landmarks(problem)?;
-        if let Goal::Features(features) = &problem.goal {
-            if problem.constraints.curves().next().is_some() {
-                return Err(unsupported(
-                    "feature curves and feature fields together are not matched yet: give landmarks along the curves instead",
-                ));
-            }
-            crate::check_features(topology, features, problem.source, target).map_err(plugin)?;
+        let features = match &problem.goal {
+            Goal::Features(features) => Some(features),
+            _ => None,
+        };
+        let shape = settings.flag("match-shape");
+        if (features.is_some() || shape) && problem.constraints.curves().next().is_some() {
+            return Err(unsupported(
+                "feature curves and matched fields (features, match-shape) together are not matched yet: give landmarks along the curves instead",
+            ));
         }
+        crate::check_features(topology, features, shape, problem.source, target).map_err(plugin)?;
         crate::consistency::check(problem, target).map_err(plugin)?;
         Ok(())
     }
@@ -303,12 +309,14 @@ impl Solver for Register {
 }
 
 /// The conformal registration `solution` of `flow` bent in the common domain so that
-/// `features` match (module `feature_match`), then measured by the flow engine with no
-/// step (a step would pull it back towards conformal).
+/// `features` match and, with `shape`, the source's aligned coordinates (modules
+/// `feature_match`, `shape`), then measured by the flow engine with no step (a step
+/// would pull it back towards conformal).
 fn after_features(
     flow: &Problem<'_>,
     initial: &InitialMap,
-    features: &Features,
+    features: Option<&Features>,
+    shape: bool,
     solution: Solution,
     context: &mut Context<'_>,
 ) -> Result<Solution, SolverError> {
@@ -318,13 +326,39 @@ fn after_features(
     let Some(Map::OnMesh(points)) = solution.map() else {
         return Ok(solution);
     };
+    let mut channels: Vec<Channel> = features
+        .map(|f| Channel {
+            source: f.source.clone(),
+            target: f.target.clone(),
+            standardize: true,
+        })
+        .into_iter()
+        .collect();
+    let shape = if shape {
+        let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
+        let fitted = Shape::new(flow.source, target, &index, points)
+            .map_err(plugin)?
+            .ok_or_else(|| {
+                plugin(RegisterError::Features {
+                    reason: "the registration's images lie on a line: no similarity places the source for match-shape".to_string(),
+                })
+            })?;
+        channels.extend(fitted.channels(flow.source, target));
+        Some(fitted)
+    } else {
+        None
+    };
     let mut report = solution.report.clone();
     let mut notes = Vec::new();
     let (matched, mismatch) = context.stage("feature match", &mut report, || {
-        match_features_after(flow.source, target, initial, points, features, &mut notes)
+        match_features_after(flow.source, target, initial, points, &channels, &mut notes)
             .map_err(plugin)
     })?;
     report.notes.extend(notes);
+    let distance = shape.as_ref().map(|s| ShapeDistance {
+        before: s.distance(flow.source, target, points),
+        after: s.distance(flow.source, target, &matched),
+    });
     let mut measure = flow.clone();
     let positions = matched.iter().map(|p| p.position(target)).collect();
     measure.initial = Some(Map::OnMesh(matched));
@@ -339,6 +373,7 @@ fn after_features(
         .notes
         .retain(|n| !n.starts_with("stopped at the iteration limit (0)"));
     measured.extras.features = Some(mismatch);
+    measured.extras.shape = distance;
     Ok(measured)
 }
 
@@ -358,8 +393,10 @@ pub(crate) fn register(
         Goal::Features(features) => Some(features),
         _ => None,
     };
+    let shape = settings.flag("match-shape");
+    let matched = features.is_some() || shape;
     let initial = context.stage("initial map", &mut report, || {
-        initial_map_for(source, target, &marks, features.is_some()).map_err(plugin)
+        initial_map_for(source, target, &marks, matched).map_err(plugin)
     })?;
     report.notes.extend(initial.notes.iter().cloned());
     let mut flow = problem.clone();
@@ -388,8 +425,8 @@ pub(crate) fn register(
     flow.initial = Some(Map::OnMesh(initial.points.clone()));
     let mut solution =
         beltrami_flow_engine::solve(&flow, settings, initial.positions.clone(), report, context)?;
-    if let Some(features) = features {
-        solution = after_features(&flow, &initial, features, solution, context)?;
+    if matched {
+        solution = after_features(&flow, &initial, features, shape, solution, context)?;
     }
     // Judged against the target's normals at the images (the rule of `beltrami
     // distortion --target` and of the flow), when the initial map was built.

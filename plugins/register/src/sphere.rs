@@ -1,24 +1,25 @@
 //! Closed genus 0: both meshes onto the unit sphere with the `sphere` initialization of
-//! `beltrami-init` (Tutte embedding of the mesh minus one face, inverse stereographic
-//! projection, Moebius centering), the source's sphere aligned with the target's, and
+//! `beltrami-init` (its `conformal` start with landmarks or a shape or feature match,
+//! else its `tutte` start, which the flow was tuned from), the source's sphere aligned with the target's, and
 //! the source's images located radially in the target's sphere polyhedron
 //! ([`crate::compose::locate_radial`]).
 //!
 //! Alignment (applied to the source's sphere positions):
 //!
-//! - no landmark: the rotation `R` minimizing `sum_i |R S_i - T(q_i)|^2` over (up to
-//!   4096 evenly picked) source vertices, `S_i` a source vertex's sphere position and
-//!   `T(q_i)` the target's sphere position at the spatial partner `q_i` of that vertex
-//!   (the closest point of the target after centring and scaling, no rotation in space);
-//! - one landmark: that rotation, then the smallest rotation taking the landmark's image
+//! - no landmark: the Moebius transformation `M` (a rotation from the Tutte start)
+//!   minimizing `sum_i |M S_i - T(q_i)|^2`
+//!   over (up to 4096 evenly picked) source vertices ([`crate::sphere_alignment`]),
+//!   `S_i` a source vertex's sphere position and `T(q_i)` the target's sphere position
+//!   at the spatial partner `q_i` of that vertex (the closest point of the target after
+//!   centring and scaling, no rotation in space);
+//! - one landmark: that transformation, then the smallest rotation taking the landmark's image
 //!   onto its target's sphere position (exact);
 //! - two or more: the Moebius transformation taking the first three landmarks' images
 //!   onto their targets' (exact); with two, the third pair is the poles of the great
 //!   circles through the two, so the transformation fixes the pole and slides along
 //!   the circle.
 //!
-//! With landmarks, both sphere maps are the conformal start of the `sphere` solver and
-//! every landmark is matched on the sphere itself ([`match_on_sphere`]): after the
+//! With landmarks, every landmark is matched on the sphere itself ([`match_on_sphere`]): after the
 //! Moebius transformation of the three landmarks that brings all of them nearest their
 //! targets, the source minus the face farthest from every landmark is mapped into the
 //! stereographic chart from that face's direction by the landmark-matching
@@ -27,9 +28,7 @@
 //! onto the sphere. The map is exact at every landmark and, with no flipped face in the
 //! chart, a bijection of the sphere.
 
-use beltrami_core::{
-    Context, FeatureMismatch, Features, Map, Problem, Solver, SolverError, Target,
-};
+use beltrami_core::{Context, FeatureMismatch, Map, Problem, Solver, SolverError, Target};
 use beltrami_fem::Frame;
 use beltrami_init::Sphere;
 use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint, Vector3};
@@ -39,12 +38,13 @@ use num_complex::Complex64;
 use crate::Routed;
 use crate::compose;
 use crate::error::{RegisterError, Side};
-use crate::feature_match::match_features;
+use crate::feature_match::{Channel, match_features};
 use crate::landmark_match::match_landmarks;
 use crate::landmarks::{
     Moebius, Resolved, SpatialMatch, best_rotation, interpolate, rotation_between,
 };
 use crate::param::{domain_mesh, each_mesh, planar_points};
+use crate::sphere_alignment::{SphereMoebius, fitted_moebius};
 
 /// Source vertices used by the rotation fit at most.
 const FIT_SAMPLES: usize = 4096;
@@ -62,22 +62,19 @@ pub(crate) fn map(
     conformal: bool,
     notes: &mut Vec<String>,
 ) -> Result<Routed<Vec<Vector3<f64>>>, RegisterError> {
-    // The Tutte start, which the flow from a map without landmarks was tuned from; with
-    // landmarks the matching is done on the sphere, where the conformal start makes the
-    // composition nearly conformal by itself (asked for by `conformal` as well).
-    let start = if marks.is_empty() && !conformal {
-        "tutte"
-    } else {
-        "conformal"
-    };
+    // The Tutte start, which the flow from a map without landmarks was tuned from;
+    // conformal sphere maps with landmarks or when asked (a shape or feature match):
+    // composed through a Moebius transformation they make a nearly conformal map by
+    // themselves, and the alignment by geometry chooses among exactly those.
+    let conformal = conformal || !marks.is_empty();
     // The two sphere maps are independent: computed at once, on two cores.
     let (source_sphere, target_sphere) = each_mesh(source, target, notes, |mesh, side, notes| {
-        sphere(mesh, side, start, notes)
+        sphere(mesh, side, conformal, notes)
     })?;
     let target_at =
         |p: &SurfacePoint| -> Vector3<f64> { interpolate(target, &target_sphere, p).normalize() };
 
-    let fit = || -> Result<nalgebra::Matrix3<f64>, RegisterError> {
+    let fit = || -> Result<SphereMoebius, RegisterError> {
         let spatial = SpatialMatch::new(source, target);
         let step = source.vertex_count().div_ceil(FIT_SAMPLES).max(1);
         let mut pairs = Vec::new();
@@ -85,7 +82,13 @@ pub(crate) fn map(
             let partner = target_index.locate(&spatial.to_target(&source.position(v)))?;
             pairs.push((source_sphere[v.idx()], target_at(&partner.point)));
         }
-        Ok(best_rotation(&pairs))
+        // A Moebius transformation of Tutte sphere maps is no nearer conformal than a
+        // rotation: they are only turned.
+        Ok(if conformal {
+            fitted_moebius(&pairs).0
+        } else {
+            SphereMoebius::rotation(best_rotation(&pairs))
+        })
     };
 
     let s: Vec<Vector3<f64>> = marks
@@ -95,21 +98,25 @@ pub(crate) fn map(
     let t: Vec<Vector3<f64>> = marks.iter().map(|m| target_at(&m.target)).collect();
     let aligned: Vec<Vector3<f64>> = match marks {
         [] => {
-            let r = fit()?;
-            notes.push(
-                "sphere: no landmark; source sphere rotated to match a rough spatial correspondence (centroids and sizes)"
-                    .to_string(),
-            );
-            source_sphere.iter().map(|s| r * s).collect()
+            let m = fit()?;
+            let how = if conformal {
+                "the Moebius transformation"
+            } else {
+                "the rotation"
+            };
+            notes.push(format!(
+                "sphere: no landmark; source sphere moved by {how} that best matches a rough spatial correspondence (centroids and sizes)"
+            ));
+            source_sphere.iter().map(|s| m.apply(s)).collect()
         }
         [mark] => {
-            let r0 = fit()?;
-            let r = rotation_between(&(r0 * s[0]), &t[0]) * r0;
+            let m = fit()?;
+            let r = rotation_between(&m.apply(&s[0]), &t[0]);
             notes.push(format!(
-                "sphere: rotated so that landmark {} lands on its target, the rest by a rough spatial correspondence",
+                "sphere: moved so that landmark {} lands on its target, the rest by a rough spatial correspondence",
                 mark.index
             ));
-            source_sphere.iter().map(|s| r * s).collect()
+            source_sphere.iter().map(|s| r * m.apply(s)).collect()
         }
         _ => {
             let (moebius, used) = best_moebius(marks, &s, &t)?;
@@ -161,7 +168,7 @@ pub(crate) fn match_features_after(
     target_sphere: &[Vector3<f64>],
     points: &[SurfacePoint],
     marks: &[Resolved],
-    features: &Features,
+    channels: &[Channel],
     notes: &mut Vec<String>,
 ) -> Result<(Vec<SurfacePoint>, FeatureMismatch), RegisterError> {
     let on_sphere = |p: &SurfacePoint| interpolate(target, target_sphere, p).normalize();
@@ -173,7 +180,7 @@ pub(crate) fn match_features_after(
         Side::Target,
     )?;
     let fields = SphereFields {
-        features,
+        channels,
         target,
         target_sphere,
         sphere_mesh: &domain,
@@ -344,13 +351,12 @@ fn match_on_sphere(
             &punctured,
             &map,
             &fixed,
-            &fields.features.source,
+            fields.channels,
             &domain,
-            &fields.features.target,
             Side::Source,
         )?;
         notes.push(format!(
-            "sphere: features matched in the chart from source face {}: mismatch {:.4} -> {:.4} (mean squared difference of the standardized fields) in {} steps",
+            "sphere: features matched in the chart from source face {}: mismatch {:.4} -> {:.4} (mean squared difference of the fields) in {} steps",
             source.face_to_input(pole),
             matched.before,
             matched.after,
@@ -375,10 +381,10 @@ fn match_on_sphere(
     Ok((images, mismatch))
 }
 
-/// The fields of a feature match on the sphere: the features and the target with its
+/// The fields of a feature match on the sphere: the channels and the target with its
 /// sphere map.
 struct SphereFields<'a> {
-    features: &'a Features,
+    channels: &'a [Channel],
     target: &'a Mesh,
     target_sphere: &'a [Vector3<f64>],
     /// The target's sphere polyhedron (its faces over `target_sphere`).
@@ -435,15 +441,16 @@ fn pole_face(
     }
 }
 
-/// The `sphere` initialization of `mesh` from `start` (`tutte` or `conformal`) as unit
+/// The `sphere` initialization of `mesh` (its `conformal` start, or `tutte`) as unit
 /// vectors, its notes added to `notes`.
 fn sphere(
     mesh: &Mesh,
     side: Side,
-    start: &str,
+    conformal: bool,
     notes: &mut Vec<String>,
 ) -> Result<Vec<Vector3<f64>>, RegisterError> {
     let mut problem = Problem::new(mesh, Target::Sphere);
+    let start = if conformal { "conformal" } else { "tutte" };
     problem.options.set_text("start", start);
     let solution = Sphere
         .solve(&problem, &mut Context::new())
