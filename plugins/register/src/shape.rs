@@ -37,11 +37,26 @@ const TRIM: f64 = 2.5;
 /// similarity's scale: the closest-point fit must not flatten the source.
 const MAX_SHEAR: f64 = 2.0;
 
-/// The source placed in the target's frame by an affine map and its coordinate fields
-/// on both meshes.
+/// Reaches of the template's smoothing, coarse to fine, as fractions of the source's
+/// size: a displacement averaged over `k` passes reaches about `h sqrt(k)` for an edge
+/// `h`, so `k = fraction^2 n` passes for `n` vertices.
+const TEMPLATE_REACH: [f64; 4] = [0.2, 0.1, 0.05, 0.025];
+
+/// Closest-point rounds of the template per reach.
+const TEMPLATE_ROUNDS: usize = 4;
+
+/// Passes of smoothing at most (a very fine mesh is smoothed less far than asked).
+const MAX_PASSES: usize = 2000;
+
+/// A pair is used only where the template's normal and the target face's normal at the
+/// closest point agree to this cosine (a closest point across a thin fold faces away).
+const NORMAL_AGREEMENT: f64 = 0.5;
+
+/// The source placed in the target's frame (an affine map, then a smooth deformation
+/// onto the target) and its coordinate fields on both meshes.
 pub(crate) struct Shape {
-    /// `p -> M (p, 1)`.
-    alignment: Matrix3x4<f64>,
+    /// The placed source, per source vertex.
+    placed: Vec<Point3<f64>>,
     /// The target's root-mean-square distance from its centroid.
     scale: f64,
 }
@@ -121,20 +136,21 @@ impl Shape {
             .sum::<f64>()
             / n)
             .sqrt();
-        Ok((scale > 0.0).then_some(Self { alignment, scale }))
+        let affine: Vec<Point3<f64>> = source
+            .positions()
+            .iter()
+            .map(|p| apply(&alignment, p))
+            .collect();
+        let placed = deformed_template(source, index, affine)?;
+        Ok((scale > 0.0).then_some(Self { placed, scale }))
     }
 
     /// The three coordinate channels (module docs), per source vertex and per target
     /// vertex (the vertices of the target's chart).
-    pub(crate) fn channels(&self, source: &Mesh, target: &Mesh) -> Vec<Channel> {
-        let aligned: Vec<Point3<f64>> = source
-            .positions()
-            .iter()
-            .map(|p| apply(&self.alignment, p))
-            .collect();
+    pub(crate) fn channels(&self, target: &Mesh) -> Vec<Channel> {
         (0..3)
             .map(|axis| Channel {
-                source: aligned.iter().map(|p| p[axis] / self.scale).collect(),
+                source: self.placed.iter().map(|p| p[axis] / self.scale).collect(),
                 target: target
                     .positions()
                     .iter()
@@ -149,13 +165,90 @@ impl Shape {
     pub(crate) fn distance(&self, source: &Mesh, target: &Mesh, points: &[SurfacePoint]) -> f64 {
         let total: f64 = source
             .vertices()
-            .map(|v| {
-                (apply(&self.alignment, &source.position(v)) - points[v.idx()].position(target))
-                    .norm()
-            })
+            .map(|v| (self.placed[v.idx()] - points[v.idx()].position(target)).norm())
             .sum();
         total / source.vertex_count().max(1) as f64
     }
+}
+
+/// The source's vertices at `placed` moved onto the target by a smooth deformation, the
+/// non-rigid part of the closest-point fit: at each reach of `TEMPLATE_REACH`, rounds of
+/// each vertex's closest point on the target (pairs beyond `TRIM` median distances or
+/// whose normals disagree left out), the displacements to them averaged over the
+/// source's vertex neighbours (the pairs left out weigh nothing) and added.
+fn deformed_template(
+    source: &Mesh,
+    index: &SurfaceIndex<'_>,
+    mut template: Vec<Point3<f64>>,
+) -> Result<Vec<Point3<f64>>, RegisterError> {
+    let target = index.mesh();
+    let neighbours: Vec<Vec<usize>> = source
+        .vertices()
+        .map(|v| source.vertex_neighbors(v).map(|w| w.idx()).collect())
+        .collect();
+    let n = source.vertex_count();
+    for reach in TEMPLATE_REACH {
+        let passes = ((reach * reach * n as f64).round() as usize).clamp(1, MAX_PASSES);
+        for _ in 0..TEMPLATE_ROUNDS {
+            let closest = index.locate_all(&template)?;
+            let normals = vertex_normals_at(source, &template);
+            let mut distances: Vec<f64> = closest.iter().map(|l| l.distance).collect();
+            let limit = TRIM * median(&mut distances);
+            let mut weighted: Vec<(Vector3<f64>, f64)> = closest
+                .iter()
+                .zip(&template)
+                .zip(&normals)
+                .map(|((l, p), normal)| {
+                    let agrees = target.face_normal(l.point.face).dot(normal) >= NORMAL_AGREEMENT;
+                    if l.distance <= limit && agrees {
+                        (l.position - p, 1.0)
+                    } else {
+                        (Vector3::zeros(), 0.0)
+                    }
+                })
+                .collect();
+            for _ in 0..passes {
+                weighted = (0..n)
+                    .map(|i| {
+                        let (d, w) = neighbours[i].iter().fold(weighted[i], |(d, w), &j| {
+                            (d + weighted[j].0, w + weighted[j].1)
+                        });
+                        let count = (1 + neighbours[i].len()) as f64;
+                        (d / count, w / count)
+                    })
+                    .collect();
+            }
+            for (p, (d, w)) in template.iter_mut().zip(&weighted) {
+                if *w > 0.0 {
+                    *p += d / *w;
+                }
+            }
+        }
+    }
+    Ok(template)
+}
+
+/// Angle-weighted vertex normals of the source's faces over the positions `at`.
+fn vertex_normals_at(source: &Mesh, at: &[Point3<f64>]) -> Vec<Vector3<f64>> {
+    let mut sum = vec![Vector3::zeros(); source.vertex_count()];
+    for f in source.faces() {
+        let (vs, degree) = source.face_vertex_array(f);
+        for k in 0..degree {
+            let p = at[vs[k].idx()];
+            let (a, b) = (
+                at[vs[(k + 1) % degree].idx()] - p,
+                at[vs[(k + degree - 1) % degree].idx()] - p,
+            );
+            let normal = a.cross(&b);
+            let length = normal.norm();
+            if length > 0.0 {
+                sum[vs[k].idx()] += normal / length * a.angle(&b);
+            }
+        }
+    }
+    sum.into_iter()
+        .map(|s| s.try_normalize(0.0).unwrap_or_default())
+        .collect()
 }
 
 fn apply(m: &Matrix3x4<f64>, p: &Point3<f64>) -> Point3<f64> {
@@ -224,7 +317,7 @@ mod tests {
             .unwrap()
             .unwrap();
         assert!(shape.distance(&source, &target, &points) < 1e-9);
-        let channels = shape.channels(&source, &target);
+        let channels = shape.channels(&target);
         assert_eq!(channels.len(), 3);
         for channel in &channels {
             for v in source.vertices() {

@@ -343,7 +343,7 @@ fn after_features(
                     reason: "the registration's images lie on a line: no similarity places the source for match-shape".to_string(),
                 })
             })?;
-        channels.extend(fitted.channels(flow.source, target));
+        channels.extend(fitted.channels(target));
         Some(fitted)
     } else {
         None

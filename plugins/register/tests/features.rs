@@ -107,11 +107,10 @@ fn a_twisted_sphere_is_found_by_its_field() {
         "twisted sphere: mean distance to the truth {matched:.4} with the fields, {conformal:.4} without"
     );
     // A single field leaves the map free along its level sets; the regularization keeps
-    // the conformal map's own coefficient there (smoothing all of it would recover
-    // more of this smooth twist, 0.11, but costs 2.5x on cortical surfaces), so a
-    // third of the error goes.
+    // the conformal map's own coefficient there, so about half the error goes (0.226 ->
+    // 0.122, the cap about the chart's pole matched in a second chart).
     assert!(
-        matched < 0.75 * conformal,
+        matched < 0.6 * conformal,
         "mean distance to the twist: {matched:.4} with the fields, {conformal:.4} without"
     );
 }

@@ -1,0 +1,213 @@
+#!/usr/bin/env python3
+"""Registration by shape, side by side: `beltrami register --match-shape` against
+trimesh's non-rigid ICP (`trimesh.registration.nricp_amberg`, Amberg et al. 2007) and the
+closest point of the similarity-placed source, on pairs whose true correspondence is
+known (vertex i of the source corresponds to vertex i of the target).
+
+Pairs:
+- `spot`: ../shared/meshes/g0_spot.obj onto its smooth deformation
+  D(x, y, z) = (1.3 x + 0.15 sin 2y, y + 0.1 x^2, 0.8 z + 0.1 cos 3x), same faces;
+- `pial-white` (with --fs DIR, the output of benches/fsaverage.py): fsaverage5 left pial
+  onto white, also with the sulcal depth as a feature (nricp only with --nricp-cortex:
+  it runs for minutes there).
+
+For each method: the mean / median / max distance of the images from the true ones, the
+flipped faces by one outside rule for all (a source face flips when the normal of its
+image triangle points against the target's normal at the closest point of the image's
+centroid) and the wall-clock seconds (beltrami: the whole process).
+
+It installs its own dependencies (`pip install trimesh numpy scipy rtree`) into a virtual
+environment under ~/.cache/beltrami/peers-venv (or $BELTRAMI_PEERS_VENV) and re-runs
+itself there. It is not part of CI. Usage (from the repository root):
+
+    python3 benches/peers/nricp_compare.py [--meshes ../shared/meshes] [--fs DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+VENV = Path(
+    os.environ.get(
+        "BELTRAMI_PEERS_VENV", Path.home() / ".cache" / "beltrami" / "peers-venv"
+    )
+)
+REQUIREMENTS = ["trimesh", "numpy", "scipy", "rtree"]
+
+
+def bootstrap() -> None:
+    """Re-runs this script in the venv, creating it and installing trimesh if needed."""
+    python = VENV / "bin" / "python"
+    if Path(sys.prefix).resolve() == VENV.resolve():
+        return
+    if not python.exists():
+        print(f"creating {VENV}", file=sys.stderr)
+        VENV.parent.mkdir(parents=True, exist_ok=True)
+        subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
+    probe = subprocess.run(
+        [str(python), "-c", "import trimesh, numpy, scipy, rtree"], capture_output=True
+    )
+    if probe.returncode != 0:
+        print(f"installing {' '.join(REQUIREMENTS)} into {VENV}", file=sys.stderr)
+        subprocess.run(
+            [str(python), "-m", "pip", "install", "-q", *REQUIREMENTS], check=True
+        )
+    os.execv(str(python), [str(python), str(Path(__file__).resolve()), *sys.argv[1:]])
+
+
+def read_obj(path: Path):
+    """Positions and triangles (0-based) of an OBJ, in the file's order."""
+    import numpy as np
+
+    positions, faces = [], []
+    with open(path) as f:
+        for line in f:
+            if line.startswith("v "):
+                positions.append([float(t) for t in line.split()[1:4]])
+            elif line.startswith("f "):
+                faces.append([int(t.split("/")[0]) - 1 for t in line.split()[1:4]])
+    return np.array(positions, dtype=np.float64), np.array(faces, dtype=np.int64)
+
+
+def write_obj(path: Path, positions, faces) -> None:
+    with open(path, "w") as f:
+        for x, y, z in positions.tolist():
+            f.write(f"v {x!r} {y!r} {z!r}\n")
+        for a, b, c in faces.tolist():
+            f.write(f"f {a + 1} {b + 1} {c + 1}\n")
+
+
+def deform(p):
+    """The smooth deformation of the `spot` pair."""
+    import numpy as np
+
+    x, y, z = p[:, 0], p[:, 1], p[:, 2]
+    return np.stack(
+        [1.3 * x + 0.15 * np.sin(2 * y), y + 0.1 * x * x, 0.8 * z + 0.1 * np.cos(3 * x)],
+        axis=1,
+    )
+
+
+def flips(images, faces, target) -> int:
+    """Source faces whose image triangle's normal points against the target's normal at
+    the closest point of the image's centroid."""
+    import numpy as np
+    import trimesh
+
+    a, b, c = images[faces[:, 0]], images[faces[:, 1]], images[faces[:, 2]]
+    normals = np.cross(b - a, c - a)
+    _, _, tri = trimesh.proximity.closest_point(target, (a + b + c) / 3.0)
+    return int(((normals * target.face_normals[tri]).sum(axis=1) < 0).sum())
+
+
+def placed(source_v, source_f, target_v, target_f):
+    """The source moved by the centroid-and-size similarity (no rotation) of
+    `beltrami register`'s rough spatial match."""
+    import numpy as np
+    import trimesh
+
+    def centre_and_radius(v, f):
+        mesh = trimesh.Trimesh(v, f, process=False)
+        c = (mesh.triangles_center * mesh.area_faces[:, None]).sum(0) / mesh.area
+        return c, math.sqrt(((v - c) ** 2).sum(1).mean())
+
+    cs, rs = centre_and_radius(source_v, source_f)
+    ct, rt = centre_and_radius(target_v, target_f)
+    return (source_v - cs) * (rt / rs) + ct
+
+
+def row(name, images, truth, faces, target, seconds) -> str:
+    import numpy as np
+
+    d = np.linalg.norm(images - truth, axis=1)
+    flipped = flips(images, faces, target) if faces is not None else "-"
+    time_text = f"{seconds:.1f}" if seconds is not None else "-"
+    return (
+        f"| {name} | {d.mean():.4f} / {np.median(d):.4f} / {d.max():.3f} | "
+        f"{flipped} | {time_text} |"
+    )
+
+
+def compare(label, source, target_path, beltrami, work, run_nricp, extra=()) -> None:
+    import numpy as np
+    import trimesh
+
+    sv, sf = read_obj(source)
+    tv, tf = read_obj(target_path)
+    target = trimesh.Trimesh(tv, tf, process=False)
+    diagonal = float(np.linalg.norm(tv.max(0) - tv.min(0)))
+    print(f"\n### {label}: {len(sf)} faces onto {len(tf)}, target diagonal {diagonal:.3f}\n")
+    print("| method | distance to the true image, mean / median / max | flips | seconds |")
+    print("|---|---|---|---|")
+    runs = [([], "beltrami register"), (["--match-shape"], "beltrami register --match-shape")]
+    for k, (options, name) in enumerate([*runs, *extra]):
+        out = work / f"{label}_{k}.obj"
+        start = time.perf_counter()
+        subprocess.run(
+            [str(beltrami), "register", str(source), str(target_path), "-o", str(out), *options],
+            check=True,
+            capture_output=True,
+        )
+        seconds = time.perf_counter() - start
+        images, _ = read_obj(out)
+        print(row(name, images, tv, sf, target, seconds))
+    closest, _, _ = trimesh.proximity.closest_point(target, placed(sv, sf, tv, tf))
+    print(row("closest point of the placed source", closest, tv, sf, target, None))
+    if run_nricp:
+        start = time.perf_counter()
+        deformed = trimesh.registration.nricp_amberg(
+            trimesh.Trimesh(sv, sf, process=False), target
+        )
+        seconds = time.perf_counter() - start
+        print(row("trimesh nricp_amberg", np.asarray(deformed), tv, sf, target, seconds))
+
+
+def main() -> None:
+    bootstrap()
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--meshes", type=Path, default=ROOT.parent / "shared" / "meshes")
+    parser.add_argument("--fs", type=Path, help="the output directory of benches/fsaverage.py")
+    parser.add_argument("--nricp-cortex", action="store_true", help="also run nricp on the cortex")
+    parser.add_argument("--beltrami", type=Path, help="the binary (default: cargo build --release)")
+    args = parser.parse_args()
+    beltrami = args.beltrami
+    if beltrami is None:
+        subprocess.run(["cargo", "build", "--release", "-q"], cwd=ROOT, check=True)
+        target_dir = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+        beltrami = target_dir / "release" / "beltrami"
+    with tempfile.TemporaryDirectory() as tmp:
+        work = Path(tmp)
+        spot = args.meshes / "g0_spot.obj"
+        sv, sf = read_obj(spot)
+        deformed = work / "spot_deformed.obj"
+        write_obj(deformed, deform(sv), sf)
+        compare("spot", spot, deformed, beltrami, work, True)
+        if args.fs is not None:
+            sulc = str(args.fs / "fs5_left_sulc.txt")
+            compare(
+                "pial-white",
+                args.fs / "fs5_left_pial.obj",
+                args.fs / "fs5_left_white.obj",
+                beltrami,
+                work,
+                args.nricp_cortex,
+                [
+                    (["--features", sulc, sulc], "beltrami register --features sulc"),
+                    (
+                        ["--match-shape", "--features", sulc, sulc],
+                        "beltrami register --match-shape --features sulc",
+                    ),
+                ],
+            )
+
+
+if __name__ == "__main__":
+    main()
