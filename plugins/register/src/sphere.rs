@@ -147,7 +147,7 @@ pub(crate) fn map(
     let images = if marks.is_empty() {
         aligned
     } else {
-        match_on_sphere(source, &aligned, marks, &t, None, &[], notes)?.0
+        match_on_sphere(source, &aligned, marks, &t, None, &[], notes)?.images
     };
 
     let domain = domain_mesh(
@@ -196,7 +196,11 @@ pub(crate) fn match_features_after(
         target_sphere,
         sphere_mesh: &domain,
     };
-    let (mut images, first, pole) = match_on_sphere(
+    let SphereMatch {
+        mut images,
+        mismatch: first,
+        pole,
+    } = match_on_sphere(
         source,
         &aligned,
         marks,
@@ -212,7 +216,7 @@ pub(crate) fn match_features_after(
     // A large held cap (few landmarks or none) is matched in a second chart, from the
     // face farthest from the first pole and the landmarks.
     if 0.5 * pole.clearance > LARGE_CAP {
-        let (again, second, _) = match_on_sphere(
+        let again = match_on_sphere(
             source,
             &images,
             marks,
@@ -221,10 +225,10 @@ pub(crate) fn match_features_after(
             &[pole.centre],
             notes,
         )?;
-        let second = second.ok_or_else(missing)?;
+        let second = again.mismatch.ok_or_else(missing)?;
         mismatch.after = second.after;
         mismatch.steps += second.steps;
-        images = again;
+        images = again.images;
     }
     let images: Vec<Point3<f64>> = images.iter().map(|v| Point3::from(*v)).collect();
     let (located, _) = compose::locate_radial(&domain, &images)?;
@@ -310,7 +314,7 @@ fn match_on_sphere(
     fields: Option<SphereFields<'_>>,
     avoid: &[Vector3<f64>],
     notes: &mut Vec<String>,
-) -> Result<(Vec<Vector3<f64>>, Option<FeatureMismatch>, Pole), RegisterError> {
+) -> Result<SphereMatch, RegisterError> {
     let chosen = pole_face(source, aligned, marks, targets, avoid);
     let Pole {
         face: pole,
@@ -416,7 +420,19 @@ fn match_on_sphere(
             back * Vector3::new(2.0 * w.re, 2.0 * w.im, n - 1.0) / (n + 1.0)
         })
         .collect();
-    Ok((images, mismatch, chosen))
+    Ok(SphereMatch {
+        images,
+        mismatch,
+        pole: chosen,
+    })
+}
+
+/// What [`match_on_sphere`] found: the images on the unit sphere, the fields' mismatch
+/// (with fields) and the pole of its chart.
+struct SphereMatch {
+    images: Vec<Vector3<f64>>,
+    mismatch: Option<FeatureMismatch>,
+    pole: Pole,
 }
 
 /// The fields of a feature match on the sphere: the channels and the target with its
