@@ -36,50 +36,13 @@ import tempfile
 import time
 from pathlib import Path
 
+from peer_scripts import bootstrap, read_obj
+
 ROOT = Path(__file__).resolve().parents[2]
-VENV = Path(
-    os.environ.get(
-        "BELTRAMI_PEERS_VENV", Path.home() / ".cache" / "beltrami" / "peers-venv"
-    )
-)
 REQUIREMENTS = ["libigl>=2.6", "numpy", "scipy"]
 MESHES = ["disk_hemisphere", "disk_human_face", "disk_hand", "quad_disk_inspired"]
 LSCM_TOLERANCE = 1e-6
 HARMONIC_TOLERANCE = 1e-8
-
-
-def bootstrap() -> None:
-    """Re-runs this script in the venv, creating it and installing libigl if needed."""
-    python = VENV / "bin" / "python"
-    if Path(sys.prefix).resolve() == VENV.resolve():
-        return
-    if not python.exists():
-        print(f"creating {VENV}", file=sys.stderr)
-        VENV.parent.mkdir(parents=True, exist_ok=True)
-        subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
-    probe = subprocess.run(
-        [str(python), "-c", "import igl, numpy, scipy"], capture_output=True
-    )
-    if probe.returncode != 0:
-        print(f"installing {' '.join(REQUIREMENTS)} into {VENV}", file=sys.stderr)
-        subprocess.run(
-            [str(python), "-m", "pip", "install", "-q", *REQUIREMENTS], check=True
-        )
-    os.execv(str(python), [str(python), str(Path(__file__).resolve()), *sys.argv[1:]])
-
-
-def read_obj(path: Path):
-    """Positions and polygons (0-based) of an OBJ, in the file's order."""
-    import numpy as np
-
-    positions, faces = [], []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("v "):
-                positions.append([float(t) for t in line.split()[1:4]])
-            elif line.startswith("f "):
-                faces.append([int(t.split("/")[0]) - 1 for t in line.split()[1:]])
-    return np.array(positions, dtype=np.float64), faces
 
 
 def read_uv(path: Path):
@@ -216,7 +179,7 @@ def main() -> int:
         "--beltrami", type=Path, help="the binary (default: cargo build --release)"
     )
     args = parser.parse_args()
-    bootstrap()
+    bootstrap(__file__, REQUIREMENTS, 'import igl, numpy, scipy')
     import igl
     import numpy as np
 

@@ -34,47 +34,18 @@ import tempfile
 import time
 from pathlib import Path
 
+from peer_scripts import bootstrap, read_obj
+
 ROOT = Path(__file__).resolve().parents[2]
-VENV = Path(
-    os.environ.get(
-        "BELTRAMI_PEERS_VENV", Path.home() / ".cache" / "beltrami" / "peers-venv"
-    )
-)
 REQUIREMENTS = ["trimesh", "numpy", "scipy", "rtree"]
 
 
-def bootstrap() -> None:
-    """Re-runs this script in the venv, creating it and installing trimesh if needed."""
-    python = VENV / "bin" / "python"
-    if Path(sys.prefix).resolve() == VENV.resolve():
-        return
-    if not python.exists():
-        print(f"creating {VENV}", file=sys.stderr)
-        VENV.parent.mkdir(parents=True, exist_ok=True)
-        subprocess.run([sys.executable, "-m", "venv", str(VENV)], check=True)
-    probe = subprocess.run(
-        [str(python), "-c", "import trimesh, numpy, scipy, rtree"], capture_output=True
-    )
-    if probe.returncode != 0:
-        print(f"installing {' '.join(REQUIREMENTS)} into {VENV}", file=sys.stderr)
-        subprocess.run(
-            [str(python), "-m", "pip", "install", "-q", *REQUIREMENTS], check=True
-        )
-    os.execv(str(python), [str(python), str(Path(__file__).resolve()), *sys.argv[1:]])
-
-
-def read_obj(path: Path):
-    """Positions and triangles (0-based) of an OBJ, in the file's order."""
+def read_triangles(path: Path):
+    """Positions and triangles (an (m, 3) array) of a triangle mesh's OBJ."""
     import numpy as np
 
-    positions, faces = [], []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("v "):
-                positions.append([float(t) for t in line.split()[1:4]])
-            elif line.startswith("f "):
-                faces.append([int(t.split("/")[0]) - 1 for t in line.split()[1:4]])
-    return np.array(positions, dtype=np.float64), np.array(faces, dtype=np.int64)
+    positions, faces = read_obj(path)
+    return positions, np.array(faces, dtype=np.int64)
 
 
 def write_obj(path: Path, positions, faces) -> None:
@@ -140,8 +111,8 @@ def compare(label, source, target_path, beltrami, work, run_nricp, extra=()) -> 
     import numpy as np
     import trimesh
 
-    sv, sf = read_obj(source)
-    tv, tf = read_obj(target_path)
+    sv, sf = read_triangles(source)
+    tv, tf = read_triangles(target_path)
     target = trimesh.Trimesh(tv, tf, process=False)
     diagonal = float(np.linalg.norm(tv.max(0) - tv.min(0)))
     print(f"\n### {label}: {len(sf)} faces onto {len(tf)}, target diagonal {diagonal:.3f}\n")
@@ -171,7 +142,7 @@ def compare(label, source, target_path, beltrami, work, run_nricp, extra=()) -> 
 
 
 def main() -> None:
-    bootstrap()
+    bootstrap(__file__, REQUIREMENTS, 'import trimesh, numpy, scipy, rtree')
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--meshes", type=Path, default=ROOT.parent / "shared" / "meshes")
     parser.add_argument("--fs", type=Path, help="the output directory of benches/fsaverage.py")
@@ -186,7 +157,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         spot = args.meshes / "g0_spot.obj"
-        sv, sf = read_obj(spot)
+        sv, sf = read_triangles(spot)
         deformed = work / "spot_deformed.obj"
         write_obj(deformed, deform(sv), sf)
         compare("spot", spot, deformed, beltrami, work, True)

@@ -3,13 +3,15 @@
 //! is the source's carried by it, and the registration must land nearer the truth with
 //! the fields than without, every landmark exact and no face flipped.
 
+mod common;
+
 use beltrami_core::{
-    Constraint, Context, Features, Goal, Landmark, Position, Problem, Solution, Solver,
-    SolverError, Target,
+    Constraint, Features, Goal, Landmark, Position, Problem, Solution, Solver, SolverError, Target,
 };
 use beltrami_mesh::primitives::{self, Cells, icosphere, octahedral_sphere};
 use beltrami_mesh::{Mesh, Point3, VertexId};
 use beltrami_register::Register;
+use common::run_against_truth;
 
 /// A twist about the z axis by `amount * z` radians: a diffeomorphism of the sphere
 /// (and of the plane's unit disk lifted to z = 0 it is the identity, so the disk test
@@ -44,22 +46,10 @@ fn register(
     if let Some(features) = features {
         problem.goal = Goal::Features(features);
     }
-    let settings = Register.check(&problem).unwrap();
-    let solution = Register
-        .run(&problem, &settings, &mut Context::new())
-        .unwrap();
-    assert_eq!(solution.metrics.flipped(), Some(0));
+    let (error, solution) = run_against_truth(&problem, source, target, truth);
     for mark in &solution.extras.landmarks {
         assert!(mark.distance < 1e-12, "{mark:?}");
     }
-    let Some(beltrami_core::Map::OnMesh(points)) = solution.map() else {
-        panic!("a map onto the target mesh");
-    };
-    let error = source
-        .vertices()
-        .map(|v| (points[v.idx()].position(target) - truth(&source.position(v))).norm())
-        .sum::<f64>()
-        / source.vertex_count() as f64;
     (error, solution)
 }
 

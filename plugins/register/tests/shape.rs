@@ -3,10 +3,13 @@
 //! far from a similarity and from conformal, and the registration must land nearer the
 //! truth with the shape matched than without, with no face flipped.
 
-use beltrami_core::{Context, Map, OptionValue, Problem, Solution, Solver, Target};
+mod common;
+
+use beltrami_core::{OptionValue, Problem, Solution, Solver, Target};
 use beltrami_mesh::primitives::{self, Cells, icosphere, octahedral_sphere};
 use beltrami_mesh::{Mesh, Point3};
 use beltrami_register::Register;
+use common::run_against_truth;
 
 /// A bumpy ellipsoid: the unit sphere's point `p` moved radially.
 fn blob(p: &Point3<f64>) -> Point3<f64> {
@@ -24,8 +27,8 @@ fn deform(p: &Point3<f64>) -> Point3<f64> {
     )
 }
 
-/// Registers `source` onto `target`, with the shape matched when `shape`; checks that
-/// no face is flipped and returns the mean distance of the images from `truth`.
+/// Registers `source` onto `target`, with the shape matched when `shape` (checks of
+/// [`run_against_truth`]).
 fn register(
     source: &Mesh,
     target: &Mesh,
@@ -36,20 +39,7 @@ fn register(
     if shape {
         problem.options.set("match-shape", OptionValue::Bool(true));
     }
-    let settings = Register.check(&problem).unwrap();
-    let solution = Register
-        .run(&problem, &settings, &mut Context::new())
-        .unwrap();
-    assert_eq!(solution.metrics.flipped(), Some(0));
-    let Some(Map::OnMesh(points)) = solution.map() else {
-        panic!("a map onto the target mesh");
-    };
-    let error = source
-        .vertices()
-        .map(|v| (points[v.idx()].position(target) - truth(&source.position(v))).norm())
-        .sum::<f64>()
-        / source.vertex_count() as f64;
-    (error, solution)
+    run_against_truth(&problem, source, target, truth)
 }
 
 #[test]
