@@ -45,6 +45,7 @@ mod inverse_consistency;
 mod landmark_match;
 mod landmarks;
 mod modulus;
+mod nonrigid_icp;
 mod param;
 mod polygon;
 mod projection;

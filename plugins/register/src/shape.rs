@@ -1,19 +1,21 @@
 //! The source's shape matched on the target: a bijective non-rigid alignment.
 //!
-//! After the conformal registration `f` (a bijection, the landmarks exact), the
-//! similarity `A` that best carries the source's vertices onto their images
-//! (`SpatialMatch::fitted`, Umeyama 1991) places the source in the target's frame. The
-//! three coordinates of `A(x_i)` at the source's vertices and of `y_j` at the target's
-//! are matched as fields (module `feature_match`), both divided by the target's
-//! root-mean-square distance from its centroid: each image is pulled towards where the
-//! aligned source lies on the target, the pull smoothed and made a Beltrami coefficient
-//! with `|mu| < 1`. This is the non-rigid ICP of Amberg, Romdhani and Vetter (CVPR
-//! 2007) with the stiffness of the smoothed coefficient in place of an affine
-//! regularizer, and a bijection by construction in place of closest points that may
-//! fold.
+//! After the conformal registration `f` (a bijection, the landmarks exact):
 //!
-//! The distance reported is the mean over source vertices of `|A(x_i) - f(x_i)|`, in
-//! the target's units, before and after.
+//! 1. the similarity that best carries the source's vertices onto their images
+//!    (`SpatialMatch::fitted`, Umeyama 1991), refined by an affine closest-point fit,
+//!    places the source in the target's frame;
+//! 2. the placed source is deformed onto the target by the optimal-step non-rigid ICP
+//!    of Amberg, Romdhani and Vetter (CVPR 2007; module `nonrigid_icp`): a template
+//!    `T_i` per source vertex, near the target and smooth, but not a bijection;
+//! 3. the three coordinates of `T_i` at the source's vertices and of `y_j` at the
+//!    target's are matched as fields (module `feature_match`), both divided by the
+//!    target's root-mean-square distance from its centroid: each image is pulled
+//!    towards where the template lies on the target, the pull smoothed and made a
+//!    Beltrami coefficient with `|mu| < 1`, so that the map stays a bijection.
+//!
+//! The distance reported is the mean over source vertices of `|T_i - f(x_i)|`, in the
+//! target's units, before and after.
 
 use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
@@ -22,6 +24,7 @@ use nalgebra::{Matrix3, Matrix3x4, Matrix4, Matrix4x3, Vector4};
 use crate::error::RegisterError;
 use crate::feature_match::Channel;
 use crate::landmarks::SpatialMatch;
+use crate::nonrigid_icp::nonrigid_icp;
 
 /// Source vertices used to fit the alignment at most (evenly picked).
 const FIT_SAMPLES: usize = 2048;
@@ -31,29 +34,14 @@ const ICP_ROUNDS: usize = 30;
 
 /// Pairs farther apart than this many times the median distance are left out of an
 /// affine fit (folds and parts the other shape lacks).
-const TRIM: f64 = 2.5;
+pub(crate) const TRIM: f64 = 2.5;
 
 /// An affine fit is kept only while its singular values stay within this factor of the
 /// similarity's scale: the closest-point fit must not flatten the source.
 const MAX_SHEAR: f64 = 2.0;
 
-/// Reaches of the template's smoothing, coarse to fine, as fractions of the source's
-/// size: a displacement averaged over `k` passes reaches about `h sqrt(k)` for an edge
-/// `h`, so `k = fraction^2 n` passes for `n` vertices.
-const TEMPLATE_REACH: [f64; 4] = [0.2, 0.1, 0.05, 0.025];
-
-/// Closest-point rounds of the template per reach.
-const TEMPLATE_ROUNDS: usize = 4;
-
-/// Passes of smoothing at most (a very fine mesh is smoothed less far than asked).
-const MAX_PASSES: usize = 2000;
-
-/// A pair is used only where the template's normal and the target face's normal at the
-/// closest point agree to this cosine (a closest point across a thin fold faces away).
-const NORMAL_AGREEMENT: f64 = 0.5;
-
-/// The source placed in the target's frame (an affine map, then a smooth deformation
-/// onto the target) and its coordinate fields on both meshes.
+/// The source placed in the target's frame (an affine map, then the non-rigid ICP's
+/// template) and its coordinate fields on both meshes.
 pub(crate) struct Shape {
     /// The placed source, per source vertex.
     placed: Vec<Point3<f64>>,
@@ -62,15 +50,17 @@ pub(crate) struct Shape {
 }
 
 impl Shape {
-    /// The affine placement of the source (module docs): the similarity that best
-    /// carries the source's vertices onto their images `points` on `target`, then
-    /// refined by an affine closest-point fit (rounds of: each sampled source vertex's
-    /// closest point on the target, pairs beyond `TRIM` median distances dropped, the
-    /// least-squares affine map of the rest) while it lowers the trimmed mean distance.
-    /// `None` when the images do not fix a similarity (every image on a line).
+    /// The placed source (module docs): the similarity that best carries the source's
+    /// vertices onto their images `points` on `target`, refined by an affine
+    /// closest-point fit (rounds of: each sampled source vertex's closest point on the
+    /// target, pairs beyond `TRIM` median distances dropped, the least-squares affine
+    /// map of the rest) while it lowers the trimmed mean distance, then deformed by the
+    /// non-rigid ICP. `None` when the images do not fix a similarity (every image on a
+    /// line).
     ///
     /// # Errors
-    /// [`RegisterError::Spatial`] when a closest point cannot be found.
+    /// [`RegisterError::Spatial`] when a closest point cannot be found,
+    /// [`RegisterError::Solve`] when a non-rigid ICP system cannot be solved.
     pub(crate) fn new(
         source: &Mesh,
         target: &Mesh,
@@ -141,7 +131,7 @@ impl Shape {
             .iter()
             .map(|p| apply(&alignment, p))
             .collect();
-        let placed = deformed_template(source, index, affine)?;
+        let placed = nonrigid_icp(source, index, &affine)?;
         Ok((scale > 0.0).then_some(Self { placed, scale }))
     }
 
@@ -171,65 +161,8 @@ impl Shape {
     }
 }
 
-/// The source's vertices at `placed` moved onto the target by a smooth deformation, the
-/// non-rigid part of the closest-point fit: at each reach of `TEMPLATE_REACH`, rounds of
-/// each vertex's closest point on the target (pairs beyond `TRIM` median distances or
-/// whose normals disagree left out), the displacements to them averaged over the
-/// source's vertex neighbours (the pairs left out weigh nothing) and added.
-fn deformed_template(
-    source: &Mesh,
-    index: &SurfaceIndex<'_>,
-    mut template: Vec<Point3<f64>>,
-) -> Result<Vec<Point3<f64>>, RegisterError> {
-    let target = index.mesh();
-    let neighbours: Vec<Vec<usize>> = source
-        .vertices()
-        .map(|v| source.vertex_neighbors(v).map(|w| w.idx()).collect())
-        .collect();
-    let n = source.vertex_count();
-    for reach in TEMPLATE_REACH {
-        let passes = ((reach * reach * n as f64).round() as usize).clamp(1, MAX_PASSES);
-        for _ in 0..TEMPLATE_ROUNDS {
-            let closest = index.locate_all(&template)?;
-            let normals = vertex_normals_at(source, &template);
-            let mut distances: Vec<f64> = closest.iter().map(|l| l.distance).collect();
-            let limit = TRIM * median(&mut distances);
-            let mut weighted: Vec<(Vector3<f64>, f64)> = closest
-                .iter()
-                .zip(&template)
-                .zip(&normals)
-                .map(|((l, p), normal)| {
-                    let agrees = target.face_normal(l.point.face).dot(normal) >= NORMAL_AGREEMENT;
-                    if l.distance <= limit && agrees {
-                        (l.position - p, 1.0)
-                    } else {
-                        (Vector3::zeros(), 0.0)
-                    }
-                })
-                .collect();
-            for _ in 0..passes {
-                weighted = (0..n)
-                    .map(|i| {
-                        let (d, w) = neighbours[i].iter().fold(weighted[i], |(d, w), &j| {
-                            (d + weighted[j].0, w + weighted[j].1)
-                        });
-                        let count = (1 + neighbours[i].len()) as f64;
-                        (d / count, w / count)
-                    })
-                    .collect();
-            }
-            for (p, (d, w)) in template.iter_mut().zip(&weighted) {
-                if *w > 0.0 {
-                    *p += d / *w;
-                }
-            }
-        }
-    }
-    Ok(template)
-}
-
 /// Angle-weighted vertex normals of the source's faces over the positions `at`.
-fn vertex_normals_at(source: &Mesh, at: &[Point3<f64>]) -> Vec<Vector3<f64>> {
+pub(crate) fn vertex_normals_at(source: &Mesh, at: &[Point3<f64>]) -> Vec<Vector3<f64>> {
     let mut sum = vec![Vector3::zeros(); source.vertex_count()];
     for f in source.faces() {
         let (vs, degree) = source.face_vertex_array(f);
@@ -256,7 +189,7 @@ fn apply(m: &Matrix3x4<f64>, p: &Point3<f64>) -> Point3<f64> {
 }
 
 /// The median of `values` (reordered), 0 for none.
-fn median(values: &mut [f64]) -> f64 {
+pub(crate) fn median(values: &mut [f64]) -> f64 {
     if values.is_empty() {
         return 0.0;
     }
