@@ -32,8 +32,8 @@
 //! about the pole within half its clearance from the landmarks is held there; when that
 //! cap is large (a chordal radius above `LARGE_CAP`: few landmarks or none), the match
 //! is run again in a second chart whose pole is the face farthest from the first pole
-//! and the landmarks, so that the first cap is matched too (`g0_spot` onto its smooth
-//! deformation with `--match-shape`: 0.119 -> 0.069 mean distance to the truth).
+//! and the landmarks, so that the first cap is matched too (fsaverage5 pial onto white
+//! with the sulcal depth and no landmarks: 1.96 -> 0.70 mm mean distance to the truth).
 
 use beltrami_core::{Context, FeatureMismatch, Map, Problem, Solver, SolverError, Target};
 use beltrami_fem::Frame;
