@@ -7,9 +7,10 @@
 //! `E(X) = alpha^2 sum_{edges ij} |G (X_i - X_j)|_F^2 + sum_i w_i^2 |h_i^T X_i - u_i|^2`
 //!
 //! (their eq. 2-4 without landmarks, `G = diag(1, 1, 1, gamma)` with `gamma = 1`), `u_i`
-//! the closest point
-//! of the target to the vertex's current image and `w_i` 1, or 0 for a pair farther than
-//! 2.5 median distances or whose normals differ by more than 60 degrees. Its normal
+//! the closest point of the target to the vertex's current image and `w_i` 1, or 0 for a
+//! pair whose normals differ by more than 60 degrees (a closest point across a thin
+//! fold; far pairs are kept: the stiffness carries them, and leaving them out measured
+//! worse, 0.015 -> 0.021 on `g0_spot` at 2.5 median distances). Its normal
 //! equations `(alpha^2 L (x) G^2 + blockdiag(w_i^2 h_i h_i^T)) X = blockdiag(w_i^2 h_i)
 //! U` (`L` the graph Laplacian of the source's edges) are one sparse symmetric positive
 //! definite system of `4n` unknowns with three right-hand sides, of one pattern for
@@ -28,7 +29,7 @@ use faer::Mat;
 use faer::sparse::{CreationError, FaerError, SparseColMat, Triplet};
 
 use crate::error::{RegisterError, Side};
-use crate::shape::{TRIM, median, vertex_normals_at};
+use crate::shape::vertex_normals_at;
 
 /// The stiffness schedule, per `sqrt(n)` (module docs), stiff to supple.
 const STIFFNESS: [f64; 6] = [1.0, 0.5, 0.25, 0.12, 0.06, 0.03];
@@ -99,14 +100,11 @@ pub(crate) fn nonrigid_icp(
             let positions: Vec<Point3<f64>> = images.iter().map(from_unit).collect();
             let closest = index.locate_all(&positions)?;
             let normals = vertex_normals_at(source, &positions);
-            let mut distances: Vec<f64> = closest.iter().map(|l| l.distance).collect();
-            let limit = TRIM * median(&mut distances);
             let weights: Vec<f64> = closest
                 .iter()
                 .zip(&normals)
                 .map(|(l, normal)| {
-                    let agrees = target.face_normal(l.point.face).dot(normal) >= NORMAL_AGREEMENT;
-                    if l.distance <= limit && agrees {
+                    if target.face_normal(l.point.face).dot(normal) >= NORMAL_AGREEMENT {
                         1.0
                     } else {
                         0.0
@@ -205,8 +203,7 @@ mod tests {
     #[test]
     fn a_deformed_blob_is_followed_to_its_deformation() {
         // The blob onto a finer mesh of it under `deform`: the source where it is lies
-        // 0.155 from the truth on average, the template 0.068 (the bumps let it slide
-        // a little: closest points are not the truth).
+        // 0.155 from the truth on average, the template 0.031.
         let mut soup = icosphere(3);
         for p in &mut soup.positions {
             *p = blob(p);
@@ -229,8 +226,9 @@ mod tests {
         let start = error(source.positions());
         let template = nonrigid_icp(&source, &index, source.positions()).unwrap();
         let end = error(&template);
+        eprintln!("deformed blob: the template {start:.4} -> {end:.4} from the truth");
         assert!(
-            end < 0.55 * start,
+            end < 0.3 * start,
             "mean distance to the truth {start} -> {end}"
         );
     }

@@ -34,7 +34,7 @@ const ICP_ROUNDS: usize = 30;
 
 /// Pairs farther apart than this many times the median distance are left out of an
 /// affine fit (folds and parts the other shape lacks).
-pub(crate) const TRIM: f64 = 2.5;
+const TRIM: f64 = 2.5;
 
 /// An affine fit is kept only while its singular values stay within this factor of the
 /// similarity's scale: the closest-point fit must not flatten the source.
@@ -189,7 +189,7 @@ fn apply(m: &Matrix3x4<f64>, p: &Point3<f64>) -> Point3<f64> {
 }
 
 /// The median of `values` (reordered), 0 for none.
-pub(crate) fn median(values: &mut [f64]) -> f64 {
+fn median(values: &mut [f64]) -> f64 {
     if values.is_empty() {
         return 0.0;
     }
