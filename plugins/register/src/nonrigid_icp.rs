@@ -29,7 +29,7 @@ use faer::Mat;
 use faer::sparse::{CreationError, FaerError, SparseColMat, Triplet};
 
 use crate::error::{RegisterError, Side};
-use crate::shape::vertex_normals_at;
+use crate::shape::{centroid_and_spread, vertex_normals_at};
 
 /// The stiffness schedule, per `sqrt(n)` (module docs), stiff to supple.
 const STIFFNESS: [f64; 6] = [1.0, 0.5, 0.25, 0.12, 0.06, 0.03];
@@ -56,13 +56,7 @@ pub(crate) fn nonrigid_icp(
     placed: &[Point3<f64>],
 ) -> Result<Vec<Point3<f64>>, RegisterError> {
     let n = source.vertex_count();
-    let centre = placed.iter().map(|p| p.coords).sum::<Vector3<f64>>() / n.max(1) as f64;
-    let radius = (placed
-        .iter()
-        .map(|p| (p.coords - centre).norm_squared())
-        .sum::<f64>()
-        / n.max(1) as f64)
-        .sqrt();
+    let (centre, radius) = centroid_and_spread(placed);
     if radius.is_nan() || radius <= 0.0 {
         return Ok(placed.to_vec());
     }
@@ -180,25 +174,14 @@ pub(crate) fn nonrigid_icp(
 }
 
 #[cfg(test)]
+#[path = "../tests/fixtures/blob.rs"]
+mod fixtures;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use beltrami_mesh::primitives::{icosphere, octahedral_sphere};
-
-    /// A bumpy ellipsoid: the unit sphere's point `p` moved radially.
-    fn blob(p: &Point3<f64>) -> Point3<f64> {
-        let u = p.coords.normalize();
-        let r = 1.0 + 0.25 * (3.0 * u.x + 0.5).sin() * (2.0 * u.y).cos() + 0.15 * (4.0 * u.z).sin();
-        Point3::new(0.9 * r * u.x, 0.65 * r * u.y, 0.5 * r * u.z)
-    }
-
-    /// A smooth stretch and bend of space.
-    fn deform(p: &Point3<f64>) -> Point3<f64> {
-        Point3::new(
-            1.3 * p.x + 0.05 * (2.0 * p.y).sin(),
-            p.y + 0.05 * p.x * p.x,
-            0.8 * p.z + 0.05 * (3.0 * p.x).cos(),
-        )
-    }
+    use fixtures::{blob, deform};
 
     #[test]
     fn a_deformed_blob_is_followed_to_its_deformation() {

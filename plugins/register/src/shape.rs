@@ -110,22 +110,7 @@ impl Shape {
                 _ => break,
             }
         }
-        let n = target.vertex_count().max(1) as f64;
-        let centroid = Point3::from(
-            target
-                .positions()
-                .iter()
-                .map(|p| p.coords)
-                .sum::<Vector3<f64>>()
-                / n,
-        );
-        let scale = (target
-            .positions()
-            .iter()
-            .map(|p| (p - centroid).norm_squared())
-            .sum::<f64>()
-            / n)
-            .sqrt();
+        let (_, scale) = centroid_and_spread(target.positions());
         let affine: Vec<Point3<f64>> = source
             .positions()
             .iter()
@@ -159,6 +144,19 @@ impl Shape {
             .sum();
         total / source.vertex_count().max(1) as f64
     }
+}
+
+/// The mean of `points` and their root-mean-square distance from it (0 for none).
+pub(crate) fn centroid_and_spread(points: &[Point3<f64>]) -> (Vector3<f64>, f64) {
+    let n = points.len().max(1) as f64;
+    let centroid = points.iter().map(|p| p.coords).sum::<Vector3<f64>>() / n;
+    let spread = (points
+        .iter()
+        .map(|p| (p.coords - centroid).norm_squared())
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    (centroid, spread)
 }
 
 /// Angle-weighted vertex normals of the source's faces over the positions `at`.

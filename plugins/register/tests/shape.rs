@@ -4,28 +4,15 @@
 //! truth with the shape matched than without, with no face flipped.
 
 mod common;
+#[path = "fixtures/blob.rs"]
+mod fixtures;
 
 use beltrami_core::{OptionValue, Problem, Solution, Solver, Target};
 use beltrami_mesh::primitives::{self, Cells, icosphere, octahedral_sphere};
 use beltrami_mesh::{Mesh, Point3};
 use beltrami_register::Register;
 use common::run_against_truth;
-
-/// A bumpy ellipsoid: the unit sphere's point `p` moved radially.
-fn blob(p: &Point3<f64>) -> Point3<f64> {
-    let u = p.coords.normalize();
-    let r = 1.0 + 0.25 * (3.0 * u.x + 0.5).sin() * (2.0 * u.y).cos() + 0.15 * (4.0 * u.z).sin();
-    Point3::new(0.9 * r * u.x, 0.65 * r * u.y, 0.5 * r * u.z)
-}
-
-/// A smooth deformation of space: a stretch along x, a bend and a sag.
-fn deform(p: &Point3<f64>) -> Point3<f64> {
-    Point3::new(
-        1.3 * p.x + 0.05 * (2.0 * p.y).sin(),
-        p.y + 0.05 * p.x * p.x,
-        0.8 * p.z + 0.05 * (3.0 * p.x).cos(),
-    )
-}
+use fixtures::{blob, deform};
 
 /// Registers `source` onto `target`, with the shape matched when `shape` (checks of
 /// [`run_against_truth`]).
