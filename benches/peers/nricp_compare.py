@@ -12,9 +12,10 @@ Pairs:
   it runs for minutes there).
 
 For each method: the mean / median / max distance of the images from the true ones, the
-flipped faces by one outside rule for all (a source face flips when the normal of its
-image triangle points against the target's normal at the closest point of the image's
-centroid) and the wall-clock seconds (beltrami: the whole process).
+flipped faces by one rule for all, `register`'s own, recomputed outside beltrami by
+flip_check.py (each image vertex at its exact closest point of the target; a face flips
+when its image's area vector points against the sum of the target's interpolated normals
+at its corners) and the wall-clock seconds (beltrami: the whole process).
 
 It installs its own dependencies (`pip install trimesh numpy scipy rtree`) into a virtual
 environment under ~/.cache/beltrami/peers-venv (or $BELTRAMI_PEERS_VENV) and re-runs
@@ -34,7 +35,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from peer_scripts import bootstrap, read_obj
+from flip_check import flipped_faces
+from peer_scripts import ClosestPoints, bootstrap, read_obj
 
 ROOT = Path(__file__).resolve().parents[2]
 REQUIREMENTS = ["trimesh", "numpy", "scipy", "rtree"]
@@ -67,16 +69,9 @@ def deform(p):
     )
 
 
-def flips(images, faces, target) -> int:
-    """Source faces whose image triangle's normal points against the target's normal at
-    the closest point of the image's centroid."""
-    import numpy as np
-    import trimesh
-
-    a, b, c = images[faces[:, 0]], images[faces[:, 1]], images[faces[:, 2]]
-    normals = np.cross(b - a, c - a)
-    _, _, tri = trimesh.proximity.closest_point(target, (a + b + c) / 3.0)
-    return int(((normals * target.face_normals[tri]).sum(axis=1) < 0).sum())
+def flips(images, faces, target_v, target_f) -> int:
+    """Source faces flipped on the target by `register`'s rule (flip_check.py)."""
+    return int(flipped_faces(faces.tolist(), images, target_v, target_f).sum())
 
 
 def placed(source_v, source_f, target_v, target_f):
@@ -95,11 +90,12 @@ def placed(source_v, source_f, target_v, target_f):
     return (source_v - cs) * (rt / rs) + ct
 
 
-def row(name, images, truth, faces, target, seconds) -> str:
+def row(name, images, truth, faces, target_f, seconds) -> str:
+    """A table row; `truth` is also the target's positions (vertex i onto vertex i)."""
     import numpy as np
 
     d = np.linalg.norm(images - truth, axis=1)
-    flipped = flips(images, faces, target) if faces is not None else "-"
+    flipped = flips(images, faces, truth, target_f)
     time_text = f"{seconds:.1f}" if seconds is not None else "-"
     return (
         f"| {name} | {d.mean():.4f} / {np.median(d):.4f} / {d.max():.3f} | "
@@ -129,16 +125,16 @@ def compare(label, source, target_path, beltrami, work, run_nricp, extra=()) -> 
         )
         seconds = time.perf_counter() - start
         images, _ = read_obj(out)
-        print(row(name, images, tv, sf, target, seconds))
-    closest, _, _ = trimesh.proximity.closest_point(target, placed(sv, sf, tv, tf))
-    print(row("closest point of the placed source", closest, tv, sf, target, None))
+        print(row(name, images, tv, sf, tf, seconds))
+    _, _, closest = ClosestPoints(tv, tf).query(placed(sv, sf, tv, tf))
+    print(row("closest point of the placed source", closest, tv, sf, tf, None))
     if run_nricp:
         start = time.perf_counter()
         deformed = trimesh.registration.nricp_amberg(
             trimesh.Trimesh(sv, sf, process=False), target
         )
         seconds = time.perf_counter() - start
-        print(row("trimesh nricp_amberg", np.asarray(deformed), tv, sf, target, seconds))
+        print(row("trimesh nricp_amberg", np.asarray(deformed), tv, sf, tf, seconds))
 
 
 def main() -> None:
