@@ -802,6 +802,9 @@ impl FlowSystem {
         } else if turned == 0 {
             self.skip_reuse = self.skip_reuse.saturating_sub(1);
         }
+        // A failed factorization leaves the solver without one: the next solve must not
+        // take the old factor as kept.
+        self.kept = false;
         self.solver.factorize(self.matrix.as_ref())?;
         self.factorizations += 1;
         self.kept = true;

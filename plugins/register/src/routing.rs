@@ -4,7 +4,12 @@
 //!
 //! 1. **Placement.** Source positions are carried into the target's frame by a
 //!    [`SpatialMatch`]: the similarity fitted to the landmarks when at least three (not
-//!    on one line) are given, otherwise the rough match of centroids and sizes.
+//!    on one line) are given, otherwise the rough match of centroids and sizes, then
+//!    warped ([`Warp`]) so that known correspondences land on their partners: the
+//!    landmarks, points of the paired boundary loops and, without the landmarks'
+//!    similarity, the closest points on the target of up to [`WARP_SURFACE_SAMPLES`]
+//!    spread source vertices (two surfaces of different shapes then overlap where
+//!    the arcs are drawn, and each arc's corridor follows the target's own handle).
 //! 2. **Boundary loops** are paired by the landmarks whose source and target are both on
 //!    a boundary loop (two landmarks pairing one loop with two others are refused, naming
 //!    them), then the rest by the smallest sum of distances between the placed source
@@ -67,6 +72,10 @@ const RING_COST: f64 = 50.0;
 
 /// Points of every boundary loop that refine the placement ([`Warp`]), at most.
 const WARP_LOOP_SAMPLES: usize = 32;
+
+/// Vertices of the mesh with the cut graph whose closest points on the other one refine
+/// a placement no landmarks fix ([`Warp`]), at most.
+const WARP_SURFACE_SAMPLES: usize = 256;
 
 /// Points per kd-tree leaf.
 const BUCKET: usize = 16;
@@ -578,6 +587,20 @@ impl Drawing<'_> {
                     )))?;
                 taken[target_loop[nearest].idx()] = true;
                 out[n] = Some(target_loop[nearest]);
+            }
+        }
+        if self.pins.len() < 3 {
+            // No similarity from landmarks: the rough placement is pulled onto the other
+            // surface where it lies near it, by closest points of spread samples.
+            let step = self
+                .from
+                .vertex_count()
+                .div_ceil(WARP_SURFACE_SAMPLES)
+                .max(1);
+            for v in self.from.vertices().step_by(step) {
+                let p = self.from.position(v);
+                let located = self.onto_index.locate(&self.place.to_target(&p))?;
+                pairs.push((p, located.position));
             }
         }
         let warp = Warp::new(self.place, &pairs, self.onto);
