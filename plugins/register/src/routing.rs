@@ -6,10 +6,12 @@
 //!    [`SpatialMatch`]: the similarity fitted to the landmarks when at least three (not
 //!    on one line) are given, otherwise the rough match of centroids and sizes, then
 //!    warped ([`Warp`]) so that known correspondences land on their partners: the
-//!    landmarks, points of the paired boundary loops and, without the landmarks'
-//!    similarity, the closest points on the target of up to [`WARP_SURFACE_SAMPLES`]
-//!    spread source vertices (two surfaces of different shapes then overlap where
-//!    the arcs are drawn, and each arc's corridor follows the target's own handle).
+//!    landmarks, points of the paired boundary loops and, on a closed surface without
+//!    the landmarks' similarity, the closest points on the target of up to
+//!    [`WARP_SURFACE_SAMPLES`] spread source vertices (two surfaces of different shapes
+//!    then overlap where the arcs are drawn, and each arc's corridor follows the
+//!    target's own handle; with boundary loops their points anchor the warp, and
+//!    closest points there made the four-boundary faces' initial map worse).
 //! 2. **Boundary loops** are paired by the landmarks whose source and target are both on
 //!    a boundary loop (two landmarks pairing one loop with two others are refused, naming
 //!    them), then the rest by the smallest sum of distances between the placed source
@@ -589,9 +591,10 @@ impl Drawing<'_> {
                 out[n] = Some(target_loop[nearest]);
             }
         }
-        if self.pins.len() < 3 {
-            // No similarity from landmarks: the rough placement is pulled onto the other
-            // surface where it lies near it, by closest points of spread samples.
+        if self.pins.len() < 3 && self.from_loops.vertices.is_empty() {
+            // A closed surface with no similarity from landmarks (nor boundary loops to
+            // anchor it): the rough placement is pulled onto the other surface by the
+            // closest points of spread samples.
             let step = self
                 .from
                 .vertex_count()
