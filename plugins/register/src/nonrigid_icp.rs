@@ -180,23 +180,13 @@ mod fixtures;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use beltrami_mesh::primitives::{icosphere, octahedral_sphere};
-    use fixtures::{blob, deform};
+    use fixtures::{blob_pair, deform};
 
     #[test]
     fn a_deformed_blob_is_followed_to_its_deformation() {
         // The blob onto a finer mesh of it under `deform`: the source where it is lies
         // 0.155 from the truth on average, the template 0.031.
-        let mut soup = icosphere(3);
-        for p in &mut soup.positions {
-            *p = blob(p);
-        }
-        let source = Mesh::from_soup(&soup).unwrap();
-        let mut soup = octahedral_sphere(5);
-        for p in &mut soup.positions {
-            *p = deform(&blob(p));
-        }
-        let target = Mesh::from_soup(&soup).unwrap();
+        let (source, target) = blob_pair(3);
         let index = SurfaceIndex::new(&target).unwrap();
         let truth: Vec<Point3<f64>> = source.positions().iter().map(deform).collect();
         let error = |at: &[Point3<f64>]| {

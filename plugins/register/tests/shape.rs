@@ -8,11 +8,11 @@ mod common;
 mod fixtures;
 
 use beltrami_core::{OptionValue, Problem, Solution, Solver, Target};
-use beltrami_mesh::primitives::{self, Cells, icosphere, octahedral_sphere};
+use beltrami_mesh::primitives::{self, Cells};
 use beltrami_mesh::{Mesh, Point3};
 use beltrami_register::Register;
 use common::run_against_truth;
-use fixtures::{blob, deform};
+use fixtures::{blob_pair, deform};
 
 /// Registers `source` onto `target`, with the shape matched when `shape` (checks of
 /// [`run_against_truth`]).
@@ -31,16 +31,7 @@ fn register(
 
 #[test]
 fn a_deformed_blob_is_found_by_its_shape() {
-    let mut soup = icosphere(4);
-    for p in &mut soup.positions {
-        *p = blob(p);
-    }
-    let source = Mesh::from_soup(&soup).unwrap();
-    let mut soup = octahedral_sphere(5);
-    for p in &mut soup.positions {
-        *p = deform(&blob(p));
-    }
-    let target = Mesh::from_soup(&soup).unwrap();
+    let (source, target) = blob_pair(4);
     let (conformal, _) = register(&source, &target, &deform, false);
     let (matched, solution) = register(&source, &target, &deform, true);
     let distance = solution.extras.shape.expect("the shape match is reported");
