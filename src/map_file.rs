@@ -6,16 +6,18 @@
 //! [`beltrami_mesh::io`]) with, per vertex, the image of the map ([`image`]):
 //!
 //! - a planar map ([`Map::Planar`]) `x + i y` as the texture coordinate `(x, y)`
-//!   (OBJ: one `vt` per vertex and faces `f a/a b/b c/c`; glTF: `TEXCOORD_0`), the
-//!   positions staying the source's;
+//!   (OBJ: one `vt` per vertex and faces `f a/a b/b c/c`; glTF: `TEXCOORD_0`; PLY: `s t`;
+//!   OFF: `STOFF`), the positions staying the source's (STL holds no texture coordinates
+//!   and is refused);
 //! - a map into R^3 ([`Map::Spatial`]) as the positions;
 //! - a map onto a target mesh ([`Map::OnMesh`]) as the positions of its surface points
 //!   on that target, which must be given.
 //!
-//! glTF and GLB files also get, when the solution measured `mu` ([`Metrics::mu`]), one
-//! color per vertex (`COLOR_0`): the viridis color ([`beltrami_render::viridis`], dark
-//! at 0, yellow at 1 and above) of the vertex's `|mu|`, the mean of `|mu|` over its
-//! incident faces ([`vertex_mu`]). OBJ files get no colors.
+//! glTF, GLB, PLY and OFF files also get, when the solution measured `mu`
+//! ([`Metrics::mu`]), one color per vertex (glTF `COLOR_0`, PLY `red green blue`, COFF):
+//! the viridis color ([`beltrami_render::viridis`], dark at 0, yellow at 1 and above) of
+//! the vertex's `|mu|`, the mean of `|mu|` over its incident faces ([`vertex_mu`]). OBJ
+//! and STL files get no colors.
 //!
 //! Every file is written atomically (complete or absent,
 //! [`beltrami_mesh::io::write_atomically`]).
@@ -148,8 +150,8 @@ pub fn write(
     })?;
     let map = solution.map().ok_or(MapFileError::NoMap)?;
     let image = image(mesh, map, target)?;
-    let colors: Option<Vec<[f32; 3]>> = match (&solution.metrics.mu, format) {
-        (Some(field), Format::Gltf | Format::Glb) => {
+    let colors: Option<Vec<[f32; 3]>> = match &solution.metrics.mu {
+        Some(field) if format.holds_colors() => {
             Some(vertex_mu(mesh, field)?.into_iter().map(viridis).collect())
         }
         _ => None,
@@ -164,7 +166,7 @@ pub fn write(
     }
     match format {
         Format::Obj => io::obj::write_with_sections(path, mesh, &attributes, sections)?,
-        Format::Gltf | Format::Glb => io::write(path, mesh, &attributes)?,
+        _ => io::write(path, mesh, &attributes)?,
     }
     Ok(())
 }

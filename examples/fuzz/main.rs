@@ -146,9 +146,45 @@ fn builtin_seeds(target: &str) -> Vec<Vec<u8>> {
         "landmarks" => vec!["v 0 1\nv 3 3\np 2 0.1 0.2 0\nc 1,2,3 1,2,3\n".into()],
         "correspondence" => vec![targets::correspondence_seed()],
         "cut" => vec![format!("\u{0}{}", targets::torus_obj()), format!("\u{1}{square}")],
+        "ply" => vec![format!("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float s\nproperty float t\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n3 0 1 2\n3 0 2 3\n")],
+        "stl" => vec!["solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n".into()],
+        "off" => vec!["OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n4 0 2 3 1\n".into(), "STCOFF 3 1 0\n0 0 0 1 0 0 1 0 0\n1 0 0 0 1 0 1 1 0\n0 1 0 0 0 1 1 0 1\n3 0 1 2\n".into()],
         _ => Vec::new(),
     };
-    seeds.into_iter().map(String::into_bytes).collect()
+    let mut seeds: Vec<Vec<u8>> = seeds.into_iter().map(String::into_bytes).collect();
+    seeds.extend(binary_seeds(target));
+    seeds
+}
+
+/// Built-in seeds that are not text: a binary PLY (big endian) and a binary STL square.
+fn binary_seeds(target: &str) -> Vec<Vec<u8>> {
+    let square = [[0f32, 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]];
+    match target {
+        "ply" => {
+            let mut bytes = b"ply\nformat binary_big_endian 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\nelement face 2\nproperty list uchar uint vertex_indices\nend_header\n".to_vec();
+            for c in square.iter().flatten() {
+                bytes.extend(f64::from(*c).to_be_bytes());
+            }
+            for face in [[0u32, 1, 2], [0, 2, 3]] {
+                bytes.push(3);
+                face.iter().for_each(|i| bytes.extend(i.to_be_bytes()));
+            }
+            vec![bytes]
+        }
+        "stl" => {
+            let mut bytes = vec![0u8; 80];
+            bytes.extend(2u32.to_le_bytes());
+            for t in [[0, 1, 2], [0, 2, 3]] {
+                bytes.extend([0u8; 12]);
+                t.iter()
+                    .flat_map(|&k| square[k])
+                    .for_each(|c| bytes.extend(c.to_le_bytes()));
+                bytes.extend([0u8; 2]);
+            }
+            vec![bytes]
+        }
+        _ => Vec::new(),
+    }
 }
 
 /// The seeds of a target: built in, plus every file of `tests/corpus/TARGET/`.

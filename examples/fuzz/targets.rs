@@ -16,9 +16,12 @@ use beltrami::mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, cut_graph,
 use num_complex::Complex64;
 
 /// The targets, by the name the driver and the corpus folders use.
-pub const TARGETS: [&str; 8] = [
+pub const TARGETS: [&str; 11] = [
     "obj",
     "gltf",
+    "ply",
+    "stl",
+    "off",
     "build",
     "expr",
     "field",
@@ -32,6 +35,9 @@ pub fn run(name: &str, data: &[u8]) -> Result<(), String> {
     match name {
         "obj" => obj(data),
         "gltf" => gltf(data),
+        "ply" => positioned(Path::new("fuzz.ply"), io::ply::parse(data)),
+        "stl" => positioned(Path::new("fuzz.stl"), io::stl::parse(data)),
+        "off" => positioned(Path::new("fuzz.off"), io::off::parse(data)),
         "build" => build(data),
         "expr" => expr(data),
         "field" => field(data),
@@ -79,6 +85,13 @@ fn built(path: &Path, raw: RawMesh, options: &BuildOptions) -> Result<(), String
 fn obj(data: &[u8]) -> Result<(), String> {
     let path = Path::new("fuzz.obj");
     let raw = io::obj::parse(path, data).map_err(|e| e.to_string())?;
+    built(path, raw, &BuildOptions::default())
+}
+
+/// A PLY, STL or OFF reader's result (a syntax error with its place), then the builder
+/// and the cuts.
+fn positioned(path: &Path, raw: Result<RawMesh, (io::FilePosition, String)>) -> Result<(), String> {
+    let raw = raw.map_err(|(at, message)| format!("{at}: {message}"))?;
     built(path, raw, &BuildOptions::default())
 }
 

@@ -748,9 +748,10 @@ def cut_to_disk(V: ArrayLike, F: ArrayLike, *, info: bool = False) -> Any:
 
 
 def read_mesh(path: Union[str, "os.PathLike[str]"], *, uv: bool = False) -> Any:
-    """Reads an OBJ, glTF or GLB mesh: ``(V, F)``, or ``(V, F, UV)`` with ``uv=True``
-    (``UV`` ``(n, 2)`` when the file has one texture coordinate per vertex, else None).
-    The mesh is validated as the command line validates its input."""
+    """Reads an OBJ, PLY, STL, OFF, glTF or GLB mesh: ``(V, F)``, or ``(V, F, UV)``
+    with ``uv=True`` (``UV`` ``(n, 2)`` when the file has one texture coordinate per
+    vertex, else None). The mesh is validated as the command line validates its input;
+    an STL file's corners are welded into vertices by exact position."""
     V, F, UV = _native.read_mesh(os.fspath(path))
     return (V, F, UV) if uv else (V, F)
 
@@ -758,8 +759,9 @@ def read_mesh(path: Union[str, "os.PathLike[str]"], *, uv: bool = False) -> Any:
 def write_mesh(
     path: Union[str, "os.PathLike[str]"], V: ArrayLike, F: ArrayLike, uv: Optional[ArrayLike] = None
 ) -> None:
-    """Writes the mesh (OBJ, glTF or GLB by extension), with texture coordinates ``uv``
-    ``(n, 2)`` when given; atomically (a complete file or none)."""
+    """Writes the mesh (OBJ, PLY, STL, OFF, glTF or GLB by extension), with texture
+    coordinates ``uv`` ``(n, 2)`` when given (STL holds none: an error); atomically (a
+    complete file or none)."""
     V, F = _mesh(V, F)
     UV = None if uv is None else _matrix("uv", uv, np.float64, ConstraintError)
     _native.write_mesh(os.fspath(path), V, F, UV)

@@ -1,4 +1,4 @@
-//! Mesh files: `read_mesh` and `write_mesh` (OBJ, glTF, GLB by extension).
+//! Mesh files: `read_mesh` and `write_mesh` (OBJ, PLY, STL, OFF, glTF, GLB by extension).
 
 use std::path::PathBuf;
 
@@ -69,8 +69,9 @@ pub fn write_mesh(
         return Err(errors::raise(
             Kind::File,
             format!(
-                "{}: unknown output format (expected .obj, .gltf or .glb)",
-                path.display()
+                "{}: unknown output format (expected {})",
+                path.display(),
+                io::Format::EXTENSIONS
             ),
         ));
     }

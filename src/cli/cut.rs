@@ -16,7 +16,7 @@ use super::load::load_mesh;
 
 #[derive(Debug, Args)]
 pub struct CutArgs {
-    /// Mesh file (.obj, .gltf, .glb): one connected surface, not a closed genus-0 one.
+    /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb): one connected surface, not a closed genus-0 one.
     pub mesh: PathBuf,
     /// Where to write the cut mesh (.obj).
     #[arg(short, long, value_name = "OUT.obj")]

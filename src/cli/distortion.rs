@@ -20,7 +20,7 @@ use super::load::load_mesh;
 
 #[derive(Debug, Args)]
 pub struct DistortionArgs {
-    /// Source mesh (.obj, .gltf, .glb).
+    /// Source mesh (.obj, .ply, .stl, .off, .gltf, .glb).
     pub source: PathBuf,
     /// The map: a mesh with SOURCE's faces (same vertex indices) whose texture
     /// coordinates (`vt`, a map into the plane) or, without them, whose positions (a map

@@ -49,7 +49,7 @@ pub struct GenerateArgs {
     /// The circle domain's holes, `x,y,r` each, separated by `;`.
     #[arg(long, default_value = "-0.4,0,0.2;0.35,0.3,0.15")]
     pub holes: String,
-    /// Output mesh (.obj, .gltf, .glb).
+    /// Output mesh (.obj, .ply, .stl, .off, .gltf, .glb).
     #[arg(short, long)]
     pub output: PathBuf,
 }

@@ -11,7 +11,7 @@ use super::picture::load_map;
 
 #[derive(Debug, Args)]
 pub struct HistogramArgs {
-    /// Mesh file (.obj, .gltf, .glb); its texture coordinates (vt) are the map when no
+    /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb); its texture coordinates (vt) are the map when no
     /// MAPPED is given.
     pub mesh: PathBuf,
     /// The map: a mesh with MESH's faces whose texture coordinates or, without them,

@@ -9,7 +9,7 @@ use super::load::load_mesh;
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Mesh file (.obj, .gltf, .glb).
+    /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb).
     pub mesh: PathBuf,
     /// Print one JSON object instead of text.
     #[arg(long)]
@@ -53,6 +53,7 @@ pub fn run(args: &InfoArgs, quiet: bool) -> anyhow::Result<()> {
             "orientable": true,
             "faces_reoriented": report.faces_reoriented,
             "unreferenced_vertices": report.unreferenced_vertices.len(),
+            "stl_weld": loaded.mesh.weld.map(|w| json!({"corners": w.corners, "vertices": w.vertices})),
             "repaired": {
                 "dropped_degenerate_faces": report.dropped_degenerate_faces,
                 "dropped_duplicate_faces": report.dropped_duplicate_faces,
@@ -102,6 +103,12 @@ pub fn run(args: &InfoArgs, quiet: bool) -> anyhow::Result<()> {
         println!(
             "  unreferenced    {} vertices (left out; indices follow the file)",
             report.unreferenced_vertices.len()
+        );
+    }
+    if let Some(weld) = loaded.mesh.weld {
+        println!(
+            "  STL weld        {} corners into {} vertices (exact positions)",
+            weld.corners, weld.vertices
         );
     }
     println!("  area            {area:.6e}");

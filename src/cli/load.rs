@@ -47,6 +47,12 @@ pub fn load_mesh(path: &Path, repair: bool, quiet: bool) -> anyhow::Result<Loade
     if !quiet {
         let r = &mesh.report;
         let name = path.display();
+        if let Some(weld) = mesh.weld {
+            eprintln!(
+                "note: {name}: STL: {} triangle corners welded into {} vertices by exact position (vertex indices follow first appearance)",
+                weld.corners, weld.vertices
+            );
+        }
         if r.faces_reoriented > 0 {
             eprintln!(
                 "note: {name}: {} faces were re-oriented to match their neighbours",

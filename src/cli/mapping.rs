@@ -7,7 +7,9 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, bail};
 use beltrami::map_file::{self, Image};
 use beltrami::report;
-use beltrami_core::{Context, OptionValue, Options, Pin, Problem, Progress, Solution, Solver};
+use beltrami_core::{
+    Context, OptionValue, Options, Pin, Problem, Progress, Solution, Solver, Target,
+};
 use beltrami_fem::ReferenceNormal;
 use beltrami_mesh::Mesh;
 use beltrami_mesh::io::obj::MeshSections;
@@ -110,11 +112,27 @@ impl CommonArgs {
 pub fn check_output_format(output: &Path) -> anyhow::Result<()> {
     if Format::from_path(output).is_none() {
         bail!(
-            "{}: unknown output format (expected .obj, .gltf or .glb)",
-            output.display()
+            "{}: unknown output format (expected {})",
+            output.display(),
+            Format::EXTENSIONS
         );
     }
     Ok(())
+}
+
+/// Fails, before the solve, when a map onto `target` is planar (written as texture
+/// coordinates) and `output`'s format holds none (STL).
+pub fn check_output_holds_map(output: &Path, target: &Target<'_>) -> anyhow::Result<()> {
+    match Format::from_path(output) {
+        Some(format) if target.is_planar() && !format.holds_uvs() => {
+            Err(anyhow::Error::new(io::WriteError::Unsupported {
+                path: output.to_path_buf(),
+                format,
+                what: "texture coordinates",
+            }))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Fails, before any work, when `output` is not a mesh format beltrami writes or when

@@ -34,7 +34,7 @@ pub enum WeightsArg {
 
 #[derive(Debug, Args)]
 pub struct ParamArgs {
-    /// Mesh file (.obj, .gltf, .glb).
+    /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb).
     pub mesh: PathBuf,
     /// Solver name (`beltrami solvers` lists them): tutte, harmonic, lscm, sphere, qcmc.
     #[arg(long)]
@@ -94,6 +94,7 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     mapping::check_outputs(&args.output, &args.common, &[])?;
     let registry = beltrami::registry();
     let solver = registry.get(&args.solver)?;
+    mapping::check_output_holds_map(&args.output, &target_of(args, solver))?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
 

@@ -60,7 +60,7 @@ pub enum QcBoundaryArg {
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("goal").args(["mu", "mu_expr", "conformal"])))]
 pub struct QcArgs {
-    /// Mesh file (.obj, .gltf, .glb).
+    /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb).
     pub mesh: PathBuf,
     /// Solver name: lsqc, beltrami-flow, extremal or qcmc (onto a circle domain).
     /// Default: lsqc onto the plane, beltrami-flow onto the disk, an annulus or the
@@ -298,7 +298,9 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     let mesh = &loaded.mesh.mesh;
     let goal = goal_of(args, mesh, solver)?;
 
-    let mut problem = Problem::new(mesh, target_of(args, mesh, solver)?);
+    let target = target_of(args, mesh, solver)?;
+    mapping::check_output_holds_map(&args.output, &target)?;
+    let mut problem = Problem::new(mesh, target);
     problem.goal = goal;
     let init = match args.init.as_deref() {
         None => None,

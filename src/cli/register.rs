@@ -18,7 +18,7 @@ use super::mapping;
 
 #[derive(Debug, Args)]
 pub struct RegisterArgs {
-    /// The mesh to map (.obj, .gltf, .glb).
+    /// The mesh to map (.obj, .ply, .stl, .off, .gltf, .glb).
     pub source: PathBuf,
     /// The mesh to map onto, of the same topology.
     pub target: PathBuf,

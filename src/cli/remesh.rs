@@ -57,7 +57,7 @@ pub enum SizeFieldArg {
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("resolution").args(["edge_length", "vertices"])))]
 pub struct RemeshArgs {
-    /// Mesh file (.obj, .gltf, .glb): one connected surface of any genus, with or
+    /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb): one connected surface of any genus, with or
     /// without boundary.
     pub mesh: PathBuf,
     /// The edge length on the surface, in the mesh's units.
@@ -126,7 +126,7 @@ pub struct RemeshArgs {
         allow_hyphen_values = true
     )]
     pub feature_tolerance: f64,
-    /// Output mesh (.obj, .gltf, .glb).
+    /// Output mesh (.obj, .ply, .stl, .off, .gltf, .glb).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Write the JSON report here.

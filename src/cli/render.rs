@@ -37,7 +37,7 @@ pub enum ColorArg {
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Mesh file (.obj, .gltf, .glb); its texture coordinates (vt) are the map when
+    /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb); its texture coordinates (vt) are the map when
     /// there is no --map.
     pub mesh: PathBuf,
     /// The map: a mesh with MESH's faces whose texture coordinates (a map into the

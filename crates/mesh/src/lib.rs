@@ -3,7 +3,7 @@
 //!
 //! The halfedge mesh under every beltrami solver: triangle and quad faces (mixed
 //! allowed), validated on construction, with explicit boundary halfedges, circulators,
-//! topology and geometry queries, and mesh IO (OBJ, glTF/GLB).
+//! topology and geometry queries, and mesh IO (OBJ, PLY, STL, OFF, glTF/GLB).
 //!
 //! ```
 //! use beltrami_mesh::{Mesh, PolygonSoup};

@@ -403,10 +403,16 @@ fn missing_files_and_unknown_formats_are_typed_errors() {
         io::read(&missing, &BuildOptions::default()),
         Err(ReadError::Io { .. })
     ));
+    let xyz = write_file(dir.path(), "mesh.xyz", "0 0 0\n");
+    assert!(matches!(
+        io::read(&xyz, &BuildOptions::default()),
+        Err(ReadError::UnknownFormat { .. })
+    ));
+    // STL is a known format: a solid without facets or `endsolid` is a syntax error.
     let stl = write_file(dir.path(), "mesh.stl", "solid x\n");
     assert!(matches!(
         io::read(&stl, &BuildOptions::default()),
-        Err(ReadError::UnknownFormat { .. })
+        Err(ReadError::Syntax { .. })
     ));
 }
 

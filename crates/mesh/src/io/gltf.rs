@@ -103,6 +103,7 @@ pub fn parse_bytes(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
         soup: merged.soup,
         corner_uvs: merged.uvs,
         face_lines: None,
+        weld: None,
     })
 }
 

@@ -1,5 +1,5 @@
-//! Reading and writing meshes: Wavefront OBJ (through `tobj`) and glTF 2.0 / GLB
-//! (through `gltf`).
+//! Reading and writing meshes: Wavefront OBJ (through `tobj`), glTF 2.0 / GLB (through
+//! `gltf`), PLY, STL and OFF (by hand: see each module for why).
 //!
 //! # Indices
 //!
@@ -18,8 +18,12 @@
 mod atomic;
 pub mod gltf;
 pub mod obj;
+pub mod off;
+pub mod ply;
 mod slots;
 pub mod source;
+pub mod stl;
+mod text;
 
 use std::path::{Path, PathBuf};
 
@@ -38,8 +42,40 @@ pub struct RawMesh {
     /// Texture coordinates per face corner, in the soup's face and corner order, when the
     /// file gives one for every corner.
     pub corner_uvs: Option<Vec<Vector2<f64>>>,
-    /// For OBJ files, the 1-based line number of every face, to name it in errors.
+    /// For text files (OBJ, ASCII PLY, ASCII STL, OFF), the 1-based line number of every
+    /// face, to name it in errors.
     pub face_lines: Option<Vec<u32>>,
+    /// For STL files, which list every triangle's corners by position: how the corners
+    /// were welded into vertices.
+    pub weld: Option<Weld>,
+}
+
+/// The welding of an STL file's triangle corners into shared vertices: corners with
+/// bit-identical coordinates (`-0.0` counted as `0.0`) become one vertex.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Weld {
+    /// Triangle corners in the file (three per triangle).
+    pub corners: usize,
+    /// Vertices left after welding.
+    pub vertices: usize,
+}
+
+/// Where in a file a syntax error is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FilePosition {
+    /// A 1-based line of a text file or text section.
+    Line(usize),
+    /// A 0-based byte offset into a binary file.
+    Byte(u64),
+}
+
+impl std::fmt::Display for FilePosition {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FilePosition::Line(line) => write!(f, ":{line}"),
+            FilePosition::Byte(byte) => write!(f, " (byte {byte})"),
+        }
+    }
 }
 
 /// A validated mesh read from a file.
@@ -52,6 +88,8 @@ pub struct LoadedMesh {
     /// Texture coordinates per face halfedge (indexed by the [`crate::HalfedgeId`] of
     /// the face halfedge leaving the corner's vertex), when the file has them.
     pub corner_uvs: Option<Vec<Vector2<f64>>>,
+    /// How an STL file's corners were welded into vertices.
+    pub weld: Option<Weld>,
 }
 
 impl LoadedMesh {
@@ -88,10 +126,22 @@ pub enum ReadError {
         error: std::io::Error,
     },
     /// The extension is not one beltrami reads.
-    #[error("{path}: unknown mesh format (expected .obj, .gltf or .glb)")]
+    #[error("{path}: unknown mesh format (expected {})", Format::EXTENSIONS)]
     UnknownFormat {
         /// The file.
         path: PathBuf,
+    },
+    /// The file is not valid PLY, STL or OFF.
+    #[error("{path}{at}: not a valid {format} file: {message}")]
+    Syntax {
+        /// The file.
+        path: PathBuf,
+        /// The format the file was read as.
+        format: Format,
+        /// Where the error is.
+        at: FilePosition,
+        /// What is wrong.
+        message: String,
     },
     /// The file is not valid OBJ.
     #[error("{path}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
@@ -172,10 +222,24 @@ pub enum WriteError {
         error: std::io::Error,
     },
     /// The extension is not one beltrami writes.
-    #[error("{path}: unknown mesh format (expected .obj, .gltf or .glb)")]
+    #[error("{path}: unknown mesh format (expected {})", Format::EXTENSIONS)]
     UnknownFormat {
         /// The destination.
         path: PathBuf,
+    },
+    /// The format cannot hold an attribute that was asked for (texture coordinates in an
+    /// STL file).
+    #[error(
+        "{path}: {format} files cannot hold {what}; write {} instead",
+        Format::holding(what)
+    )]
+    Unsupported {
+        /// The destination.
+        path: PathBuf,
+        /// The destination's format.
+        format: Format,
+        /// The attribute.
+        what: &'static str,
     },
     /// A per-vertex attribute does not have one value per mesh vertex.
     #[error("{what} has {got} values but the mesh has {expected} vertices")]
@@ -205,7 +269,8 @@ pub struct VertexAttributes<'a> {
     pub positions: Option<&'a [Point3<f64>]>,
     /// Texture coordinates (e.g. a planar map), written as `vt` / `TEXCOORD_0`.
     pub uvs: Option<&'a [Vector2<f64>]>,
-    /// Linear RGB colors in [0, 1], written as `COLOR_0` (glTF only).
+    /// RGB colors in [0, 1], written as glTF `COLOR_0`, PLY `red green blue` bytes and
+    /// COFF values (OBJ and STL have no vertex colors and leave them out).
     pub colors: Option<&'a [[f32; 3]]>,
 }
 
@@ -261,9 +326,18 @@ pub enum Format {
     Gltf,
     /// glTF 2.0 binary container.
     Glb,
+    /// PLY (Stanford polygon file format), ASCII or binary.
+    Ply,
+    /// STL (stereolithography), ASCII or binary: triangles listed by corner positions.
+    Stl,
+    /// OFF (Geomview object file format) and its variants COFF, NOFF, STOFF.
+    Off,
 }
 
 impl Format {
+    /// The extensions beltrami reads and writes, for messages.
+    pub const EXTENSIONS: &'static str = ".obj, .ply, .stl, .off, .gltf or .glb";
+
     /// The format named by a path's extension (case-insensitive).
     pub fn from_path(path: &Path) -> Option<Format> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
@@ -271,8 +345,43 @@ impl Format {
             "obj" => Some(Format::Obj),
             "gltf" => Some(Format::Gltf),
             "glb" => Some(Format::Glb),
+            "ply" => Some(Format::Ply),
+            "stl" => Some(Format::Stl),
+            "off" => Some(Format::Off),
             _ => None,
         }
+    }
+
+    /// Whether files of this format can hold per-vertex texture coordinates.
+    pub fn holds_uvs(self) -> bool {
+        self != Format::Stl
+    }
+
+    /// Whether files of this format can hold per-vertex colors.
+    pub fn holds_colors(self) -> bool {
+        !matches!(self, Format::Obj | Format::Stl)
+    }
+
+    /// The extensions of the formats that hold `what` (an attribute named as in
+    /// [`WriteError::Unsupported`]), for messages.
+    fn holding(what: &str) -> &'static str {
+        match what {
+            "vertex colors" => ".ply, .off, .gltf or .glb",
+            _ => ".obj, .ply, .off, .gltf or .glb",
+        }
+    }
+}
+
+impl std::fmt::Display for Format {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Format::Obj => "OBJ",
+            Format::Gltf => "glTF",
+            Format::Glb => "GLB",
+            Format::Ply => "PLY",
+            Format::Stl => "STL",
+            Format::Off => "OFF",
+        })
     }
 }
 
@@ -281,13 +390,16 @@ pub fn read_raw(path: &Path) -> Result<RawMesh, ReadError> {
     match Format::from_path(path) {
         Some(Format::Obj) => obj::read(path),
         Some(Format::Gltf | Format::Glb) => gltf::read(path),
+        Some(Format::Ply) => ply::read(path),
+        Some(Format::Stl) => stl::read(path),
+        Some(Format::Off) => off::read(path),
         None => Err(ReadError::UnknownFormat {
             path: path.to_path_buf(),
         }),
     }
 }
 
-/// Reads and validates a mesh file (`.obj`, `.gltf`, `.glb`).
+/// Reads and validates a mesh file (any [`Format`], by extension).
 pub fn read(path: &Path, options: &BuildOptions) -> Result<LoadedMesh, ReadError> {
     let raw = read_raw(path)?;
     build_raw(path, raw, options)
@@ -318,6 +430,7 @@ pub fn build_raw(
         mesh,
         report,
         corner_uvs,
+        weld: raw.weld,
     })
 }
 
@@ -365,7 +478,10 @@ fn corner_uvs_of_mesh(mesh: &Mesh, soup: &PolygonSoup, uv: &[Vector2<f64>]) -> V
     out
 }
 
-/// Writes `mesh` with the given attributes, choosing the format by extension.
+/// Writes `mesh` with the given attributes, choosing the format by extension. Colors go
+/// where the format holds them and are left out elsewhere (they only decorate a result);
+/// texture coordinates for a format that cannot hold them are an error
+/// ([`WriteError::Unsupported`]), before anything is written.
 pub fn write(
     path: &Path,
     mesh: &Mesh,
@@ -374,6 +490,9 @@ pub fn write(
     match Format::from_path(path) {
         Some(Format::Obj) => obj::write(path, mesh, attributes),
         Some(Format::Gltf | Format::Glb) => gltf::write(path, mesh, attributes),
+        Some(Format::Ply) => ply::write(path, mesh, attributes),
+        Some(Format::Stl) => stl::write(path, mesh, attributes),
+        Some(Format::Off) => off::write(path, mesh, attributes),
         None => Err(WriteError::UnknownFormat {
             path: path.to_path_buf(),
         }),

@@ -166,6 +166,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
             soup,
             corner_uvs: None,
             face_lines: Some(face_lines),
+            weld: None,
         });
     }
     let prepared = prepare(bytes);
@@ -207,6 +208,7 @@ fn parse_with_tobj(path: &Path, bytes: &[u8], prepared: Prepared) -> Result<RawM
             soup: PolygonSoup::new(Vec::new()),
             corner_uvs: None,
             face_lines: Some(prepared.face_lines),
+            weld: None,
         });
     };
     let m = model.mesh;
@@ -257,6 +259,7 @@ fn parse_with_tobj(path: &Path, bytes: &[u8], prepared: Prepared) -> Result<RawM
         soup,
         corner_uvs,
         face_lines: Some(prepared.face_lines),
+        weld: None,
     })
 }
 
@@ -673,7 +676,7 @@ fn face_line(mesh: &Mesh, slots: &OutputSlots, with_uvs: bool, i: usize, line: &
 
 /// Appends the decimal digits of `k` (the formatting machinery of `write!` costs more
 /// than the digits on face lines, a third of writing a large mesh).
-fn push_decimal(line: &mut Vec<u8>, mut k: usize) {
+pub(super) fn push_decimal(line: &mut Vec<u8>, mut k: usize) {
     let mut digits = [0u8; 20];
     let mut at = digits.len();
     loop {
@@ -694,7 +697,7 @@ const LINE_BLOCK: usize = 1 << 14;
 /// Formatting numbers is most of the cost of writing a large mesh (shortest round-trip
 /// decimals), so consecutive blocks of lines are formatted on the available cores at
 /// once and written in order; at most one block per core is held in memory.
-fn write_lines(
+pub(super) fn write_lines(
     w: &mut impl std::io::Write,
     count: usize,
     line: impl Fn(usize, &mut Vec<u8>) -> std::io::Result<()> + Sync,
