@@ -350,13 +350,13 @@ mod tests {
             write(&obj, &source, &remeshed, None, None),
             Err(MapFileError::NoMap)
         ));
-        let ply = dir.path().join("out.ply");
+        let xyz = dir.path().join("out.xyz");
         let spatial = Solution::from_map(
             Map::Spatial(target.positions().to_vec()),
             Report::new("test"),
         );
         assert!(matches!(
-            write(&ply, &source, &spatial, None, None),
+            write(&xyz, &source, &spatial, None, None),
             Err(MapFileError::Write(WriteError::UnknownFormat { .. }))
         ));
         let mut nan = target.positions().to_vec();

@@ -105,3 +105,68 @@ fn an_unknown_extension_lists_every_format() {
     assert!(!out.status.success());
     assert!(text(&out.stderr).contains("expected .obj, .ply, .stl, .off, .gltf or .glb"));
 }
+
+#[test]
+fn info_hints_at_repair_for_a_triangle_soup_and_the_repair_welds_it() {
+    // Two triangles of a square, each with its own three corners: an STL-like soup.
+    let dir = tempfile::tempdir().unwrap();
+    let soup = dir.path().join("soup.off");
+    std::fs::write(
+        &soup,
+        "OFF\n6 2 0\n0 0 0\n1 0 0\n1 1 0\n0 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 3 4 5\n",
+    )
+    .unwrap();
+    let out = beltrami(&["info", s(&soup)]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains("hint: 2 vertices lie exactly on another vertex"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("2 components with 2 boundary loops; `--repair` merges them"),
+        "{stdout}"
+    );
+    let out = beltrami(&["info", "--repair", s(&soup)]);
+    let stdout = text(&out.stdout);
+    assert!(stdout.contains("components      1"), "{stdout}");
+    assert!(!stdout.contains("hint:"), "{stdout}");
+}
+
+#[test]
+fn one_based_faces_in_an_off_file_get_a_hint() {
+    let dir = tempfile::tempdir().unwrap();
+    let off = dir.path().join("one.off");
+    std::fs::write(&off, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 1 2 3\n").unwrap();
+    let out = beltrami(&["info", s(&off)]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(stderr.contains(":6: face 0 refers to vertex 3"), "{stderr}");
+    assert!(stderr.contains("hint: the faces look 1-based"), "{stderr}");
+}
+
+#[test]
+fn info_lists_at_most_a_dozen_components() {
+    let dir = tempfile::tempdir().unwrap();
+    let many = dir.path().join("many.off");
+    let mut text_file = String::from("OFF\n60 20 0\n");
+    for k in 0..20 {
+        let x = 2.0 * k as f64;
+        text_file.push_str(&format!("{x} 0 0\n{} 0 0\n{x} 1 0\n", x + 1.0));
+    }
+    for k in 0..20 {
+        text_file.push_str(&format!("3 {} {} {}\n", 3 * k, 3 * k + 1, 3 * k + 2));
+    }
+    std::fs::write(&many, text_file).unwrap();
+    let out = beltrami(&["info", s(&many)]);
+    let stdout = text(&out.stdout);
+    assert!(
+        stdout.contains(
+            "genus           0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, ... (8 more; --json lists all)"
+        ),
+        "{stdout}"
+    );
+    let out = beltrami(&["info", "--json", s(&many)]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["genus"].as_array().unwrap().len(), 20);
+}

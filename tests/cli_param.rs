@@ -417,12 +417,12 @@ fn a_pin_beyond_the_mesh_names_the_index() {
 #[test]
 fn an_unknown_output_format_fails_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
-    let output = dir.path().join("out.ply");
+    let output = dir.path().join("out.xyz");
     let out = beltrami(&["param", HEMISPHERE, "--solver", "lscm", "-o", s(&output)]);
     assert!(!out.status.success());
     let err = text(&out.stderr);
     assert!(
-        err.contains("out.ply") && err.contains("unknown output format"),
+        err.contains("out.xyz") && err.contains("unknown output format"),
         "{err}"
     );
     assert!(!output.exists());

@@ -5,7 +5,7 @@
 //! result lines up with the caller's own arrays. Inside, the halfedge mesh numbers its
 //! vertices and faces itself ([`beltrami_mesh::VertexMap`], [`Mesh::face_to_input`]).
 
-use beltrami_mesh::{Mesh, Point3, PolygonSoup, VertexId};
+use beltrami_mesh::{Mesh, MeshError, Point3, PolygonSoup, VertexId};
 use num_complex::Complex64;
 use numpy::ndarray::{Array1, Array2, ArrayView1, ArrayView2};
 use pyo3::prelude::*;
@@ -62,7 +62,18 @@ pub fn soup(v: ArrayView2<'_, f64>, f: ArrayView2<'_, i64>) -> PyResult<PolygonS
 /// The halfedge mesh of a soup (no repair: a degenerate or duplicate face is an error
 /// naming it, as on the command line without `--repair`).
 pub fn build(soup: &PolygonSoup) -> PyResult<Mesh> {
-    Mesh::from_soup(soup).map_err(|e| errors::from_error(Kind::Mesh, &e))
+    Mesh::from_soup(soup).map_err(|e| {
+        if matches!(e, MeshError::VertexIndexOutOfRange { .. }) && soup.looks_one_based() {
+            errors::raise(
+                Kind::Mesh,
+                format!(
+                    "{e}; F looks 1-based (no face uses vertex 0, and the largest index is len(V)): give F - 1"
+                ),
+            )
+        } else {
+            errors::from_error(Kind::Mesh, &e)
+        }
+    })
 }
 
 /// The mesh of `V` and `F` ([`soup`], then [`build`]).

@@ -155,7 +155,7 @@ def test_files(tmp_path, disk):
     with pytest.raises(beltrami.MeshFileError, match="missing.obj"):
         beltrami.read_mesh(tmp_path / "missing.obj")
     with pytest.raises(beltrami.MeshFileError, match="unknown output format"):
-        beltrami.write_mesh(tmp_path / "mesh.stl", *disk)
+        beltrami.write_mesh(tmp_path / "mesh.xyz", *disk)
     bad = tmp_path / "bad.obj"
     bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")
     with pytest.raises(beltrami.MeshFileError, match="7"):

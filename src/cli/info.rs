@@ -53,6 +53,7 @@ pub fn run(args: &InfoArgs, quiet: bool) -> anyhow::Result<()> {
             "orientable": true,
             "faces_reoriented": report.faces_reoriented,
             "unreferenced_vertices": report.unreferenced_vertices.len(),
+            "coincident_vertices": coincident_vertices(m),
             "stl_weld": loaded.mesh.weld.map(|w| json!({"corners": w.corners, "vertices": w.vertices})),
             "repaired": {
                 "dropped_degenerate_faces": report.dropped_degenerate_faces,
@@ -117,13 +118,43 @@ pub fn run(args: &InfoArgs, quiet: bool) -> anyhow::Result<()> {
         bbox.min.x, bbox.min.y, bbox.min.z, bbox.max.x, bbox.max.y, bbox.max.z
     );
     println!("  load            {parse_ms:.1} ms parse + {build_ms:.1} ms build");
+    let coincident = coincident_vertices(m);
+    if coincident > 0 {
+        println!(
+            "hint: {coincident} vertices lie exactly on another vertex (a triangle soup, or seams cut for texturing), so the surface falls into {} components with {} boundary loops; `--repair` merges them",
+            components.len(),
+            loops.len()
+        );
+    }
     Ok(())
 }
 
+/// The items joined by commas, the first [`LISTED`] of them and a count of the rest (the
+/// JSON output has every item).
 fn join<T: ToString>(items: &[T]) -> String {
-    items
+    let mut text = items
         .iter()
+        .take(LISTED)
         .map(T::to_string)
         .collect::<Vec<_>>()
-        .join(", ")
+        .join(", ");
+    if items.len() > LISTED {
+        text.push_str(&format!(
+            ", ... ({} more; --json lists all)",
+            items.len() - LISTED
+        ));
+    }
+    text
+}
+
+/// How many items of a list the text output shows.
+const LISTED: usize = 12;
+
+/// The number of mesh vertices that share their exact position with an earlier one.
+fn coincident_vertices(mesh: &beltrami_mesh::Mesh) -> usize {
+    let mut seen = std::collections::HashSet::with_capacity(mesh.vertex_count());
+    mesh.positions()
+        .iter()
+        .filter(|p| !seen.insert([p.x, p.y, p.z].map(|c| (c + 0.0).to_bits())))
+        .count()
 }

@@ -27,7 +27,15 @@ pub fn load_mesh(path: &Path, repair: bool, quiet: bool) -> anyhow::Result<Loade
     let raw = io::read_raw(path)?;
     let parse = start.elapsed();
     let start = Instant::now();
+    let one_based = raw.soup.looks_one_based();
     let mesh = io::build_raw(path, raw, &options).map_err(|e| {
+        if one_based
+            && matches!(&e, ReadError::Mesh { error: MeshError::VertexIndexOutOfRange { .. }, .. })
+        {
+            return anyhow!(
+                "{e}\nhint: the faces look 1-based (no face uses vertex 0, and the largest index is the vertex count), but this format numbers vertices from 0"
+            );
+        }
         let repairable = matches!(
             &e,
             ReadError::Mesh {

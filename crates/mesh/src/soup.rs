@@ -76,6 +76,14 @@ impl PolygonSoup {
         self.offsets.push(self.indices.len());
     }
 
+    /// Whether the faces look 1-based: no face uses vertex 0 and some face uses vertex
+    /// `vertex_count()`, one past the last, as when indices written from 1 are read as
+    /// 0-based. Error messages about an index out of range add this as a hint.
+    pub fn looks_one_based(&self) -> bool {
+        let n = self.positions.len();
+        !self.indices.contains(&0) && self.indices.iter().any(|&i| i as usize == n)
+    }
+
     /// Number of faces.
     pub fn face_count(&self) -> usize {
         self.offsets.len() - 1
@@ -94,5 +102,21 @@ impl PolygonSoup {
     /// Iterates over the faces in order.
     pub fn faces(&self) -> impl ExactSizeIterator<Item = &[u32]> + '_ {
         self.offsets.windows(2).map(|w| &self.indices[w[0]..w[1]])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn faces_that_skip_vertex_zero_and_reach_the_count_look_one_based() {
+        let positions = vec![Point3::origin(); 3];
+        let one_based = PolygonSoup::from_triangles(positions.clone(), &[[1, 2, 3]]);
+        assert!(one_based.looks_one_based());
+        let zero_based = PolygonSoup::from_triangles(positions.clone(), &[[0, 1, 2]]);
+        assert!(!zero_based.looks_one_based());
+        let out_of_range = PolygonSoup::from_triangles(positions, &[[1, 2, 7]]);
+        assert!(!out_of_range.looks_one_based());
     }
 }

@@ -97,6 +97,22 @@ fn triangle_file(dir: &Path, name: &str, scenes_and_nodes: Value) -> PathBuf {
     write_json(dir, name, &doc)
 }
 
+/// The material of the first primitive of a glTF or GLB file, through the gltf crate.
+fn first_material(bytes: &[u8]) -> Option<Material> {
+    let doc = ::gltf::Gltf::from_slice(bytes).unwrap();
+    let primitive = doc.meshes().next()?.primitives().next()?;
+    let material = primitive.material();
+    material.index().map(|_| Material {
+        double_sided: material.double_sided(),
+        metallic: material.pbr_metallic_roughness().metallic_factor(),
+    })
+}
+
+struct Material {
+    double_sided: bool,
+    metallic: f32,
+}
+
 #[test]
 fn triangle_mesh_round_trips_through_glb_and_gltf() {
     let soup = icosphere(2);
@@ -119,6 +135,10 @@ fn triangle_mesh_round_trips_through_glb_and_gltf() {
             bytes.starts_with(b"glTF"),
             name.to_lowercase().ends_with(".glb")
         );
+        // The texture coordinates' primitive has the two-sided material loaders need.
+        let material = first_material(&bytes).expect("a material");
+        assert!(material.double_sided);
+        assert_eq!(material.metallic, 0.0);
 
         let loaded = load(&path);
         let back = &loaded.mesh;
@@ -151,6 +171,7 @@ fn files_without_uvs_read_back_without_uvs() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("torus.glb");
     io::write(&path, &mesh, &VertexAttributes::default()).unwrap();
+    assert!(first_material(&std::fs::read(&path).unwrap()).is_none());
     let loaded = load(&path);
     assert!(loaded.corner_uvs.is_none());
     assert_eq!(loaded.mesh.genus(), Some(1));

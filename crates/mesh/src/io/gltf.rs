@@ -19,7 +19,9 @@
 //!
 //! # Writing
 //!
-//! [`write()`] writes one mesh with one triangle primitive under one node in one scene:
+//! [`write()`] writes one mesh with one triangle primitive under one node in one scene
+//! (with texture coordinates, the primitive gets a white two-sided material, without
+//! which loaders such as trimesh drop them):
 //! quads are split along their first diagonal, `(v0, v1, v2)` and `(v0, v2, v3)`. Vertex
 //! `k` of the file is input vertex `k` whenever no vertices were merged (unreferenced
 //! vertices included, with their own positions, zero texture coordinates and black
@@ -582,22 +584,35 @@ pub fn write(
         )
         .into();
     }
-    let document = json!({
+    let mut primitive = json!({
+        "attributes": attribute_map,
+        "indices": indices,
+        "mode": TRIANGLES,
+    });
+    let mut document = json!({
         "asset": { "version": "2.0", "generator": "beltrami" },
         "scene": 0,
         "scenes": [{ "nodes": [0] }],
         "nodes": [{ "mesh": 0 }],
-        "meshes": [{
-            "primitives": [{
-                "attributes": attribute_map,
-                "indices": indices,
-                "mode": TRIANGLES,
-            }],
-        }],
         "accessors": buffer.accessors,
         "bufferViews": buffer.views,
         "buffers": [buffer_json],
     });
+    if vertices.uvs.is_some() {
+        // Viewers and loaders (trimesh, three.js) keep texture coordinates only on a
+        // primitive with a material: a plain white, rough, two-sided one.
+        primitive["material"] = 0.into();
+        document["materials"] = json!([{
+            "name": "beltrami",
+            "doubleSided": true,
+            "pbrMetallicRoughness": {
+                "baseColorFactor": [1.0, 1.0, 1.0, 1.0],
+                "metallicFactor": 0.0,
+                "roughnessFactor": 1.0,
+            },
+        }]);
+    }
+    document["meshes"] = json!([{ "primitives": [primitive] }]);
 
     super::write_atomically(path, |w| {
         if binary {
