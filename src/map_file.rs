@@ -366,6 +366,6 @@ mod tests {
             write(&obj, &source, &nan, None, None),
             Err(MapFileError::Write(WriteError::NonFinite { vertex: 2, .. }))
         ));
-        assert!(!obj.exists() && !ply.exists());
+        assert!(!obj.exists() && !xyz.exists());
     }
 }

@@ -67,9 +67,11 @@ __all__ = [
     "register",
     "remesh",
     "remesh_in_place",
+    "repair",
     "solvers",
     "sphere_map",
     "tutte",
+    "weld",
     "write_mesh",
 ]
 
@@ -742,6 +744,58 @@ def cut_to_disk(V: ArrayLike, F: ArrayLike, *, info: bool = False) -> Any:
     cut-mesh vertex ``j`` copies. ``beltrami cut``."""
     V2, F2, original, report = _native.cut_to_disk(*_mesh(V, F))
     return (V2, F2, original, json.loads(report)) if info else (V2, F2, original)
+
+
+def repair(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    merge_vertices: bool = True,
+    drop_degenerate_faces: bool = True,
+    drop_duplicate_faces: bool = True,
+) -> Tuple[np.ndarray, np.ndarray, dict]:
+    """The mesh mended as ``beltrami info --repair`` mends a file: vertices at exactly
+    the same position merged into the first, faces with a repeated vertex or zero area
+    dropped, faces with the vertex set of an earlier face dropped, then every face
+    oriented consistently with its component. Vertices no kept face uses are left out.
+
+    Returns ``(V2, F2, info)``. ``info["vertex_index"]`` has one entry per row of ``V``:
+    its row in ``V2`` (-1 when left out); ``info["face_index"]`` has one entry per row of
+    ``F2``: its row in ``F``. The other keys list what changed by input row:
+    ``merged_vertices`` (pairs ``(merged, kept)``), ``dropped_degenerate_faces``,
+    ``dropped_duplicate_faces``, ``unreferenced_vertices``, ``faces_reoriented``.
+
+    >>> import numpy as np, beltrami
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 0, 0], [1, 1, 0], [0, 1, 0.0]])
+    >>> F = np.array([[0, 1, 2], [3, 4, 5]])            # a square as a triangle soup
+    >>> V2, F2, info = beltrami.repair(V, F)
+    >>> V2.shape, F2.tolist(), info["vertex_index"].tolist()
+    ((4, 3), [[0, 1, 2], [0, 2, 3]], [0, 1, 2, 0, 2, 3])
+    """
+    V2, F2, vertex_index, face_index, report = _native.repair(
+        *_mesh(V, F), merge_vertices, drop_degenerate_faces, drop_duplicate_faces
+    )
+    info = json.loads(report)
+    info["vertex_index"] = vertex_index
+    info["face_index"] = face_index
+    return V2, F2, info
+
+
+def weld(V: ArrayLike, F: ArrayLike) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mesh with vertices at exactly the same position merged (a triangle soup, an
+    STL file's corners): ``repair`` without dropping faces. Returns ``(V2, F2, index)``,
+    ``index[i]`` the row of ``V2`` of row ``i`` of ``V`` (-1 when no face uses it). A
+    face whose corners weld together is a ``MeshError`` naming it: ``repair`` drops such
+    faces.
+
+    >>> import numpy as np, beltrami
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]])
+    >>> V2, F2, index = beltrami.weld(V, [[0, 1, 2], [3, 4, 5]])
+    >>> len(V2), index.tolist()
+    (4, [0, 1, 2, 1, 3, 2])
+    """
+    V2, F2, info = repair(V, F, drop_degenerate_faces=False, drop_duplicate_faces=False)
+    return V2, F2, info["vertex_index"]
 
 
 # ---- files and the catalog -----------------------------------------------------------

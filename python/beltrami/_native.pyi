@@ -54,3 +54,10 @@ def remesh_in_place(
     allow_flips: bool = False,
 ) -> Tuple[Floats, str]: ...
 def cut_to_disk(v: Floats, f: Ints) -> Tuple[Floats, Ints, Ints, str]: ...
+def repair(
+    v: Floats,
+    f: Ints,
+    merge_vertices: bool = ...,
+    drop_degenerate_faces: bool = ...,
+    drop_duplicate_faces: bool = ...,
+) -> Tuple[Floats, Ints, Ints, Ints, str]: ...

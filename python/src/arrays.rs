@@ -200,6 +200,29 @@ pub fn vertex(mesh: &Mesh, i: i64, what: &str) -> PyResult<VertexId> {
         })
 }
 
+/// The positions `(n, 3)` and faces `(m, k)` of a mesh by its own vertex and face ids
+/// (a mesh built here, or repaired: not the input's rows), or `None` for a mesh that
+/// mixes triangles and quads.
+pub fn own_order(mesh: &Mesh) -> Option<(Array2<f64>, Array2<i64>)> {
+    let mut v = Array2::zeros((mesh.vertex_count(), 3));
+    for (i, p) in mesh.positions().iter().enumerate() {
+        for c in 0..3 {
+            v[[i, c]] = p[c];
+        }
+    }
+    let k = mesh.faces().next().map_or(3, |f| mesh.face_degree(f));
+    let mut f = Array2::zeros((mesh.face_count(), k));
+    for face in mesh.faces() {
+        if mesh.face_degree(face) != k {
+            return None;
+        }
+        for (c, vertex) in mesh.face_vertices(face).enumerate() {
+            f[[face.idx(), c]] = vertex.idx() as i64;
+        }
+    }
+    Some((v, f))
+}
+
 /// The faces of a mesh as an `(m, k)` array in input order (`k` = 3 or 4), or `None`
 /// for a mesh that mixes triangles and quads.
 pub fn faces(mesh: &Mesh) -> Option<Array2<i64>> {

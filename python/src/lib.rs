@@ -7,7 +7,7 @@
 //! (`beltrami/_errors.py`); this module builds meshes from arrays ([`arrays`]), turns a
 //! call's description into a [`beltrami_core::Problem`] and solves it with the GIL
 //! released ([`solve`]), and measures ([`measure`]), remeshes and cuts
-//! ([`surgery`]) and reads and writes files ([`files`]). Errors become the package's
+//! ([`surgery`]), repairs ([`repair`]) and reads and writes files ([`files`]). Errors become the package's
 //! exceptions with the command line's messages ([`errors`]).
 
 use pyo3::prelude::*;
@@ -16,6 +16,7 @@ mod arrays;
 mod errors;
 mod files;
 mod measure;
+mod repair;
 mod solve;
 mod surgery;
 
@@ -33,5 +34,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(surgery::remesh, m)?)?;
     m.add_function(wrap_pyfunction!(surgery::remesh_in_place, m)?)?;
     m.add_function(wrap_pyfunction!(surgery::cut_to_disk, m)?)?;
+    m.add_function(wrap_pyfunction!(repair::repair, m)?)?;
     Ok(())
 }

@@ -13,18 +13,10 @@ use serde_json::json;
 use crate::arrays;
 use crate::errors::{self, Kind};
 
-/// The positions `(n, 3)` and faces `(m, k)` of a mesh built here (its vertices and
-/// faces in its own order).
+/// The positions `(n, 3)` and faces `(m, k)` of a mesh built here.
 fn mesh_arrays(mesh: &Mesh) -> PyResult<(Array2<f64>, Array2<i64>)> {
-    let mut v = Array2::zeros((mesh.vertex_count(), 3));
-    for (i, p) in mesh.positions().iter().enumerate() {
-        for c in 0..3 {
-            v[[i, c]] = p[c];
-        }
-    }
-    let f = arrays::faces(mesh)
-        .ok_or_else(|| errors::raise(Kind::Solver, "the new mesh mixes triangles and quads"))?;
-    Ok((v, f))
+    arrays::own_order(mesh)
+        .ok_or_else(|| errors::raise(Kind::Solver, "the new mesh mixes triangles and quads"))
 }
 
 /// A new triangle mesh of the surface `V`, `F` with the asked edge length (or about

@@ -47,3 +47,12 @@ def test_block_runs_as_written(doc, line, code, tmp_path, monkeypatch):
         [sys.executable, str(script)], cwd=ROOT, env=env, capture_output=True, text=True, timeout=600
     )
     assert run.returncode == 0, f"{doc}:{line}\n{run.stderr}"
+
+
+def test_docstring_examples_run(monkeypatch):
+    import beltrami
+
+    monkeypatch.chdir(ROOT)
+    result = doctest.testmod(beltrami, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted > 0
+    assert result.failed == 0
