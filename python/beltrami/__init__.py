@@ -181,10 +181,13 @@ def _result(out: Dict[str, Any], info: bool) -> Any:
 
 
 def _param(solver: str, V: ArrayLike, F: ArrayLike, boundary: str, weights: Optional[str],
-           pins: Sequence[int], options: Optional[Dict[str, Any]], info: bool) -> Any:
+           pins: Sequence[int], options: Optional[Dict[str, Any]], info: bool,
+           components: Optional[str] = None) -> Any:
     """``beltrami param --solver SOLVER`` onto the plane with ``boundary``."""
     spec = {"target": "plane", "boundary": boundary, "pins": _pins(pins),
             "options": _options(options, weights=weights)}
+    if components is not None:
+        spec["components"] = components
     return _result(_solve(solver, V, F, spec), info)
 
 
@@ -195,6 +198,7 @@ def tutte(
     boundary: str = "circle",
     weights: Optional[str] = None,
     pins: Sequence[int] = (),
+    components: Optional[str] = None,
     options: Optional[Dict[str, Any]] = None,
     info: bool = False,
 ) -> Any:
@@ -203,7 +207,7 @@ def tutte(
     circle by arc length (``boundary='circle'``) or on the unit square. Bijective for a
     convex boundary (Tutte 1963, Floater 2003). Returns ``UV`` ``(n, 2)``.
     ``beltrami param --solver tutte``."""
-    return _param("tutte", V, F, boundary, weights, pins, options, info)
+    return _param("tutte", V, F, boundary, weights, pins, options, info, components)
 
 
 def harmonic(
@@ -213,28 +217,60 @@ def harmonic(
     boundary: str = "circle",
     weights: Optional[str] = None,
     pins: Sequence[int] = (),
+    components: Optional[str] = None,
     options: Optional[Dict[str, Any]] = None,
     info: bool = False,
 ) -> Any:
     """The discrete harmonic map of a disk (cotangent weights, Pinkall-Polthier 1993)
     with the boundary on the unit circle by arc length or on the unit square. Returns
     ``UV`` ``(n, 2)``. ``beltrami param --solver harmonic``."""
-    return _param("harmonic", V, F, boundary, weights, pins, options, info)
+    return _param("harmonic", V, F, boundary, weights, pins, options, info, components)
 
 
 def lscm(
     V: ArrayLike,
     F: ArrayLike,
+    b: Optional[ArrayLike] = None,
+    bc: Optional[ArrayLike] = None,
     *,
     pins: Sequence[int] = (),
+    components: Optional[str] = None,
     options: Optional[Dict[str, Any]] = None,
     info: bool = False,
 ) -> Any:
     """Least-squares conformal map (Levy et al. 2002): the minimum of
-    ``sum_f A_f |f_zbar|^2`` with a free boundary and two pinned vertices (``pins``; by
-    default two boundary vertices far apart) sent to 0 and 1. Returns ``UV`` ``(n, 2)``.
-    ``beltrami param --solver lscm``."""
-    return _param("lscm", V, F, "free", None, pins, options, info)
+    ``sum_f A_f |f_zbar|^2`` with a free boundary. Returns ``UV`` ``(n, 2)``.
+
+    Pinned vertices fix the similarity the energy leaves free. ``b`` (rows of ``V``) and
+    ``bc`` (``(len(b), 2)`` positions), as libigl's ``lscm(V, F, b, bc)``: each vertex of
+    ``b`` goes exactly to its row of ``bc`` (two or more pins). Or ``pins`` (two rows of
+    ``V``) sent to 0 and 1; by default two boundary vertices far apart.
+    ``beltrami param --solver lscm``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> UV = beltrami.lscm(V, F, [0, 60], [[0.0, 0.0], [2.0, 0.0]])
+    >>> UV[[0, 60]].round(12).tolist()
+    [[0.0, 0.0], [2.0, 0.0]]
+    """
+    if b is None and bc is None:
+        return _param("lscm", V, F, "free", None, pins, options, info, components)
+    if pins:
+        raise OptionError("give pins, or b and bc, not both")
+    if b is None or bc is None:
+        raise ConstraintError("b and bc go together: b the pinned rows of V, bc their (k, 2) positions")
+    b = _pins(np.asarray(b).reshape(-1))
+    bc = _matrix("bc", bc, np.float64, ConstraintError)
+    if bc.shape != (len(b), 2):
+        raise ConstraintError(f"bc has shape {bc.shape}; expected ({len(b)}, 2), one position per vertex of b")
+    bad = np.flatnonzero(~np.isfinite(bc).all(axis=1))
+    if len(bad):
+        raise ConstraintError(f"bc row {bad[0]} is not finite: {bc[bad[0]].tolist()}")
+    spec = {"target": "plane", "boundary": "free", "pins": b, "pin_positions": bc.tolist(),
+            "options": _options(options)}
+    if components is not None:
+        spec["components"] = components
+    return _result(_solve("lscm", V, F, spec), info)
 
 
 def sphere_map(

@@ -13,10 +13,12 @@
 //! | `free_radius` | `annulus`: let the inner radius move (else the input's is kept) |
 //! | `goal` | `{"kind": "conformal", "p": P}`, `{"kind": "mu", "frame": F}` (`mu`), `{"kind": "mu_expr", "expr": E}`, `{"kind": "extremal"}`, `{"kind": "features", "source": S, "target": T}` (each a list of numbers per vertex row or `"mean-curvature"`) |
 //! | `pins` | input vertex indices held where the solver puts them |
+//! | `pin_positions` | `[[x, y], ...]`, one per pin: where each goes (libigl's `bc`) |
 //! | `normal_constraint` | `space`: the weight of the normal constraint |
 //! | `area_constraint` | `space`: `true` keeps the area to first order |
 //! | `landmarks` | `mesh`: the text of a landmarks file |
 //! | `planar_landmarks` | `disk`: `[[vertex, x, y], ...]`, boundary vertices moved to points of the unit circle |
+//! | `components` | `each`: every connected component solved on its own, the planar maps side by side ([`components::solve_each`]) |
 //! | `options` | solver options as text, `{name: value}` (`--option NAME=VALUE`) |
 //! | `defaults` | the command's defaults, set when the solver declares the option |
 //!
@@ -32,7 +34,7 @@ use beltrami::landmarks::Landmarks;
 use beltrami::map_file::{self, Image};
 use beltrami_core::{
     Constraint, Context, Features, Goal, Landmark, Map, Pin, PlanarBoundary, Position, Problem,
-    Progress, Solution, Target,
+    Progress, Solution, Target, components,
 };
 use beltrami_fem::{BeltramiField, Expr, Frame};
 use beltrami_mesh::Mesh;
@@ -229,18 +231,28 @@ fn constraints(
     inputs: &Inputs<'_>,
 ) -> PyResult<()> {
     let mesh = problem.source;
-    for pin in spec
-        .get("pins")
-        .and_then(Value::as_array)
-        .into_iter()
-        .flatten()
-    {
+    let pins = spec.get("pins").and_then(Value::as_array);
+    let positions = spec.get("pin_positions").and_then(Value::as_array);
+    for (k, pin) in pins.into_iter().flatten().enumerate() {
         let index = pin.as_i64().ok_or_else(|| {
             errors::raise(Kind::Constraint, format!("pin {pin}: not a vertex index"))
         })?;
+        let position = positions.and_then(|p| p.get(k)).map(|xy| {
+            let xy = xy.as_array().map(Vec::as_slice).unwrap_or_default();
+            match xy {
+                [x, y] => Ok(Position::Planar(Complex64::new(
+                    x.as_f64().unwrap_or(f64::NAN),
+                    y.as_f64().unwrap_or(f64::NAN),
+                ))),
+                _ => Err(errors::raise(
+                    Kind::Constraint,
+                    format!("bc row {k}: expected a position (x, y)"),
+                )),
+            }
+        });
         problem.constraints.push(Constraint::Pin(Pin {
             vertex: arrays::vertex(mesh, index, "pins")?,
-            position: None,
+            position: position.transpose()?,
         }));
     }
     if let Some(weight) = spec.get("normal_constraint").and_then(Value::as_f64) {
@@ -332,9 +344,14 @@ fn run(
     py: Python<'_>,
     solver: &dyn beltrami_core::Solver,
     problem: &Problem<'_>,
+    each_component: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(Solution, f64)> {
-    let settings = solver.check(problem).map_err(|e| errors::from_solver(&e))?;
+    let settings = if each_component {
+        None
+    } else {
+        Some(solver.check(problem).map_err(|e| errors::from_solver(&e))?)
+    };
     let cancel = Arc::new(AtomicBool::new(false));
     let mut pending: Option<PyErr> = None;
     let start = Instant::now();
@@ -358,7 +375,10 @@ fn run(
                     flag.store(true, Ordering::Relaxed);
                 }
             });
-        solver.run(problem, &settings, &mut context)
+        match &settings {
+            Some(settings) => solver.run(problem, settings, &mut context),
+            None => components::solve_each(solver, problem, &mut context),
+        }
     });
     let seconds = start.elapsed().as_secs_f64();
     if let Some(e) = pending {
@@ -433,7 +453,16 @@ pub fn solve<'py>(
     constraints(&spec, &mut problem, target_mesh.as_ref(), &inputs)?;
     options(&spec, &mut problem, solver);
 
-    let (solution, seconds) = run(py, solver, &problem, progress)?;
+    let each_component = match text(&spec, "components") {
+        None => false,
+        Some("each") => true,
+        Some(other) => {
+            return Err(option_error(format!(
+                "components={other:?}: expected 'each' (every connected component mapped on its own, side by side)"
+            )));
+        }
+    };
+    let (solution, seconds) = run(py, solver, &problem, each_component, progress)?;
     let out = PyDict::new(py);
     let Some(map) = solution.map() else {
         return Err(errors::raise(

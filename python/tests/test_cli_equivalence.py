@@ -383,3 +383,43 @@ def test_the_four_point_problem_matches_qc(cli, generated, tmp_path):
     assert report["k"] == pytest.approx(report_of(r)["k"], abs=1e-12)
     # The exact k of these points is 0.1225 (plugins/extremal/tests/four_point.rs).
     assert report["k"] == pytest.approx(0.1225, rel=0.03)
+
+
+def test_lscm_takes_libigl_b_and_bc(hemisphere):
+    V, F = beltrami.read_mesh(hemisphere)
+    # The hemisphere pressed flat: a planar disk, whose own positions are a conformal
+    # map. Pins at a similarity of their positions: LSCM gives that similarity exactly
+    # (zero energy, the unique minimizer through the pins), with three pins or two.
+    flat = V * [1.0, 1.0, 0.0]
+    z = flat[:, 0] + 1j * flat[:, 1]
+    moved = (0.6 - 0.8j) * 2 * z + (1 + 0.5j)
+    b = np.array([0, 60, 700])
+    bc = np.column_stack([moved[b].real, moved[b].imag])
+    for k in (3, 2):
+        UV = beltrami.lscm(flat, F, b[:k], bc[:k])
+        np.testing.assert_allclose(UV[b[:k]], bc[:k], atol=1e-12)
+        np.testing.assert_allclose(UV @ [1, 1j], moved, atol=1e-9)
+    # On the curved surface every pin still lands exactly where asked.
+    UV = beltrami.lscm(V, F, b, bc)
+    np.testing.assert_allclose(UV[b], bc, atol=1e-12)
+    with pytest.raises(beltrami.ConstraintError, match=r"bc has shape \(2, 2\); expected \(3, 2\)"):
+        beltrami.lscm(V, F, b, bc[:2])
+    with pytest.raises(beltrami.ConstraintError, match="bc row 1 is not finite"):
+        beltrami.lscm(V, F, b[:2], [[0, 0], [np.nan, 1]])
+    with pytest.raises(beltrami.OptionError, match="not both"):
+        beltrami.lscm(V, F, b[:2], bc[:2], pins=[0, 1])
+
+
+def test_components_each_matches_param(cli, hemisphere, tmp_path):
+    V, F = beltrami.read_mesh(hemisphere)
+    V2 = np.vstack([V, V * 0.5 + [3.0, 0.0, 0.0]])
+    F2 = np.vstack([F, F + len(V)])
+    path = tmp_path / "two.obj"
+    beltrami.write_mesh(path, V2, F2)
+    out = tmp_path / "out.obj"
+    cli("param", path, "--solver", "lscm", "--components", "each", "-o", out)
+    close(beltrami.lscm(V2, F2, components="each"), uv_of(out))
+    with pytest.raises(beltrami.UnsupportedError, match="2 components"):
+        beltrami.lscm(V2, F2)
+    with pytest.raises(beltrami.OptionError, match="expected 'each'"):
+        beltrami.lscm(V2, F2, components="all")

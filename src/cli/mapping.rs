@@ -167,6 +167,22 @@ pub fn resolve_pins(specs: &[PinSpec], mesh: &Mesh) -> anyhow::Result<Vec<Pin>> 
         .collect()
 }
 
+/// `, at most ~T left` for a stage with a known step count, from the time its steps so far
+/// took (`elapsed`). "At most": iterative solvers count up to their iteration limit and
+/// usually stop before it.
+fn time_left(p: &Progress, elapsed: Duration) -> Option<String> {
+    let total = p.total?;
+    if p.done == 0 || p.done >= total || elapsed < Duration::from_secs(1) {
+        return None;
+    }
+    let left = elapsed.as_secs_f64() * (total - p.done) as f64 / p.done as f64;
+    Some(if left < 90.0 {
+        format!(", at most ~{left:.0} s left")
+    } else {
+        format!(", at most ~{:.0} min left", left / 60.0)
+    })
+}
+
 /// `stage done/total energy E` of a progress report.
 fn progress_line(p: &Progress) -> String {
     let mut line = p.stage.to_string();
@@ -185,6 +201,8 @@ pub(super) struct LateBar {
     start: Instant,
     shown: bool,
     enabled: bool,
+    /// The current stage and when it began, for the time left.
+    stage: Option<(&'static str, Instant)>,
 }
 
 impl LateBar {
@@ -199,6 +217,7 @@ impl LateBar {
             start: Instant::now(),
             shown: false,
             enabled,
+            stage: None,
         }
     }
 
@@ -211,7 +230,19 @@ impl LateBar {
             self.bar.enable_steady_tick(Duration::from_millis(120));
             self.shown = true;
         }
-        self.bar.set_message(progress_line(p));
+        let since = match self.stage {
+            Some((stage, since)) if stage == p.stage => since,
+            _ => {
+                let now = Instant::now();
+                self.stage = Some((p.stage, now));
+                now
+            }
+        };
+        let mut line = progress_line(p);
+        if let Some(left) = time_left(p, since.elapsed()) {
+            line.push_str(&left);
+        }
+        self.bar.set_message(line);
     }
 
     pub(super) fn finish(&self) {
@@ -228,6 +259,15 @@ pub fn solve(
     progress: ProgressStyleArg,
 ) -> anyhow::Result<(Solution, f64)> {
     let settings = solver.check(problem)?;
+    run_with_progress(progress, |context| solver.run(problem, &settings, context))
+}
+
+/// Runs `run` with a context that shows progress as asked and stops on Ctrl-C; returns
+/// its solution and the seconds it took.
+pub fn run_with_progress(
+    progress: ProgressStyleArg,
+    run: impl FnOnce(&mut Context<'_>) -> Result<Solution, beltrami_core::SolverError>,
+) -> anyhow::Result<(Solution, f64)> {
     let mut bar = LateBar::new(progress == ProgressStyleArg::Bar);
     let start = Instant::now();
     let solution = {
@@ -240,7 +280,7 @@ pub fn solve(
                 }
             })
             .with_cancel_flag(super::interrupt::cancel_flag());
-        solver.run(problem, &settings, &mut context)
+        run(&mut context)
     };
     bar.finish();
     Ok((solution?, start.elapsed().as_secs_f64()))
@@ -415,4 +455,34 @@ pub fn finish(
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn progress(done: usize, total: Option<usize>) -> Progress {
+        Progress {
+            stage: "iteration",
+            done,
+            total,
+            energy: None,
+        }
+    }
+
+    #[test]
+    fn time_left_scales_the_time_per_step_by_the_steps_left() {
+        let ten = Duration::from_secs(10);
+        assert_eq!(
+            time_left(&progress(10, Some(40)), ten).as_deref(),
+            Some(", at most ~30 s left")
+        );
+        assert_eq!(
+            time_left(&progress(2, Some(100)), ten).as_deref(),
+            Some(", at most ~8 min left")
+        );
+        assert_eq!(time_left(&progress(10, None), ten), None);
+        assert_eq!(time_left(&progress(0, Some(40)), ten), None);
+        assert_eq!(time_left(&progress(40, Some(40)), ten), None);
+    }
 }

@@ -19,6 +19,7 @@ mod register;
 mod remesh;
 mod render;
 mod solvers;
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -62,6 +63,8 @@ pub enum Command {
     /// Draw a mesh or a map as PNG: the parameter domain, the surface in 3D or both side
     /// by side, colored by |mu| or with a checkerboard of the map.
     Render(render::RenderArgs),
+    /// A self-contained HTML page of a mesh or a map (WebGL; turn by dragging).
+    View(view::ViewArgs),
     /// Draw the histogram of |mu| of a map as PNG (share of faces or of area).
     Histogram(histogram::HistogramArgs),
     /// Cut a surface of genus >= 1 (or with several boundary loops) into a disk along a
@@ -88,6 +91,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(args) => bench::run(&args),
         Command::Cut(args) => cut::run(&args, cli.quiet),
         Command::Render(args) => render::run(&args, cli.quiet),
+        Command::View(args) => view::run(&args, cli.quiet),
         Command::Histogram(args) => histogram::run(&args, cli.quiet),
         Command::Remesh(args) => remesh::run(&args, cli.quiet),
         Command::Batch(args) => batch::run(&args, cli.quiet),

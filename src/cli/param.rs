@@ -3,7 +3,9 @@
 use std::path::PathBuf;
 
 use beltrami::map_file;
-use beltrami_core::{Constraint, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind};
+use beltrami_core::{
+    Constraint, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind, components,
+};
 use clap::{Args, ValueEnum};
 
 use super::load::load_mesh;
@@ -19,6 +21,16 @@ pub enum BoundaryArg {
     Square,
     /// Free (LSCM).
     Free,
+}
+
+/// What `--components` does with a mesh of several connected components.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ComponentsArg {
+    /// Map every component on its own and place the maps side by side, left to right
+    /// in the order of each component's first face (maps into the plane only).
+    Each,
+    /// Map only the component with the most faces; OUT holds that component alone.
+    Largest,
 }
 
 /// Edge weights of `--weights`.
@@ -55,6 +67,10 @@ pub struct ParamArgs {
     /// repeatable. LSCM's two pins go to (0,0) and (1,0).
     #[arg(long = "pin")]
     pub pins: Vec<PinSpec>,
+    /// A mesh in several connected components (a scan in pieces): `each` maps every
+    /// component, `largest` only the largest. Without it such a mesh is refused.
+    #[arg(long, value_enum)]
+    pub components: Option<ComponentsArg>,
     /// Output mesh: .obj (the input's vertices and faces, one `vt` per vertex; for the
     /// sphere, the sphere positions) or .glb/.gltf (UVs and |mu| colors).
     #[arg(short, long)]
@@ -121,12 +137,45 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
             .map(Constraint::Pin),
     );
 
-    let (solution, seconds, sections) = mapping::solve_formatting_output(
-        solver,
-        &problem,
-        args.common.progress(quiet),
-        &args.output,
-    )?;
+    let progress = args.common.progress(quiet);
+    let parts;
+    let (mesh, solution, seconds, sections) = match args.components {
+        Some(ComponentsArg::Largest) if mesh.component_count() > 1 => {
+            parts = components::parts(mesh)?;
+            let part = components::largest(&parts).map(|k| &parts[k]);
+            let part = part.ok_or_else(|| anyhow::anyhow!("the mesh has no faces"))?;
+            let problem = part.problem(&problem, solver.name())?;
+            let (mut solution, seconds) = mapping::solve(solver, &problem, progress)?;
+            solution.report.notes.push(format!(
+                "the largest of {} components mapped ({} of {} faces); OUT holds it alone",
+                parts.len(),
+                part.mesh.face_count(),
+                mesh.face_count()
+            ));
+            (&part.mesh, solution, seconds, None)
+        }
+        Some(ComponentsArg::Each) => {
+            let (solution, seconds) = mapping::run_with_progress(progress, |context| {
+                components::solve_each(solver, &problem, context)
+            })?;
+            (mesh, solution, seconds, None)
+        }
+        _ => {
+            let (solution, seconds, sections) =
+                mapping::solve_formatting_output(solver, &problem, progress, &args.output)
+                    .map_err(|e| {
+                        if mesh.component_count() > 1 {
+                            anyhow::anyhow!(
+                                "{}\nhint: `--components each` maps every connected component on its own (side by side), `--components largest` the largest alone",
+                                beltrami::report::error_message(e.as_ref())
+                            )
+                        } else {
+                            e
+                        }
+                    })?;
+            (mesh, solution, seconds, sections)
+        }
+    };
     map_file::write(&args.output, mesh, &solution, None, sections.as_ref())?;
     mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);

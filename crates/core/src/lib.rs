@@ -69,6 +69,7 @@
 //! ```
 
 mod accepts;
+pub mod components;
 mod constraint;
 mod error;
 mod features;
