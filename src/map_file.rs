@@ -134,16 +134,18 @@ pub fn vertex_mu(mesh: &Mesh, field: &BeltramiField) -> Result<Vec<f64>, MapFile
         .collect())
 }
 
-/// Writes the map of `solution` (a map of `mesh`'s vertices) to `path` (`.obj`,
-/// `.gltf` or `.glb`) as described in the module docs; `target` is the target mesh of a
-/// map onto one. An OBJ file takes the text of the lines that do not depend on the map
-/// from `sections` where they fit ([`io::obj::write_with_sections`]).
+/// Writes the map of `solution` (a map of `mesh`'s vertices) to `path` (any mesh format
+/// but STL for a planar map) as described in the module docs; `target` is the target
+/// mesh of a map onto one. An OBJ file takes the text of the lines that do not depend on
+/// the map from `sections` where they fit ([`io::obj::write_with_sections`]) and the
+/// input's grouping lines `obj_groups` ([`io::LoadedMesh::obj_groups`]).
 pub fn write(
     path: &Path,
     mesh: &Mesh,
     solution: &Solution,
     target: Option<&Mesh>,
     sections: Option<&io::obj::MeshSections>,
+    obj_groups: &[(u32, String)],
 ) -> Result<(), MapFileError> {
     let format = Format::from_path(path).ok_or_else(|| WriteError::UnknownFormat {
         path: path.to_path_buf(),
@@ -158,6 +160,7 @@ pub fn write(
     };
     let mut attributes = VertexAttributes {
         colors: colors.as_deref(),
+        obj_groups,
         ..Default::default()
     };
     match &image {
@@ -202,7 +205,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
 
         let obj = dir.path().join("map.obj");
-        write(&obj, &mesh, &solution, None, None).unwrap();
+        write(&obj, &mesh, &solution, None, None, &[]).unwrap();
         let back = read(&obj);
         assert_eq!(back.mesh.positions(), mesh.positions());
         let uv = back.vertex_uvs().unwrap();
@@ -211,7 +214,7 @@ mod tests {
         }
 
         let glb = dir.path().join("map.glb");
-        write(&glb, &mesh, &solution, None, None).unwrap();
+        write(&glb, &mesh, &solution, None, None, &[]).unwrap();
         let back = read(&glb);
         for (p, q) in back.mesh.positions().iter().zip(mesh.positions()) {
             assert!((p - q).norm() < 1e-6);
@@ -278,11 +281,11 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let obj = dir.path().join("on_target.obj");
 
-        let err = write(&obj, &source, &solution, None, None).unwrap_err();
+        let err = write(&obj, &source, &solution, None, None, &[]).unwrap_err();
         assert!(matches!(err, MapFileError::NoTarget), "{err}");
         assert!(!obj.exists());
 
-        write(&obj, &source, &solution, Some(&target), None).unwrap();
+        write(&obj, &source, &solution, Some(&target), None, &[]).unwrap();
         let back = read(&obj);
         assert!(back.vertex_uvs().is_none());
         for (v, (p, q)) in back.mesh.positions().iter().zip(&points).enumerate() {
@@ -294,7 +297,7 @@ mod tests {
         let glb = dir.path().join("bad.glb");
         points[7].coords = [0.7, 0.7, -0.4, 0.0];
         let bad = Solution::from_map(Map::OnMesh(points), Report::new("test"));
-        let err = write(&glb, &source, &bad, Some(&target), None).unwrap_err();
+        let err = write(&glb, &source, &bad, Some(&target), None, &[]).unwrap_err();
         assert!(
             matches!(err, MapFileError::OffTarget { vertex: 7, .. }),
             "{err}"
@@ -311,7 +314,7 @@ mod tests {
         );
         let dir = tempfile::tempdir().unwrap();
         let glb = dir.path().join("spatial.glb");
-        write(&glb, &source, &solution, None, None).unwrap();
+        write(&glb, &source, &solution, None, None, &[]).unwrap();
         let back = read(&glb);
         for (p, q) in back.mesh.positions().iter().zip(target.positions()) {
             assert!((p - q).norm() < 1e-6);
@@ -328,7 +331,7 @@ mod tests {
             Map::Planar(vec![Complex64::new(0.0, 0.0); 3]),
             Report::new("test"),
         );
-        let err = write(&obj, &source, &short, None, None).unwrap_err();
+        let err = write(&obj, &source, &short, None, None, &[]).unwrap_err();
         assert!(
             matches!(
                 err,
@@ -347,7 +350,7 @@ mod tests {
             ..short
         };
         assert!(matches!(
-            write(&obj, &source, &remeshed, None, None),
+            write(&obj, &source, &remeshed, None, None, &[]),
             Err(MapFileError::NoMap)
         ));
         let xyz = dir.path().join("out.xyz");
@@ -356,14 +359,14 @@ mod tests {
             Report::new("test"),
         );
         assert!(matches!(
-            write(&xyz, &source, &spatial, None, None),
+            write(&xyz, &source, &spatial, None, None, &[]),
             Err(MapFileError::Write(WriteError::UnknownFormat { .. }))
         ));
         let mut nan = target.positions().to_vec();
         nan[2].x = f64::NAN;
         let nan = Solution::from_map(Map::Spatial(nan), Report::new("test"));
         assert!(matches!(
-            write(&obj, &source, &nan, None, None),
+            write(&obj, &source, &nan, None, None, &[]),
             Err(MapFileError::Write(WriteError::NonFinite { vertex: 2, .. }))
         ));
         assert!(!obj.exists() && !xyz.exists());

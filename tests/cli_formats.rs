@@ -170,3 +170,47 @@ fn info_lists_at_most_a_dozen_components() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["genus"].as_array().unwrap().len(), 20);
 }
+
+#[test]
+fn a_parameterization_keeps_the_inputs_groups_and_materials() {
+    let dir = tempfile::tempdir().unwrap();
+    let bundled = std::fs::read_to_string("meshes/disk_hemisphere.obj").unwrap();
+    let mut grouped = String::new();
+    let mut faces = 0;
+    for line in bundled.lines() {
+        if line.starts_with("f ") {
+            if faces == 0 {
+                grouped.push_str("mtllib skin.mtl\ng top\nusemtl skin\n");
+            }
+            if faces == 1000 {
+                grouped.push_str("g rim\n");
+            }
+            faces += 1;
+        }
+        grouped.push_str(line);
+        grouped.push('\n');
+    }
+    let input = dir.path().join("grouped.obj");
+    std::fs::write(&input, grouped).unwrap();
+    let output = dir.path().join("uv.obj");
+    let out = beltrami(&[
+        "param",
+        s(&input),
+        "--solver",
+        "lscm",
+        "-o",
+        s(&output),
+        "-q",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let written = std::fs::read_to_string(&output).unwrap();
+    let lines: Vec<&str> = written.lines().filter(|l| !l.starts_with("v")).collect();
+    let at = |wanted: &str| lines.iter().position(|l| *l == wanted).unwrap();
+    assert_eq!(
+        &lines[at("mtllib skin.mtl")..at("mtllib skin.mtl") + 3],
+        ["mtllib skin.mtl", "g top", "usemtl skin"]
+    );
+    assert!(lines[at("usemtl skin") + 1].starts_with("f "));
+    // 1000 faces between `g top` and `g rim`, as in the input.
+    assert_eq!(at("g rim") - at("usemtl skin") - 1, 1000);
+}

@@ -68,6 +68,7 @@ __all__ = [
     "remesh",
     "remesh_in_place",
     "repair",
+    "show",
     "solvers",
     "sphere_map",
     "tutte",
@@ -832,6 +833,49 @@ def weld(V: ArrayLike, F: ArrayLike) -> Tuple[np.ndarray, np.ndarray, np.ndarray
     """
     V2, F2, info = repair(V, F, drop_degenerate_faces=False, drop_duplicate_faces=False)
     return V2, F2, info["vertex_index"]
+
+
+def show(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    uv: Optional[ArrayLike] = None,
+    mu: Optional[ArrayLike] = None,
+    name: str = "mesh",
+) -> None:
+    """Shows the mesh in polyscope's window (``pip install "beltrami[view]"``): the
+    texture coordinates ``uv`` ``(n, 2)`` as a checkered parameterization and ``|mu|``
+    (one value per face, complex or real) in viridis over ``[0, 1]``. Without a display,
+    ``beltrami view`` writes a self-contained HTML page instead.
+
+    >>> import beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> uv = beltrami.lscm(V, F)
+    >>> beltrami.show(V, F, uv=uv, mu=beltrami.beltrami_coefficient(V, F, uv))  # doctest: +SKIP
+    """
+    try:
+        import polyscope as ps
+    except ImportError:
+        raise UnsupportedError(
+            'beltrami.show draws with polyscope, which is not installed: pip install "beltrami[view]"'
+            " (or polyscope); `beltrami view` writes an HTML page without it"
+        ) from None
+    V, F = _mesh(V, F)
+    ps.init()
+    surface = ps.register_surface_mesh(name, V, F)
+    if uv is not None:
+        uv = _matrix("uv", uv, np.float64, ConstraintError)
+        if uv.shape != (len(V), 2):
+            raise ConstraintError(f"uv has shape {uv.shape}; expected ({len(V)}, 2)")
+        surface.add_parameterization_quantity("uv", uv, defined_on="vertices", enabled=True)
+    if mu is not None:
+        modulus = np.abs(np.asarray(mu))
+        if modulus.shape != (len(F),):
+            raise FieldError(f"mu has shape {modulus.shape}; expected ({len(F)},), one value per face")
+        surface.add_scalar_quantity(
+            "|mu|", modulus, defined_on="faces", cmap="viridis", vminmax=(0.0, 1.0), enabled=uv is None
+        )
+    ps.show()
 
 
 # ---- files and the catalog -----------------------------------------------------------

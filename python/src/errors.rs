@@ -45,9 +45,34 @@ impl Kind {
     }
 }
 
-/// The Python exception of `kind` with `message`.
+/// The command line's advice in the library's messages and what a Python user does
+/// instead.
+const IN_PYTHON_TERMS: [(&str, &str); 6] = [
+    ("`beltrami cut`", "`beltrami.cut_to_disk(V, F)`"),
+    (
+        "`--allow-missed-landmarks` (option `allow-missed-landmarks`)",
+        "`allow_missed_landmarks=True`",
+    ),
+    (
+        "`--allow-flips`, option `allow-flips`",
+        "`allow_flips=True`",
+    ),
+    ("(`--pin v0`)", "(`pins=[0]`)"),
+    ("add --normal-constraint", "give normal_constraint="),
+    ("use beltrami-flow", "use beltrami.beltrami_flow"),
+];
+
+/// `message` with the command line's advice in Python terms ([`IN_PYTHON_TERMS`]).
+fn in_python_terms(message: String) -> String {
+    IN_PYTHON_TERMS
+        .iter()
+        .fold(message, |text, (cli, python)| text.replace(cli, python))
+}
+
+/// The Python exception of `kind` with `message` (its command-line advice put in Python
+/// terms).
 pub fn raise(kind: Kind, message: impl Into<String>) -> PyErr {
-    let message = message.into();
+    let message = in_python_terms(message.into());
     Python::attach(|py| {
         let class = py
             .import("beltrami._errors")

@@ -48,6 +48,15 @@ def test_harmonic_refuses_a_closed_mesh(closed):
         beltrami.harmonic(*closed)
 
 
+def test_advice_is_in_python_terms(closed):
+    # The command line says "run `beltrami cut` first or use beltrami-flow".
+    with pytest.raises(beltrami.UnsupportedError) as error:
+        beltrami.lscm(*closed)
+    message = str(error.value)
+    assert "beltrami.cut_to_disk(V, F)" in message and "beltrami.beltrami_flow" in message, message
+    assert "`beltrami cut`" not in message
+
+
 def test_lscm_names_a_pin_off_the_mesh(disk):
     with pytest.raises(beltrami.ConstraintError, match=r"vertex 99999"):
         beltrami.lscm(*disk, pins=[0, 99999])

@@ -139,7 +139,8 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
 
     let progress = args.common.progress(quiet);
     let parts;
-    let (mesh, solution, seconds, sections) = match args.components {
+    let groups = loaded.mesh.obj_groups.as_slice();
+    let (mesh, solution, seconds, sections, groups) = match args.components {
         Some(ComponentsArg::Largest) if mesh.component_count() > 1 => {
             parts = components::parts(mesh)?;
             let part = components::largest(&parts).map(|k| &parts[k]);
@@ -152,13 +153,14 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
                 part.mesh.face_count(),
                 mesh.face_count()
             ));
-            (&part.mesh, solution, seconds, None)
+            // The part's faces are not the input's: its groups are not written.
+            (&part.mesh, solution, seconds, None, &[][..])
         }
         Some(ComponentsArg::Each) => {
             let (solution, seconds) = mapping::run_with_progress(progress, |context| {
                 components::solve_each(solver, &problem, context)
             })?;
-            (mesh, solution, seconds, None)
+            (mesh, solution, seconds, None, groups)
         }
         _ => {
             let (solution, seconds, sections) =
@@ -173,10 +175,17 @@ pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
                             e
                         }
                     })?;
-            (mesh, solution, seconds, sections)
+            (mesh, solution, seconds, sections, groups)
         }
     };
-    map_file::write(&args.output, mesh, &solution, None, sections.as_ref())?;
+    map_file::write(
+        &args.output,
+        mesh,
+        &solution,
+        None,
+        sections.as_ref(),
+        groups,
+    )?;
     mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
     let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
     let mut circles = super::qc::circles(mesh, &solution, &mut report);

@@ -366,7 +366,14 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     ) {
         bail!("{} gave points in space for a planar target", solver.name());
     }
-    map_file::write(&args.output, mesh, &solution, None, sections.as_ref())?;
+    map_file::write(
+        &args.output,
+        mesh,
+        &solution,
+        None,
+        sections.as_ref(),
+        &loaded.mesh.obj_groups,
+    )?;
     if let Some(path) = &args.qd {
         write_quadratic_differential(path, mesh, &solution)?;
     }

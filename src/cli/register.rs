@@ -166,7 +166,14 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     } else {
         None
     };
-    map_file::write(&args.output, source, &solution, Some(target), None)?;
+    map_file::write(
+        &args.output,
+        source,
+        &solution,
+        Some(target),
+        None,
+        &source_loaded.mesh.obj_groups,
+    )?;
     if let Some(path) = &args.correspondence {
         let Some(Map::OnMesh(points)) = solution.map() else {
             bail!("the register solver did not give points on the target mesh");

@@ -55,6 +55,43 @@ f 5 1 3
 ";
 
 #[test]
+fn objects_groups_and_materials_are_written_back_before_their_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write_file(dir.path(), "shuffled.obj", SHUFFLED);
+    let loaded = load(&path);
+    let uvs: Vec<Vector2<f64>> = loaded
+        .mesh
+        .positions()
+        .iter()
+        .map(|p| Vector2::new(p.x, p.y))
+        .collect();
+    let out = dir.path().join("out.obj");
+    let attributes = VertexAttributes {
+        uvs: Some(&uvs),
+        obj_groups: &loaded.obj_groups,
+        ..Default::default()
+    };
+    io::write(&out, &loaded.mesh, &attributes).unwrap();
+    let text = std::fs::read_to_string(&out).unwrap();
+    let after_vertices: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with("v ") && !l.starts_with("vt ") && !l.starts_with('#'))
+        .map(|l| l.split(' ').next().unwrap())
+        .collect();
+    assert_eq!(
+        after_vertices,
+        ["mtllib", "o", "g", "usemtl", "f", "f", "s", "g", "f", "f"],
+        "{text}"
+    );
+    assert!(
+        text.contains("g part_a\nusemtl red\nf 5/5 3/3 4/4\n"),
+        "{text}"
+    );
+    // The output reads back to the same groups.
+    assert_eq!(load(&out).obj_groups, loaded.obj_groups);
+}
+
+#[test]
 fn vertex_indices_follow_the_file_when_faces_use_them_out_of_order() {
     let dir = tempfile::tempdir().unwrap();
     let path = write_file(dir.path(), "shuffled.obj", SHUFFLED);

@@ -1,4 +1,4 @@
-//! `beltrami bench load`: OBJ parse time against halfedge build time.
+//! `beltrami bench load`: parse time of each mesh format against halfedge build time.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -15,6 +15,10 @@ pub struct LoadArgs {
     /// Sizes of the generated triangle grids, in triangles (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "100000,400000,1000000")]
     pub triangles: Vec<usize>,
+    /// Formats the generated grids are written in and read back from (comma-separated:
+    /// obj, ply, stl, off, glb, gltf).
+    #[arg(long = "format", value_delimiter = ',', default_value = "obj")]
+    pub formats: Vec<String>,
     /// Also time these mesh files.
     #[arg(long = "mesh")]
     pub meshes: Vec<PathBuf>,
@@ -33,17 +37,22 @@ pub fn run(args: &LoadArgs) -> anyhow::Result<()> {
         let n = ((t as f64 / 2.0).sqrt().round() as usize).max(1);
         let soup = grid(n, n, Cells::Triangles);
         let mesh = Mesh::from_soup(&soup)?;
-        let path = dir.path().join(format!("grid_{n}x{n}.obj"));
-        io::obj::write(&path, &mesh, &VertexAttributes::default())?;
-        cases.push((format!("grid {n}x{n}"), path));
+        for format in &args.formats {
+            let path = dir.path().join(format!("grid_{n}x{n}.{format}"));
+            if io::Format::from_path(&path).is_none() {
+                anyhow::bail!(
+                    "--format {format}: not a mesh format (obj, ply, stl, off, glb, gltf)"
+                );
+            }
+            io::write(&path, &mesh, &VertexAttributes::default())?;
+            cases.push((format!("grid {n}x{n} .{format}"), path));
+        }
     }
     for m in &args.meshes {
         cases.push((m.display().to_string(), m.clone()));
     }
     if !args.json {
-        println!(
-            "| mesh | vertices | faces | file MB | parse (tobj) s | build s | build / parse |"
-        );
+        println!("| mesh | vertices | faces | file MB | parse s | build s | build / parse |");
         println!("|---|---|---|---|---|---|---|");
     }
     for (name, path) in &cases {

@@ -106,6 +106,7 @@ pub fn parse_bytes(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
         corner_uvs: merged.uvs,
         face_lines: None,
         weld: None,
+        obj_groups: Vec::new(),
     })
 }
 

@@ -48,6 +48,10 @@ pub struct RawMesh {
     /// For STL files, which list every triangle's corners by position: how the corners
     /// were welded into vertices.
     pub weld: Option<Weld>,
+    /// For OBJ files, the grouping lines (`o`, `g`, `s`, `usemtl`, `mtllib`) that stand
+    /// before a face, as `(input face index, lines)`: an OBJ output of the same faces
+    /// writes them back ([`VertexAttributes::obj_groups`]).
+    pub obj_groups: Vec<(u32, String)>,
 }
 
 /// The welding of an STL file's triangle corners into shared vertices: corners with
@@ -59,6 +63,9 @@ pub struct Weld {
     /// Vertices left after welding.
     pub vertices: usize,
 }
+
+/// A syntax error of the PLY, STL and OFF parsers: where it is, and what is wrong.
+pub type SyntaxError = (FilePosition, String);
 
 /// Where in a file a syntax error is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -90,6 +97,8 @@ pub struct LoadedMesh {
     pub corner_uvs: Option<Vec<Vector2<f64>>>,
     /// How an STL file's corners were welded into vertices.
     pub weld: Option<Weld>,
+    /// An OBJ file's grouping lines before its faces ([`RawMesh::obj_groups`]).
+    pub obj_groups: Vec<(u32, String)>,
 }
 
 impl LoadedMesh {
@@ -272,6 +281,10 @@ pub struct VertexAttributes<'a> {
     /// RGB colors in [0, 1], written as glTF `COLOR_0`, PLY `red green blue` bytes and
     /// COFF values (OBJ and STL have no vertex colors and leave them out).
     pub colors: Option<&'a [[f32; 3]]>,
+    /// OBJ only: grouping lines to write before faces, by input face index, as read
+    /// ([`LoadedMesh::obj_groups`]); the lines of a face the mesh dropped go before the
+    /// next face it kept.
+    pub obj_groups: &'a [(u32, String)],
 }
 
 impl VertexAttributes<'_> {
@@ -399,6 +412,25 @@ pub fn read_raw(path: &Path) -> Result<RawMesh, ReadError> {
     }
 }
 
+/// Reads `path` and parses its bytes with `parse`, a reader whose syntax errors say
+/// where they are (PLY, STL, OFF).
+fn read_with(
+    path: &Path,
+    format: Format,
+    parse: fn(&[u8]) -> Result<RawMesh, SyntaxError>,
+) -> Result<RawMesh, ReadError> {
+    let bytes = source::read_bytes(path).map_err(|error| ReadError::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    parse(&bytes).map_err(|(at, message)| ReadError::Syntax {
+        path: path.to_path_buf(),
+        format,
+        at,
+        message,
+    })
+}
+
 /// Reads and validates a mesh file (any [`Format`], by extension).
 pub fn read(path: &Path, options: &BuildOptions) -> Result<LoadedMesh, ReadError> {
     let raw = read_raw(path)?;
@@ -431,6 +463,7 @@ pub fn build_raw(
         report,
         corner_uvs,
         weld: raw.weld,
+        obj_groups: raw.obj_groups,
     })
 }
 

@@ -2,8 +2,10 @@
 //!
 //! # Reading
 //!
-//! Only `v`, `vt` and `f` lines matter; groups, objects, materials, smoothing groups,
-//! normals, points and polylines are ignored. Faces keep their vertex count (no
+//! Only `v`, `vt` and `f` lines make the mesh; normals, points and polylines are
+//! ignored. Objects, groups, smoothing groups, materials and material libraries (`o`,
+//! `g`, `s`, `usemtl`, `mtllib`) are kept as text with the face they stand before
+//! ([`RawMesh::obj_groups`]) and written back before it by [`write_with_sections`]. Faces keep their vertex count (no
 //! triangulation), so triangles and quads come through as they are and other polygons
 //! are rejected by the mesh builder with their face index and line.
 //!
@@ -59,6 +61,14 @@ struct Prepared {
     /// The first `vt` line with a NaN or infinite coordinate: its 1-based line, its
     /// 0-based texture coordinate index and its two values.
     non_finite_uv: Option<(usize, usize, f64, f64)>,
+    /// The grouping lines before faces ([`RawMesh::obj_groups`]).
+    groups: Vec<(u32, String)>,
+}
+
+/// Whether a line's first token starts a grouping line kept for output: objects, groups,
+/// smoothing groups, materials and material libraries.
+fn is_grouping(token: &[u8]) -> bool {
+    matches!(token, b"o" | b"g" | b"s" | b"usemtl" | b"mtllib")
 }
 
 /// The first two numbers of a `vt` line, when both parse.
@@ -108,9 +118,15 @@ fn prepare(bytes: &[u8]) -> Prepared {
     let mut all_corners_have_uv = true;
     let mut non_finite_uv = None;
     let mut texcoords = 0usize;
+    let mut groups: Vec<(u32, String)> = Vec::new();
+    let mut pending = String::new();
     let mut start = 0;
     for (i, line) in bytes.split(|&c| c == b'\n').enumerate() {
         let token = first_token(line);
+        if is_grouping(token) {
+            pending.push_str(String::from_utf8_lossy(line.trim_ascii()).as_ref());
+            pending.push('\n');
+        }
         let keep = match token {
             b"v" => {
                 vertex_count += 1;
@@ -127,6 +143,9 @@ fn prepare(bytes: &[u8]) -> Prepared {
                 true
             }
             b"f" => {
+                if !pending.is_empty() {
+                    groups.push((face_lines.len() as u32, std::mem::take(&mut pending)));
+                }
                 face_lines.push((i + 1) as u32);
                 all_corners_have_uv &= line
                     .trim_ascii()
@@ -156,6 +175,7 @@ fn prepare(bytes: &[u8]) -> Prepared {
         face_lines,
         all_corners_have_uv,
         non_finite_uv,
+        groups,
     }
 }
 
@@ -167,6 +187,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<RawMesh, ReadError> {
             corner_uvs: None,
             face_lines: Some(face_lines),
             weld: None,
+            obj_groups: Vec::new(),
         });
     }
     let prepared = prepare(bytes);
@@ -209,6 +230,7 @@ fn parse_with_tobj(path: &Path, bytes: &[u8], prepared: Prepared) -> Result<RawM
             corner_uvs: None,
             face_lines: Some(prepared.face_lines),
             weld: None,
+            obj_groups: Vec::new(),
         });
     };
     let m = model.mesh;
@@ -260,6 +282,7 @@ fn parse_with_tobj(path: &Path, bytes: &[u8], prepared: Prepared) -> Result<RawM
         corner_uvs,
         face_lines: Some(prepared.face_lines),
         weld: None,
+        obj_groups: prepared.groups,
     })
 }
 
@@ -576,7 +599,8 @@ pub fn write_with_sections(
     let with_uvs = attributes.uvs.is_some();
     let ready = sections.filter(|s| s.faces_len == mesh.face_count() && s.slots == slots.len());
     let vertices = ready.filter(|_| attributes.positions.is_none());
-    let faces = ready.filter(|s| s.with_uvs == with_uvs);
+    let faces = ready.filter(|s| s.with_uvs == with_uvs && attributes.obj_groups.is_empty());
+    let groups = groups_before_faces(mesh, attributes.obj_groups);
     let position = match vertices {
         Some(_) => Vec::new(),
         None => slots.positions(mesh, attributes),
@@ -596,11 +620,32 @@ pub fn write_with_sections(
         match faces {
             Some(sections) => w.write_all(&sections.faces),
             None => write_lines(w, mesh.face_count(), |i, line| {
+                if let Some(text) = &groups[i] {
+                    line.extend_from_slice(text.as_bytes());
+                }
                 face_line(mesh, &slots, with_uvs, i, line);
                 Ok(())
             }),
         }
     })
+}
+
+/// Per mesh face, the grouping lines to write before it: those of its input face and of
+/// the input faces the mesh dropped since the previous face it kept.
+fn groups_before_faces(mesh: &Mesh, groups: &[(u32, String)]) -> Vec<Option<String>> {
+    let mut out = vec![None; mesh.face_count()];
+    let mut next = groups.iter().peekable();
+    for f in mesh.faces() {
+        let input = mesh.face_to_input(f);
+        let mut text = String::new();
+        while let Some((_, lines)) = next.next_if(|(g, _)| *g as usize <= input) {
+            text.push_str(lines);
+        }
+        if !text.is_empty() {
+            out[f.idx()] = Some(text);
+        }
+    }
+    out
 }
 
 /// The text of the `v` and `f` lines of a mesh's OBJ file, formatted before the map to

@@ -26,7 +26,7 @@ use std::path::Path;
 use nalgebra::{Point3, Vector2};
 
 use super::obj::{push_decimal, write_lines};
-use super::slots::OutputSlots;
+use super::slots::{OutputSlots, VertexValues};
 use super::text::{Lines, as_text};
 use super::{FilePosition, Format, RawMesh, ReadError, VertexAttributes, WriteError};
 use crate::{FaceId, Mesh, PolygonSoup};
@@ -40,21 +40,12 @@ struct Variant {
 
 /// Reads an OFF file. See the module docs for what is kept.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
-    let bytes = super::source::read_bytes(path).map_err(|error| ReadError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
-    parse(&bytes).map_err(|(at, message)| ReadError::Syntax {
-        path: path.to_path_buf(),
-        format: Format::Off,
-        at,
-        message,
-    })
+    super::read_with(path, Format::Off, parse)
 }
 
 /// Parses the bytes of an OFF file; a syntax error says where (its line) and what is
 /// wrong.
-pub fn parse(bytes: &[u8]) -> Result<RawMesh, (FilePosition, String)> {
+pub fn parse(bytes: &[u8]) -> Result<RawMesh, super::SyntaxError> {
     parse_lines(bytes).map_err(|(line, message)| (FilePosition::Line(line), message))
 }
 
@@ -179,6 +170,7 @@ fn parse_lines(bytes: &[u8]) -> Result<RawMesh, Fail> {
         corner_uvs,
         face_lines: Some(face_lines),
         weld: None,
+        obj_groups: Vec::new(),
     })
 }
 
@@ -228,9 +220,11 @@ pub fn write(
 ) -> Result<(), WriteError> {
     attributes.check(mesh)?;
     let slots = OutputSlots::new(mesh);
-    let positions = slots.positions(mesh, attributes);
-    let uvs = attributes.uvs.map(|u| slots.scatter(u));
-    let colors = attributes.colors.map(|c| slots.scatter(c));
+    let VertexValues {
+        positions,
+        uvs,
+        colors,
+    } = slots.vertex_values(mesh, attributes);
     super::write_atomically(path, |w| {
         let st = if uvs.is_some() { "ST" } else { "" };
         let c = if colors.is_some() { "C" } else { "" };

@@ -30,7 +30,7 @@ use std::path::Path;
 
 use nalgebra::{Point3, Vector2};
 
-use super::slots::OutputSlots;
+use super::slots::{OutputSlots, VertexValues};
 use super::text::{Words, as_text};
 use super::{FilePosition, Format, RawMesh, ReadError, VertexAttributes, WriteError};
 use crate::{FaceId, Mesh, PolygonSoup};
@@ -130,20 +130,11 @@ struct Header {
 }
 
 /// A syntax error: where, and what is wrong.
-type Fail = (FilePosition, String);
+type Fail = super::SyntaxError;
 
 /// Reads a PLY file. See the module docs for what is kept.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
-    let bytes = super::source::read_bytes(path).map_err(|error| ReadError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
-    parse(&bytes).map_err(|(at, message)| ReadError::Syntax {
-        path: path.to_path_buf(),
-        format: Format::Ply,
-        at,
-        message,
-    })
+    super::read_with(path, Format::Ply, parse)
 }
 
 /// Parses the bytes of a PLY file.
@@ -453,6 +444,7 @@ fn read_body(
         corner_uvs,
         face_lines: (header.encoding == Encoding::Ascii).then_some(body.face_lines),
         weld: None,
+        obj_groups: Vec::new(),
     })
 }
 
@@ -609,9 +601,11 @@ pub fn write(
 ) -> Result<(), WriteError> {
     attributes.check(mesh)?;
     let slots = OutputSlots::new(mesh);
-    let positions = slots.positions(mesh, attributes);
-    let uvs = attributes.uvs.map(|u| slots.scatter(u));
-    let colors = attributes.colors.map(|c| slots.scatter(c));
+    let VertexValues {
+        positions,
+        uvs,
+        colors,
+    } = slots.vertex_values(mesh, attributes);
     let index_type = if slots.len() <= i32::MAX as usize {
         "int"
     } else {

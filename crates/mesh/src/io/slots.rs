@@ -1,7 +1,7 @@
 //! Output numbering of written meshes: the input's own vertex order when it can be
 //! restored.
 
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector2};
 
 use super::VertexAttributes;
 use crate::{Mesh, VertexId};
@@ -82,4 +82,25 @@ impl OutputSlots {
         }
         out
     }
+
+    /// The positions, texture coordinates and colors to write, each moved to its slot
+    /// ([`OutputSlots::positions`], [`OutputSlots::scatter`]).
+    pub(crate) fn vertex_values(
+        &self,
+        mesh: &Mesh,
+        attributes: &VertexAttributes<'_>,
+    ) -> VertexValues {
+        VertexValues {
+            positions: self.positions(mesh, attributes),
+            uvs: attributes.uvs.map(|u| self.scatter(u)),
+            colors: attributes.colors.map(|c| self.scatter(c)),
+        }
+    }
+}
+
+/// Per-vertex values in output order ([`OutputSlots::vertex_values`]).
+pub(crate) struct VertexValues {
+    pub(crate) positions: Vec<Point3<f64>>,
+    pub(crate) uvs: Option<Vec<Vector2<f64>>>,
+    pub(crate) colors: Option<Vec<[f32; 3]>>,
 }

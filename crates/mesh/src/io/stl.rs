@@ -40,20 +40,11 @@ const HEADER: usize = 80;
 const RECORD: usize = 50;
 
 /// A syntax error: where, and what is wrong.
-type Fail = (FilePosition, String);
+type Fail = super::SyntaxError;
 
 /// Reads an STL file. See the module docs for what is kept.
 pub fn read(path: &Path) -> Result<RawMesh, ReadError> {
-    let bytes = super::source::read_bytes(path).map_err(|error| ReadError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
-    parse(&bytes).map_err(|(at, message)| ReadError::Syntax {
-        path: path.to_path_buf(),
-        format: Format::Stl,
-        at,
-        message,
-    })
+    super::read_with(path, Format::Stl, parse)
 }
 
 /// Parses the bytes of an STL file.
@@ -268,6 +259,7 @@ impl Welder {
             corner_uvs: None,
             face_lines,
             weld: Some(weld),
+            obj_groups: Vec::new(),
         }
     }
 }
