@@ -18,6 +18,10 @@ python:
     pip install "./python[test]"
     python -m pytest -q python/tests
 
+# Build the Python wheel (abi3: one wheel for CPython 3.9 and later) into dist/.
+wheel:
+    pip wheel --no-deps -w dist ./python
+
 # What CI runs: fmt, clippy, tests.
 ci:
     bash .ci/run
