@@ -207,7 +207,14 @@ def tutte(
     neighbours (``weights`` ``uniform`` or ``mean-value``), the boundary on the unit
     circle by arc length (``boundary='circle'``) or on the unit square. Bijective for a
     convex boundary (Tutte 1963, Floater 2003). Returns ``UV`` ``(n, 2)``.
-    ``beltrami param --solver tutte``."""
+    ``beltrami param --solver tutte``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> UV = beltrami.tutte(V, F)
+    >>> UV.shape, beltrami.distortion(V, F, UV)["flipped"]
+    ((1861, 2), 0)
+    """
     return _param("tutte", V, F, boundary, weights, pins, options, info, components)
 
 
@@ -224,7 +231,14 @@ def harmonic(
 ) -> Any:
     """The discrete harmonic map of a disk (cotangent weights, Pinkall-Polthier 1993)
     with the boundary on the unit circle by arc length or on the unit square. Returns
-    ``UV`` ``(n, 2)``. ``beltrami param --solver harmonic``."""
+    ``UV`` ``(n, 2)``. ``beltrami param --solver harmonic``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> UV = beltrami.harmonic(V, F)
+    >>> round(beltrami.distortion(V, F, UV)["mu_mean"], 2)
+    0.01
+    """
     return _param("harmonic", V, F, boundary, weights, pins, options, info, components)
 
 
@@ -284,7 +298,14 @@ def sphere_map(
     """A conformal map of a closed genus-0 mesh onto the unit sphere, without flipped
     faces: the harmonic map of the punctured mesh, Moebius centring and chart
     corrections (docs/sphere.md). Returns ``W`` ``(n, 3)`` on the unit sphere.
-    ``beltrami param --solver sphere``."""
+    ``beltrami param --solver sphere``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/spot.obj")
+    >>> W = beltrami.sphere_map(V, F)
+    >>> bool(np.allclose(np.linalg.norm(W, axis=1), 1)), beltrami.distortion(V, F, W)["flipped"]
+    (True, 0)
+    """
     spec = {"target": "sphere", "options": _options(options)}
     return _result(_solve("sphere", V, F, spec), info)
 
@@ -324,7 +345,15 @@ def lsqc(
     boundary held at ``boundary_map`` ``(n, 3)`` (the quaternionic map of Gruber-Aulisa
     2022), optionally with the normal constraint of weight ``normal_constraint`` and the
     area constraint (``area_constraint=True``, section 4.2).
-    Returns ``UV`` ``(n, 2)`` or ``X`` ``(n, 3)``. ``beltrami qc --solver lsqc``."""
+    Returns ``UV`` ``(n, 2)`` or ``X`` ``(n, 3)``. ``beltrami qc --solver lsqc``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> flat = V * [1, 1, 0]                    # the hemisphere pressed into the plane
+    >>> UV = beltrami.lsqc(flat, F, mu_expr="0.3", boundary="free")
+    >>> bool(np.allclose(beltrami.beltrami_coefficient(flat, F, UV), 0.3))
+    True
+    """
     if target not in ("plane", "space"):
         raise OptionError(f"lsqc maps into the plane or space, not target={target!r}")
     spec = {
@@ -367,7 +396,14 @@ def beltrami_flow(
     (smallest ``L^p`` norm of mu, ``p >= 2``) when neither is given. On the sphere
     ``mu_expr`` is in the stereographic coordinate. ``progress(stage, done, total,
     energy)`` is called at every step. Returns ``UV`` ``(n, 2)`` or ``W`` ``(n, 3)`` on
-    the sphere. ``beltrami qc --solver beltrami-flow``."""
+    the sphere. ``beltrami qc --solver beltrami-flow``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> UV = beltrami.beltrami_flow(V, F, target="disk")
+    >>> round(float(np.abs(UV @ [1, 1j]).max()), 9), round(beltrami.distortion(V, F, UV)["mu_max"], 2)
+    (1.0, 0.02)
+    """
     if target not in ("disk", "annulus", "sphere", "plane"):
         raise OptionError(
             f"beltrami_flow maps onto 'disk', 'annulus', 'sphere' or 'plane', not target={target!r}"
@@ -461,7 +497,16 @@ def extremal(
     Instead of ``boundary_map``, ``landmarks`` ``[(vertex, (x, y)), ...]`` poses the
     four-point problem: four boundary vertices moved to points of the unit circle, the
     rest of the boundary sliding on it (``beltrami qc --solver extremal --target disk
-    --landmarks FILE``)."""
+    --landmarks FILE``).
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> flat = V * [1, 1, 0]                    # the hemisphere pressed into the plane
+    >>> stretched = flat[:, :2] * [2.0, 1.0]    # the boundary values of a stretch by 2
+    >>> UV = beltrami.extremal(flat, F, stretched)   # the stretch itself, k = 1/3
+    >>> bool(np.allclose(UV, stretched)), round(beltrami.distortion(flat, F, UV)["mu_max"], 6)
+    (True, 0.333333)
+    """
     return _extremal_like(
         "extremal", V, F, boundary_map, init,
         {"tolerance": tolerance, "max_iters": max_iters, "threads": threads},
@@ -485,7 +530,16 @@ def qc_iteration(
     """The QC iteration towards the Teichmueller map with the boundary values of
     ``boundary_map`` (Lui et al. 2014): alternate the LSQC map of the current mu with
     averaging of mu and projection onto constant modulus. Returns ``UV`` ``(n, 2)``.
-    ``beltrami qc --solver qc-iteration --boundary given``."""
+    ``beltrami qc --solver qc-iteration --boundary given``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> flat = V * [1, 1, 0]                    # the hemisphere pressed into the plane
+    >>> stretched = flat[:, :2] * [2.0, 1.0]    # the boundary values of a stretch by 2
+    >>> UV = beltrami.qc_iteration(flat, F, stretched)
+    >>> bool(np.allclose(UV, stretched))
+    True
+    """
     return _extremal_like(
         "qc-iteration", V, F, boundary_map, init,
         {"tolerance": tolerance, "max_iters": max_iters, "threads": threads},
@@ -687,7 +741,16 @@ def beltrami_coefficient(V: ArrayLike, F: ArrayLike, X: ArrayLike) -> np.ndarray
     face (rows of ``F``; complex). ``X`` ``(n, 2)`` is a map into the plane, measured in
     the plane's frame when ``V`` lies in z = 0 and in each face's frame otherwise;
     ``X`` ``(n, 3)`` a map into R^3, measured in the face frames. As ``beltrami
-    distortion --per-face``."""
+    distortion --per-face``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> flat = V * [1, 1, 0]                    # the hemisphere pressed into the plane
+    >>> stretched = flat[:, :2] * [2.0, 1.0]    # the boundary values of a stretch by 2
+    >>> mu = beltrami.beltrami_coefficient(flat, F, stretched)
+    >>> bool(np.allclose(np.abs(mu), 1 / 3))                # (2 - 1) / (2 + 1)
+    True
+    """
     V, F = _mesh(V, F)
     mu, _frame = _native.beltrami_coefficient(V, F, _matrix("X", X, np.float64, ConstraintError))
     return mu
@@ -697,7 +760,14 @@ def distortion(V: ArrayLike, F: ArrayLike, X: ArrayLike) -> Dict[str, Any]:
     """Statistics of ``|mu|`` of the map with images ``X`` (see
     :func:`beltrami_coefficient`): ``faces``, ``flipped``, ``mu_mean``, ``mu_max``,
     ``mu_std``, ``mu_l2`` (area-weighted), ``frame`` and ``flipped_faces`` (rows of
-    ``F``). As ``beltrami distortion --json``."""
+    ``F``). As ``beltrami distortion --json``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> d = beltrami.distortion(V, F, beltrami.tutte(V, F))
+    >>> d["flipped"], round(d["mu_mean"], 3)
+    (0, 0.135)
+    """
     V, F = _mesh(V, F)
     return _native.distortion(V, F, _matrix("X", X, np.float64, ConstraintError))
 
@@ -705,7 +775,13 @@ def distortion(V: ArrayLike, F: ArrayLike, X: ArrayLike) -> Dict[str, Any]:
 def mesh_info(V: ArrayLike, F: ArrayLike) -> Dict[str, Any]:
     """Validates the mesh and returns its sizes and topology: ``vertices``, ``faces``,
     ``edges``, ``boundary_loops``, ``components``, ``euler_characteristic``, ``genus``,
-    ``topology``. An invalid mesh raises :class:`MeshError` naming the element."""
+    ``topology``. An invalid mesh raises :class:`MeshError` naming the element.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> beltrami.mesh_info(V, F)["topology"]
+    'genus 0 and one boundary loop'
+    """
     return _native.mesh_info(*_mesh(V, F))
 
 
@@ -731,7 +807,14 @@ def remesh(
     constrained Delaunay refinement with angles of at least ``min_angle`` degrees, lift
     back (docs/remesh.md); input vertices farther than ``feature_tolerance`` times the
     edge length from the result are inserted (``inf``: none). Returns ``(V2, F2)``.
-    ``beltrami remesh``."""
+    ``beltrami remesh``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> V2, F2 = beltrami.remesh(V, F, vertices=500)
+    >>> abs(len(V2) - 500) < 50
+    True
+    """
     V, F = _mesh(V, F)
     V2, F2, report = _native.remesh(
         V,
@@ -885,7 +968,13 @@ def read_mesh(path: Union[str, "os.PathLike[str]"], *, uv: bool = False) -> Any:
     """Reads an OBJ, PLY, STL, OFF, glTF or GLB mesh: ``(V, F)``, or ``(V, F, UV)``
     with ``uv=True`` (``UV`` ``(n, 2)`` when the file has one texture coordinate per
     vertex, else None). The mesh is validated as the command line validates its input;
-    an STL file's corners are welded into vertices by exact position."""
+    an STL file's corners are welded into vertices by exact position.
+
+    >>> import beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> V.shape, F.shape
+    ((1861, 3), (3600, 3))
+    """
     V, F, UV = _native.read_mesh(os.fspath(path))
     return (V, F, UV) if uv else (V, F)
 
@@ -895,7 +984,16 @@ def write_mesh(
 ) -> None:
     """Writes the mesh (OBJ, PLY, STL, OFF, glTF or GLB by extension), with texture
     coordinates ``uv`` ``(n, 2)`` when given (STL holds none: an error); atomically (a
-    complete file or none)."""
+    complete file or none).
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "uv.ply")
+    >>> beltrami.write_mesh(path, V, F, uv=beltrami.tutte(V, F))
+    >>> beltrami.read_mesh(path, uv=True)[2].shape
+    (1861, 2)
+    """
     V, F = _mesh(V, F)
     UV = None if uv is None else _matrix("uv", uv, np.float64, ConstraintError)
     _native.write_mesh(os.fspath(path), V, F, UV)
@@ -903,5 +1001,10 @@ def write_mesh(
 
 def solvers() -> list:
     """Every registered solver with what it accepts and its options (types, defaults,
-    ranges), as ``beltrami solvers --json``."""
+    ranges), as ``beltrami solvers --json``.
+
+    >>> import beltrami
+    >>> sorted(s["name"] for s in beltrami.solvers())[:4]
+    ['beltrami-flow', 'extremal', 'harmonic', 'lscm']
+    """
     return json.loads(_native.solvers())
