@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Callable, Dict, Iterable, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 
@@ -192,6 +192,34 @@ def _param(solver: str, V: ArrayLike, F: ArrayLike, boundary: str, weights: Opti
     return _result(_solve(solver, V, F, spec), info)
 
 
+@overload
+def tutte(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    boundary: str = ...,
+    weights: Optional[str] = ...,
+    pins: Sequence[int] = ...,
+    components: Optional[str] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def tutte(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    boundary: str = ...,
+    weights: Optional[str] = ...,
+    pins: Sequence[int] = ...,
+    components: Optional[str] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
+
+
 def tutte(
     V: ArrayLike,
     F: ArrayLike,
@@ -218,6 +246,34 @@ def tutte(
     return _param("tutte", V, F, boundary, weights, pins, options, info, components)
 
 
+@overload
+def harmonic(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    boundary: str = ...,
+    weights: Optional[str] = ...,
+    pins: Sequence[int] = ...,
+    components: Optional[str] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def harmonic(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    boundary: str = ...,
+    weights: Optional[str] = ...,
+    pins: Sequence[int] = ...,
+    components: Optional[str] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
+
+
 def harmonic(
     V: ArrayLike,
     F: ArrayLike,
@@ -240,6 +296,34 @@ def harmonic(
     0.01
     """
     return _param("harmonic", V, F, boundary, weights, pins, options, info, components)
+
+
+@overload
+def lscm(
+    V: ArrayLike,
+    F: ArrayLike,
+    b: Optional[ArrayLike] = ...,
+    bc: Optional[ArrayLike] = ...,
+    *,
+    pins: Sequence[int] = ...,
+    components: Optional[str] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def lscm(
+    V: ArrayLike,
+    F: ArrayLike,
+    b: Optional[ArrayLike] = ...,
+    bc: Optional[ArrayLike] = ...,
+    *,
+    pins: Sequence[int] = ...,
+    components: Optional[str] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
 
 
 def lscm(
@@ -288,6 +372,26 @@ def lscm(
     return _result(_solve("lscm", V, F, spec), info)
 
 
+@overload
+def sphere_map(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def sphere_map(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
+
+
 def sphere_map(
     V: ArrayLike,
     F: ArrayLike,
@@ -314,6 +418,46 @@ def sphere_map(
 
 
 _QC_DEFAULTS = {"tolerance": "1e-06", "max-iters": "200"}
+
+
+@overload
+def lsqc(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = ...,
+    mu_expr: Optional[str] = ...,
+    mu_frame: Optional[str] = ...,
+    target: str = ...,
+    boundary: Optional[str] = ...,
+    boundary_map: Optional[ArrayLike] = ...,
+    pins: Sequence[int] = ...,
+    normal_constraint: Optional[float] = ...,
+    area_constraint: bool = ...,
+    threads: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def lsqc(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = ...,
+    mu_expr: Optional[str] = ...,
+    mu_frame: Optional[str] = ...,
+    target: str = ...,
+    boundary: Optional[str] = ...,
+    boundary_map: Optional[ArrayLike] = ...,
+    pins: Sequence[int] = ...,
+    normal_constraint: Optional[float] = ...,
+    area_constraint: bool = ...,
+    threads: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
 
 
 def lsqc(
@@ -368,6 +512,52 @@ def lsqc(
     }
     out = _solve("lsqc", V, F, spec, boundary_map=boundary_map, mu=mu)
     return _result(out, info)
+
+
+@overload
+def beltrami_flow(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = ...,
+    mu_expr: Optional[str] = ...,
+    mu_frame: Optional[str] = ...,
+    p: Optional[float] = ...,
+    target: str = ...,
+    boundary: Optional[str] = ...,
+    boundary_map: Optional[ArrayLike] = ...,
+    free_radius: bool = ...,
+    pins: Sequence[int] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def beltrami_flow(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = ...,
+    mu_expr: Optional[str] = ...,
+    mu_frame: Optional[str] = ...,
+    p: Optional[float] = ...,
+    target: str = ...,
+    boundary: Optional[str] = ...,
+    boundary_map: Optional[ArrayLike] = ...,
+    free_radius: bool = ...,
+    pins: Sequence[int] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
 
 
 def beltrami_flow(
@@ -472,6 +662,40 @@ def _extremal_like(
     return out["image"], report
 
 
+@overload
+def extremal(
+    V: ArrayLike,
+    F: ArrayLike,
+    boundary_map: Optional[ArrayLike] = ...,
+    *,
+    landmarks: Any = ...,
+    init: Union[str, ArrayLike, None] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def extremal(
+    V: ArrayLike,
+    F: ArrayLike,
+    boundary_map: Optional[ArrayLike] = ...,
+    *,
+    landmarks: Any = ...,
+    init: Union[str, ArrayLike, None] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
+
+
 def extremal(
     V: ArrayLike,
     F: ArrayLike,
@@ -514,6 +738,38 @@ def extremal(
     )
 
 
+@overload
+def qc_iteration(
+    V: ArrayLike,
+    F: ArrayLike,
+    boundary_map: ArrayLike,
+    *,
+    init: Union[str, ArrayLike, None] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def qc_iteration(
+    V: ArrayLike,
+    F: ArrayLike,
+    boundary_map: ArrayLike,
+    *,
+    init: Union[str, ArrayLike, None] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
+
+
 def qc_iteration(
     V: ArrayLike,
     F: ArrayLike,
@@ -545,6 +801,40 @@ def qc_iteration(
         {"tolerance": tolerance, "max_iters": max_iters, "threads": threads},
         options, progress, info,
     )
+
+
+@overload
+def circle_domain(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = ...,
+    mu_expr: Optional[str] = ...,
+    mu_frame: Optional[str] = ...,
+    outer: Optional[int] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def circle_domain(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    mu: Optional[ArrayLike] = ...,
+    mu_expr: Optional[str] = ...,
+    mu_frame: Optional[str] = ...,
+    outer: Optional[int] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
 
 
 def circle_domain(
@@ -631,6 +921,54 @@ def _reversed_landmarks(text: Optional[str]) -> Optional[str]:
     return "\n".join(lines) + "\n"
 
 
+@overload
+def register(
+    V: ArrayLike,
+    F: ArrayLike,
+    TV: ArrayLike,
+    TF: ArrayLike,
+    *,
+    landmarks: Any = ...,
+    mu: Optional[ArrayLike] = ...,
+    p: Optional[float] = ...,
+    features: Optional[Tuple[Any, Any]] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    allow_flips: bool = ...,
+    allow_missed_landmarks: bool = ...,
+    match_shape: bool = ...,
+    inverse_consistency: bool = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[False] = ...,
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+@overload
+def register(
+    V: ArrayLike,
+    F: ArrayLike,
+    TV: ArrayLike,
+    TF: ArrayLike,
+    *,
+    landmarks: Any = ...,
+    mu: Optional[ArrayLike] = ...,
+    p: Optional[float] = ...,
+    features: Optional[Tuple[Any, Any]] = ...,
+    tolerance: Optional[float] = ...,
+    max_iters: Optional[int] = ...,
+    threads: Optional[int] = ...,
+    allow_flips: bool = ...,
+    allow_missed_landmarks: bool = ...,
+    match_shape: bool = ...,
+    inverse_consistency: bool = ...,
+    options: Optional[Dict[str, Any]] = ...,
+    progress: Optional[Progress] = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray, Dict[str, Any]]: ...
+
+
 def register(
     V: ArrayLike,
     F: ArrayLike,
@@ -692,7 +1030,7 @@ def register(
         goal = {"kind": "features", "source": field(fs), "target": field(ft)}
     else:
         goal = {"kind": "mu", "frame": "face"} if mu is not None else _goal(None, None, None, p)
-    spec = {
+    spec: Dict[str, Any] = {
         "target": "mesh",
         "goal": goal,
         "landmarks": _landmarks(landmarks),
@@ -788,6 +1126,38 @@ def mesh_info(V: ArrayLike, F: ArrayLike) -> Dict[str, Any]:
 # ---- new meshes ----------------------------------------------------------------------
 
 
+@overload
+def remesh(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    edge_length: Optional[float] = ...,
+    vertices: Optional[int] = ...,
+    param: str = ...,
+    min_angle: float = ...,
+    size_field: str = ...,
+    max_vertices: int = ...,
+    feature_tolerance: float = ...,
+    info: Literal[False] = ...,
+) -> Tuple[np.ndarray, np.ndarray]: ...
+
+
+@overload
+def remesh(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    edge_length: Optional[float] = ...,
+    vertices: Optional[int] = ...,
+    param: str = ...,
+    min_angle: float = ...,
+    size_field: str = ...,
+    max_vertices: int = ...,
+    feature_tolerance: float = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, np.ndarray, Dict[str, Any]]: ...
+
+
 def remesh(
     V: ArrayLike,
     F: ArrayLike,
@@ -830,6 +1200,38 @@ def remesh(
     return (V2, F2, json.loads(report)) if info else (V2, F2)
 
 
+@overload
+def remesh_in_place(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    reference: str = ...,
+    constraint: str = ...,
+    max_iters: int = ...,
+    tolerance: float = ...,
+    feature_angle: float = ...,
+    project: bool = ...,
+    allow_flips: bool = ...,
+    info: Literal[False] = ...,
+) -> np.ndarray: ...
+
+
+@overload
+def remesh_in_place(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    reference: str = ...,
+    constraint: str = ...,
+    max_iters: int = ...,
+    tolerance: float = ...,
+    feature_angle: float = ...,
+    project: bool = ...,
+    allow_flips: bool = ...,
+    info: Literal[True],
+) -> Tuple[np.ndarray, Dict[str, Any]]: ...
+
+
 def remesh_in_place(
     V: ArrayLike,
     F: ArrayLike,
@@ -855,6 +1257,24 @@ def remesh_in_place(
         bool(project), bool(allow_flips),
     )
     return (V2, json.loads(report)) if info else V2
+
+
+@overload
+def cut_to_disk(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    info: Literal[False] = ...,
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+@overload
+def cut_to_disk(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    info: Literal[True],
+) -> Tuple[np.ndarray, np.ndarray, np.ndarray, Dict[str, Any]]: ...
 
 
 def cut_to_disk(V: ArrayLike, F: ArrayLike, *, info: bool = False) -> Any:
@@ -962,6 +1382,16 @@ def show(
 
 
 # ---- files and the catalog -----------------------------------------------------------
+
+
+@overload
+def read_mesh(path: Union[str, "os.PathLike[str]"], *, uv: Literal[False] = ...) -> Tuple[np.ndarray, np.ndarray]: ...
+
+
+@overload
+def read_mesh(
+    path: Union[str, "os.PathLike[str]"], *, uv: Literal[True]
+) -> Tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]: ...
 
 
 def read_mesh(path: Union[str, "os.PathLike[str]"], *, uv: bool = False) -> Any:
