@@ -103,3 +103,86 @@ fn a_malformed_jobs_file_is_refused_before_any_job_runs() {
     assert!(stderr.contains("line 2"), "{stderr}");
     assert!(!output.exists(), "no job ran");
 }
+
+/// A jobs file of `lines` in a fresh folder; the folder and the file.
+fn jobs_file(lines: &[String]) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let jobs = dir.path().join("jobs.jsonl");
+    std::fs::write(&jobs, lines.join("\n")).unwrap();
+    (dir, jobs)
+}
+
+fn tutte_job(output: &str) -> String {
+    format!(
+        r#"{{"command": "param", "input": "meshes/disk_hemisphere.obj", "output": "{output}", "options": {{"solver": "tutte"}}}}"#
+    )
+}
+
+#[test]
+fn colliding_outputs_are_refused_before_any_job_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.obj");
+    let same_a = dir.path().join("sub/../a.obj");
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    let (_keep, jobs) = jobs_file(&[tutte_job(s(&a)), tutte_job(s(&same_a))]);
+    let out = beltrami(&["batch", s(&jobs)]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("line 2: the output")
+            && stderr.contains("is also the output of the job on line 1"),
+        "{stderr}"
+    );
+    assert!(!a.exists(), "a job ran");
+
+    // The report may not overwrite the jobs file or a job's output.
+    let (_keep, jobs) = jobs_file(&[tutte_job(s(&a))]);
+    let out = beltrami(&["batch", s(&jobs), "--report", s(&jobs)]);
+    assert!(
+        text(&out.stderr).contains("is the jobs file"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = beltrami(&["batch", s(&jobs), "--report", s(&a)]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("is also the --report file"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!a.exists());
+}
+
+#[test]
+fn a_byte_order_mark_and_flags_disguised_as_paths_or_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.obj");
+    let (_keep, jobs) = jobs_file(&[format!("\u{feff}{}", tutte_job(s(&a)))]);
+    let out = beltrami(&["batch", s(&jobs), "-q"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(a.exists());
+
+    for (line, expected) in [
+        (
+            r#"{"command": "param", "input": "--help", "output": "x.obj"}"#,
+            "the input \"--help\" starts with `-`",
+        ),
+        (
+            r#"{"command": "param", "input": "a.obj", "output": "x.obj", "options": {"help": true}}"#,
+            "\"help\" is not a job option",
+        ),
+        (
+            r#"{"command": "param", "input": "a.obj", "output": "x.obj", "options": {"solver": "--help"}}"#,
+            "which the command would read as a flag",
+        ),
+    ] {
+        let (_keep, jobs) = jobs_file(&[line.to_string()]);
+        let out = beltrami(&["batch", s(&jobs)]);
+        assert!(!out.status.success(), "{line}");
+        assert!(
+            text(&out.stderr).contains(expected),
+            "{line}: {}",
+            text(&out.stderr)
+        );
+    }
+}

@@ -252,3 +252,51 @@ fn the_qc_iteration_maps_a_curved_patch_into_space() {
     );
     assert!(!bad.exists());
 }
+
+#[test]
+fn with_no_iteration_k_is_the_start_maps_mean_distortion() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, map, _) = ring_problem(dir.path(), 4);
+    let (out, report) = (dir.path().join("out.obj"), dir.path().join("r.json"));
+    let run = beltrami(&[
+        "qc",
+        s(&input),
+        "--solver",
+        "qc-iteration",
+        "--boundary",
+        "given",
+        "--boundary-map",
+        s(&map),
+        "--max-iters",
+        "0",
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    // The start map (the least-squares map of mu = 0 with the ring map's boundary) is
+    // far from conformal: its k is its area-weighted mean |mu|, not 0.
+    let mesh = io::read(&input, &BuildOptions::default()).unwrap().mesh;
+    let uv = io::read(&out, &BuildOptions::default())
+        .unwrap()
+        .vertex_uvs()
+        .unwrap();
+    let image: Vec<Complex64> = uv.iter().map(|t| Complex64::new(t.x, t.y)).collect();
+    let measured =
+        beltrami_fem::distortion::measure_planar(&mesh, &image, beltrami_fem::Frame::Global)
+            .unwrap();
+    let (mut weighted, mut area) = (0.0, 0.0);
+    for f in mesh.faces() {
+        weighted += mesh.face_area(f) * measured.field.mu[f.idx()].norm();
+        area += mesh.face_area(f);
+    }
+    let (k, mean) = (r["k"].as_f64().unwrap(), weighted / area);
+    assert!(mean > 0.1, "{r}");
+    assert!(
+        (k - mean).abs() < 1e-9,
+        "k {k}, area-weighted mean |mu| {mean}"
+    );
+}

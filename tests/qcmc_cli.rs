@@ -211,7 +211,9 @@ fn a_generated_circle_domain_maps_onto_a_circle_domain() {
         "circle-domain",
         "--level",
         "2",
-        "--holes=-0.4,0,0.2;0.35,0.3,0.15",
+        // The documented form, a separate value that starts with a minus sign.
+        "--holes",
+        "-0.4,0,0.2;0.35,0.3,0.15",
         "-o",
         s(&mesh),
     ]);

@@ -96,6 +96,11 @@ def _mesh(V: ArrayLike, F: ArrayLike) -> Tuple[np.ndarray, np.ndarray]:
     F = np.asarray(F)
     if F.dtype.kind not in "iu":
         raise MeshError(f"F has dtype {F.dtype}; give integer vertex indices")
+    limit = np.iinfo(np.int64).max
+    if F.dtype.kind == "u" and F.ndim == 2 and F.size and F.max() > limit:
+        # Casting to int64 would wrap the index to a negative one.
+        face, corner = (int(i) for i in np.argwhere(F > limit)[0])
+        raise MeshError(f"face {face} refers to vertex {F[face, corner]}, beyond any vertex index")
     return V, _matrix("F", F, np.int64, MeshError)
 
 
@@ -618,9 +623,9 @@ def _planar_landmarks(landmarks: Any) -> list:
         try:
             vertex, point = pair
             w = complex(point) if np.ndim(point) == 0 else complex(float(point[0]), float(point[1]))
+            out.append([int(vertex), w.real, w.imag])
         except (TypeError, ValueError, IndexError):
-            raise ConstraintError(f"landmark {k}: expected (vertex, (x, y))") from None
-        out.append([int(vertex), w.real, w.imag])
+            raise ConstraintError(f"landmark {k}: expected (vertex, (x, y)), got {pair!r}") from None
     return out
 
 
@@ -891,13 +896,15 @@ def _landmarks(landmarks: Any) -> Optional[str]:
     for k, pair in enumerate(landmarks):
         try:
             src, goal = pair
+            if np.ndim(goal) == 0:
+                lines.append(f"v {int(src)} {int(goal)}")
+            else:
+                x, y, z = (float(c) for c in goal)
+                lines.append(f"p {int(src)} {x!r} {y!r} {z!r}")
         except (TypeError, ValueError):
-            raise ConstraintError(f"landmark {k}: expected (source vertex, target vertex or point)") from None
-        if np.ndim(goal) == 0:
-            lines.append(f"v {int(src)} {int(goal)}")
-        else:
-            x, y, z = (float(c) for c in goal)
-            lines.append(f"p {int(src)} {x!r} {y!r} {z!r}")
+            raise ConstraintError(
+                f"landmark {k}: expected (source vertex, target vertex or (x, y, z)), got {pair!r}"
+            ) from None
     return "\n".join(lines) + "\n"
 
 
@@ -1186,6 +1193,9 @@ def remesh(
     True
     """
     V, F = _mesh(V, F)
+    for name, value in (("vertices", vertices), ("max_vertices", max_vertices)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1):
+            raise OptionError(f"{name}={value!r}: give a whole number of vertices, at least 1")
     V2, F2, report = _native.remesh(
         V,
         F,

@@ -144,6 +144,10 @@ def test_negative_indices_and_bad_shapes_are_mesh_errors(disk):
         beltrami.mesh_info(np.zeros((3, 5)), F)
     with pytest.raises(beltrami.MeshError, match="integer"):
         beltrami.mesh_info(V, F.astype(float))
+    huge = F.astype(np.uint64)
+    huge[5, 1] = 2**63
+    with pytest.raises(beltrami.MeshError, match=r"face 5 refers to vertex 9223372036854775808"):
+        beltrami.mesh_info(V, huge)
 
 
 def test_remesh_needs_a_resolution(disk):
@@ -241,3 +245,17 @@ def test_extremal_needs_a_boundary_map_or_landmarks(disk):
         beltrami.extremal(*disk)
     with pytest.raises(beltrami.UnsupportedError, match="v0 is not on the boundary"):
         beltrami.extremal(*disk, landmarks=[(0, (1.0, 0.0))])
+
+
+def test_every_bad_argument_is_a_beltrami_error(disk):
+    V, F = disk
+    with pytest.raises(beltrami.OptionError, match=r"vertices=-1: give a whole number of vertices"):
+        beltrami.remesh(V, F, vertices=-1)
+    with pytest.raises(beltrami.OptionError, match=r"max_vertices=2.5"):
+        beltrami.remesh(V, F, vertices=100, max_vertices=2.5)
+    with pytest.raises(beltrami.ConstraintError, match=r"landmark 0: expected \(source vertex.*got \('a', 'b'\)"):
+        beltrami.register(V, F, V, F, landmarks=[("a", "b")])
+    with pytest.raises(beltrami.ConstraintError, match=r"landmark 0: expected \(vertex, \(x, y\)\), got \('a', \(0, 1\)\)"):
+        beltrami.extremal(V, F, landmarks=[("a", (0, 1))])
+    with pytest.raises(beltrami.OptionError, match=r"takes a whole number from \d+ to \d+, got `-1`"):
+        beltrami.beltrami_flow(V, F, max_iters=-1)

@@ -92,6 +92,15 @@ pub fn parse_job(line: usize, text: &str) -> anyhow::Result<Job> {
         .get("output")
         .and_then(Value::as_str)
         .with_context(|| format!("line {line}: no \"output\" path"))?;
+    let dashed = |what: &str, text: &str| -> anyhow::Result<()> {
+        if text.starts_with('-') {
+            bail!(
+                "line {line}: {what} \"{text}\" starts with `-`, which the command would read as a flag"
+            );
+        }
+        Ok(())
+    };
+    dashed("the output", output)?;
     let inputs: Vec<String> = match object.get("input") {
         Some(Value::String(s)) => vec![s.clone()],
         Some(Value::Array(items)) => items
@@ -104,6 +113,9 @@ pub fn parse_job(line: usize, text: &str) -> anyhow::Result<Job> {
             .collect::<anyhow::Result<_>>()?,
         _ => bail!("line {line}: no \"input\" (a path or a list of paths)"),
     };
+    for input in &inputs {
+        dashed("the input", input)?;
+    }
     for key in object.keys() {
         if !["command", "input", "output", "options"].contains(&key.as_str()) {
             bail!("line {line}: unknown key \"{key}\" (command, input, output, options)");
@@ -117,6 +129,12 @@ pub fn parse_job(line: usize, text: &str) -> anyhow::Result<Job> {
             .as_object()
             .with_context(|| format!("line {line}: \"options\" is not an object"))?;
         for (name, value) in options {
+            if matches!(name.as_str(), "help" | "version" | "output" | "o") || name.starts_with('-')
+            {
+                bail!(
+                    "line {line}: \"{name}\" is not a job option (the output is the job's \"output\"; help and version are not jobs)"
+                );
+            }
             let flag = format!("--{name}");
             let items = match value {
                 Value::Array(items) => items.clone(),
@@ -126,6 +144,9 @@ pub fn parse_job(line: usize, text: &str) -> anyhow::Result<Job> {
                 match item {
                     Value::Bool(true) => args.push(flag.clone()),
                     Value::Bool(false) => {}
+                    Value::String(s) if s.starts_with("--") => bail!(
+                        "line {line}: option \"{name}\" has the value \"{s}\", which the command would read as a flag"
+                    ),
                     Value::String(s) => args.extend([flag.clone(), s]),
                     Value::Number(n) => args.extend([flag.clone(), n.to_string()]),
                     other => bail!("line {line}: option \"{name}\" has the value {other}"),
@@ -139,6 +160,41 @@ pub fn parse_job(line: usize, text: &str) -> anyhow::Result<Job> {
         output: PathBuf::from(output),
         args,
     })
+}
+
+/// Fails, before any job runs, when two jobs write the same file, or a job writes the
+/// jobs file or the `--report` file, or the report would overwrite the jobs file: each
+/// would destroy another's result (and `--resume` would then skip a job whose output
+/// belongs to another). Paths are compared after making them absolute and resolving
+/// `.` and `..` (and the folders' links, where the folder exists).
+fn check_collisions(file: &Path, report: Option<&Path>, jobs: &[Job]) -> anyhow::Result<()> {
+    let key = |path: &Path| -> PathBuf {
+        let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+        match (absolute.parent(), absolute.file_name()) {
+            (Some(folder), Some(name)) => folder
+                .canonicalize()
+                .map_or_else(|_| absolute.clone(), |f| f.join(name)),
+            _ => absolute,
+        }
+    };
+    let mut seen: std::collections::HashMap<PathBuf, String> = std::collections::HashMap::new();
+    seen.insert(key(file), "the jobs file".to_string());
+    if let Some(report) = report
+        && let Some(other) = seen.insert(key(report), "the --report file".to_string())
+    {
+        bail!("--report {} is {other}", report.display());
+    }
+    for job in jobs {
+        let name = format!("the output of the job on line {}", job.line);
+        if let Some(other) = seen.insert(key(&job.output), name) {
+            bail!(
+                "line {}: the output {} is also {other}: every job needs its own output",
+                job.line,
+                job.output.display()
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Runs `job` as a child `beltrami` process; its report line.
@@ -205,6 +261,8 @@ fn error_message(stderr: &str) -> Option<String> {
 pub fn run(args: &BatchArgs, quiet: bool) -> anyhow::Result<()> {
     let text = std::fs::read_to_string(&args.file)
         .with_context(|| format!("cannot read the jobs file {}", args.file.display()))?;
+    // Editors on Windows start UTF-8 files with a byte-order mark.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     // A malformed line is a mistake in the file, found before any job runs.
     let jobs: Vec<Job> = text
         .lines()
@@ -216,6 +274,7 @@ pub fn run(args: &BatchArgs, quiet: bool) -> anyhow::Result<()> {
     if let Some(path) = &args.report {
         super::outputs::check(&[("--report", Some(path.as_path()))])?;
     }
+    check_collisions(&args.file, args.report.as_deref(), &jobs)?;
     let workers = args
         .jobs
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));

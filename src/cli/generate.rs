@@ -47,7 +47,11 @@ pub struct GenerateArgs {
     #[arg(long, default_value_t = 0.4)]
     pub inner: f64,
     /// The circle domain's holes, `x,y,r` each, separated by `;`.
-    #[arg(long, default_value = "-0.4,0,0.2;0.35,0.3,0.15")]
+    #[arg(
+        long,
+        default_value = "-0.4,0,0.2;0.35,0.3,0.15",
+        allow_hyphen_values = true
+    )]
     pub holes: String,
     /// Output mesh (.obj, .ply, .stl, .off, .gltf, .glb).
     #[arg(short, long)]

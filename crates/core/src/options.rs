@@ -56,6 +56,17 @@ impl OptionKind {
         }
     }
 
+    /// What a value must be, in words for messages: "a number", "a whole number from 1
+    /// to 100", "true or false", "one of a, b".
+    pub fn expected(&self) -> String {
+        match self {
+            OptionKind::Float { .. } => "a number".to_string(),
+            OptionKind::Int { min, max, .. } => format!("a whole number from {min} to {max}"),
+            OptionKind::Bool { .. } => "true or false".to_string(),
+            OptionKind::Choice { choices, .. } => format!("one of {}", choices.join(", ")),
+        }
+    }
+
     /// The default value.
     pub fn default_value(&self) -> OptionValue {
         match *self {
@@ -116,14 +127,14 @@ pub enum OptionError {
         known: String,
     },
     /// A value of the wrong type (a word for a number, a fraction for a whole number).
-    #[error("{solver}: option `{option}` takes a {expected}, got `{got}`")]
+    #[error("{solver}: option `{option}` takes {expected}, got `{got}`")]
     Type {
         /// The solver.
         solver: &'static str,
         /// The option.
         option: &'static str,
-        /// The declared type.
-        expected: &'static str,
+        /// What the declared type admits, in words ([`OptionKind::expected`]).
+        expected: String,
         /// The value given.
         got: String,
     },
@@ -318,7 +329,7 @@ fn check(
     let wrong_type = || OptionError::Type {
         solver,
         option: spec.name,
-        expected: spec.kind.type_name(),
+        expected: spec.kind.expected(),
         got: value.to_string(),
     };
     let range = |min: String, max: String| OptionError::Range {

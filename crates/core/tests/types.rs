@@ -330,10 +330,14 @@ fn bad_options_are_named() {
         e,
         OptionError::Type {
             option: "max-iters",
-            expected: "int",
             ..
         }
     ));
+    assert!(
+        e.to_string().contains("takes a whole number from ")
+            && e.to_string().ends_with("got `2.5`"),
+        "{e}"
+    );
     let e = resolve(&[("max-iters", OptionValue::Choice("many".into()))]).unwrap_err();
     assert!(matches!(
         e,
@@ -347,10 +351,13 @@ fn bad_options_are_named() {
         e,
         OptionError::Type {
             option: "verbose",
-            expected: "bool",
             ..
         }
     ));
+    assert!(
+        e.to_string().contains("takes true or false, got `maybe`"),
+        "{e}"
+    );
     let e = resolve(&[("weights", OptionValue::Choice("mean".into()))]).unwrap_err();
     assert!(matches!(
         e,

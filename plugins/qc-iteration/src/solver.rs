@@ -187,7 +187,6 @@ fn iterate(
         initial_distortion: Some(system.distortion()?.stats),
         ..Metrics::default()
     };
-    let mut k = 0.0;
     let mut stop = Stop::IterationLimit;
     let started = std::time::Instant::now();
     for iteration in 0..max_iters {
@@ -196,7 +195,7 @@ fn iterate(
             break;
         }
         let measured = system.measured()?;
-        k = weighted_mean(measured.iter().map(|m| m.norm()), &areas);
+        let k = weighted_mean(measured.iter().map(|m| m.norm()), &areas);
         let mut next: Vec<Complex64> = transport
             .smooth(&measured)
             .into_iter()
@@ -248,6 +247,9 @@ fn iterate(
             mesh.face_count()
         ));
     }
+    // The k of the map returned (the mean |mu| the last step aimed at belongs to the map
+    // before it; with no step at all, the start map's).
+    let k = weighted_mean(system.measured()?.iter().map(|m| m.norm()), &areas);
     metrics.k = Some(k);
     metrics.stop = Some(stop);
     metrics.mu = Some(distortion.field);
