@@ -288,3 +288,50 @@ fn the_space_target_maps_a_curved_surface_into_r3() {
     );
     assert!(!none.exists());
 }
+
+#[test]
+fn numbers_too_large_to_compute_with_are_named_with_their_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let run = beltrami(&[
+        "qc",
+        "meshes/disk_hemisphere.obj",
+        "--solver",
+        "beltrami-flow",
+        "--target",
+        "disk",
+        "--conformal",
+        "--p",
+        "1e308",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("needs 2 <= p <= 100"),
+        "{}",
+        text(&run.stderr)
+    );
+    let run = beltrami(&[
+        "qc",
+        "meshes/disk_hemisphere.obj",
+        "--target",
+        "space",
+        "--conformal",
+        "--boundary",
+        "given",
+        "--boundary-map",
+        "meshes/disk_hemisphere.obj",
+        "--normal-constraint",
+        "1e300",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run.stderr).contains("the weight must be > 0 and at most 100000000"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!out.exists());
+}

@@ -200,6 +200,29 @@ fn a_folded_start_from_a_file_ends_without_flips() {
         s(&report),
     ]);
     assert!(run.status.success(), "{}", text(&run.stderr));
+    // A bad start file is named by its own flag.
+    let missing = dir.path().join("no_start.obj");
+    let bad = beltrami(&[
+        "qc",
+        s(&input),
+        "--solver",
+        "extremal",
+        "--boundary",
+        "given",
+        "--boundary-map",
+        s(&map),
+        "--init",
+        s(&missing),
+        "-o",
+        s(&dir.path().join("never.obj")),
+    ]);
+    assert!(!bad.status.success());
+    let stderr = text(&bad.stderr);
+    assert!(
+        stderr.contains(&format!("--init {}", missing.display())),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("--boundary-map"), "{stderr}");
     let r = read_json(&report);
     let folded_flips = r["initial_flipped"].as_u64().unwrap();
     assert!(folded_flips > 10, "the start has {folded_flips} flips");

@@ -52,6 +52,13 @@ fn no_corpus_input_panics_in_any_target() {
 }
 
 #[test]
+fn a_long_flat_sum_is_not_deep() {
+    // 1,000 terms: a chain is one level, however long.
+    let sum = vec!["0.0001*z"; 1000].join("+");
+    targets::run("expr", sum.as_bytes()).expect("a flat sum of 1000 terms is accepted");
+}
+
+#[test]
 fn deep_expressions_are_refused_by_depth_not_by_stack_overflow() {
     for name in [
         "nested-parentheses-10000.txt",

@@ -179,9 +179,15 @@ fn goal_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<Go
 }
 
 /// The planar map of `--boundary-map` ([`beltrami::mapped::read_planar`]).
-fn boundary_map(path: &std::path::Path, mesh: &Mesh) -> anyhow::Result<Vec<Complex64>> {
+/// The planar map of the file `path` given to `flag` (`--boundary-map` or `--init`),
+/// named in errors.
+fn planar_map_file(
+    flag: &str,
+    path: &std::path::Path,
+    mesh: &Mesh,
+) -> anyhow::Result<Vec<Complex64>> {
     beltrami::mapped::read_planar(path, mesh, false)
-        .with_context(|| format!("--boundary-map {}", path.display()))
+        .with_context(|| format!("{flag} {}", path.display()))
 }
 
 /// The target of `--target` (and `--boundary`, `--free-radius`). `--target plane` is
@@ -207,7 +213,7 @@ fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<
                     let Some(path) = &args.boundary_map else {
                         bail!("--boundary given needs --boundary-map FILE");
                     };
-                    PlanarBoundary::Given(boundary_map(path, mesh)?)
+                    PlanarBoundary::Given(planar_map_file("--boundary-map", path, mesh)?)
                 }
             })
         }
@@ -306,7 +312,8 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         None => None,
         Some(name @ ("harmonic" | "tutte")) => Some(name),
         Some(path) => {
-            problem.initial = Some(Map::Planar(boundary_map(std::path::Path::new(path), mesh)?));
+            let path = std::path::Path::new(path);
+            problem.initial = Some(Map::Planar(planar_map_file("--init", path, mesh)?));
             None
         }
     };

@@ -27,6 +27,11 @@ use thiserror::Error;
 
 use crate::Position;
 
+/// The largest weight of the normal constraint: the penalty then outweighs the conformal
+/// energy by about 1e8, and in double precision a larger ratio leaves the conformal
+/// part of the normal equations below rounding.
+pub const MAX_NORMAL_WEIGHT: f64 = 1e8;
+
 /// A vertex held at a point: `position: None` lets the solver choose (LSCM's default
 /// `(0, 0)` and `(1, 0)`, or where the initial map puts it for iterative solvers).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -292,8 +297,10 @@ pub enum ConstraintError {
         /// The number of boundary loops.
         count: usize,
     },
-    /// A non-positive or non-finite weight.
-    #[error("constraint {index} (normal): the weight must be finite and > 0, got {weight}")]
+    /// A weight that is not in `(0, MAX_NORMAL_WEIGHT]`.
+    #[error(
+        "constraint {index} (normal): the weight must be > 0 and at most {MAX_NORMAL_WEIGHT} (a larger penalty drowns the conformal energy in rounding), got {weight}"
+    )]
     Weight {
         /// The constraint's index.
         index: usize,
@@ -542,7 +549,7 @@ impl Constraints {
                     None
                 }
                 Constraint::Normal { weight } => {
-                    if !(weight.is_finite() && *weight > 0.0) {
+                    if !(*weight > 0.0 && *weight <= MAX_NORMAL_WEIGHT) {
                         return Err(ConstraintError::Weight {
                             index,
                             weight: *weight,

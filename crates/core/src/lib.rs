@@ -86,7 +86,7 @@ pub mod topology;
 pub use accepts::{Accepts, Element, GoalKind, TargetKind, Topology};
 pub use constraint::{
     Constraint, ConstraintError, ConstraintKind, Constraints, Curve, Direction, Landmark,
-    LoopMatch, Pin, Slide,
+    LoopMatch, MAX_NORMAL_WEIGHT, Pin, Slide,
 };
 pub use error::SolverError;
 pub use features::Features;

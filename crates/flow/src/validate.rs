@@ -11,6 +11,10 @@ use num_complex::Complex64;
 
 use crate::NAME;
 
+/// The largest exponent of the `L^p` goal: `|mu|^p` must stay a normal double for the
+/// distortions a flow meets (`0.001^100 = 1e-300`).
+pub(crate) const MAX_P: f64 = 100.0;
+
 /// How far (relative) a vertex may be off the unit circle or sphere for the source to be
 /// taken as already on the target.
 pub const ON_TARGET: f64 = 1e-9;
@@ -186,8 +190,10 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
     }
     match &problem.goal {
         Goal::Conformal { p } => {
-            if !(p.is_finite() && *p >= 2.0) {
-                return Err(invalid(format!("the L^p goal needs p >= 2, got {p}")));
+            if !(*p >= 2.0 && *p <= MAX_P) {
+                return Err(invalid(format!(
+                    "the L^p goal needs 2 <= p <= {MAX_P} (|mu|^p of a larger p underflows to zero), got {p}"
+                )));
             }
             Ok(CheckedGoal {
                 frame: if planar { Frame::Global } else { Frame::Face },

@@ -70,8 +70,9 @@ impl Repair {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BuildOptions {
     /// A face is degenerate when its area is at most
-    /// `degenerate_area_tolerance * d^2`, with `d` the bounding-box diagonal of all input
-    /// vertices. Default `1e-12`. A negative value (down to minus infinity) accepts
+    /// `degenerate_area_tolerance * d^2`, with `d` the bounding-box diagonal of the
+    /// vertices the faces use (an unreferenced vertex far away changes nothing). Default
+    /// `1e-12`. A negative value (down to minus infinity) accepts
     /// every face, even one of zero area (for meshes whose faces were validated before);
     /// NaN and plus infinity are refused ([`MeshError::InvalidTolerance`]).
     pub degenerate_area_tolerance: f64,
@@ -468,7 +469,7 @@ fn coincident_representatives(positions: &[Point3<f64>]) -> Vec<u32> {
 
 /// Fails when a coordinate exceeds [`MAX_COORDINATE`] in magnitude (naming the first such
 /// vertex) or when the vertices, not all at one point, span less than [`MIN_EXTENT`].
-/// All vertices count, used or not, as in the degeneracy threshold.
+/// All vertices count, used or not: a coordinate out of range is refused wherever it is.
 fn check_range(positions: &[Point3<f64>]) -> Result<(), MeshError> {
     for (vertex, p) in positions.iter().enumerate() {
         let value = [p.x, p.y, p.z]
@@ -503,16 +504,21 @@ fn check_range(positions: &[Point3<f64>]) -> Result<(), MeshError> {
     Ok(())
 }
 
-fn squared_bbox_diagonal(positions: &[Point3<f64>]) -> f64 {
+/// The squared bounding-box diagonal of the vertices the faces use (indices out of range
+/// are left to the face checks): an unreferenced vertex far away must not make every face
+/// degenerate. 0 when no face uses a vertex.
+fn squared_bbox_diagonal(soup: &PolygonSoup) -> f64 {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for p in positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
+    for &i in soup.faces().flatten() {
+        if let Some(p) = soup.positions.get(i as usize) {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
         }
     }
-    (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum()
+    (0..3).map(|k| (hi[k] - lo[k]).max(0.0).powi(2)).sum()
 }
 
 /// Checks every face and copies the valid ones (through the vertex representatives) into
@@ -616,7 +622,7 @@ pub(crate) fn build(
     check_range(&soup.positions)?;
 
     let repair = options.repair;
-    let threshold = options.degenerate_area_tolerance * squared_bbox_diagonal(&soup.positions);
+    let threshold = options.degenerate_area_tolerance * squared_bbox_diagonal(soup);
     let mut report = BuildReport {
         degenerate_area_threshold: threshold,
         ..BuildReport::default()

@@ -1026,3 +1026,21 @@ fn large_meshes_group_their_edges_in_ranges_as_in_one() {
         }
     );
 }
+
+#[test]
+fn an_unreferenced_vertex_far_away_does_not_make_faces_degenerate() {
+    // A unit square of two triangles and a vertex no face uses at 1e12: the faces'
+    // area 0.5 is far above 1e-12 of their own extent, though not of the outlier's.
+    let positions = vec![
+        Point3::new(0.0, 0.0, 0.0),
+        Point3::new(1.0, 0.0, 0.0),
+        Point3::new(1.0, 1.0, 0.0),
+        Point3::new(0.0, 1.0, 0.0),
+        Point3::new(1e12, 0.0, 0.0),
+    ];
+    let soup = PolygonSoup::from_triangles(positions, &[[0, 1, 2], [0, 2, 3]]);
+    let (mesh, report) = Mesh::build(&soup, &BuildOptions::default()).unwrap();
+    assert_eq!(mesh.face_count(), 2);
+    assert_eq!(report.unreferenced_vertices, [4]);
+    assert!((report.degenerate_area_threshold - 2e-12).abs() < 1e-24);
+}

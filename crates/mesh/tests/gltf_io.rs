@@ -605,3 +605,36 @@ fn write_errors_leave_nothing_behind() {
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
 }
+
+#[test]
+fn node_transforms_must_be_finite_and_rotations_unit_quaternions() {
+    let dir = tempfile::tempdir().unwrap();
+    let node = |node: Value| json!({ "scene": 0, "scenes": [{ "nodes": [0] }], "nodes": [node] });
+    let far = triangle_file(
+        dir.path(),
+        "far.gltf",
+        node(json!({ "translation": [1e300, 0.0, 0.0], "mesh": 0 })),
+    );
+    assert!(read_error(&far).contains("node 0: its translation, rotation or scale is not finite"));
+    // A quaternion of length 2 would scale the mesh by 4.
+    let long = triangle_file(
+        dir.path(),
+        "long.gltf",
+        node(json!({ "rotation": [0.0, 0.0, 0.0, 2.0], "mesh": 0 })),
+    );
+    assert!(
+        read_error(&long).contains("rotation quaternion has length 2, not 1"),
+        "{}",
+        read_error(&long)
+    );
+    let unit = triangle_file(
+        dir.path(),
+        "unit.gltf",
+        node(
+            json!({ "rotation": [0.0, 0.0, std::f32::consts::FRAC_1_SQRT_2, std::f32::consts::FRAC_1_SQRT_2], "mesh": 0 }),
+        ),
+    );
+    let raw = gltf::read(&unit).unwrap();
+    // A quarter turn about z: (1, 0, 0) goes to (0, 1, 0).
+    assert!((raw.soup.positions[1] - Point3::new(0.0, 1.0, 0.0)).norm() < 1e-6);
+}

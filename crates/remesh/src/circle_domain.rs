@@ -26,8 +26,8 @@ pub struct Hole {
 ///
 /// # Errors
 /// [`RemeshError::InvalidOption`] (option `holes` or `h`) when `h` is not in
-/// `(0, 0.5]`, a hole is not finite, reaches within `h` of the unit circle or of another
-/// hole; [`RemeshError::Build`] if the triangulation does not give a valid mesh.
+/// `(0, 0.5]`, a hole is not finite, has a radius under `h / 2`, reaches within `h` of
+/// the unit circle or of another hole; [`RemeshError::Build`] if the triangulation does not give a valid mesh.
 pub fn circle_domain(holes: &[Hole], h: f64) -> Result<Mesh, RemeshError> {
     let invalid =
         |option: &'static str, message: String| RemeshError::InvalidOption { option, message };
@@ -43,6 +43,16 @@ pub fn circle_domain(holes: &[Hole], h: f64) -> Result<Mesh, RemeshError> {
             return Err(invalid(
                 "holes",
                 format!("hole {k} ({center}, radius {radius}) is not a disk"),
+            ));
+        }
+        if radius < h / 2.0 {
+            // Its circle's samples would crowd into slivers against the lattice.
+            return Err(invalid(
+                "holes",
+                format!(
+                    "hole {k} ({center}, radius {radius}) is smaller than half the edge length {h}: give a radius of at least {} or a smaller edge length",
+                    h / 2.0
+                ),
             ));
         }
         if center.norm() + radius > 1.0 - h {

@@ -259,6 +259,7 @@ fn mesh_instances(doc: &Document) -> Result<Vec<(::gltf::Mesh<'_>, Matrix4<f64>)
                     scene.index()
                 ));
             }
+            check_transform(&node)?;
             let local = node.transform().matrix();
             let world = parent * Matrix4::from_fn(|r, c| f64::from(local[c][r]));
             if let Some(mesh) = node.mesh() {
@@ -270,6 +271,44 @@ fn mesh_instances(doc: &Document) -> Result<Vec<(::gltf::Mesh<'_>, Matrix4<f64>)
         }
     }
     Ok(out)
+}
+
+/// Refuses a node transform that is not finite (a value beyond `f32`, which glTF stores)
+/// or whose rotation is not a unit quaternion, as glTF requires (a longer one would scale
+/// the mesh by its squared length without a word).
+fn check_transform(node: &::gltf::Node<'_>) -> Result<(), String> {
+    let finite = |values: &[f32]| values.iter().all(|x| x.is_finite());
+    match node.transform() {
+        ::gltf::scene::Transform::Matrix { matrix } => {
+            if !finite(matrix.as_flattened()) {
+                return Err(format!("node {}: its matrix is not finite", node.index()));
+            }
+        }
+        ::gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            if !(finite(&translation) && finite(&rotation) && finite(&scale)) {
+                return Err(format!(
+                    "node {}: its translation, rotation or scale is not finite (beyond the 32-bit floats glTF stores)",
+                    node.index()
+                ));
+            }
+            let length = rotation
+                .iter()
+                .map(|&q| f64::from(q).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            if (length - 1.0).abs() > 1e-3 {
+                return Err(format!(
+                    "node {}: its rotation quaternion has length {length}, not 1 (glTF requires unit quaternions)",
+                    node.index()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The soup being assembled from the primitives.
