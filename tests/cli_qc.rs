@@ -335,3 +335,51 @@ fn numbers_too_large_to_compute_with_are_named_with_their_limit() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn a_closed_surface_held_at_one_vertex_with_its_area_maps_onto_itself() {
+    // docs/qc-space.md: one held vertex and the area constraint fix a closed surface's
+    // map into space; the conformal one is the identity.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let run = beltrami(&[
+        "qc",
+        "meshes/spot.obj",
+        "--target",
+        "space",
+        "--conformal",
+        "--pin",
+        "v0",
+        "--area-constraint",
+        "-o",
+        s(&out),
+        "-q",
+    ]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let source = io::read(Path::new("meshes/spot.obj"), &Default::default())
+        .unwrap()
+        .mesh;
+    let image = io::read(&out, &Default::default()).unwrap().mesh;
+    let far = source
+        .positions()
+        .iter()
+        .zip(image.positions())
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(far < 1e-8, "the image moved up to {far}");
+    // Without a pin or a boundary map nothing holds the map: refused, saying both ways.
+    let run = beltrami(&[
+        "qc",
+        "meshes/spot.obj",
+        "--target",
+        "space",
+        "--conformal",
+        "-o",
+        s(&out),
+    ]);
+    assert!(
+        text(&run.stderr).contains("or vertices where they are (--pin)"),
+        "{}",
+        text(&run.stderr)
+    );
+}

@@ -588,7 +588,7 @@ def beltrami_flow(
     """The discrete Beltrami flow (Wong-Zhao 2014): the bijective map onto ``target``
     (``'disk'``, ``'annulus'``, ``'sphere'`` or ``'plane'``, the input's own planar
     region) with Beltrami coefficient ``mu``/``mu_expr``, or the most conformal one
-    (smallest ``L^p`` norm of mu, ``p >= 2``) when neither is given. On the sphere
+    (smallest ``L^p`` norm of mu, ``2 <= p <= 100``) when neither is given. On the sphere
     ``mu_expr`` is in the stereographic coordinate. ``progress(stage, done, total,
     energy)`` is called at every step. Returns ``UV`` ``(n, 2)`` or ``W`` ``(n, 3)`` on
     the sphere. ``beltrami qc --solver beltrami-flow``.

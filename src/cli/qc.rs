@@ -14,8 +14,8 @@ use std::path::PathBuf;
 use anyhow::{Context as _, bail};
 use beltrami::map_file;
 use beltrami_core::{
-    Constraint, Goal, GoalKind, Map, OptionValue, PlanarBoundary, Problem, Solver, Target,
-    TargetKind,
+    Constraint, Goal, GoalKind, Map, OptionValue, PlanarBoundary, Position, Problem, Solver,
+    Target, TargetKind,
 };
 use beltrami_fem::{BeltramiField, Expr};
 use beltrami_mesh::Mesh;
@@ -77,7 +77,7 @@ pub struct QcArgs {
     /// The most conformal map instead: the smallest L^p norm of mu.
     #[arg(long)]
     pub conformal: bool,
-    /// The exponent of `--conformal` (beltrami-flow: p >= 2; lsqc: 2 only) [default: 2].
+    /// The exponent of `--conformal` (beltrami-flow: 2 <= p <= 100; lsqc: 2 only) [default: 2].
     #[arg(long)]
     pub p: Option<f64>,
     /// Where the map goes.
@@ -266,9 +266,12 @@ fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
     if args.area_constraint && args.target != TargetArg::Space {
         bail!("--area-constraint keeps the area of a map into space: it needs --target space");
     }
-    if args.target == TargetArg::Space && args.boundary != Some(QcBoundaryArg::Given) {
+    if args.target == TargetArg::Space
+        && args.boundary != Some(QcBoundaryArg::Given)
+        && args.pins.is_empty()
+    {
         bail!(
-            "--target space holds the boundary at the positions of a map: add --boundary given --boundary-map MAP"
+            "--target space holds vertices where they go: the boundary at the positions of a map (add --boundary given --boundary-map MAP), or vertices where they are (--pin)"
         );
     }
     if args.boundary_map.is_some() && args.boundary != Some(QcBoundaryArg::Given) {
@@ -317,11 +320,21 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             None
         }
     };
-    problem.constraints.extend(
-        mapping::resolve_pins(&args.pins, mesh)?
-            .into_iter()
-            .map(Constraint::Pin),
-    );
+    // Into space a pin holds its vertex where it is (with the area constraint, one pin
+    // fixes a closed surface: docs/qc-space.md).
+    let space = args.target == TargetArg::Space;
+    problem
+        .constraints
+        .extend(
+            mapping::resolve_pins(&args.pins, mesh)?
+                .into_iter()
+                .map(|mut pin| {
+                    if space {
+                        pin.position = Some(Position::Spatial(mesh.position(pin.vertex)));
+                    }
+                    Constraint::Pin(pin)
+                }),
+        );
     if let Some(weight) = args.normal_constraint {
         problem.constraints.push(Constraint::Normal { weight });
     }

@@ -22,7 +22,7 @@ pub struct RegisterArgs {
     pub source: PathBuf,
     /// The mesh to map onto, of the same topology.
     pub target: PathBuf,
-    /// Minimize the L^p norm of mu (p >= 2) [default: 2].
+    /// Minimize the L^p norm of mu (2 <= p <= 100) [default: 2].
     #[arg(long)]
     pub p: Option<f64>,
     /// A prescribed Beltrami coefficient per source face instead (the field format,

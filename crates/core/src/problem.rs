@@ -77,7 +77,7 @@ pub enum Goal {
     /// As conformal as the constraints allow: minimize the `L^p` norm of `mu` (`p = 2`
     /// for least squares).
     Conformal {
-        /// The exponent `p >= 2`.
+        /// The exponent, `2 <= p <= 100`.
         p: f64,
     },
     /// A prescribed Beltrami coefficient per face.

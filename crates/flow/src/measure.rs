@@ -329,7 +329,7 @@ pub struct Objective {
     pub areas: Vec<f64>,
     /// The target coefficient per face, in the source elements' frame (`None`: zero).
     pub sigma: Option<Vec<Complex64>>,
-    /// The exponent `p >= 2`.
+    /// The exponent, `2 <= p <= 100`.
     pub p: f64,
     /// The least weight of a face in the barrier: the mean of `areas` or zero
     /// ([`Barrier::area_floor`]).

@@ -111,7 +111,7 @@ pub const ACCEPTS: Accepts = Accepts {
 /// towards its goal, and measures the result. `report` receives the stage timings and
 /// notes (a solver's own stages before this one stay first).
 ///
-/// Reads: `goal` (`Conformal { p >= 2 }` or `Prescribed(field)`), `target`
+/// Reads: `goal` (`Conformal { 2 <= p <= 100 }` or `Prescribed(field)`), `target`
 /// (`Plane(Keep | Square | Polygon | Circle)`, `Disk`, `Annulus`, `Sphere`, `Mesh` with
 /// `problem.initial` a map onto it, open feature curves and landmarks), pins without
 /// positions (held where `initial` puts them) and the options ([`OPTIONS`], resolved in

@@ -295,8 +295,13 @@ fn bad_problems_are_typed_errors() {
     assert!(message.contains("face f7 "), "{message}");
 
     let mut p = Problem::new(&disk, Target::Disk);
-    p.goal = Goal::Conformal { p: 1.5 };
-    assert!(rejected(&p).contains("p >= 2"));
+    for exponent in [1.5, 1e308, f64::NAN] {
+        p.goal = Goal::Conformal { p: exponent };
+        assert!(
+            rejected(&p).contains("needs 2 <= p <= 100"),
+            "p = {exponent}"
+        );
+    }
 
     assert!(rejected(&Problem::new(&disk, Target::Plane(PlanarBoundary::Free))).contains("lsqc"));
     assert!(rejected(&Problem::new(&disk, Target::Sphere)).contains("closed genus-0"));

@@ -22,7 +22,7 @@ use crate::{
 /// parameter domain chosen by the topology, aligned by the landmarks), then the discrete
 /// Beltrami flow on the target mesh ([`beltrami_flow_engine::solve`] with `Target::Mesh`).
 ///
-/// Reads: `target` (`Mesh` only), `goal` (`Conformal { p >= 2 }`, `Prescribed`, or
+/// Reads: `target` (`Mesh` only), `goal` (`Conformal { 2 <= p <= 100 }`, `Prescribed`, or
 /// `Features`: fields matched in the common domain, then no flow, which would pull the
 /// map back towards conformal),
 /// landmarks (each with a `Position::Spatial` on the target; the vertex is pulled there
