@@ -283,6 +283,24 @@ pub enum ConstraintError {
         /// The least length (2 open, 3 closed).
         needed: usize,
     },
+    /// A curve chain that visits a vertex twice.
+    #[error(
+        "constraint {index} ({kind}): the {side} chain visits vertex {vertex} twice (at positions {first} and {second}); a chain is a simple path, and a closed one does not repeat its first vertex at the end"
+    )]
+    RepeatedChainVertex {
+        /// The constraint's index.
+        index: usize,
+        /// Its kind.
+        kind: ConstraintKind,
+        /// `source` or `target`.
+        side: &'static str,
+        /// The vertex.
+        vertex: VertexId,
+        /// Its first position in the chain (0-based).
+        first: usize,
+        /// Its second position.
+        second: usize,
+    },
     /// A boundary loop index outside the mesh's loops.
     #[error(
         "constraint {index} (loop-match): the {side} has no boundary loop {boundary_loop} (it has {count})"
@@ -518,6 +536,21 @@ impl Constraints {
                                 got: chain.len(),
                                 needed,
                             });
+                        }
+                    }
+                    for (side, chain) in [("source", &curve.source), ("target", &curve.target)] {
+                        let mut seen = std::collections::HashMap::with_capacity(chain.len());
+                        for (second, &vertex) in chain.iter().enumerate() {
+                            if let Some(first) = seen.insert(vertex, second) {
+                                return Err(ConstraintError::RepeatedChainVertex {
+                                    index,
+                                    kind,
+                                    side,
+                                    vertex,
+                                    first,
+                                    second,
+                                });
+                            }
                         }
                     }
                     for &v in &curve.source {

@@ -152,8 +152,32 @@ fn malformed_constraints_name_the_constraint_and_the_element() {
         })
     ));
 
+    // A chain that comes back to a vertex: 0, 1, 2, 1, 3.
+    let looped = Constraint::Curve(Curve {
+        source: [0, 1, 2, 1, 3].map(VertexId).to_vec(),
+        target: [0, 1, 2, 3, 4].map(VertexId).to_vec(),
+        closed: false,
+    });
+    let e = validate(vec![looped], &mesh).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ConstraintError::RepeatedChainVertex {
+                side: "source",
+                first: 1,
+                second: 3,
+                ..
+            }
+        ),
+        "{e}"
+    );
+
     assert!(matches!(
         validate(vec![Constraint::Normal { weight: -1.0 }], &mesh),
+        Err(ConstraintError::Weight { .. })
+    ));
+    assert!(matches!(
+        validate(vec![Constraint::Normal { weight: 1e300 }], &mesh),
         Err(ConstraintError::Weight { .. })
     ));
     assert!(matches!(
