@@ -1,5 +1,6 @@
 //! Command-line interface: argument parsing and one module per command.
 
+mod atlas;
 mod batch;
 mod bench;
 mod cut;
@@ -73,6 +74,10 @@ pub enum Command {
     /// Remesh a surface with the asked edge length: parameterize it, triangulate the
     /// parameter domain with constrained Delaunay refinement, lift back.
     Remesh(remesh::RemeshArgs),
+    /// A texture atlas of any triangle mesh (closed or open, any genus): conformal charts
+    /// with cone singularities, cut along trees through the cones, packed into the unit
+    /// square; written with per-corner texture coordinates.
+    Atlas(atlas::AtlasArgs),
     /// Run many param, qc, register and remesh jobs (one JSON object per line) in
     /// parallel, one JSON report line per job; `--resume` skips finished outputs.
     Batch(batch::BatchArgs),
@@ -94,6 +99,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::View(args) => view::run(&args, cli.quiet),
         Command::Histogram(args) => histogram::run(&args, cli.quiet),
         Command::Remesh(args) => remesh::run(&args, cli.quiet),
+        Command::Atlas(args) => atlas::run(&args, cli.quiet),
         Command::Batch(args) => batch::run(&args, cli.quiet),
     }
 }

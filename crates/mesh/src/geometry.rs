@@ -178,6 +178,38 @@ impl Mesh {
         sum.into_iter().map(|s| s.normalize()).collect()
     }
 
+    /// The discrete curvature at `v` from its corner angles: at an interior vertex the
+    /// angle defect `2 pi - sum theta` (the integrated Gaussian curvature of its dual
+    /// cell), at a boundary vertex the turning angle `pi - sum theta` (the integrated
+    /// geodesic curvature of the boundary there, positive where the surface is convex
+    /// at its boundary). By Gauss-Bonnet the sum over all vertices is `2 pi chi`.
+    pub fn angle_defect(&self, v: VertexId) -> f64 {
+        let sum: f64 = self
+            .outgoing_halfedges(v)
+            .filter(|&h| self.face(h).is_some())
+            .map(|h| self.corner_angle(h))
+            .sum();
+        let full = if self.is_boundary_vertex(v) {
+            std::f64::consts::PI
+        } else {
+            std::f64::consts::TAU
+        };
+        full - sum
+    }
+
+    /// The barycentric area of every vertex, by vertex id: the area of each face split
+    /// equally among its corners. The areas sum to the mesh's area.
+    pub fn vertex_areas(&self) -> Vec<f64> {
+        let mut areas = vec![0.0; self.vertex_count()];
+        for f in self.faces() {
+            let share = self.face_area(f) / self.face_degree(f) as f64;
+            for v in self.face_vertices(f) {
+                areas[v.idx()] += share;
+            }
+        }
+        areas
+    }
+
     /// Bounding box of the mesh's vertices.
     pub fn bounding_box(&self) -> BoundingBox {
         // A built mesh has at least one face and so at least three vertices.

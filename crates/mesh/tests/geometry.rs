@@ -811,3 +811,26 @@ fn with_positions_keeps_the_connectivity_and_checks_the_count() {
         Err(beltrami_mesh::MeshError::NonFiniteCoordinate { vertex: 5, .. })
     ));
 }
+
+/// Gauss-Bonnet: the angle defects of all vertices sum to `2 pi chi` (sphere 4 pi, disk
+/// 2 pi, torus 0), and a flat grid has no defect inside and `pi / 2` at its corners.
+#[test]
+fn angle_defects_sum_to_two_pi_chi() {
+    let total = |m: &Mesh| m.vertices().map(|v| m.angle_defect(v)).sum::<f64>();
+    let sphere = mesh(&primitives::icosphere(3));
+    assert!(close(total(&sphere), 2.0 * TAU, 1e-9));
+    let disk = mesh(&primitives::disk(3));
+    assert!(close(total(&disk), TAU, 1e-9));
+    let torus = mesh(&primitives::torus(24, 12, 1.0, 0.3, Cells::Triangles));
+    assert!(close(total(&torus), 0.0, 1e-9));
+    let grid = mesh(&primitives::grid(4, 4, Cells::Triangles));
+    for v in grid.vertices() {
+        let p = grid.position(v);
+        let corner = (p.x == 0.0 || p.x == 1.0) && (p.y == 0.0 || p.y == 1.0);
+        let expected = if corner { FRAC_PI_2 } else { 0.0 };
+        assert!(
+            close(grid.angle_defect(v), expected, 1e-12),
+            "{v:?} at {p:?}"
+        );
+    }
+}

@@ -124,7 +124,7 @@ pub(crate) fn match_features(
     domain: &Mesh,
     side: Side,
 ) -> Result<FeatureMatch, RegisterError> {
-    let weights = vertex_areas(mesh);
+    let weights = mesh.vertex_areas();
     let mut held = vec![false; mesh.vertex_count()];
     for &(v, _) in fixed {
         if let Some(h) = held.get_mut(v.idx()) {
@@ -280,18 +280,6 @@ fn standardized(values: &[f64]) -> Vec<f64> {
         1.0
     };
     values.iter().map(|x| (x - mean) * scale).collect()
-}
-
-/// A third of the area of the faces around each vertex.
-fn vertex_areas(mesh: &Mesh) -> Vec<f64> {
-    let mut areas = vec![0.0; mesh.vertex_count()];
-    for f in mesh.faces() {
-        let third = mesh.face_area(f) / mesh.face_degree(f) as f64;
-        for v in mesh.face_vertices(f) {
-            areas[v.idx()] += third;
-        }
-    }
-    areas
 }
 
 /// The median length of the edges of `mesh` under the planar map `map`.

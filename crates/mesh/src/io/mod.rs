@@ -20,6 +20,7 @@ pub mod gltf;
 pub mod obj;
 pub mod off;
 pub mod ply;
+mod seamed;
 mod slots;
 pub mod source;
 pub mod stl;
@@ -33,6 +34,7 @@ use thiserror::Error;
 use crate::{BuildOptions, BuildReport, Mesh, MeshError, PolygonSoup};
 
 pub use atomic::write_atomically;
+pub use seamed::{CornerUvs, write_seamed};
 
 /// The content of a mesh file before validation.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -249,6 +251,13 @@ pub enum WriteError {
         format: Format,
         /// The attribute.
         what: &'static str,
+    },
+    /// Texture coordinates with seams did not split the mesh into a valid mesh (a
+    /// coordinate shared by corners of one vertex that are not in one fan).
+    #[error("the texture coordinates' seams do not split the mesh into a valid mesh: {message}")]
+    Seams {
+        /// Why the split mesh was refused.
+        message: String,
     },
     /// A per-vertex attribute does not have one value per mesh vertex.
     #[error("{what} has {got} values but the mesh has {expected} vertices")]

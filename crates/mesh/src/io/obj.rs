@@ -632,7 +632,7 @@ pub fn write_with_sections(
 
 /// Per mesh face, the grouping lines to write before it: those of its input face and of
 /// the input faces the mesh dropped since the previous face it kept.
-fn groups_before_faces(mesh: &Mesh, groups: &[(u32, String)]) -> Vec<Option<String>> {
+pub(super) fn groups_before_faces(mesh: &Mesh, groups: &[(u32, String)]) -> Vec<Option<String>> {
     let mut out = vec![None; mesh.face_count()];
     let mut next = groups.iter().peekable();
     for f in mesh.faces() {
@@ -700,7 +700,7 @@ fn header(slots: &OutputSlots, mesh: &Mesh) -> String {
 }
 
 /// Appends the `v` line of `p`.
-fn vertex_line(p: &Point3<f64>, line: &mut Vec<u8>) -> std::io::Result<()> {
+pub(super) fn vertex_line(p: &Point3<f64>, line: &mut Vec<u8>) -> std::io::Result<()> {
     writeln!(line, "v {} {} {}", p.x, p.y, p.z)
 }
 

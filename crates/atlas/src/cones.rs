@@ -1,0 +1,211 @@
+//! Cone singularities placed greedily where the conformal scale is most extreme
+//! (Ben-Chen, Gotsman and Bunin 2008, "Conformal flattening by curvature prescription
+//! and metric scaling", section 4).
+//!
+//! A conformal flattening multiplies the surface's lengths by `e^u`; with the
+//! curvature of the flat metric zero away from the cones, `u` solves the discrete
+//! Yamabe equation `L u = -Omega` at every vertex that is neither a cone nor on the
+//! boundary (`L` the positive semi-definite cotan Laplacian, `Omega` the angle
+//! defect), with `u = 0` at the cones and on the boundary (no area distortion there;
+//! Springborn, Schroeder and Pinkall 2008 and Sawhney and Crane 2017 use the same
+//! linearization). The curvature a cone takes is whatever is left there; the greedy
+//! rule adds the next cone at the vertex of largest `|u|`, until the map's predicted
+//! L2 stretch `sqrt(mean_A(e^{-2u}) mean_A(e^{2u}))` (see [`crate::stretch`]) is at
+//! most the goal or the count is reached.
+//!
+//! A closed surface with no cone yet first gets the scale of the metric of constant
+//! curvature (`L u = -(Omega - Omega_total a_i / A)`, one vertex held), and its first
+//! cone where that scale deviates most from its mean. A closed surface of genus 0 gets
+//! at least two cones (its cut is a path between them), of genus `g >= 2` at least one
+//! (the Yamabe equation without one has no solution); a torus needs none.
+//!
+//! The Dirichlet conditions are imposed as a penalty `P = 1e10 max_i L_ii` on the
+//! diagonal, so the sparsity pattern and its symbolic factorization are shared by every
+//! step; each new cone costs one numeric factorization.
+
+use beltrami_fem::operators::cotan_laplacian;
+use beltrami_fem::{SolveOptions, SpdSolver};
+use beltrami_mesh::{Mesh, VertexId};
+use faer::Mat;
+use faer::sparse::SparseColMat;
+
+use crate::AtlasError;
+
+/// The relative size of the penalty that holds a vertex's scale at zero.
+const PENALTY: f64 = 1e10;
+
+/// Cones of a chart and the log scale factor of its flattening.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cones {
+    /// The cone vertices, in the order they were placed.
+    pub vertices: Vec<VertexId>,
+    /// The log scale factor `u` of every vertex (0 at the cones and on the boundary).
+    pub scale: Vec<f64>,
+    /// The predicted L2 stretch of the flattening with these cones.
+    pub predicted_stretch: f64,
+}
+
+/// How many cones to place.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConeGoal {
+    /// Stop once the predicted L2 stretch is at most this.
+    pub stretch: f64,
+    /// Never place more than this many cones.
+    pub max_cones: usize,
+}
+
+/// Places cones on `mesh` (one connected triangle mesh) greedily until `goal` is met
+/// (see the module docs).
+pub fn place_cones(mesh: &Mesh, goal: ConeGoal) -> Result<Cones, AtlasError> {
+    let mut system = ScaleSystem::new(mesh)?;
+    let closed = mesh.boundary_loop_count() == 0;
+    let euler = mesh.vertex_count() as i64 - mesh.edge_count() as i64 + mesh.face_count() as i64;
+    let min_cones = match (closed, euler) {
+        (true, 2) => 2,
+        (true, e) if e < 0 => 1,
+        _ => 0,
+    };
+    let mut cones = Vec::new();
+    let mut fixed: Vec<bool> = mesh
+        .vertices()
+        .map(|v| mesh.is_boundary_vertex(v))
+        .collect();
+    if closed {
+        let u = system.constant_curvature_scale()?;
+        if min_cones == 0 {
+            let predicted = system.predicted_stretch(&u);
+            if predicted <= goal.stretch || goal.max_cones == 0 {
+                return Ok(Cones {
+                    vertices: cones,
+                    scale: u,
+                    predicted_stretch: predicted,
+                });
+            }
+        }
+        let mean = system.area_mean(&u);
+        let first = extreme(&u, &fixed, mean);
+        fixed[first.idx()] = true;
+        cones.push(first);
+    }
+    loop {
+        let u = system.solve(&fixed)?;
+        let predicted = system.predicted_stretch(&u);
+        let done = cones.len() >= min_cones
+            && (predicted <= goal.stretch || cones.len() >= goal.max_cones);
+        if done || fixed.iter().all(|&f| f) {
+            return Ok(Cones {
+                vertices: cones,
+                scale: u,
+                predicted_stretch: predicted,
+            });
+        }
+        let next = extreme(&u, &fixed, 0.0);
+        fixed[next.idx()] = true;
+        cones.push(next);
+    }
+}
+
+/// The free vertex where `|u - center|` is largest.
+fn extreme(u: &[f64], fixed: &[bool], center: f64) -> VertexId {
+    let best = (0..u.len())
+        .filter(|&i| !fixed[i])
+        .max_by(|&a, &b| (u[a] - center).abs().total_cmp(&(u[b] - center).abs()))
+        .unwrap_or(0);
+    VertexId::from_usize(best)
+}
+
+/// The Yamabe system of one chart with a fixed pattern.
+struct ScaleSystem {
+    laplacian: SparseColMat<usize, f64>,
+    /// Index of each diagonal entry in the values of `laplacian`.
+    diagonal: Vec<usize>,
+    penalty: f64,
+    solver: SpdSolver<f64>,
+    defect: Vec<f64>,
+    area: Vec<f64>,
+}
+
+impl ScaleSystem {
+    fn new(mesh: &Mesh) -> Result<Self, AtlasError> {
+        let laplacian = cotan_laplacian(mesh)?;
+        let symbolic = laplacian.symbolic();
+        let (col_ptr, rows) = (symbolic.col_ptr(), symbolic.row_idx());
+        let diagonal: Vec<usize> = (0..laplacian.ncols())
+            .map(|j| {
+                (col_ptr[j]..col_ptr[j + 1])
+                    .find(|&k| rows[k] == j)
+                    .unwrap_or(col_ptr[j])
+            })
+            .collect();
+        let values = laplacian.val();
+        let largest = diagonal.iter().map(|&k| values[k]).fold(0.0, f64::max);
+        let solver = SpdSolver::new(symbolic, SolveOptions::default())?;
+        Ok(Self {
+            diagonal,
+            penalty: PENALTY * largest.max(f64::MIN_POSITIVE),
+            solver,
+            defect: mesh.vertices().map(|v| mesh.angle_defect(v)).collect(),
+            area: mesh.vertex_areas(),
+            laplacian,
+        })
+    }
+
+    /// `u` with `L u = -defect` at free vertices and `u = 0` at fixed ones.
+    fn solve(&mut self, fixed: &[bool]) -> Result<Vec<f64>, AtlasError> {
+        let rhs: Vec<f64> = self
+            .defect
+            .iter()
+            .zip(fixed)
+            .map(|(&d, &f)| if f { 0.0 } else { -d })
+            .collect();
+        self.solve_held(fixed, &rhs)
+    }
+
+    /// The scale of the metric of constant curvature on a closed surface, with vertex
+    /// 0 held at zero (the right-hand side sums to zero, so holding one vertex only
+    /// fixes the additive constant).
+    fn constant_curvature_scale(&mut self) -> Result<Vec<f64>, AtlasError> {
+        let total: f64 = self.defect.iter().sum();
+        let area: f64 = self.area.iter().sum();
+        let rhs: Vec<f64> = self
+            .defect
+            .iter()
+            .zip(&self.area)
+            .map(|(&d, &a)| -(d - total * a / area))
+            .collect();
+        let mut fixed = vec![false; rhs.len()];
+        fixed[0] = true;
+        self.solve_held(&fixed, &rhs)
+    }
+
+    fn solve_held(&mut self, fixed: &[bool], rhs: &[f64]) -> Result<Vec<f64>, AtlasError> {
+        let mut matrix = self.laplacian.clone();
+        let values = matrix.val_mut();
+        for (i, &f) in fixed.iter().enumerate() {
+            if f {
+                values[self.diagonal[i]] += self.penalty;
+            }
+        }
+        self.solver.factorize(matrix.as_ref())?;
+        let mut x = Mat::from_fn(rhs.len(), 1, |i, _| rhs[i]);
+        self.solver.solve_in_place(x.as_mut())?;
+        Ok((0..rhs.len()).map(|i| x[(i, 0)]).collect())
+    }
+
+    fn area_mean(&self, u: &[f64]) -> f64 {
+        let total: f64 = self.area.iter().sum();
+        u.iter().zip(&self.area).map(|(u, a)| u * a).sum::<f64>() / total
+    }
+
+    /// `sqrt(mean_A(e^{-2u}) mean_A(e^{2u}))`, the L2 stretch of a conformal map with
+    /// log scale `u` (see [`crate::stretch`]).
+    fn predicted_stretch(&self, u: &[f64]) -> f64 {
+        let total: f64 = self.area.iter().sum();
+        let (mut shrink, mut grow) = (0.0, 0.0);
+        for (&u, &a) in u.iter().zip(&self.area) {
+            shrink += a * (-2.0 * u).exp();
+            grow += a * (2.0 * u).exp();
+        }
+        (shrink * grow).sqrt() / total
+    }
+}
