@@ -186,7 +186,7 @@ fn split_piece(piece: Piece) -> Result<Vec<Piece>, AtlasError> {
             splits: piece.splits,
         });
     }
-    let half = split::split_in_two(&piece.mesh);
+    let half = split::split_in_two(&piece.mesh)?;
     let border: Vec<EdgeId> = piece
         .mesh
         .edges()
