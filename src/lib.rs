@@ -27,6 +27,8 @@
 //!   unit disk minus disks whose centres and radii are found with the map.
 //! - [`remesh`]: remeshing through a parameterization (spade's constrained Delaunay
 //!   refinement of the parameter domain with a size field measured on the surface).
+//! - [`atlas`]: texture atlases of any triangle mesh (cones, cuts, boundary first
+//!   flattening, charts split where they overlap, packing) and texture stretch.
 //! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
 //!   |mu| histograms as PNG.
 //!
@@ -58,6 +60,7 @@ pub mod mapped;
 pub mod report;
 pub mod vertex_field;
 
+pub use beltrami_atlas as atlas;
 pub use beltrami_core as core;
 pub use beltrami_fem as fem;
 pub use beltrami_flow as flow;

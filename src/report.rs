@@ -122,6 +122,55 @@ pub fn mu_error_keys(error: Option<&MuError>) -> JsonMap<String, Value> {
     keys
 }
 
+/// The report of a texture atlas of `mesh` (`beltrami atlas --report` without the file
+/// names): sizes, charts and cones, Sander's stretch, flipped faces, the seams (edges,
+/// length, share of the total edge length), the splits by reason, the options, each
+/// chart's faces and cones (as input vertex indices) and the seconds.
+pub fn atlas(
+    mesh: &Mesh,
+    atlas: &beltrami_atlas::Atlas,
+    options: &beltrami_atlas::AtlasOptions,
+    seconds: f64,
+) -> JsonMap<String, Value> {
+    let seams = atlas.uv.seams(mesh);
+    let total: f64 = mesh.edges().map(|e| mesh.edge_length(e)).sum();
+    let seam_length: f64 = seams.iter().map(|&e| mesh.edge_length(e)).sum();
+    let s = &atlas.stretch;
+    let value = json!({
+        "topology": beltrami_core::topology::describe(mesh),
+        "vertices": mesh.vertex_count(),
+        "faces": mesh.face_count(),
+        "uvs": atlas.uv.uvs.len(),
+        "charts": atlas.charts.len(),
+        "cones": atlas.charts.iter().map(|c| c.cones.len()).sum::<usize>(),
+        "stretch": {"l2": s.l2, "linf": s.linf, "area_distortion": s.area_distortion},
+        "flipped_faces": s.flipped_faces,
+        "seams": {"edges": seams.len(), "length": seam_length, "length_share": seam_length / total},
+        "splits": {
+            "overlap": atlas.splits.overlap,
+            "flipped": atlas.splits.flipped,
+            "stretch": atlas.splits.stretch,
+        },
+        "options": {
+            "cones": match options.cones {
+                beltrami_atlas::ConeCount::Auto => json!("auto"),
+                beltrami_atlas::ConeCount::Exactly(n) => json!(n),
+            },
+            "max_stretch": options.max_stretch,
+            "padding": options.padding,
+        },
+        "chart_list": atlas.charts.iter().map(|c| json!({
+            "faces": c.faces,
+            "cones": c.cones.iter().map(|v| mesh.vertex_map().to_input(*v)).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "seconds": seconds,
+    });
+    match value {
+        Value::Object(map) => map,
+        _ => JsonMap::new(),
+    }
+}
+
 /// The report of a remeshing of `input` (`beltrami remesh --report` without the file
 /// names): the method and parameterizer, sizes, angles, edge lengths, distances (also
 /// relative to the input's bounding-box diagonal), the seconds and the timings.

@@ -52,6 +52,7 @@ __all__ = [
     "OptionError",
     "SolverError",
     "UnsupportedError",
+    "atlas",
     "beltrami_coefficient",
     "beltrami_flow",
     "circle_domain",
@@ -1131,6 +1132,42 @@ def mesh_info(V: ArrayLike, F: ArrayLike) -> Dict[str, Any]:
 
 
 # ---- new meshes ----------------------------------------------------------------------
+
+
+def atlas(
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    cones: Union[str, int] = "auto",
+    max_stretch: float = 1.1,
+    padding: float = 0.004,
+) -> Tuple[np.ndarray, np.ndarray, Dict[str, Any]]:
+    """A texture atlas of the triangle mesh ``V``, ``F`` (closed or open, any genus, any
+    number of pieces): conformal charts with cone singularities (``cones``: ``"auto"``
+    places them until the L2 stretch of each chart is at most ``max_stretch``, a number
+    places that many per chart), cut open along trees through the cones, split where they
+    would overlap, packed into the unit square with ``padding`` (a fraction of the side)
+    between charts (docs/atlas.md). Returns ``(UV, FUV, info)``: the texture coordinates
+    ``(k, 2)``, per face the row of ``UV`` of each corner ``(m, 3)`` (``FUV[i, c]`` is the
+    coordinate of corner ``F[i, c]``), and the report of ``beltrami atlas --report``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/spot.obj")
+    >>> UV, FUV, info = beltrami.atlas(V, F)
+    >>> bool(UV.min() >= 0 and UV.max() <= 1) and info["flipped_faces"] == 0
+    True
+    >>> info["stretch"]["l2"] <= 1.1
+    True
+    """
+    V, F = _mesh(V, F)
+    if cones == "auto":
+        count = None
+    elif isinstance(cones, (int, np.integer)) and not isinstance(cones, bool) and cones >= 0:
+        count = int(cones)
+    else:
+        raise OptionError(f"cones={cones!r}: give 'auto' or a whole number of cones per chart")
+    UV, FUV, report = _native.atlas(V, F, count, float(max_stretch), float(padding))
+    return UV, FUV, json.loads(report)
 
 
 @overload

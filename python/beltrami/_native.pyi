@@ -31,6 +31,13 @@ def solve(
     progress: Optional[Progress] = None,
 ) -> Dict[str, Any]: ...
 def solvers() -> str: ...
+def atlas(
+    v: Floats,
+    f: Ints,
+    cones: Optional[int] = None,
+    max_stretch: float = 1.1,
+    padding: float = 0.004,
+) -> Tuple[Floats, Ints, str]: ...
 def remesh(
     v: Floats,
     f: Ints,

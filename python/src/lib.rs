@@ -7,12 +7,13 @@
 //! (`beltrami/_errors.py`); this module builds meshes from arrays ([`arrays`]), turns a
 //! call's description into a [`beltrami_core::Problem`] and solves it with the GIL
 //! released ([`solve`]), and measures ([`measure`]), remeshes and cuts
-//! ([`surgery`]), repairs ([`repair`]) and reads and writes files ([`files`]). Errors become the package's
+//! ([`surgery`]), makes texture atlases ([`atlas`]), repairs ([`repair`]) and reads and writes files ([`files`]). Errors become the package's
 //! exceptions with the command line's messages ([`errors`]).
 
 use pyo3::prelude::*;
 
 mod arrays;
+mod atlas;
 mod errors;
 mod files;
 mod measure;
@@ -31,6 +32,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(measure::distortion, m)?)?;
     m.add_function(wrap_pyfunction!(solve::solve, m)?)?;
     m.add_function(wrap_pyfunction!(solve::solvers, m)?)?;
+    m.add_function(wrap_pyfunction!(atlas::atlas, m)?)?;
     m.add_function(wrap_pyfunction!(surgery::remesh, m)?)?;
     m.add_function(wrap_pyfunction!(surgery::remesh_in_place, m)?)?;
     m.add_function(wrap_pyfunction!(surgery::cut_to_disk, m)?)?;

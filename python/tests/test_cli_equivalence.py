@@ -423,3 +423,32 @@ def test_components_each_matches_param(cli, hemisphere, tmp_path):
         beltrami.lscm(V2, F2)
     with pytest.raises(beltrami.OptionError, match="expected 'each'"):
         beltrami.lscm(V2, F2, components="all")
+
+
+def test_atlas_matches_the_command(cli, tmp_path):
+    spot = MESHES / "spot.obj"
+    out, r = tmp_path / "out.obj", tmp_path / "r.json"
+    cli("atlas", spot, "-o", out, "--report", r)
+    V, F = beltrami.read_mesh(spot)
+    UV, FUV, info = beltrami.atlas(V, F)
+    lines = out.read_text().splitlines()
+    vt = np.array([[float(x) for x in l.split()[1:3]] for l in lines if l.startswith("vt ")])
+    f = [[[int(x) - 1 for x in c.split("/")] for c in l.split()[1:]] for l in lines if l.startswith("f ")]
+    close(UV, vt)
+    np.testing.assert_array_equal(FUV, np.array([[c[1] for c in face] for face in f]))
+    np.testing.assert_array_equal(F, np.array([[c[0] for c in face] for face in f]))
+    assert info["charts"] == report_of(r)["charts"]
+    # Sander's L2 stretch recomputed here from the arrays agrees with the report.
+    P, T = V[F], UV[FUV]
+    a2 = (T[:, 1, 0] - T[:, 0, 0]) * (T[:, 2, 1] - T[:, 0, 1]) - (T[:, 1, 1] - T[:, 0, 1]) * (T[:, 2, 0] - T[:, 0, 0])
+    assert (a2 > 0).all()
+    ss = (P[:, 0] * (T[:, 1, 1] - T[:, 2, 1])[:, None] + P[:, 1] * (T[:, 2, 1] - T[:, 0, 1])[:, None] + P[:, 2] * (T[:, 0, 1] - T[:, 1, 1])[:, None]) / a2[:, None]
+    st = (P[:, 0] * (T[:, 2, 0] - T[:, 1, 0])[:, None] + P[:, 1] * (T[:, 0, 0] - T[:, 2, 0])[:, None] + P[:, 2] * (T[:, 1, 0] - T[:, 0, 0])[:, None]) / a2[:, None]
+    area = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
+    l2 = np.sqrt(((ss**2).sum(1) + (st**2).sum(1)) / 2 @ area / area.sum()) * np.sqrt(0.5 * a2.sum() / area.sum())
+    assert l2 == pytest.approx(info["stretch"]["l2"], rel=1e-9)
+    assert l2 <= 1.1
+    with pytest.raises(beltrami.OptionError, match="cones"):
+        beltrami.atlas(V, F, cones="many")
+    with pytest.raises(beltrami.OptionError, match="max-stretch"):
+        beltrami.atlas(V, F, max_stretch=0.5)

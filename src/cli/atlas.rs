@@ -118,7 +118,7 @@ pub fn run(args: &AtlasArgs, quiet: bool) -> anyhow::Result<()> {
     if let Some(path) = &args.png {
         write_png(path, mesh, &uvs, &corners)?;
     }
-    let report = report_json(args, mesh, &atlas, seconds);
+    let report = report_json(args, mesh, &atlas, &options, seconds);
     if let Some(path) = &args.report {
         let text = serde_json::to_string_pretty(&report)?;
         io::write_atomically(path, |w| std::io::Write::write_all(w, text.as_bytes()))
@@ -127,7 +127,7 @@ pub fn run(args: &AtlasArgs, quiet: bool) -> anyhow::Result<()> {
     if args.json {
         println!("{report}");
     } else if !quiet {
-        print_summary(args, mesh, &atlas, seconds);
+        print_summary(args, &report);
     }
     Ok(())
 }
@@ -171,68 +171,47 @@ fn write_png(
         .with_context(|| format!("cannot write the picture {}", path.display()))
 }
 
-/// The seam edges' number and their share of the total edge length.
-fn seams(mesh: &Mesh, atlas: &Atlas) -> (usize, f64) {
-    let seams = atlas.uv.seams(mesh);
-    let total: f64 = mesh.edges().map(|e| mesh.edge_length(e)).sum();
-    let length: f64 = seams.iter().map(|&e| mesh.edge_length(e)).sum();
-    (seams.len(), length / total)
+fn report_json(
+    args: &AtlasArgs,
+    mesh: &Mesh,
+    atlas: &Atlas,
+    options: &AtlasOptions,
+    seconds: f64,
+) -> Value {
+    let mut report = serde_json::Map::new();
+    report.insert("mesh".into(), json!(args.mesh.display().to_string()));
+    report.insert("output".into(), json!(args.output.display().to_string()));
+    report.extend(beltrami::report::atlas(mesh, atlas, options, seconds));
+    Value::Object(report)
 }
 
-fn report_json(args: &AtlasArgs, mesh: &Mesh, atlas: &Atlas, seconds: f64) -> Value {
-    let (seam_edges, seam_share) = seams(mesh, atlas);
-    let s = &atlas.stretch;
-    json!({
-        "mesh": args.mesh.display().to_string(),
-        "output": args.output.display().to_string(),
-        "vertices": mesh.vertex_count(),
-        "faces": mesh.face_count(),
-        "charts": atlas.charts.len(),
-        "cones": atlas.charts.iter().map(|c| c.cones.len()).sum::<usize>(),
-        "stretch": {"l2": s.l2, "linf": s.linf, "area_distortion": s.area_distortion},
-        "flipped_faces": s.flipped_faces,
-        "seams": {"edges": seam_edges, "length_share": seam_share},
-        "splits": {
-            "overlap": atlas.splits.overlap,
-            "flipped": atlas.splits.flipped,
-            "stretch": atlas.splits.stretch,
-        },
-        "options": {
-            "cones": match args.cones.0 {
-                ConeCount::Auto => json!("auto"),
-                ConeCount::Exactly(n) => json!(n),
-            },
-            "max_stretch": args.max_stretch,
-            "padding": args.padding,
-        },
-        "chart_list": atlas.charts.iter().map(|c| json!({
-            "faces": c.faces,
-            "cones": c.cones.iter().map(|v| mesh.vertex_map().to_input(*v)).collect::<Vec<_>>(),
-        })).collect::<Vec<_>>(),
-        "seconds": seconds,
-    })
-}
-
-fn print_summary(args: &AtlasArgs, mesh: &Mesh, atlas: &Atlas, seconds: f64) {
-    let (seam_edges, seam_share) = seams(mesh, atlas);
-    let s = &atlas.stretch;
+fn print_summary(args: &AtlasArgs, report: &Value) {
+    let number = |path: &[&str]| {
+        path.iter()
+            .fold(report, |v, k| &v[*k])
+            .as_f64()
+            .unwrap_or(f64::NAN)
+    };
     println!(
-        "{} -> {} ({seconds:.3} s)",
+        "{} -> {} ({:.3} s)",
         args.mesh.display(),
-        args.output.display()
+        args.output.display(),
+        number(&["seconds"])
     );
     println!(
         "  charts          {}  cones {}",
-        atlas.charts.len(),
-        atlas.charts.iter().map(|c| c.cones.len()).sum::<usize>()
+        report["charts"], report["cones"]
     );
     println!(
         "  stretch         L2 {:.4}  Linf {:.3}  area distortion {:.4}",
-        s.l2, s.linf, s.area_distortion
+        number(&["stretch", "l2"]),
+        number(&["stretch", "linf"]),
+        number(&["stretch", "area_distortion"])
     );
     println!(
-        "  seams           {seam_edges} edges, {:.2}% of the edge length",
-        100.0 * seam_share
+        "  seams           {} edges, {:.2}% of the edge length",
+        report["seams"]["edges"],
+        100.0 * number(&["seams", "length_share"])
     );
-    println!("  flipped faces   {}", s.flipped_faces);
+    println!("  flipped faces   {}", report["flipped_faces"]);
 }
