@@ -9,10 +9,16 @@
 //! (`beltrami_fem::ReferenceNormal`); for a map onto another surface, [`target_normals`]
 //! gives that surface's normals at the image, the rule `register` judges its maps by.
 
+use std::collections::HashMap;
 use std::path::Path;
 
+use beltrami_atlas::SeamedUv;
+use beltrami_fem::Frame;
+use beltrami_fem::distortion::{Distortion, measure_planar};
 use beltrami_mesh::io::{self, LoadedMesh, ReadError};
-use beltrami_mesh::{BuildOptions, Mesh, Point3, Repair, SurfacePoint, Vector3, VertexId};
+use beltrami_mesh::{
+    BuildOptions, Mesh, Point3, Repair, SurfacePoint, Vector3, VertexId, split_corners,
+};
 use beltrami_spatial::{SpatialError, SurfaceIndex};
 use num_complex::Complex64;
 use thiserror::Error;
@@ -208,6 +214,70 @@ pub fn planar_images(
             .map(|v| Complex64::new(uv[v.idx()].x, uv[v.idx()].y))
             .collect(),
     ))
+}
+
+/// The texture coordinates of a file per face corner of the source, seams allowed:
+/// corner `k` of source face `f` takes the coordinate of corner `k` of the file's face
+/// `f` (the faces agree, [`correspondence`]); equal coordinates at one vertex share an
+/// index. `None` when the file has no texture coordinates or a face is not a triangle.
+pub fn corner_images(source: &Mesh, mapped: &LoadedMesh) -> Option<SeamedUv> {
+    let corner = mapped.corner_uvs.as_ref()?;
+    let mesh = &mapped.mesh;
+    if source.faces().any(|f| source.face_degree(f) != 3) {
+        return None;
+    }
+    let mut index: HashMap<(VertexId, [u64; 2]), u32> = HashMap::new();
+    let mut uvs = Vec::new();
+    let corners = source
+        .faces()
+        .map(|f| {
+            let mut out = [0u32; 3];
+            for (k, (v, h)) in source
+                .face_vertices(f)
+                .zip(mesh.face_halfedges(f))
+                .enumerate()
+            {
+                let uv = corner[h.idx()];
+                // -0.0 and 0.0 are one coordinate.
+                let key = (v, [(uv.x + 0.0).to_bits(), (uv.y + 0.0).to_bits()]);
+                out[k] = *index.entry(key).or_insert_with(|| {
+                    uvs.push([uv.x, uv.y]);
+                    (uvs.len() - 1) as u32
+                });
+            }
+            out
+        })
+        .collect();
+    Some(SeamedUv { uvs, corners })
+}
+
+/// The distortion of a map into the plane given per face corner (with seams): every
+/// face measured with its own corners' coordinates in `frame`, on a copy of the source
+/// whose faces share no vertex ([`split_corners`] by corner; a face keeps its first
+/// vertex, so its frame and `mu` are the source's, and the faces keep their order).
+pub fn measure_seamed(mesh: &Mesh, uv: &SeamedUv, frame: Frame) -> Result<Distortion, SeamedError> {
+    let corner: Vec<u32> = (0..mesh.halfedge_count() as u32).collect();
+    let (split, origin) = split_corners(mesh, &corner)?;
+    let mut at_corner = vec![Complex64::default(); mesh.halfedge_count()];
+    for f in mesh.faces() {
+        for (k, h) in mesh.face_halfedges(f).enumerate() {
+            let t = uv.uvs[uv.corners[f.idx()][k] as usize];
+            at_corner[h.idx()] = Complex64::new(t[0], t[1]);
+        }
+    }
+    let map: Vec<Complex64> = origin.iter().map(|&(_, h)| at_corner[h as usize]).collect();
+    Ok(measure_planar(&split, &map, frame)?)
+}
+
+/// Why a map with seams could not be measured.
+#[derive(Debug, Error)]
+pub enum SeamedError {
+    /// The seams do not split the source into a valid mesh.
+    #[error("splitting the mesh into separate faces: {0}")]
+    Split(#[from] beltrami_mesh::MeshError),
+    /// The measure failed (a degenerate face, a non-finite coordinate).
+    #[error(transparent)]
+    Measure(#[from] beltrami_fem::FemError),
 }
 
 /// The map into R^3 of a file's positions: per source vertex, the position of its vertex

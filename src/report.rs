@@ -123,7 +123,8 @@ pub fn mu_error_keys(error: Option<&MuError>) -> JsonMap<String, Value> {
 }
 
 /// The report of a texture atlas of `mesh` (`beltrami atlas --report` without the file
-/// names): sizes, charts and cones, Sander's stretch, flipped faces, the seams (edges,
+/// names): sizes, charts and cones, Sander's stretch, flipped faces, `|mu|` (mean and
+/// max, as `beltrami distortion` measures the written file), the seams (edges,
 /// length, share of the total edge length), the splits by reason, the options, each
 /// chart's faces and cones (as input vertex indices) and the seconds.
 pub fn atlas(
@@ -136,6 +137,15 @@ pub fn atlas(
     let total: f64 = mesh.edges().map(|e| mesh.edge_length(e)).sum();
     let seam_length: f64 = seams.iter().map(|&e| mesh.edge_length(e)).sum();
     let s = &atlas.stretch;
+    // |mu| as `beltrami distortion` measures the written file.
+    let frame = if beltrami_fem::element::is_planar(mesh) {
+        beltrami_fem::Frame::Global
+    } else {
+        beltrami_fem::Frame::Face
+    };
+    let mu = crate::mapped::measure_seamed(mesh, &atlas.uv, frame)
+        .ok()
+        .map(|d| json!({"mean": d.stats.mu_mean, "max": d.stats.mu_max}));
     let value = json!({
         "topology": beltrami_core::topology::describe(mesh),
         "vertices": mesh.vertex_count(),
@@ -145,6 +155,7 @@ pub fn atlas(
         "cones": atlas.charts.iter().map(|c| c.cones.len()).sum::<usize>(),
         "stretch": {"l2": s.l2, "linf": s.linf, "area_distortion": s.area_distortion},
         "flipped_faces": s.flipped_faces,
+        "mu": mu,
         "seams": {"edges": seams.len(), "length": seam_length, "length_share": seam_length / total},
         "splits": {
             "overlap": atlas.splits.overlap,

@@ -84,6 +84,21 @@ fn a_torus_atlas_keeps_the_vertices_and_agrees_with_its_report() {
     );
     assert!(l2 <= 1.1);
     assert!(report["charts"].as_u64().unwrap() >= 1);
+
+    // `distortion` reads the seamed file and agrees with the report.
+    let out = beltrami(&["distortion", s(&input), s(&output), "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let measured: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(measured["flipped"], 0);
+    for (a, b) in [
+        (&measured["mu_mean"], &report["mu"]["mean"]),
+        (&measured["mu_max"], &report["mu"]["max"]),
+        (&measured["stretch"]["l2"], &report["stretch"]["l2"]),
+        (&measured["stretch"]["linf"], &report["stretch"]["linf"]),
+    ] {
+        let (a, b) = (a.as_f64().unwrap(), b.as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-9 * b.abs().max(1.0), "{a} against {b}");
+    }
 }
 
 #[test]

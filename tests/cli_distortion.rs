@@ -456,7 +456,7 @@ fn mismatched_connectivity_names_the_first_differing_face() {
 }
 
 #[test]
-fn texture_seams_and_a_target_for_a_planar_map_are_refused() {
+fn texture_seams_are_measured_face_by_face_and_a_target_for_a_planar_map_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let source = dir.path().join("square.obj");
     std::fs::write(
@@ -473,12 +473,18 @@ fn texture_seams_and_a_target_for_a_planar_map_are_refused() {
          f 1/1 2/2 3/3\nf 1/1 3/5 4/4\n",
     )
     .unwrap();
-    let out = beltrami(&["distortion", s(&source), s(&seams)]);
-    assert!(!out.status.success());
-    let err = text(&out.stderr);
+    // The first face is mapped by the identity (mu = 0); the second, (0,0) (1,1) (0,1)
+    // onto (0,0) (2,2) (0,1), by u = 2x, v = x + y: f_z = (3 + i)/2, f_zbar = (1 + i)/2,
+    // |mu| = |(1 + i)/(3 + i)| = sqrt(20)/10.
+    let v = report(&[s(&source), s(&seams)]);
+    assert_eq!(v["flipped"], 0);
     assert!(
-        err.contains("texture seams") && err.contains("vertex 2 has two different vt"),
-        "{err}"
+        (number(&v, "mu_max") - 20f64.sqrt() / 10.0).abs() < 1e-12,
+        "{v}"
+    );
+    assert!(
+        (number(&v, "mu_mean") - 20f64.sqrt() / 20.0).abs() < 1e-12,
+        "{v}"
     );
 
     let uv = dir.path().join("uv.obj");

@@ -213,5 +213,10 @@ fn print_summary(args: &AtlasArgs, report: &Value) {
         report["seams"]["edges"],
         100.0 * number(&["seams", "length_share"])
     );
+    println!(
+        "  |mu|            mean {:.4}  max {:.4}",
+        number(&["mu", "mean"]),
+        number(&["mu", "max"])
+    );
     println!("  flipped faces   {}", report["flipped_faces"]);
 }

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use beltrami::mapped;
+use beltrami_atlas::Stretch;
 use beltrami_fem::distortion::{self, Distortion, Histogram};
 use beltrami_fem::{Frame, ReferenceNormal, element};
 use beltrami_mesh::io::LoadedMesh;
@@ -65,6 +66,8 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
     let measuring = || format!("measuring the map of {}", args.source.display());
     // Notes on the reference normal: printed, or in the JSON report.
     let mut notes = Vec::new();
+    // Sander's texture stretch, for maps into the plane.
+    let mut stretch = None;
 
     let (kind, reference, measured) = if mapped.corner_uvs.is_some() {
         if args.target.is_some() {
@@ -74,10 +77,22 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
                 args.mapped.display()
             );
         }
-        let map = mapped::planar_images(&mapped, &to_mapped)
-            .with_context(|| format!("{} has", args.mapped.display()))?
-            .unwrap_or_default();
-        let measured = distortion::measure_planar(mesh, &map, frame).with_context(measuring)?;
+        let seamed = mapped::corner_images(mesh, &mapped);
+        let measured = match (mapped::planar_images(&mapped, &to_mapped), &seamed) {
+            (Ok(map), _) => distortion::measure_planar(mesh, &map.unwrap_or_default(), frame)
+                .with_context(measuring)?,
+            // Seams: each face measured with its own corners' coordinates, on the source
+            // split where the coordinates differ (same faces, in the same order).
+            (Err(mapped::MappedError::Seam { .. }), Some(uv)) => {
+                mapped::measure_seamed(mesh, uv, frame).with_context(measuring)?
+            }
+            (Err(error), _) => {
+                return Err(
+                    anyhow::Error::new(error).context(format!("{} has", args.mapped.display()))
+                );
+            }
+        };
+        stretch = seamed.map(|uv| beltrami_atlas::stretch(mesh, &uv));
         (
             MapKind::Planar,
             Reference::Chosen(ReferenceNormal::Plane),
@@ -118,7 +133,7 @@ pub fn run(args: &DistortionArgs, quiet: bool) -> anyhow::Result<()> {
             .and_then(|field| field.write(path))
             .with_context(|| format!("writing the per-face field {}", path.display()))?;
     }
-    print_report(args, kind, frame, reference, &notes, &measured);
+    print_report(args, kind, frame, reference, &notes, &measured, stretch);
     Ok(())
 }
 
@@ -248,6 +263,7 @@ fn print_report(
     reference: Reference,
     notes: &[String],
     d: &Distortion,
+    stretch: Option<Stretch>,
 ) {
     let s = &d.stats;
     let h = &s.histogram;
@@ -265,6 +281,11 @@ fn print_report(
             "mu_max": s.mu_max,
             "mu_std": s.mu_std,
             "mu_l2": s.mu_l2,
+            "stretch": stretch.map(|t| json!({
+                "l2": t.l2,
+                "linf": t.linf,
+                "area_distortion": t.area_distortion,
+            })),
             "histogram": {
                 "bin_width": Histogram::WIDTH,
                 "counts": h.bins,
@@ -288,6 +309,12 @@ fn print_report(
     println!("  |mu| max        {:.6e}", s.mu_max);
     println!("  |mu| std        {:.6e}", s.mu_std);
     println!("  |mu| L2 (area)  {:.6e}", s.mu_l2);
+    if let Some(t) = stretch {
+        println!(
+            "  stretch         L2 {:.4}  Linf {:.3}  area distortion {:.4} (Sander et al. 2001)",
+            t.l2, t.linf, t.area_distortion
+        );
+    }
     println!("  |mu| histogram");
     for (k, count) in h.bins.iter().enumerate() {
         let (a, b) = (

@@ -819,6 +819,54 @@ pub fn cut_along(mesh: &Mesh, edges: &[EdgeId]) -> Result<(Mesh, Vec<VertexId>),
     Ok((cut_mesh, to_original))
 }
 
+/// Splits the vertices of `mesh` by a class given per face corner (`class[h]` for the
+/// face halfedge `h` leaving the corner's vertex; e.g. the index of its texture
+/// coordinate): corners of one vertex with equal classes share a vertex of the result,
+/// corners with different classes get different ones. Faces keep their ids, order and
+/// first vertex. Returns the split mesh and, per vertex of it, the original vertex and
+/// the class.
+///
+/// # Errors
+/// [`MeshError`] if the split is not a valid mesh (corners of one class at a vertex
+/// that are not one fan: the vertex would be pinched).
+pub fn split_corners(
+    mesh: &Mesh,
+    class: &[u32],
+) -> Result<(Mesh, Vec<(VertexId, u32)>), MeshError> {
+    let mut vertex_of: std::collections::HashMap<(VertexId, u32), u32> =
+        std::collections::HashMap::new();
+    let mut origin: Vec<(VertexId, u32)> = Vec::new();
+    let mut positions = Vec::new();
+    let mut faces: Vec<u32> = Vec::with_capacity(4 * mesh.face_count());
+    let mut sizes = Vec::with_capacity(mesh.face_count());
+    for f in mesh.faces() {
+        let mut size = 0;
+        for h in mesh.face_halfedges(f) {
+            let key = (mesh.origin(h), class[h.idx()]);
+            let v = *vertex_of.entry(key).or_insert_with(|| {
+                positions.push(mesh.position(key.0));
+                origin.push(key);
+                (positions.len() - 1) as u32
+            });
+            faces.push(v);
+            size += 1;
+        }
+        sizes.push(size);
+    }
+    let mut soup = PolygonSoup::new(positions);
+    let mut at = 0;
+    for size in sizes {
+        soup.push_face(&faces[at..at + size]);
+        at += size;
+    }
+    let options = BuildOptions {
+        degenerate_area_tolerance: -1.0,
+        repair: Repair::NONE,
+    };
+    let (split, _) = Mesh::build(&soup, &options)?;
+    Ok((split, origin))
+}
+
 /// The polygon soup of `mesh` with every vertex split into one copy per wedge of faces
 /// between consecutive cut edges around it (boundary edges always separate), and the
 /// original vertex of every copy. Copy 0 of vertex `v` keeps the id `v`.

@@ -52,7 +52,7 @@ mod vertex_map;
 pub use build::{BuildOptions, BuildReport, MAX_COORDINATE, MIN_EXTENT, Repair};
 pub use cut::{
     CutError, CutGraph, CutMesh, Generator, GeneratorKind, TorusSides, cut_along, cut_graph,
-    cut_to_disk, shortest_path_tree,
+    cut_to_disk, shortest_path_tree, split_corners,
 };
 pub use error::MeshError;
 pub use frame::FaceFrame;

@@ -9,12 +9,12 @@
 use std::io::Write as _;
 use std::path::Path;
 
-use nalgebra::{Point3, Vector2};
+use nalgebra::Vector2;
 
 use super::obj::{push_decimal, vertex_line, write_lines};
 use super::slots::OutputSlots;
 use super::{Format, VertexAttributes, WriteError};
-use crate::{FaceId, Mesh, PolygonSoup};
+use crate::{FaceId, Mesh, split_corners};
 
 /// Texture coordinates per face corner.
 #[derive(Debug, Clone, Copy)]
@@ -125,30 +125,13 @@ fn split_at_seams(
     mesh: &Mesh,
     corner_uvs: &CornerUvs<'_>,
 ) -> Result<(Mesh, Vec<Vector2<f64>>), WriteError> {
-    let mut vertex_of_uv: Vec<Option<u32>> = vec![None; corner_uvs.uvs.len()];
-    let mut positions: Vec<Point3<f64>> = Vec::new();
-    let mut uvs = Vec::new();
-    let mut corners = Vec::with_capacity(4);
-    let mut faces: Vec<Vec<u32>> = Vec::with_capacity(mesh.face_count());
-    for f in mesh.faces() {
-        corners.clear();
-        for h in mesh.face_halfedges(f) {
-            let t = corner_uvs.corners[h.idx()] as usize;
-            let v = *vertex_of_uv[t].get_or_insert_with(|| {
-                positions.push(mesh.position(mesh.origin(h)));
-                uvs.push(corner_uvs.uvs[t]);
-                (positions.len() - 1) as u32
-            });
-            corners.push(v);
-        }
-        faces.push(corners.clone());
-    }
-    let mut soup = PolygonSoup::new(positions);
-    for face in &faces {
-        soup.push_face(face);
-    }
-    let split = Mesh::from_soup(&soup).map_err(|error| WriteError::Seams {
-        message: error.to_string(),
-    })?;
+    let (split, origin) =
+        split_corners(mesh, corner_uvs.corners).map_err(|error| WriteError::Seams {
+            message: error.to_string(),
+        })?;
+    let uvs = origin
+        .iter()
+        .map(|&(_, t)| corner_uvs.uvs[t as usize])
+        .collect();
     Ok((split, uvs))
 }
