@@ -1,4 +1,4 @@
-"""Every Python code block of docs/python.md and docs/scale.md runs as written, from the
+"""Every Python code block of docs/python.md, docs/scale.md and docs/atlas.md runs as written, from the
 repository's root (where the bundled meshes are): a block of ``>>>`` lines as a doctest
 (outputs and error messages compared), any other block saved as a script and run with
 ``python``, as a user who copies it would."""
@@ -13,7 +13,7 @@ import pytest
 
 from conftest import ROOT
 
-DOCS = ["docs/python.md", "docs/scale.md"]
+DOCS = ["docs/python.md", "docs/scale.md", "docs/atlas.md"]
 
 
 def python_blocks():
