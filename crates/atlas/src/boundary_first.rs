@@ -36,6 +36,8 @@ pub enum FlattenFailure {
     NotADisk,
     /// Closing the boundary curve needed a non-positive edge length.
     CurveDoesNotClose,
+    /// A face came out with a non-positive area.
+    Folded,
 }
 
 /// The flat positions of the vertices of `disk` for the log scale factors `u` (see the
@@ -44,20 +46,12 @@ pub fn flatten_disk(
     disk: &Mesh,
     u: &[f64],
 ) -> Result<Result<Vec<[f64; 2]>, FlattenFailure>, AtlasError> {
-    let euler = disk.vertex_count() as i64 - disk.edge_count() as i64 + disk.face_count() as i64;
-    if disk.boundary_loop_count() != 1 || euler != 1 {
+    if !is_disk(disk) {
         return Ok(Err(FlattenFailure::NotADisk));
     }
     let laplacian = cotan_laplacian(disk)?;
     let lu = multiply(&laplacian, u);
-    let mut ring: Vec<VertexId> = disk
-        .boundary_loops()
-        .next()
-        .map(|b| disk.loop_vertices(b).collect())
-        .unwrap_or_default();
-    // Boundary halfedges run clockwise about the disk; the curve is laid
-    // counter-clockwise, with the interior on its left.
-    ring.reverse();
+    let ring = counter_clockwise_ring(disk);
     let n = ring.len();
     let turning: Vec<f64> = ring
         .iter()
@@ -94,6 +88,24 @@ pub fn flatten_disk(
     Ok(Ok(position))
 }
 
+/// The boundary vertices of a disk in counter-clockwise order (the interior on the
+/// left): boundary halfedges run clockwise, so their loop is walked backwards.
+pub(crate) fn counter_clockwise_ring(disk: &Mesh) -> Vec<VertexId> {
+    let mut ring: Vec<VertexId> = disk
+        .boundary_loops()
+        .next()
+        .map(|b| disk.loop_vertices(b).collect())
+        .unwrap_or_default();
+    ring.reverse();
+    ring
+}
+
+/// Whether `disk` is a topological disk: one boundary loop, Euler characteristic 1.
+pub(crate) fn is_disk(disk: &Mesh) -> bool {
+    let euler = disk.vertex_count() as i64 - disk.edge_count() as i64 + disk.face_count() as i64;
+    disk.boundary_loop_count() == 1 && euler == 1
+}
+
 /// The lengths nearest to `lengths` (weights `1 / l`) for which the polygon with unit
 /// edge directions `tangents` closes; `None` if one comes out non-positive.
 fn close_curve(lengths: &[f64], tangents: &[[f64; 2]]) -> Option<Vec<f64>> {
@@ -123,7 +135,7 @@ fn close_curve(lengths: &[f64], tangents: &[[f64; 2]]) -> Option<Vec<f64>> {
 }
 
 /// Replaces the interior positions by the harmonic extension of the boundary's.
-fn extend_harmonically(
+pub(crate) fn extend_harmonically(
     disk: &Mesh,
     laplacian: &SparseColMat<usize, f64>,
     position: &mut [[f64; 2]],
@@ -173,7 +185,7 @@ fn extend_harmonically(
 }
 
 /// `L x` for a sparse `L`.
-fn multiply(matrix: &SparseColMat<usize, f64>, x: &[f64]) -> Vec<f64> {
+pub(crate) fn multiply(matrix: &SparseColMat<usize, f64>, x: &[f64]) -> Vec<f64> {
     let symbolic = matrix.symbolic();
     let (col_ptr, rows, values) = (symbolic.col_ptr(), symbolic.row_idx(), matrix.val());
     let mut out = vec![0.0; matrix.nrows()];

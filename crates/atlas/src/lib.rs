@@ -46,6 +46,7 @@ mod seamed;
 pub mod shortest_paths;
 pub mod split;
 pub mod stretch;
+pub mod unit_disk;
 
 use beltrami_core::components::parts;
 use beltrami_mesh::{EdgeId, FaceId, Mesh, VertexId, cut_along};

@@ -1,0 +1,106 @@
+//! A conformal map of a disk onto the unit disk by boundary first flattening (Sawhney
+//! and Crane 2017, section 5.3 "Uniformization": a disk's conformal map onto the
+//! circle is the flattening whose boundary curvature is that of a circle).
+//!
+//! A circle of length `S` turns by `2 pi l / S` along an arc of length `l`, so the target
+//! turning angle at boundary vertex `i` is `k~_i = pi (l~_{i-1} + l~_i) / S` (its dual
+//! arc), with `l~` the flattened edge lengths `e^{(u_a + u_b)/2} l`. The scale `u` then
+//! solves the Neumann problem `L u = -Omega` inside, `L u = k~ - k` on the boundary
+//! (the Neumann-to-Dirichlet step of BFF; the right-hand side sums to zero by
+//! Gauss-Bonnet, and one vertex is held to fix the constant), which changes `l~`; a few
+//! rounds settle it (one factorization serves them all). The boundary vertices are then
+//! put on the unit circle at the angles `2 pi` times their share of the arc length, so
+//! the boundary lies exactly on the circle, and the interior is the harmonic extension
+//! (cotan weights) of the boundary.
+
+use std::f64::consts::{PI, TAU};
+
+use beltrami_fem::operators::cotan_laplacian;
+use beltrami_fem::{SolveOptions, SpdSolver};
+use beltrami_mesh::Mesh;
+use faer::Mat;
+
+use crate::AtlasError;
+use crate::boundary_first::{FlattenFailure, counter_clockwise_ring, extend_harmonically, is_disk};
+
+/// Rounds of the boundary lengths and the Neumann problem.
+const ROUNDS: usize = 4;
+
+/// The positions on the unit disk of the vertices of `disk` (see the module docs), or
+/// why there are none (not a disk, a non-positive length, a folded face).
+pub fn map_to_unit_disk(disk: &Mesh) -> Result<Result<Vec<[f64; 2]>, FlattenFailure>, AtlasError> {
+    if !is_disk(disk) {
+        return Ok(Err(FlattenFailure::NotADisk));
+    }
+    let laplacian = cotan_laplacian(disk)?;
+    let ring = counter_clockwise_ring(disk);
+    let n = ring.len();
+    let rest: Vec<f64> = (0..n)
+        .map(|i| (disk.position(ring[(i + 1) % n]) - disk.position(ring[i])).norm())
+        .collect();
+    // Hold the first interior vertex (or the first boundary one) at u = 0 by a penalty.
+    let held = disk
+        .vertices()
+        .find(|&v| !disk.is_boundary_vertex(v))
+        .unwrap_or(ring[0]);
+    let mut matrix = laplacian.clone();
+    {
+        let symbolic = laplacian.symbolic();
+        let (col_ptr, rows) = (symbolic.col_ptr(), symbolic.row_idx());
+        let j = held.idx();
+        if let Some(k) = (col_ptr[j]..col_ptr[j + 1]).find(|&k| rows[k] == j) {
+            let values = matrix.val_mut();
+            values[k] += 1e10 * values[k].abs().max(f64::MIN_POSITIVE);
+        }
+    }
+    let mut solver = SpdSolver::new(matrix.symbolic(), SolveOptions::default())?;
+    solver.factorize(matrix.as_ref())?;
+    let defect: Vec<f64> = disk.vertices().map(|v| disk.angle_defect(v)).collect();
+    let mut u = vec![0.0; disk.vertex_count()];
+    let mut lengths = rest.clone();
+    for _ in 0..ROUNDS {
+        let total: f64 = lengths.iter().sum();
+        let mut rhs = Mat::<f64>::zeros(u.len(), 1);
+        for v in disk.vertices() {
+            rhs[(v.idx(), 0)] = -defect[v.idx()];
+        }
+        for i in 0..n {
+            let target = PI * (lengths[(i + n - 1) % n] + lengths[i]) / total;
+            rhs[(ring[i].idx(), 0)] = target - defect[ring[i].idx()];
+        }
+        rhs[(held.idx(), 0)] = 0.0;
+        solver.solve_in_place(rhs.as_mut())?;
+        for (i, x) in u.iter_mut().enumerate() {
+            *x = rhs[(i, 0)];
+        }
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            lengths[i] = ((u[a.idx()] + u[b.idx()]) / 2.0).exp() * rest[i];
+        }
+    }
+    if lengths.iter().any(|l| !(l.is_finite() && *l > 0.0)) {
+        return Ok(Err(FlattenFailure::CurveDoesNotClose));
+    }
+    let total: f64 = lengths.iter().sum();
+    let mut position = vec![[0.0; 2]; disk.vertex_count()];
+    let mut walked = 0.0;
+    for i in 0..n {
+        let angle = TAU * walked / total;
+        position[ring[i].idx()] = [angle.cos(), angle.sin()];
+        walked += lengths[i];
+    }
+    extend_harmonically(disk, &laplacian, &mut position)?;
+    let folded = disk.faces().any(|f| {
+        let (v, _) = disk.face_vertex_array(f);
+        let [a, b, c] = [
+            position[v[0].idx()],
+            position[v[1].idx()],
+            position[v[2].idx()],
+        ];
+        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) <= 0.0
+    });
+    if folded {
+        return Ok(Err(FlattenFailure::Folded));
+    }
+    Ok(Ok(position))
+}
