@@ -8,7 +8,7 @@ use crate::AtlasError;
 use crate::boundary_first::{FlattenFailure, flatten_disk};
 use crate::cone_cut::cone_cut;
 use crate::cones::{ConeGoal, place_cones};
-use crate::overlap::curve_crosses_itself;
+use crate::overlap::{curve_crosses_itself, folded_faces};
 
 /// A chart laid flat.
 #[derive(Debug, Clone)]
@@ -47,15 +47,7 @@ pub fn flatten_chart(
         Ok(uv) => uv,
         Err(failure) => return Ok(Err(ChartFailure::Flatten(failure))),
     };
-    let flipped = disk
-        .faces()
-        .filter(|&f| {
-            let (v, _) = disk.face_vertex_array(f);
-            let [a, b, c] = [uv[v[0].idx()], uv[v[1].idx()], uv[v[2].idx()]];
-            let area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-            area2 <= 0.0 || area2.is_nan()
-        })
-        .count();
+    let flipped = folded_faces(&disk, &uv);
     if flipped > 0 {
         return Ok(Err(ChartFailure::Flipped(flipped)));
     }

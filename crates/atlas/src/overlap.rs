@@ -1,4 +1,4 @@
-//! Whether a flat disk overlaps itself.
+//! Whether a flat disk overlaps itself: folded faces and a self-crossing boundary.
 //!
 //! A map of a disk whose faces all keep their orientation is one-to-one exactly when its
 //! boundary curve is simple (the degree of the map at a point is the winding number of
@@ -6,6 +6,8 @@
 //! is positive, and no two boundary segments that are not neighbours along the curve
 //! meet (touching counts: two surface points would share a texel). Segments are
 //! bucketed in a uniform grid of cells about as large as the mean segment.
+
+use beltrami_mesh::Mesh;
 
 use std::collections::HashMap;
 
@@ -47,9 +49,21 @@ pub fn curve_crosses_itself(points: &[[f64; 2]]) -> bool {
     })
 }
 
-/// Twice the signed area of the triangle `a b c`.
-fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+/// Twice the signed area of the triangle `a b c` (positive when counter-clockwise).
+pub fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
     (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// The faces of `mesh` whose image under the flat positions `uv` (per vertex) has a
+/// non-positive (or undefined) signed area.
+pub fn folded_faces(mesh: &Mesh, uv: &[[f64; 2]]) -> usize {
+    mesh.faces()
+        .filter(|&f| {
+            let (v, _) = mesh.face_vertex_array(f);
+            let area2 = orient(uv[v[0].idx()], uv[v[1].idx()], uv[v[2].idx()]);
+            area2 <= 0.0 || area2.is_nan()
+        })
+        .count()
 }
 
 /// Whether `p`, known to be on the line through `a b`, lies within the segment.

@@ -22,6 +22,7 @@ use faer::Mat;
 
 use crate::AtlasError;
 use crate::boundary_first::{FlattenFailure, counter_clockwise_ring, extend_harmonically, is_disk};
+use crate::overlap::folded_faces;
 
 /// Rounds of the boundary lengths and the Neumann problem.
 const ROUNDS: usize = 4;
@@ -90,15 +91,7 @@ pub fn map_to_unit_disk(disk: &Mesh) -> Result<Result<Vec<[f64; 2]>, FlattenFail
         walked += lengths[i];
     }
     extend_harmonically(disk, &laplacian, &mut position)?;
-    let folded = disk.faces().any(|f| {
-        let (v, _) = disk.face_vertex_array(f);
-        let [a, b, c] = [
-            position[v[0].idx()],
-            position[v[1].idx()],
-            position[v[2].idx()],
-        ];
-        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) <= 0.0
-    });
+    let folded = folded_faces(disk, &position) > 0;
     if folded {
         return Ok(Err(FlattenFailure::Folded));
     }
