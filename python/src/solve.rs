@@ -18,7 +18,7 @@
 //! | `area_constraint` | `space`: `true` keeps the area to first order |
 //! | `landmarks` | `mesh`: the text of a landmarks file |
 //! | `planar_landmarks` | `disk`: `[[vertex, x, y], ...]`, boundary vertices moved to points of the unit circle |
-//! | `components` | `each`: every connected component solved on its own, the planar maps side by side ([`components::solve_each`]) |
+//! | `components` | `each`: every connected component solved on its own, the planar maps side by side ([`components::solve_each`]); `largest`: the largest alone, NaN rows for the other vertices |
 //! | `options` | solver options as text, `{name: value}` (`--option NAME=VALUE`) |
 //! | `defaults` | the command's defaults, set when the solver declares the option |
 //!
@@ -453,16 +453,42 @@ pub fn solve<'py>(
     constraints(&spec, &mut problem, target_mesh.as_ref(), &inputs)?;
     options(&spec, &mut problem, solver);
 
-    let each_component = match text(&spec, "components") {
-        None => false,
-        Some("each") => true,
+    let pieces = match text(&spec, "components") {
+        None => Pieces::Whole,
+        Some("each") => Pieces::Each,
+        Some("largest") => Pieces::Largest,
         Some(other) => {
             return Err(option_error(format!(
-                "components={other:?}: expected 'each' (every connected component mapped on its own, side by side)"
+                "components={other:?}: expected 'each' (every connected component mapped on its own, side by side) or 'largest' (the largest alone, NaN rows elsewhere)"
             )));
         }
     };
-    let (solution, seconds) = run(py, solver, &problem, each_component, progress)?;
+    let parts = match pieces {
+        Pieces::Largest if mesh.component_count() > 1 => {
+            Some(components::parts(&mesh).map_err(|e| errors::from_error(Kind::Mesh, &e))?)
+        }
+        _ => None,
+    };
+    let largest = parts
+        .as_ref()
+        .and_then(|p| components::largest(p).map(|k| &p[k]));
+    let (solution, seconds) = match largest {
+        Some(part) => {
+            let on_part = part
+                .problem(&problem, solver.name())
+                .map_err(|e| errors::from_solver(&e))?;
+            let (mut solution, seconds) = run(py, solver, &on_part, false, progress)?;
+            solution.report.notes.push(format!(
+                "the largest of {} components mapped ({} of {} faces); the other vertices' rows are NaN",
+                parts.as_ref().map_or(0, Vec::len),
+                part.mesh.face_count(),
+                mesh.face_count()
+            ));
+            (solution, seconds)
+        }
+        None => run(py, solver, &problem, pieces == Pieces::Each, progress)?,
+    };
+    let solved = largest.map_or(&mesh, |part| &part.mesh);
     let out = PyDict::new(py);
     let Some(map) = solution.map() else {
         return Err(errors::raise(
@@ -470,21 +496,36 @@ pub fn solve<'py>(
             format!("{} gave no map", solver.name()),
         ));
     };
-    let image = map_file::image(&mesh, map, target_mesh.as_ref())
+    let image = map_file::image(solved, map, target_mesh.as_ref())
         .map_err(|e| errors::from_error(Kind::Solver, &e))?;
+    // Values of the solved mesh's vertices on the whole mesh's (NaN off the part).
+    let whole = |values: Vec<Vec<f64>>, columns: usize| -> Vec<Vec<f64>> {
+        match largest {
+            None => values,
+            Some(part) => {
+                let mut out = vec![vec![f64::NAN; columns]; mesh.vertex_count()];
+                for (k, row) in values.into_iter().enumerate() {
+                    out[part.vertices[k].idx()] = row;
+                }
+                out
+            }
+        }
+    };
     match image {
         Image::Uv(uv) => {
             out.set_item("kind", "uv")?;
+            let rows = whole(uv.iter().map(|t| vec![t.x, t.y]).collect(), 2);
             out.set_item(
                 "image",
-                arrays::vertex_rows(&mesh, &uv, 2, |t| vec![t.x, t.y]).into_pyarray(py),
+                arrays::vertex_rows(&mesh, &rows, 2, Clone::clone).into_pyarray(py),
             )?;
         }
         Image::Positions(p) => {
             out.set_item("kind", "xyz")?;
+            let rows = whole(p.iter().map(|p| vec![p.x, p.y, p.z]).collect(), 3);
             out.set_item(
                 "image",
-                arrays::vertex_rows(&mesh, &p, 3, |p| vec![p.x, p.y, p.z]).into_pyarray(py),
+                arrays::vertex_rows(&mesh, &rows, 3, Clone::clone).into_pyarray(py),
             )?;
         }
     }
@@ -515,8 +556,17 @@ pub fn solve<'py>(
             arrays::face_rows(&mesh, &qd.values, nan).into_pyarray(py),
         )?;
     }
-    out.set_item("report", report(&mesh, &solution, seconds))?;
+    out.set_item("report", report(solved, &solution, seconds))?;
     Ok(out)
+}
+
+/// `components=`: the whole mesh as one problem, every component on its own, or the
+/// largest alone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pieces {
+    Whole,
+    Each,
+    Largest,
 }
 
 /// Every registered solver as the JSON text of `beltrami solvers --json`.

@@ -410,7 +410,7 @@ def test_lscm_takes_libigl_b_and_bc(hemisphere):
         beltrami.lscm(V, F, b[:2], bc[:2], pins=[0, 1])
 
 
-def test_components_each_matches_param(cli, hemisphere, tmp_path):
+def test_components_each_and_largest_match_param(cli, hemisphere, tmp_path):
     V, F = beltrami.read_mesh(hemisphere)
     V2 = np.vstack([V, V * 0.5 + [3.0, 0.0, 0.0]])
     F2 = np.vstack([F, F + len(V)])
@@ -423,6 +423,14 @@ def test_components_each_matches_param(cli, hemisphere, tmp_path):
         beltrami.lscm(V2, F2)
     with pytest.raises(beltrami.OptionError, match="expected 'each'"):
         beltrami.lscm(V2, F2, components="all")
+    # The largest alone (both have as many faces: the first of equals), NaN elsewhere.
+    largest = tmp_path / "largest.obj"
+    cli("param", path, "--solver", "lscm", "--components", "largest", "-o", largest)
+    UV, report = beltrami.lscm(V2, F2, components="largest", info=True)
+    close(UV[: len(V)], uv_of(largest))
+    close(UV[: len(V)], beltrami.lscm(V, F))
+    assert np.isnan(UV[len(V):]).all()
+    assert any("largest of 2 components" in note for note in report["notes"])
 
 
 def test_atlas_matches_the_command(cli, tmp_path):
