@@ -1028,6 +1028,22 @@ mod tests {
                 Role::Free => assert_eq!(flow.vertex[v].z, 0.0),
             }
         }
+
+        // A factorization that fails is not kept: the next solve factors again instead
+        // of running conjugate gradients with a factor the solver no longer has (a
+        // genus-3 registration once ended with "no factorization to solve with").
+        assert!(system.kept);
+        let matrix = system.matrix.clone();
+        system.matrix.val_mut().fill(f64::NAN);
+        system.skip_reuse = 1;
+        assert!(system.solve_normal_equations(0).is_err());
+        assert!(!system.kept);
+        system.matrix = matrix;
+        system.skip_reuse = 0;
+        let before = system.factorizations;
+        system.solve_normal_equations(0).unwrap();
+        assert_eq!(system.factorizations, before + 1);
+        assert!(system.rhs.iter().all(|x| x.is_finite()));
     }
 
     /// The tilt penalty keeps the area against the reference normal of faces tilted
