@@ -130,6 +130,13 @@ fn outputs_without_seamed_uvs_and_bad_options_are_refused_before_work() {
     let input = dir.path().join("torus.obj");
     let mesh = Mesh::from_soup(&torus(16, 8, 1.0, 0.4, Cells::Triangles)).unwrap();
     io::obj::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let grid = Mesh::from_soup(&torus(8, 6, 1.0, 0.4, Cells::Quads)).unwrap();
+    io::obj::write(
+        &dir.path().join("quads.obj"),
+        &grid,
+        &VertexAttributes::default(),
+    )
+    .unwrap();
     for (args, expected) in [
         (vec!["-o", "atlas.stl"], ".obj, .ply, .gltf or .glb"),
         (vec!["-o", "atlas.off"], ".obj, .ply, .gltf or .glb"),
@@ -139,6 +146,10 @@ fn outputs_without_seamed_uvs_and_bad_options_are_refused_before_work() {
         ),
         (vec!["-o", "atlas.obj", "--padding", "0.5"], "padding"),
         (vec!["-o", "atlas.obj", "--cones", "many"], "auto"),
+        (
+            vec!["quads", "-o", "atlas.obj"],
+            "face 0 (0-based, in the file's order) has 4 corners",
+        ),
     ] {
         let output: Vec<String> = args
             .iter()
@@ -147,8 +158,14 @@ fn outputs_without_seamed_uvs_and_bad_options_are_refused_before_work() {
                 a => a.to_owned(),
             })
             .collect();
-        let mut full = vec!["atlas", s(&input)];
-        full.extend(output.iter().map(String::as_str));
+        // `quads` swaps the input for a quad grid.
+        let quads = dir.path().join("quads.obj");
+        let (first, rest) = match output.first().map(String::as_str) {
+            Some("quads") => (s(&quads), &output[1..]),
+            _ => (s(&input), &output[..]),
+        };
+        let mut full = vec!["atlas", first];
+        full.extend(rest.iter().map(String::as_str));
         let out = beltrami(&full);
         assert!(!out.status.success(), "{args:?}");
         assert!(

@@ -1,7 +1,7 @@
 //! Why an atlas could not be made.
 
 use beltrami_fem::{FemError, SolveError};
-use beltrami_mesh::{CutError, FaceId, MeshError};
+use beltrami_mesh::{CutError, MeshError};
 use thiserror::Error;
 
 /// Why an atlas could not be made. Every variant names the option or face at fault.
@@ -17,22 +17,22 @@ pub enum AtlasError {
     },
     /// The mesh has a face that is not a triangle.
     #[error(
-        "face {face} has {corners} corners: atlases are made of triangle meshes; split the quads into triangles first"
+        "face {face} (0-based, in the file's order) has {corners} corners: atlases are made of triangle meshes; split the quads into triangles first"
     )]
     NotTriangles {
-        /// The first face that is not a triangle.
-        face: FaceId,
+        /// The first face that is not a triangle, by its input index.
+        face: usize,
         /// Its number of corners.
         corners: usize,
     },
     /// A chart could not be laid flat even as a few faces (a bug: please report it with
     /// the mesh).
     #[error(
-        "the chart holding face {face} ({faces} faces) could not be laid flat without overlap after {splits} splits"
+        "the chart holding face {face} (0-based, in the file's order; {faces} faces) could not be laid flat without overlap after {splits} splits"
     )]
     Unflattenable {
-        /// A face of the chart.
-        face: FaceId,
+        /// A face of the chart, by its input index.
+        face: usize,
         /// Its number of faces.
         faces: usize,
         /// How often it was split.

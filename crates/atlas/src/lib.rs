@@ -115,7 +115,7 @@ pub fn atlas(mesh: &Mesh, options: &AtlasOptions) -> Result<Atlas, AtlasError> {
     options.validate()?;
     if let Some(face) = mesh.faces().find(|&f| mesh.face_degree(f) != 3) {
         return Err(AtlasError::NotTriangles {
-            face,
+            face: mesh.face_to_input(face),
             corners: mesh.face_degree(face),
         });
     }
@@ -153,7 +153,7 @@ pub fn atlas(mesh: &Mesh, options: &AtlasOptions) -> Result<Atlas, AtlasError> {
                 piece
             }
         };
-        work.extend(split_piece(accepted)?);
+        work.extend(split_piece(mesh, accepted)?);
     }
     Ok(assemble(mesh, flat, options.padding, splits))
 }
@@ -178,11 +178,11 @@ fn disk_uv(chart: &FlatChart) -> SeamedUv {
     }
 }
 
-/// The two halves of a piece (more pieces if a half falls apart).
-fn split_piece(piece: Piece) -> Result<Vec<Piece>, AtlasError> {
+/// The two halves of a piece of `mesh` (more pieces if a half falls apart).
+fn split_piece(mesh: &Mesh, piece: Piece) -> Result<Vec<Piece>, AtlasError> {
     if piece.splits >= MAX_SPLITS {
         return Err(AtlasError::Unflattenable {
-            face: piece.faces[0],
+            face: mesh.face_to_input(piece.faces[0]),
             faces: piece.faces.len(),
             splits: piece.splits,
         });
