@@ -19,9 +19,11 @@
 //! at least two cones (its cut is a path between them), of genus `g >= 2` at least one
 //! (the Yamabe equation without one has no solution); a torus needs none.
 //!
-//! The Dirichlet conditions are imposed as a penalty `P = 1e10 max_i L_ii` on the
-//! diagonal, so the sparsity pattern and its symbolic factorization are shared by every
-//! step; each new cone costs one numeric factorization.
+//! The boundary (and a closed chart's first cone) is held by a penalty
+//! `P = 1e10 max_i L_ii` on the diagonal of one factored matrix; every later cone costs
+//! one solve with that factorization, the cones held exactly through the Woodbury
+//! identity (`u = u0 - G_S (G_SS)^{-1} u0_S`, `G` the factored matrix's inverse, `S`
+//! the cones added).
 
 use beltrami_fem::operators::cotan_laplacian;
 use beltrami_fem::{SolveOptions, SpdSolver};
@@ -87,8 +89,22 @@ pub fn place_cones(mesh: &Mesh, goal: ConeGoal) -> Result<Cones, AtlasError> {
         fixed[first.idx()] = true;
         cones.push(first);
     }
+    // One factorization with the boundary (and a closed chart's first cone) held; each
+    // further cone is one more solve: with `G` the inverse of that matrix and `S` the
+    // added cones, `u = u0 - G_S (G_SS)^{-1} u0_S` is the solution with `S` held too
+    // (the limit of the penalty, by the Woodbury identity).
+    system.factor(&fixed)?;
+    let rhs: Vec<f64> = system
+        .defect
+        .iter()
+        .zip(&fixed)
+        .map(|(&d, &f)| if f { 0.0 } else { -d })
+        .collect();
+    let base = system.solve_factored(&rhs)?;
+    let mut added: Vec<usize> = Vec::new();
+    let mut columns: Vec<Vec<f64>> = Vec::new();
     loop {
-        let u = system.solve(&fixed)?;
+        let u = held_at(&base, &added, &columns);
         let predicted = system.predicted_stretch(&u);
         let done = cones.len() >= min_cones
             && (predicted <= goal.stretch || cones.len() >= goal.max_cones);
@@ -102,7 +118,51 @@ pub fn place_cones(mesh: &Mesh, goal: ConeGoal) -> Result<Cones, AtlasError> {
         let next = extreme(&u, &fixed, 0.0);
         fixed[next.idx()] = true;
         cones.push(next);
+        let mut unit = vec![0.0; u.len()];
+        unit[next.idx()] = 1.0;
+        columns.push(system.solve_factored(&unit)?);
+        added.push(next.idx());
     }
+}
+
+/// `base - G_S (G_SS)^{-1} base_S`: the scale with the vertices `added` held at zero
+/// too, from the columns `G e_s` of the held system's inverse.
+fn held_at(base: &[f64], added: &[usize], columns: &[Vec<f64>]) -> Vec<f64> {
+    let k = added.len();
+    let mut u = base.to_vec();
+    if k == 0 {
+        return u;
+    }
+    let mut matrix: Vec<Vec<f64>> = added
+        .iter()
+        .map(|&i| columns.iter().map(|g| g[i]).collect())
+        .collect();
+    let mut alpha: Vec<f64> = added.iter().map(|&i| base[i]).collect();
+    // Gaussian elimination with partial pivoting (k is at most the cone budget).
+    for c in 0..k {
+        let pivot = (c..k)
+            .max_by(|&a, &b| matrix[a][c].abs().total_cmp(&matrix[b][c].abs()))
+            .unwrap_or(c);
+        matrix.swap(c, pivot);
+        alpha.swap(c, pivot);
+        for r in c + 1..k {
+            let factor = matrix[r][c] / matrix[c][c];
+            for j in c..k {
+                matrix[r][j] -= factor * matrix[c][j];
+            }
+            alpha[r] -= factor * alpha[c];
+        }
+    }
+    for c in (0..k).rev() {
+        let tail: f64 = (c + 1..k).map(|j| matrix[c][j] * alpha[j]).sum();
+        alpha[c] = (alpha[c] - tail) / matrix[c][c];
+    }
+    for (g, a) in columns.iter().zip(&alpha) {
+        for (x, gi) in u.iter_mut().zip(g) {
+            *x -= a * gi;
+        }
+    }
+    u
 }
 
 /// The free vertex where `|u - center|` is largest.
@@ -150,17 +210,6 @@ impl ScaleSystem {
         })
     }
 
-    /// `u` with `L u = -defect` at free vertices and `u = 0` at fixed ones.
-    fn solve(&mut self, fixed: &[bool]) -> Result<Vec<f64>, AtlasError> {
-        let rhs: Vec<f64> = self
-            .defect
-            .iter()
-            .zip(fixed)
-            .map(|(&d, &f)| if f { 0.0 } else { -d })
-            .collect();
-        self.solve_held(fixed, &rhs)
-    }
-
     /// The scale of the metric of constant curvature on a closed surface, with vertex
     /// 0 held at zero (the right-hand side sums to zero, so holding one vertex only
     /// fixes the additive constant).
@@ -179,6 +228,12 @@ impl ScaleSystem {
     }
 
     fn solve_held(&mut self, fixed: &[bool], rhs: &[f64]) -> Result<Vec<f64>, AtlasError> {
+        self.factor(fixed)?;
+        self.solve_factored(rhs)
+    }
+
+    /// Factors `L` with the vertices `fixed` held (the penalty on their diagonal).
+    fn factor(&mut self, fixed: &[bool]) -> Result<(), AtlasError> {
         let mut matrix = self.laplacian.clone();
         let values = matrix.val_mut();
         for (i, &f) in fixed.iter().enumerate() {
@@ -187,6 +242,11 @@ impl ScaleSystem {
             }
         }
         self.solver.factorize(matrix.as_ref())?;
+        Ok(())
+    }
+
+    /// Solves with the last factorization.
+    fn solve_factored(&mut self, rhs: &[f64]) -> Result<Vec<f64>, AtlasError> {
         let mut x = Mat::from_fn(rhs.len(), 1, |i, _| rhs[i]);
         self.solver.solve_in_place(x.as_mut())?;
         Ok((0..rhs.len()).map(|i| x[(i, 0)]).collect())
