@@ -145,10 +145,11 @@ fn held_at(base: &[f64], added: &[usize], columns: &[Vec<f64>]) -> Vec<f64> {
             .unwrap_or(c);
         matrix.swap(c, pivot);
         alpha.swap(c, pivot);
+        let pivot_row = matrix[c].clone();
         for r in c + 1..k {
-            let factor = matrix[r][c] / matrix[c][c];
-            for j in c..k {
-                matrix[r][j] -= factor * matrix[c][j];
+            let factor = matrix[r][c] / pivot_row[c];
+            for (x, p) in matrix[r][c..].iter_mut().zip(&pivot_row[c..]) {
+                *x -= factor * p;
             }
             alpha[r] -= factor * alpha[c];
         }
