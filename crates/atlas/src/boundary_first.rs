@@ -22,8 +22,8 @@
 
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::operators::cotan_laplacian;
-use beltrami_fem::{SolveOptions, solve::solve_spd};
 use beltrami_mesh::{Mesh, VertexId};
+use beltrami_sparse::{SolveOptions, solve_spd};
 use faer::Mat;
 use faer::sparse::SparseColMat;
 

@@ -26,8 +26,8 @@
 //! the cones added).
 
 use beltrami_fem::operators::cotan_laplacian;
-use beltrami_fem::{SolveOptions, SpdSolver};
 use beltrami_mesh::{Mesh, VertexId};
+use beltrami_sparse::{SolveOptions, SpdSolver};
 use faer::Mat;
 use faer::sparse::SparseColMat;
 

@@ -1,7 +1,8 @@
 //! Why an atlas could not be made.
 
-use beltrami_fem::{FemError, SolveError};
+use beltrami_fem::FemError;
 use beltrami_mesh::{CutError, MeshError};
+use beltrami_sparse::SolveError;
 use thiserror::Error;
 
 /// Why an atlas could not be made. Every variant names the option or face at fault.

@@ -20,8 +20,8 @@
 //!    all but the largest fan go to the other half.
 
 use beltrami_fem::operators::cotan_laplacian;
-use beltrami_fem::{SolveOptions, SpdSolver};
 use beltrami_mesh::{Mesh, VertexId};
+use beltrami_sparse::{SolveOptions, SpdSolver};
 use faer::Mat;
 
 use crate::AtlasError;

@@ -16,8 +16,8 @@
 use std::f64::consts::{PI, TAU};
 
 use beltrami_fem::operators::cotan_laplacian;
-use beltrami_fem::{SolveOptions, SpdSolver};
 use beltrami_mesh::Mesh;
+use beltrami_sparse::{SolveOptions, SpdSolver};
 use faer::Mat;
 
 use crate::AtlasError;

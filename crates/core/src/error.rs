@@ -1,7 +1,8 @@
 //! Errors of solvers.
 
-use beltrami_fem::{BoundaryError, DofError, FemError, FieldError, SolveError, WeightError};
+use beltrami_fem::{BoundaryError, DofError, FemError, FieldError, WeightError};
 use beltrami_mesh::MeshError;
+use beltrami_sparse::SolveError;
 use thiserror::Error;
 
 use crate::{ConstraintError, OptionError};

@@ -118,7 +118,7 @@ impl Face {
 /// matrix's values in the order of `pattern`: the lower triangle (rows `>=` columns,
 /// each column's rows increasing) of a pattern holding every pair of reduced unknowns
 /// of the corners of one face, as
-/// [`normal_pattern_of_cells`](crate::solve::normal_pattern_of_cells) of the faces gives.
+/// [`normal_pattern_of_cells`](crate::least_squares::normal_pattern_of_cells) of the faces gives.
 ///
 /// Errors: [`FemError::Length`] for a quad, a mesh with other than `dofs.n_nodes()`
 /// vertices or a pattern of other than `dofs.reduced_len()` columns,
@@ -241,8 +241,8 @@ const ENERGY_BLOCK: usize = 1 << 14;
 mod tests {
     use super::*;
     use crate::dof::DofConstraints;
+    use crate::least_squares::normal_pattern_of_cells;
     use crate::operators::beltrami_operator;
-    use crate::solve::normal_pattern_of_cells;
     use crate::{Elements, Frame};
     use beltrami_mesh::primitives::{Cells, jittered_grid};
     use faer::Mat;

@@ -10,7 +10,7 @@
 //! ```
 //!
 //! that is `x = K y + x0`. A least-squares energy `|A x - b|^2` then becomes the
-//! unconstrained problem `|A K y - (b - A x0)|^2` in `y` (see [`crate::solve`]).
+//! unconstrained problem `|A K y - (b - A x0)|^2` in `y` (see [`crate::least_squares`]).
 //!
 //! # Nodes, unknowns and terms
 //!
@@ -68,23 +68,22 @@
 //!
 //! # `K^H A^H W A K` without a product
 //!
-//! [`crate::solve::LeastSquaresSolver`] forms the normal equations
+//! [`crate::least_squares::LeastSquaresSolver`] forms the normal equations
 //! `K^H A^H W A K y = K^H A^H W (b - A x0)` without a sparse-sparse product: every entry
 //! `A[r, l]` adds `A[r, l] K[l, j]` into `B[r, j]` of `B = A K`, once per entry of row `l`
 //! of `K` (the target entry of `B` of each such pair is found once per pattern), and
 //! `B^H W B` is summed row by row of `B` into the precomputed positions of its lower
-//! triangle (the `solve::normal` module). Solvers that assemble their own normal
+//! triangle (the `least_squares::normal` module). Solvers that assemble their own normal
 //! equations (the Beltrami flow) do the same face by face: the local unknowns of an
 //! element are the unknowns of its nodes' terms, the coefficient of unknown `j` is the
 //! sum over the element's nodes `i` of the element's row acting on `b_ij`.
 
-use crate::solve::{SolveError, SolveOptions, solve_spd};
 use beltrami_mesh::VertexId;
+use beltrami_sparse::{Scalar, SolveError, SolveOptions, solve_spd};
 use faer::MatRef;
 use faer::sparse::{CreationError, SparseColMat, SparseColMatRef, SymbolicSparseColMat, Triplet};
 use num_complex::Complex64;
-use std::fmt::Debug;
-use std::ops::{Add, AddAssign, Mul, MulAssign, Neg, Range, Sub, SubAssign};
+use std::ops::Range;
 use thiserror::Error;
 
 /// Relative tolerance for geometric coincidences: two fixed values of one group are the
@@ -96,47 +95,12 @@ use thiserror::Error;
 /// only, far below this.
 pub const GEOMETRIC_TOLERANCE: f64 = 1e-12;
 
-mod sealed {
-    pub trait Sealed {}
-    impl Sealed for f64 {}
-    impl Sealed for num_complex::Complex64 {}
-}
-
-/// The scalar of a DOF map and of the solvers: `f64` (real components: two per planar
-/// node in the real form, three per spatial node) or [`Complex64`] (the complex form, one
-/// unknown per planar node). Sealed: the two are the only ones the constraint semantics
-/// are defined for.
-pub trait Scalar:
-    faer::traits::ComplexField<Real = f64>
-    + Copy
-    + Debug
-    + PartialEq
-    + Send
-    + Sync
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Neg<Output = Self>
-    + AddAssign
-    + SubAssign
-    + MulAssign
-    + sealed::Sealed
-    + 'static
-{
+/// The scalar of a DOF map: `f64` (real components: two per planar node in the real
+/// form, three per spatial node) or [`Complex64`] (the complex form, one unknown per
+/// planar node), with how a node's planar position sits in a nodal vector of that form.
+pub trait DofScalar: Scalar {
     /// Nodal unknowns per planar node: 2 for `f64` (`[re, im]`), 1 for `Complex64`.
     const PER_NODE: usize;
-
-    /// `x` embedded in the scalar field (imaginary part 0).
-    fn from_f64(x: f64) -> Self;
-
-    /// Complex conjugate (identity for `f64`).
-    fn conjugate(self) -> Self;
-
-    /// `|x|^2`.
-    fn norm_sqr(self) -> f64;
-
-    /// True if no component is NaN or infinite.
-    fn finite(self) -> bool;
 
     /// The complex position of node `node` read from a full nodal vector `x` of this
     /// form: `x[node]` (complex form) or `x[2 node] + i x[2 node + 1]` (real form).
@@ -144,33 +108,13 @@ pub trait Scalar:
     fn node_position(x: &[Self], node: usize) -> Complex64;
 
     /// Writes the complex position `z` into node `node` of a full nodal vector `x` of
-    /// this form, the inverse of [`Scalar::node_position`]. The caller guarantees
+    /// this form, the inverse of [`DofScalar::node_position`]. The caller guarantees
     /// `x.len() >= PER_NODE * (node + 1)`.
     fn set_node_position(x: &mut [Self], node: usize, z: Complex64);
 }
 
-impl Scalar for f64 {
+impl DofScalar for f64 {
     const PER_NODE: usize = 2;
-
-    #[inline]
-    fn from_f64(x: f64) -> Self {
-        x
-    }
-
-    #[inline]
-    fn conjugate(self) -> Self {
-        self
-    }
-
-    #[inline]
-    fn norm_sqr(self) -> f64 {
-        self * self
-    }
-
-    #[inline]
-    fn finite(self) -> bool {
-        self.is_finite()
-    }
 
     #[inline]
     fn node_position(x: &[Self], node: usize) -> Complex64 {
@@ -184,28 +128,8 @@ impl Scalar for f64 {
     }
 }
 
-impl Scalar for Complex64 {
+impl DofScalar for Complex64 {
     const PER_NODE: usize = 1;
-
-    #[inline]
-    fn from_f64(x: f64) -> Self {
-        Complex64::new(x, 0.0)
-    }
-
-    #[inline]
-    fn conjugate(self) -> Self {
-        self.conj()
-    }
-
-    #[inline]
-    fn norm_sqr(self) -> f64 {
-        Complex64::norm_sqr(&self)
-    }
-
-    #[inline]
-    fn finite(self) -> bool {
-        self.is_finite()
-    }
 
     #[inline]
     fn node_position(x: &[Self], node: usize) -> Complex64 {
@@ -317,7 +241,7 @@ pub enum DofError {
         node: VertexId,
     },
     /// Complex positions asked of a map whose nodes are not planar in its scalar
-    /// (`dim != Scalar::PER_NODE`).
+    /// (`dim != DofScalar::PER_NODE`).
     #[error("the map has {dim} components per node: complex positions exist for planar maps only")]
     NotPlanar {
         /// The map's components per node.
@@ -485,7 +409,7 @@ struct Member {
 /// assert_eq!(x, [1.0, 0.0, 0.0, 1.0, 2.0, 3.0, 0.5, 0.25, 3.0, 2.0, 2.0, 1.0]);
 /// ```
 #[derive(Debug, Clone)]
-pub struct DofBuilder<T: Scalar> {
+pub struct DofBuilder<T: DofScalar> {
     n_nodes: usize,
     dim: usize,
     /// `x0`, `dim` entries per node.
@@ -497,7 +421,7 @@ pub struct DofBuilder<T: Scalar> {
     directions: Vec<T>,
 }
 
-impl<T: Scalar> DofBuilder<T> {
+impl<T: DofScalar> DofBuilder<T> {
     /// `n_nodes` nodes with `dim` components of `T` each (`dim = 2` or `3` real
     /// components, `1` complex), all fixed at the origin `0` until stated otherwise.
     /// Errors: [`DofError::ZeroDimension`], [`DofError::TooManyNodes`].
@@ -782,7 +706,7 @@ fn check_node(node: VertexId, n_nodes: usize) -> Result<usize, DofError> {
     }
 }
 
-fn check_value<T: Scalar>(
+fn check_value<T: DofScalar>(
     node: VertexId,
     what: &'static str,
     dim: usize,
@@ -807,7 +731,7 @@ fn check_value<T: Scalar>(
 /// independent: modified Gram-Schmidt leaves each direction, once its components along
 /// the previous ones are removed, longer than [`GEOMETRIC_TOLERANCE`] times its length.
 /// `scratch` holds the orthonormalized directions.
-fn independent<T: Scalar>(directions: &[T], dim: usize, scratch: &mut Vec<T>) -> bool {
+fn independent<T: DofScalar>(directions: &[T], dim: usize, scratch: &mut Vec<T>) -> bool {
     let k = directions.len() / dim;
     if k > dim {
         return false;
@@ -891,7 +815,7 @@ struct TermInfo {
 /// ([`DofMap::set_origin`], [`DofMap::set_direction`]): the pattern of `K`, the
 /// numbering and the terms stay.
 #[derive(Debug, Clone)]
-pub struct DofMap<T: Scalar> {
+pub struct DofMap<T: DofScalar> {
     n_nodes: usize,
     dim: usize,
     /// The terms of node `i` are `terms[term_ptr[i]..term_ptr[i + 1]]`.
@@ -907,7 +831,7 @@ pub struct DofMap<T: Scalar> {
     x0: Vec<T>,
 }
 
-impl<T: Scalar> DofMap<T> {
+impl<T: DofScalar> DofMap<T> {
     /// Number of nodes.
     pub fn n_nodes(&self) -> usize {
         self.n_nodes
@@ -1176,7 +1100,7 @@ impl<T: Scalar> DofMap<T> {
     }
 
     /// The image of `node` as a complex number, read from a full vector `x` of a planar
-    /// map (`dim = Scalar::PER_NODE`; else [`DofError::NotPlanar`]).
+    /// map (`dim = DofScalar::PER_NODE`; else [`DofError::NotPlanar`]).
     pub fn node_position(&self, x: &[T], node: VertexId) -> Result<Complex64, DofError> {
         self.check_planar()?;
         check_len("x", self.full_len(), x.len())?;
@@ -1450,7 +1374,7 @@ fn resolve(
     })
 }
 
-impl<T: Scalar> DofMap<T> {
+impl<T: DofScalar> DofMap<T> {
     /// The planar map of `constraints` in the form of `T`: the groups of [`resolve`],
     /// declared on a [`DofBuilder`] in their order.
     fn planar(

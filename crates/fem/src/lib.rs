@@ -6,7 +6,9 @@
 //! mass, complex derivatives `D_z`, `D_zbar`), Beltrami coefficients of maps (planar,
 //! surface to plane, surface to surface, quaternionic), sparse assembly into fixed
 //! patterns, affine DOF maps for constraints, and constrained least-squares solves that
-//! reuse their symbolic factorization.
+//! reuse their symbolic factorization ([`least_squares`], on the sparse Cholesky of
+//! `beltrami-sparse`; the vertex graph's orders carried to the unknowns in
+//! [`vertex_graph`]).
 //!
 //! The numerics the solver plugins share live here too: boundary maps of disk meshes
 //! onto a circle, square or convex polygon ([`boundary`]), the edge weights of linear
@@ -28,22 +30,23 @@ pub mod element;
 mod error;
 pub mod expr;
 pub mod field;
+pub mod least_squares;
 pub mod mean_curvature;
 pub mod operators;
 pub mod quaternion;
 pub mod quaternionic_lsqc;
-pub mod solve;
+pub mod vertex_graph;
 pub mod weighted_mean;
 pub mod weights;
 
 pub use beltrami::ReferenceNormal;
 pub use boundary::{BoundaryError, BoundaryMap};
 pub use distortion::{Distortion, DistortionStats, Histogram, MuError};
-pub use dof::{DofBuilder, DofConstraints, DofError, DofMap, DofTerm, NodeDof};
+pub use dof::{DofBuilder, DofConstraints, DofError, DofMap, DofScalar, DofTerm, NodeDof};
 pub use element::{Elements, Frame, QuadraturePoint, TangentFrame};
 pub use error::FemError;
 pub use expr::{Expr, ExprError};
 pub use field::{BeltramiField, FieldError};
-pub use solve::{LeastSquaresSolver, Preconditioned, SolveError, SolveOptions, SpdSolver};
+pub use least_squares::LeastSquaresSolver;
 pub use weighted_mean::WeightedMeanSystem;
 pub use weights::{EdgeWeights, WeightError};

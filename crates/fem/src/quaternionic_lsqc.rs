@@ -249,7 +249,7 @@ pub enum SpaceError {
     Dof(#[from] crate::DofError),
     /// The least-squares solve failed.
     #[error(transparent)]
-    Solve(#[from] crate::SolveError),
+    Solve(#[from] beltrami_sparse::SolveError),
 }
 
 /// The least-squares quasiconformal map into R^3 of a coefficient `mu` per face
@@ -277,7 +277,7 @@ impl SpaceSystem {
         held: &[(VertexId, Point3<f64>)],
         normal: Option<NormalConstraint>,
         area: Option<AreaConstraint>,
-        options: crate::SolveOptions,
+        options: beltrami_sparse::SolveOptions,
     ) -> Result<Self, SpaceError> {
         let operator = QuaternionicOperator::new(&elements, vertex_count, normal.as_ref())?;
         let mut builder = crate::DofBuilder::<f64>::new(vertex_count, 3)?;

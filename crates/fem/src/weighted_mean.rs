@@ -29,9 +29,9 @@ use faer::{Conj, Mat, Par};
 use num_complex::Complex64;
 
 use crate::boundary::BoundaryMap;
-use crate::solve::solve_spd;
 use crate::weights::EdgeWeights;
-use crate::{SolveError, SolveOptions};
+use beltrami_sparse::solve_spd;
+use beltrami_sparse::{SolveError, SolveOptions};
 
 /// The weighted-mean system of a fixed boundary (module docs): `L_II x_I = b`, with one
 /// right-hand side column for the real and one for the imaginary parts.
@@ -160,7 +160,7 @@ impl WeightedMeanSystem {
                     let index = symbolic.col_perm().arrays().0[index.min(size - 1)];
                     SolveError::Singular {
                         index,
-                        node: Some(self.interior[index]),
+                        node: Some(self.interior[index].idx()),
                         ratio: 0.0,
                     }
                 }

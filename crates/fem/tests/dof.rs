@@ -4,9 +4,10 @@
 //! each kind of node, the structure of `K`, refilled directions, constrained least
 //! squares with known solutions, and typed errors.
 
+use beltrami_fem::LeastSquaresSolver;
 use beltrami_fem::dof::{DofBuilder, DofError, DofMap, NodeDof};
-use beltrami_fem::solve::{LeastSquaresSolver, SolveOptions};
 use beltrami_mesh::VertexId;
+use beltrami_sparse::SolveOptions;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, MatRef};
 use num_complex::Complex64;

@@ -1,13 +1,15 @@
 //! Fill-reducing orders: nested dissection against AMD, and the rule choosing between
 //! them.
 
-use beltrami_fem::solve::{
+use beltrami_fem::vertex_graph::order_of_unknowns;
+use beltrami_fem::{DofConstraints, DofMap};
+use beltrami_mesh::VertexId;
+use beltrami_sparse::{
     NESTED_DISSECTION_FROM, PlannedCholesky, SplitOrder, amd_order, factor_count,
     fill_reducing_order, first_split_order, nested_dissection_order, nested_dissection_split,
     two_core_order,
 };
-use beltrami_fem::{DofConstraints, DofMap, SolveError, SolveOptions, SpdSolver};
-use beltrami_mesh::VertexId;
+use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{SymmetricOrdering, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
@@ -359,7 +361,7 @@ fn a_split_solver_matches_the_whole_factorization() {
     let scale = solutions[1].norm_max();
     assert!((&solutions[0] - &solutions[1]).norm_max() < 1e-10 * scale);
     // A split with no second side is factored whole.
-    let one_side = beltrami_fem::solve::SplitOrder {
+    let one_side = beltrami_sparse::SplitOrder {
         order: split.order.clone(),
         sides: Some([n, 0]),
     };
@@ -512,7 +514,7 @@ fn a_vertex_order_carries_over_to_the_unknowns() {
         order: vec![3, 0, 4, 1, 2, 5, 6],
         sides: Some([3, 2]),
     };
-    let unknowns = vertices.of_unknowns(&dofs).unwrap();
+    let unknowns = order_of_unknowns(&vertices, &dofs).unwrap();
     let own = |v: usize| unknown(v).unwrap();
     assert_eq!(unknowns.order, vec![own(3), own(0), own(1), own(5), shared]);
     assert_eq!(unknowns.sides, Some([2, 1]));
@@ -521,7 +523,7 @@ fn a_vertex_order_carries_over_to_the_unknowns() {
         order: vertices.order.clone(),
         sides: None,
     };
-    let unknowns = whole.of_unknowns(&dofs).unwrap();
+    let unknowns = order_of_unknowns(&whole, &dofs).unwrap();
     assert_eq!(unknowns.order.last(), Some(&shared));
     assert_eq!(unknowns.sides, None);
     // An order of another vertex count, or naming a vertex beyond the map's, is refused.
@@ -530,7 +532,7 @@ fn a_vertex_order_carries_over_to_the_unknowns() {
         sides: None,
     };
     assert!(matches!(
-        short.of_unknowns(&dofs),
+        order_of_unknowns(&short, &dofs),
         Err(SolveError::Length { .. })
     ));
     let beyond = SplitOrder {
@@ -538,7 +540,7 @@ fn a_vertex_order_carries_over_to_the_unknowns() {
         sides: None,
     };
     assert!(matches!(
-        beyond.of_unknowns(&dofs),
+        order_of_unknowns(&beyond, &dofs),
         Err(SolveError::InvalidOrder { index: 6 })
     ));
 }

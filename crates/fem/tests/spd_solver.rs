@@ -4,8 +4,8 @@
 mod common;
 
 use beltrami_fem::assembly::Pattern;
-use beltrami_fem::solve::amd_order;
-use beltrami_fem::{SolveError, SolveOptions, SpdSolver};
+use beltrami_sparse::amd_order;
+use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
 use faer::sparse::SparseColMat;
 use faer::{Mat, MatMut};
 

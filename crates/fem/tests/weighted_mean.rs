@@ -3,8 +3,9 @@
 
 mod common;
 
-use beltrami_fem::{EdgeWeights, SolveError, SolveOptions, WeightedMeanSystem, boundary};
+use beltrami_fem::{EdgeWeights, WeightedMeanSystem, boundary};
 use beltrami_mesh::primitives::Cells;
+use beltrami_sparse::{SolveError, SolveOptions};
 use common::jittered;
 use num_complex::Complex64;
 

@@ -17,8 +17,8 @@
 
 use beltrami_core::SolverError;
 use beltrami_fem::assembly::Pattern;
-use beltrami_fem::{SolveOptions, SpdSolver};
 use beltrami_mesh::Vector3;
+use beltrami_sparse::{SolveOptions, SpdSolver};
 use faer::Mat;
 
 use crate::target::Role;

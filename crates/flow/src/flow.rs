@@ -67,8 +67,9 @@
 use std::time::Instant;
 
 use beltrami_core::{Context, Progress, SolverError};
-use beltrami_fem::{Elements, SolveOptions};
+use beltrami_fem::Elements;
 use beltrami_mesh::{FaceId, Point3, Vector2, Vector3};
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 use crate::extension::HarmonicExtension;

@@ -7,8 +7,9 @@ use beltrami_core::{
     OptionKind, OptionSpec, Output, Problem, Report, Settings, Solution, SolverError, THREADS,
     Target, TargetKind, Topology,
 };
-use beltrami_fem::{BeltramiField, DistortionStats, Elements, Frame, MuError, SolveOptions};
+use beltrami_fem::{BeltramiField, DistortionStats, Elements, Frame, MuError};
 use beltrami_mesh::{Point3, VertexId};
+use beltrami_sparse::SolveOptions;
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
@@ -603,7 +604,7 @@ impl Runner<'_, '_> {
         )
     })
     .map_err(|e| match e {
-        SolverError::Solve(beltrami_fem::SolveError::Singular { .. } | beltrami_fem::SolveError::NotPositiveDefinite { .. }) => invalid(
+        SolverError::Solve(beltrami_sparse::SolveError::Singular { .. } | beltrami_sparse::SolveError::NotPositiveDefinite { .. }) => invalid(
             "the flow is not determined: pin more vertices (disk: one interior and one boundary vertex; annulus: one boundary vertex; sphere: three vertices)",
         ),
         e => e,

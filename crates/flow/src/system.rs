@@ -38,9 +38,11 @@
 
 use beltrami_core::SolverError;
 use beltrami_fem::assembly::Pattern;
-use beltrami_fem::solve::{SplitOrder, fill_reducing_order, two_core_order};
-use beltrami_fem::{DofBuilder, DofMap, Elements, SolveError, SolveOptions, SpdSolver};
+use beltrami_fem::vertex_graph::order_of_unknowns;
+use beltrami_fem::{DofBuilder, DofMap, Elements};
 use beltrami_mesh::{FaceId, Point3, Vector3, VertexId};
+use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
+use beltrami_sparse::{SplitOrder, fill_reducing_order, two_core_order};
 use faer::MatMut;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
@@ -880,7 +882,7 @@ fn block_order(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<SplitOrder, S
             sides: None,
         }
     };
-    Ok(vertices.of_unknowns(dofs)?)
+    Ok(order_of_unknowns(&vertices, dofs)?)
 }
 
 /// A vector of R^3 (three components) as the complex number of its components along

@@ -37,8 +37,9 @@
 
 use std::collections::VecDeque;
 
-use beltrami_fem::{EdgeWeights, Elements, SolveError, solve::SaddlePointSolver};
+use beltrami_fem::{EdgeWeights, Elements};
 use beltrami_mesh::{FaceId, HalfedgeId, Mesh, VertexId};
+use beltrami_sparse::{SaddlePointSolver, SolveError};
 use num_complex::Complex64;
 
 /// The space of discrete harmonic 1-forms of a planar triangle mesh, parametrized as in

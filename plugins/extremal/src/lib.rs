@@ -33,7 +33,7 @@
 //! `1/|phi(t)|`; `k` by eq. 12) and one f-step (the least-squares quasiconformal map for
 //! `mu = k conj(phi)/|phi|` with the boundary fixed). Every step lowers `E`. Both linear
 //! systems keep their patterns: the h-step's saddle-point LU
-//! ([`beltrami_fem::solve::SaddlePointSolver`]) and the f-step's normal-equation
+//! ([`beltrami_sparse::SaddlePointSolver`]) and the f-step's normal-equation
 //! Cholesky ([`beltrami_fem::LeastSquaresSolver`]) are factored symbolically once.
 //!
 //! # Domains

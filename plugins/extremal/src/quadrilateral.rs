@@ -23,10 +23,9 @@
 //! sliding along the circle, projected back onto it) alternating with eq. 12 for `k`.
 
 use beltrami_core::{Constraint, Position, Problem, SolverError};
-use beltrami_fem::{
-    BoundaryMap, EdgeWeights, Elements, SolveOptions, WeightedMeanSystem, beltrami::planar_map,
-};
+use beltrami_fem::{BoundaryMap, EdgeWeights, Elements, WeightedMeanSystem, beltrami::planar_map};
 use beltrami_mesh::{Mesh, VertexId};
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 /// How far from the unit circle a landmark's destination may be.

@@ -11,9 +11,10 @@ use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::element::{check_planar, is_planar};
 use beltrami_fem::{
     BoundaryMap, Distortion, DofConstraints, DofMap, EdgeWeights, Elements, Frame,
-    LeastSquaresSolver, SolveOptions, WeightedMeanSystem,
+    LeastSquaresSolver, WeightedMeanSystem,
 };
 use beltrami_mesh::{Mesh, VertexId};
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 use crate::flatten::{Flattening, flatten};

@@ -74,8 +74,9 @@ use beltrami_core::{
 };
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::distortion::{Distortion, measure_planar};
-use beltrami_fem::{EdgeWeights, Elements, Frame, SolveOptions, WeightError};
+use beltrami_fem::{EdgeWeights, Elements, Frame, WeightError};
 use beltrami_mesh::Mesh;
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 /// Adds [`Tutte`], [`Harmonic`], [`Lscm`] and [`Sphere`] to `registry`.

@@ -29,15 +29,13 @@ use beltrami_core::{
 };
 use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::conformal_energy::{ConformalSystem, conformal_energy, conformal_system};
+use beltrami_fem::least_squares::{normal_pattern_of_cells, singular_at_node};
 use beltrami_fem::operators::{beltrami_operator, weighted_residual};
-use beltrami_fem::solve::{
-    NESTED_DISSECTION_FROM, PlannedCholesky, nested_dissection_split, normal_pattern_of_cells,
-    pattern_of_unknowns, vertex_graph_pattern,
-};
-use beltrami_fem::{
-    DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveError, SpdSolver,
-};
+use beltrami_fem::vertex_graph::{order_of_unknowns, pattern_of_unknowns, vertex_graph_pattern};
+use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::{FaceId, Mesh, VertexId};
+use beltrami_sparse::SpdSolver;
+use beltrami_sparse::{NESTED_DISSECTION_FROM, PlannedCholesky, nested_dissection_split};
 use faer::MatMut;
 use faer::sparse::SparseColMatRef;
 use num_complex::Complex64;
@@ -156,7 +154,7 @@ impl Solver for Lscm {
 /// dissection ([`NESTED_DISSECTION_FROM`] unknowns), the vertex graph is dissected on
 /// another thread from the start, while the DOF map is made, and the order carried over
 /// to the unknowns
-/// ([`SplitOrder::of_unknowns`](beltrami_fem::solve::SplitOrder::of_unknowns)).
+/// ([`order_of_unknowns`]).
 fn by_sides(
     mesh: &Mesh,
     constraints: &DofConstraints,
@@ -188,8 +186,8 @@ fn by_sides(
                         // A panic in the ordering thread is a bug; pass it on as one.
                         let split = thread
                             .join()
-                            .unwrap_or_else(|p| std::panic::resume_unwind(p))?
-                            .of_unknowns(dofs)?;
+                            .unwrap_or_else(|p| std::panic::resume_unwind(p))?;
+                        let split = order_of_unknowns(&split, dofs)?;
                         PlannedCholesky::with_dissection(copy, split, options)
                     }
                     None => PlannedCholesky::new(copy, options),
@@ -208,20 +206,9 @@ fn by_sides(
         context.stage("solve", report, || {
             let ConformalSystem { values, mut rhs } = system;
             if let Some(mut solver) = solver {
-                let singular = |index: usize, ratio: f64| SolveError::Singular {
-                    index,
-                    node: dofs.dof_node(index),
-                    ratio,
-                };
                 solver
                     .factorize(SparseColMatRef::new(pattern.as_ref(), &values))
-                    .map_err(|e| match e {
-                        // The energy is semidefinite: a non-positive pivot is a zero one
-                        // perturbed by rounding.
-                        SolveError::NotPositiveDefinite { index } => singular(index, 0.0),
-                        SolveError::Singular { index, ratio, .. } => singular(index, ratio),
-                        other => other,
-                    })?;
+                    .map_err(|e| singular_at_node(e, &dofs))?;
                 drop(values);
                 let n = rhs.len();
                 solver.solve_in_place(MatMut::from_column_major_slice_mut(&mut rhs, n, 1))?;

@@ -5,11 +5,12 @@ mod common;
 
 use beltrami_core::{Context, Pin, PlanarBoundary, Position, Problem, Solver, SolverError, Target};
 use beltrami_fem::operators::{beltrami_operator, weighted_residual};
-use beltrami_fem::solve::NESTED_DISSECTION_FROM;
-use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveOptions};
+use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_init::Lscm;
 use beltrami_mesh::primitives::{Cells, icosphere, torus};
 use beltrami_mesh::{Mesh, Point3};
+use beltrami_sparse::NESTED_DISSECTION_FROM;
+use beltrami_sparse::SolveOptions;
 use common::{
     boundary_vertices, flipped_faces, hemisphere, identity_error, jittered, planar, shared_disks,
     summary,

@@ -12,9 +12,10 @@ use beltrami_fem::element::check_planar;
 use beltrami_fem::operators::{beltrami_operator, weighted_residual};
 use beltrami_fem::{
     BeltramiField, Distortion, DofConstraints, DofMap, Elements, FemError, Frame,
-    LeastSquaresSolver, MuError, SolveOptions,
+    LeastSquaresSolver, MuError,
 };
 use beltrami_mesh::VertexId;
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 /// The least-squares quasiconformal map (crate docs).

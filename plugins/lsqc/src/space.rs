@@ -22,8 +22,9 @@ use beltrami_fem::quaternion::quaternionic_mu;
 use beltrami_fem::quaternionic_lsqc::{
     AreaConstraint, NormalConstraint, SpaceSystem, undetermined,
 };
-use beltrami_fem::{BeltramiField, Elements, Frame, MuError, ReferenceNormal, SolveOptions};
+use beltrami_fem::{BeltramiField, Elements, Frame, MuError, ReferenceNormal};
 use beltrami_mesh::{Point3, VertexId};
+use beltrami_sparse::SolveOptions;
 
 use crate::lsqc::{NAME, invalid, unsupported};
 

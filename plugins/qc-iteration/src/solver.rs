@@ -10,10 +10,9 @@ use beltrami_fem::operators::beltrami_operator;
 use beltrami_fem::quaternionic_lsqc::{
     AreaConstraint, NormalConstraint, SpaceSystem, undetermined,
 };
-use beltrami_fem::{
-    DofConstraints, DofMap, Elements, FemError, Frame, LeastSquaresSolver, SolveOptions,
-};
+use beltrami_fem::{DofConstraints, DofMap, Elements, FemError, Frame, LeastSquaresSolver};
 use beltrami_mesh::{Point3, VertexId};
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 use crate::line_search::best_step;

@@ -21,8 +21,9 @@
 
 use beltrami_core::SolverError;
 use beltrami_fem::boundary;
-use beltrami_fem::{EdgeWeights, SolveOptions, WeightedMeanSystem};
+use beltrami_fem::{EdgeWeights, WeightedMeanSystem};
 use beltrami_mesh::{Mesh, Point3, PolygonSoup, VertexId};
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 use crate::moebius::{DiskAutomorphism, PlaneCircle};

@@ -7,8 +7,9 @@ use beltrami_core::{
 };
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::element::check_planar;
-use beltrami_fem::{BeltramiField, Distortion, Elements, FemError, Frame, MuError, SolveOptions};
+use beltrami_fem::{BeltramiField, Distortion, Elements, FemError, Frame, MuError};
 use beltrami_mesh::Mesh;
+use beltrami_sparse::SolveOptions;
 
 use crate::NAME;
 use crate::initial::{CircleMap, Loops, initial_map};

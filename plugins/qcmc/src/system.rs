@@ -35,9 +35,10 @@
 //! factorization are fixed; each step refills the values.
 
 use beltrami_core::SolverError;
+use beltrami_fem::Elements;
 use beltrami_fem::assembly::Pattern;
-use beltrami_fem::{Elements, SolveOptions, SpdSolver};
 use beltrami_mesh::VertexId;
+use beltrami_sparse::{SolveOptions, SpdSolver};
 use faer::MatMut;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;

@@ -1,8 +1,9 @@
 //! Errors of the initial bijection.
 
 use beltrami_core::SolverError;
-use beltrami_fem::{BoundaryError, DofError, FemError, SolveError, WeightError};
+use beltrami_fem::{BoundaryError, DofError, FemError, WeightError};
 use beltrami_mesh::{CutError, MeshError, VertexId};
+use beltrami_sparse::SolveError;
 use beltrami_spatial::SpatialError;
 use thiserror::Error;
 

@@ -23,10 +23,9 @@
 
 use beltrami_fem::beltrami::{face_mu, flipped_faces, planar_map, point_mu};
 use beltrami_fem::operators::beltrami_operator;
-use beltrami_fem::{
-    DofBuilder, DofError, DofMap, Elements, Frame, LeastSquaresSolver, SolveOptions,
-};
+use beltrami_fem::{DofBuilder, DofError, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::{FaceId, Mesh, VertexId};
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 use crate::error::{RegisterError, Side};

@@ -35,8 +35,9 @@
 //! `sup |mu|` at least this.
 
 use beltrami_fem::operators::stiffness_matrix;
-use beltrami_fem::{Elements, Frame, SolveOptions, solve::solve_spd};
+use beltrami_fem::{Elements, Frame};
 use beltrami_mesh::{CutMesh, Mesh};
+use beltrami_sparse::{SolveOptions, solve_spd};
 use faer::Mat;
 use num_complex::Complex64;
 

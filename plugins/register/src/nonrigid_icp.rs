@@ -22,8 +22,8 @@
 //! root-mean-square radius, so that `gamma = 1` weighs the translations like the linear
 //! parts.
 
-use beltrami_fem::{SolveError, SolveOptions, SpdSolver};
 use beltrami_mesh::{Mesh, Point3, Vector3};
+use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
 use beltrami_spatial::SurfaceIndex;
 use faer::Mat;
 use faer::sparse::{CreationError, FaerError, SparseColMat, Triplet};

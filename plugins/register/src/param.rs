@@ -2,8 +2,9 @@
 //! length along boundary paths, and meshes with the connectivity of a mesh and the
 //! parameter positions as vertices.
 
-use beltrami_fem::{BoundaryMap, EdgeWeights, SolveOptions, WeightError, WeightedMeanSystem};
+use beltrami_fem::{BoundaryMap, EdgeWeights, WeightError, WeightedMeanSystem};
 use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, VertexId, parallel};
+use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
 use crate::error::{RegisterError, Side};

@@ -18,13 +18,14 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use beltrami_fem::operators::{ElementMatrices, complex_derivatives, real_block_form};
-use beltrami_fem::solve::solve_spd;
 use beltrami_fem::{
-    DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, SolveOptions, assembly::Pattern,
+    DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, assembly::Pattern,
 };
 use beltrami_mesh::primitives::{Cells, grid};
 use beltrami_mesh::subdivision::subdivide;
 use beltrami_mesh::{BuildOptions, Mesh, VertexId, io};
+use beltrami_sparse::SolveOptions;
+use beltrami_sparse::solve_spd;
 use clap::Args;
 use faer::prelude::Solve;
 use faer::sparse::SparseColMat;

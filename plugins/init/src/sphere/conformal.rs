@@ -64,9 +64,10 @@
 //! drifting along the Moebius group (each solve's discretization error is not invariant
 //! under it).
 
-use beltrami_fem::solve::fill_reducing_order;
-use beltrami_fem::{EdgeWeights, SolveError, SolveOptions, SpdSolver};
+use beltrami_fem::EdgeWeights;
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector3, VertexId};
+use beltrami_sparse::fill_reducing_order;
+use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
 use faer::Mat;
 use faer::sparse::{FaerError, SparseColMat, Triplet};
 use nalgebra::Rotation3;

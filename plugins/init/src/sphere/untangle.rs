@@ -16,8 +16,9 @@
 //! not convex enough the face may stay flipped: then `k` grows, up to [`MAX_RINGS`], and
 //! the faces still flipped are counted and reported.
 
-use beltrami_fem::{EdgeWeights, SolveError, SolveOptions};
+use beltrami_fem::EdgeWeights;
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector3, VertexId};
+use beltrami_sparse::{SolveError, SolveOptions};
 use nalgebra::Rotation3;
 
 use super::conformal::{Chart, ChartSystem};

@@ -1,11 +1,9 @@
 //! Equality-constrained quadratic minimization through the saddle-point (KKT) system,
-//! for constraints a [`DofMap`](crate::dof::DofMap) cannot express (general linear
+//! for constraints a DOF map (`beltrami-fem`) cannot express (general linear
 //! relations `C x = d`, e.g. a zero mean or a fixed area-weighted centroid).
 
-use super::{
-    SolveError, SolveOptions, check_finite, check_finite_matrix, check_finite_solution, check_len,
-};
-use crate::dof::Scalar;
+use crate::check::{check_finite, check_finite_matrix, check_finite_solution, check_len};
+use crate::{Scalar, SolveError, SolveOptions};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::LuError;
 use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};

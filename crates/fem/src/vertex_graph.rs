@@ -1,8 +1,10 @@
 //! The pattern of a mesh's vertex graph, for ordering a factorization before the
 //! unknowns are known.
 
-use crate::dof::{DofMap, Scalar};
+use crate::dof::{DofMap, DofScalar};
 use beltrami_mesh::{Mesh, VertexId};
+use beltrami_sparse::check::check_len;
+use beltrami_sparse::{SolveError, SplitOrder};
 use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 /// The lower triangle (diagonal included, each column's rows increasing) of the
@@ -10,7 +12,7 @@ use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 /// `w > v`, for every edge `{v, w}`. On a triangle mesh it is the pattern of any
 /// energy coupling the vertices of each face (the cotangent Laplacian, the conformal
 /// energy), before a DOF map drops fixed vertices; an order of it carries over to the
-/// unknowns ([`SplitOrder::of_unknowns`](super::SplitOrder::of_unknowns)). On quads the
+/// unknowns ([`order_of_unknowns`]). On quads the
 /// diagonals of a face are not edges.
 ///
 /// One pass over the vertices' neighbours, written in place: no list of pairs to sort.
@@ -39,9 +41,9 @@ pub fn vertex_graph_pattern(mesh: &Mesh) -> SymbolicSparseColMat<usize> {
 /// nodes, each once (the complex form with fixed nodes: a fixed node's row and column
 /// are dropped, the others renumbered, their order kept); `None` otherwise, and when
 /// the pattern is not of `dofs`' nodes. On a triangle mesh this is the pattern
-/// [`normal_pattern_of_cells`](super::normal_pattern_of_cells) gives from the faces, in
+/// [`normal_pattern_of_cells`](crate::least_squares::normal_pattern_of_cells) gives from the faces, in
 /// one pass over the graph.
-pub fn pattern_of_unknowns<T: Scalar>(
+pub fn pattern_of_unknowns<T: DofScalar>(
     vertex_graph: SymbolicSparseColMatRef<'_, usize>,
     dofs: &DofMap<T>,
 ) -> Option<SymbolicSparseColMat<usize>> {
@@ -86,6 +88,49 @@ pub fn pattern_of_unknowns<T: Scalar>(
     Some(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows))
 }
 
+/// `vertex_order`, an order of `dofs`' nodes (an order of the vertex graph: cheaper to order than
+/// the unknowns' graph, and ready before the DOF map is) carried over to its reduced
+/// unknowns: the unknowns that move one node alone take that node's place, the
+/// unknowns shared by several nodes go last, in increasing order (with the separator
+/// when there are sides); a fixed node has none. The sides' lengths are counted
+/// again in unknowns.
+///
+/// Errors: [`SolveError::Length`] when the order is not as long as `dofs` has nodes
+/// or its sides are longer, [`SolveError::InvalidOrder`] for a node out of range.
+pub fn order_of_unknowns<T: DofScalar>(
+    vertex_order: &SplitOrder,
+    dofs: &DofMap<T>,
+) -> Result<SplitOrder, SolveError> {
+    let nodes = dofs.n_nodes();
+    check_len("the length of the order", nodes, vertex_order.order.len())?;
+    let n = dofs.reduced_len();
+    let shared: Vec<bool> = (0..n)
+        .map(|j| dofs.unknown_nodes(j).is_some_and(|nodes| nodes.count() > 1))
+        .collect();
+    let [a, b] = vertex_order.sides.unwrap_or([nodes, 0]);
+    check_len("the sides of the order", nodes, nodes.max(a + b))?;
+    let mut order = Vec::with_capacity(n);
+    let mut ends = [0; 2];
+    for (part, range) in [0..a, a..a + b, a + b..nodes].into_iter().enumerate() {
+        for (k, &v) in vertex_order.order[range.clone()].iter().enumerate() {
+            let terms =
+                dofs.node_terms(VertexId::from_usize(v))
+                    .map_err(|_| SolveError::InvalidOrder {
+                        index: range.start + k,
+                    })?;
+            order.extend(terms.map(|(_, t)| t.dof).filter(|&j| !shared[j]));
+        }
+        if let Some(end) = ends.get_mut(part) {
+            *end = order.len();
+        }
+    }
+    order.extend((0..n).filter(|&j| shared[j]));
+    Ok(SplitOrder {
+        order,
+        sides: vertex_order.sides.map(|_| [ends[0], ends[1] - ends[0]]),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -119,7 +164,7 @@ mod tests {
     #[test]
     fn carried_to_the_unknowns_the_graph_is_the_faces_pattern() {
         use crate::dof::DofConstraints;
-        use crate::solve::normal_pattern_of_cells;
+        use crate::least_squares::normal_pattern_of_cells;
         use beltrami_mesh::FaceId;
         use num_complex::Complex64;
         let mesh = Mesh::from_soup(&grid(9, 7, Cells::Triangles)).unwrap();

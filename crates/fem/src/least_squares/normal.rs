@@ -60,7 +60,7 @@
 //! numeric phase.
 
 use super::SolveError;
-use crate::dof::{DofMap, Scalar};
+use crate::dof::{DofMap, DofScalar};
 use beltrami_mesh::VertexId;
 use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
@@ -134,7 +134,7 @@ enum AnyMaps {
 }
 
 /// `N = B^H W B` (lower triangle) and `g = B^H W r`, with their symbolic structure.
-pub(super) struct NormalEquations<T: Scalar> {
+pub(super) struct NormalEquations<T: DofScalar> {
     /// `K` row by row: the entries of row `l` (column `l` of `A`) are
     /// `k_values[k_row_ptr[l]..k_row_ptr[l + 1]]`, in increasing column order.
     k_row_ptr: Vec<usize>,
@@ -149,7 +149,7 @@ pub(super) struct NormalEquations<T: Scalar> {
     values: Vec<T>,
 }
 
-impl<T: Scalar> NormalEquations<T> {
+impl<T: DofScalar> NormalEquations<T> {
     /// Symbolic phase for matrices with the pattern `a` (`m x dofs.full_len()`, checked
     /// by the caller). Errors: [`SolveError::Unconstrained`] if a reduced unknown appears
     /// in no row of `A`, [`SolveError::Faer`] on allocation or index overflow.
@@ -300,7 +300,7 @@ impl<T: Scalar> NormalEquations<T> {
 /// ([`super::LeastSquaresSolver::with_planned`]).
 ///
 /// Errors: [`SolveError::Length`] for a node beyond `dofs`' nodes.
-pub fn normal_pattern_of_cells<T: Scalar, C: IntoIterator<Item = VertexId>>(
+pub fn normal_pattern_of_cells<T: DofScalar, C: IntoIterator<Item = VertexId>>(
     cells: impl Iterator<Item = C> + Clone,
     dofs: &DofMap<T>,
 ) -> Result<SymbolicSparseColMat<usize>, SolveError> {
@@ -407,7 +407,7 @@ impl<I: Index> Maps<I> {
     /// The maps and the lower pattern of `N` (module docs). `k_rows` is the pattern of
     /// `K` row by row, `row_len[i]` the number of products (entry of row `i` of `A`, entry
     /// of its row of `K`).
-    fn new<T: Scalar>(
+    fn new<T: DofScalar>(
         a: SymbolicSparseColMatRef<'_, usize>,
         k_rows: KRows<'_>,
         row_len: &[usize],
@@ -495,7 +495,7 @@ impl<I: Index> Maps<I> {
         if let Some(index) = (0..n).find(|&j| bt_ptr[j + 1] == 0) {
             return Err(SolveError::Unconstrained {
                 index,
-                node: dofs.dof_node(index),
+                node: dofs.dof_node(index).map(|v| v.idx()),
             });
         }
         for j in 0..n {
@@ -572,7 +572,7 @@ impl<I: Index> Maps<I> {
 
     /// The numeric phase of [`NormalEquations::assemble`]; `k` is `K` row by row
     /// (pointers and values).
-    fn assemble<T: Scalar>(
+    fn assemble<T: DofScalar>(
         &self,
         (k_row_ptr, k_values): (&[usize], &[T]),
         a: SparseColMatRef<'_, usize, T>,
@@ -651,7 +651,7 @@ mod tests {
     /// Two rows per element of three nodes, both with entries at every unknown of the
     /// three nodes, like a real block form: rows `2 e` and `2 e + 1` have the same
     /// columns (one block of pairs for both).
-    fn element_rows<T: Scalar>(
+    fn element_rows<T: DofScalar>(
         n_nodes: usize,
         elements: &[[usize; 3]],
         value: impl Fn(&mut u64) -> T,
@@ -672,7 +672,7 @@ mod tests {
     }
 
     /// `B^H W B` and `B^H W r` from dense matrices.
-    fn dense<T: Scalar>(
+    fn dense<T: DofScalar>(
         a: &SparseColMat<usize, T>,
         dofs: &DofMap<T>,
         w: &[f64],
@@ -694,7 +694,7 @@ mod tests {
         (normal, rhs)
     }
 
-    fn check<T: Scalar>(dofs: &DofMap<T>, value: impl Fn(&mut u64) -> T + Copy) {
+    fn check<T: DofScalar>(dofs: &DofMap<T>, value: impl Fn(&mut u64) -> T + Copy) {
         // Element [2, 5, 6] holds both shared nodes 2 and 6: their entries merge.
         let elements = [
             [0, 1, 2],

@@ -504,7 +504,7 @@ impl<'g> Dissection<'g> {
             col_ptr.push(row_idx.len());
         }
         let pattern = SymbolicSparseColMatRef::new_unsorted_checked(n, n, &col_ptr, None, &row_idx);
-        let order = super::amd_order(pattern);
+        let order = crate::amd_order(pattern);
         for &v in &vertices {
             self.part[v] = DONE;
         }
@@ -801,7 +801,7 @@ mod tests {
     fn the_first_split_of_an_irregular_grid_is_about_one_line() {
         let k = 150;
         // Adjacency lists are a pattern of both triangles without the diagonal.
-        let (col_ptr, neighbours) = super::super::vertex_separator::tests::grid(k, true);
+        let (col_ptr, neighbours) = crate::vertex_separator::tests::grid(k, true);
         let row_idx: Vec<usize> = neighbours.iter().map(|&w| w as usize).collect();
         let dissected = nested_dissection(k * k, &col_ptr, &row_idx, Depth::Multilevel);
         let [a, b] = dissected.halves.expect("a split");

@@ -11,7 +11,8 @@
 //! `r_j x r_j` block. That is the quantity AMD estimates for its own order
 //! (`n_mult_subs_ldl`), so the two compare directly.
 
-use super::{SolveError, inverse_permutation};
+use crate::SolveError;
+use crate::spd::inverse_permutation;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::simplicial::{
     prefactorize_symbolic_cholesky, prefactorize_symbolic_cholesky_scratch,
@@ -38,7 +39,7 @@ pub fn factor_count(
     order: &[usize],
 ) -> Result<FactorCount, SolveError> {
     let n = pattern.nrows();
-    super::check_len("the length of the order", n, order.len())?;
+    crate::check::check_len("the length of the order", n, order.len())?;
     let inverse = inverse_permutation(order)?;
     // The upper triangle of P A P^T, by a counting pass: an entry (i, j), i != j, read
     // in either triangle, goes to column max(p_i, p_j) at row min(p_i, p_j). Rows stay
@@ -118,9 +119,6 @@ pub(super) fn stored_multiply_subtracts(symbolic: &SymbolicCholesky<usize>, colu
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solve::vertex_graph_pattern;
-    use beltrami_mesh::Mesh;
-    use beltrami_mesh::primitives::{self, Cells};
     use faer::Side;
     use faer::perm::PermRef;
     use faer::sparse::SymbolicSparseColMat;
@@ -190,8 +188,23 @@ mod tests {
     fn the_stored_count_is_exact_for_simplicial_factors_and_bounds_supernodal_ones() {
         // A 30 x 30 grid with diagonals in a scattered order (plenty of fill, supernodes
         // of varied structure for faer's relaxation to merge).
-        let mesh = Mesh::from_soup(&primitives::grid(29, 29, Cells::Triangles)).unwrap();
-        let grid = vertex_graph_pattern(&mesh);
+        let k = 30;
+        let at = |i: usize, j: usize| i + k * j;
+        let mut edges = Vec::new();
+        for j in 0..k {
+            for i in 0..k {
+                if i + 1 < k {
+                    edges.push((at(i, j), at(i + 1, j)));
+                }
+                if j + 1 < k {
+                    edges.push((at(i, j), at(i, j + 1)));
+                }
+                if i + 1 < k && j + 1 < k {
+                    edges.push((at(i, j), at(i + 1, j + 1)));
+                }
+            }
+        }
+        let grid = pattern(k * k, &edges);
         let n = grid.nrows();
         let order: Vec<usize> = (0..n).map(|i| (i * 37) % n).collect();
         let exact = factor_count(grid.as_ref(), &order)

@@ -5,13 +5,11 @@
 //! on every call; iterative solvers refactor the same pattern every step, so this
 //! wrapper keeps both and calls the low-level `SymbolicCholesky::factorize_numeric_llt`.
 
-use super::nested_dissection::Dissected;
-use super::two_domains::{TwoDomains, TwoDomainsPlan};
-use super::{
-    Choice, NESTED_DISSECTION_FROM, SolveError, choose, dissected, inverse_permutation,
-    nested_dissection_sure,
-};
-use crate::dof::Scalar;
+use crate::nested_dissection::Dissected;
+use crate::ordering::{Choice, NESTED_DISSECTION_FROM, choose, dissected, nested_dissection_sure};
+use crate::spd::inverse_permutation;
+use crate::two_domains::{TwoDomains, TwoDomainsPlan};
+use crate::{Scalar, SolveError};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::perm::PermRef;
@@ -44,7 +42,7 @@ pub(super) enum Cholesky<T: Scalar> {
 impl<T: Scalar> Cholesky<T> {
     /// Symbolic analysis (fill-reducing order, elimination tree, supernodes) of
     /// `pattern` (square; only its lower triangle matters). The order is
-    /// [`fill_reducing_order`](super::fill_reducing_order)'s; below
+    /// [`fill_reducing_order`](crate::fill_reducing_order)'s; below
     /// [`NESTED_DISSECTION_FROM`] rows that is AMD, left to faer. A nested-dissection
     /// order is factored in its two sides at once ([`TwoDomains`]) when its first split
     /// has two sides.
@@ -178,7 +176,7 @@ impl<T: Scalar> Factor<T> {
     /// as numbered (`SymmetricOrdering::Identity`) only from its upper triangle. The
     /// factor's storage is written now, so that
     /// the kernel's first touch of its pages (which it clears) falls here, where a
-    /// caller may have planned it ([`PlannedCholesky`](super::PlannedCholesky)), rather
+    /// caller may have planned it ([`PlannedCholesky`](crate::PlannedCholesky)), rather
     /// than in the first numeric factorization.
     pub(super) fn build(
         pattern: SymbolicSparseColMatRef<'_, usize>,

@@ -666,7 +666,7 @@ pub(super) mod tests {
     /// Adjacency lists of a `k x k` grid of squares, vertex `i + k j` at column `i`,
     /// row `j`, each square split by a diagonal: always the same one, or, with
     /// `irregular`, one a fixed pseudo-random bit picks (degrees 2 to 8).
-    pub(in crate::solve) fn grid(k: usize, irregular: bool) -> (Vec<usize>, Vec<u32>) {
+    pub(crate) fn grid(k: usize, irregular: bool) -> (Vec<usize>, Vec<u32>) {
         let mut lists = vec![Vec::new(); k * k];
         let mut edge = |a: usize, b: usize| {
             lists[a].push(b as u32);

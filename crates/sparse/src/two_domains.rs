@@ -39,17 +39,16 @@
 //! when `S` is a nested dissection's top separator (about `sqrt(n)` rows of a planar
 //! mesh).
 
-use super::SolveError;
-use super::cholesky::{Factor, FactorFailure, analyse, eliminated};
-use super::factor_count::{column_multiply_subtracts, stored_multiply_subtracts};
-use crate::dof::Scalar;
-use beltrami_mesh::parallel::join;
+use crate::cholesky::{Factor, FactorFailure, analyse, eliminated};
+use crate::factor_count::{column_multiply_subtracts, stored_multiply_subtracts};
+use crate::{Scalar, SolveError};
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::{Llt, Solve};
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, SymmetricOrdering};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use faer::{Accum, Mat, MatMut, MatRef, Par, Side};
+use rayon::join;
 
 /// The two sides' factorizations and the separator's dense Schur complement (module
 /// docs).
@@ -167,7 +166,7 @@ impl TwoDomainsPlan {
 
     /// An upper bound of the multiply-subtract count of the whole matrix's
     /// factorization in the plan's order (the quantity of
-    /// [`factor_count`](super::factor_count)): each side's own columns as faer stores
+    /// [`factor_count`](crate::factor_count)): each side's own columns as faer stores
     /// them (exact, or more where its relaxed supernodes hold zeros; they are the
     /// whole factor's columns, since no entry joins the sides and the separator is
     /// eliminated last), and the separator's columns taken dense.
@@ -529,7 +528,8 @@ impl<T: Scalar> SideFactor<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solve::{dissected, factor_count};
+    use crate::factor_count;
+    use crate::ordering::dissected;
     use faer::sparse::{SparseColMat, Triplet};
     use num_complex::Complex64;
 
