@@ -33,14 +33,21 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::{Mat, Par, Side};
 use num_complex::Complex64;
 
+/// The meshes a benchmark runs on: generated grids and given files.
 #[derive(Debug, Args)]
-pub struct FemArgs {
+pub struct MeshCases {
     /// Sizes of the generated triangle grids (unit square), in triangles.
     #[arg(long, value_delimiter = ',', default_value = "100000,400000,1000000")]
     pub triangles: Vec<usize>,
-    /// Disk meshes to time as well; `FILE:k` subdivides the mesh 1-to-4 `k` times first.
+    /// Meshes to time as well; `FILE:k` subdivides the mesh 1-to-4 `k` times first.
     #[arg(long = "mesh")]
     pub meshes: Vec<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct FemArgs {
+    #[command(flatten)]
+    pub cases: MeshCases,
     /// Thread counts to time (comma-separated).
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
     pub threads: Vec<usize>,
@@ -122,7 +129,7 @@ where
 }
 
 /// Meshes to time: generated grids, then files (optionally subdivided).
-fn cases(args: &FemArgs) -> anyhow::Result<Vec<(String, Mesh)>> {
+pub fn cases(args: &MeshCases) -> anyhow::Result<Vec<(String, Mesh)>> {
     let mut out = Vec::new();
     for &t in &args.triangles {
         let n = ((t as f64 / 2.0).sqrt().round() as usize).max(1);
@@ -163,7 +170,7 @@ pub fn run(args: &FemArgs) -> anyhow::Result<()> {
         "| mesh | faces | vertices | elements s | D_zbar s | stiffness pattern s | stiffness values s |"
     );
     println!("|---|---|---|---|---|---|---|");
-    let meshes = cases(args)?;
+    let meshes = cases(&args.cases)?;
     for (name, mesh) in &meshes {
         let t = Instant::now();
         let elements = Elements::new(mesh, Frame::Face)?;

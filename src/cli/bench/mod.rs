@@ -3,6 +3,7 @@
 mod fem;
 mod flow;
 mod load;
+mod ordering;
 mod qcmc;
 mod render;
 mod spatial;
@@ -23,6 +24,10 @@ pub enum BenchKind {
     /// the LSCM system (complex N form and real 2N form), against faer on the same
     /// matrices.
     Fem(fem::FemArgs),
+    /// Fill-reducing orders (AMD, nested dissection by level sets and by multilevel
+    /// separators, METIS) on meshes' vertex graphs: order time, factor cost, one
+    /// numeric factorization.
+    Ordering(ordering::OrderingArgs),
     /// The discrete Beltrami flow against the tables of Wong-Zhao 2014, and the cost of
     /// one flow step on meshes of about 100K faces.
     Flow(flow::FlowArgs),
@@ -42,6 +47,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchKind::Load(a) => load::run(a),
         BenchKind::Fem(a) => fem::run(a),
         BenchKind::Flow(a) => flow::run(a),
+        BenchKind::Ordering(a) => ordering::run(a),
         BenchKind::Qcmc(a) => qcmc::run(a),
         BenchKind::Render(a) => render::run(a),
         BenchKind::Spatial(a) => spatial::run(a),
