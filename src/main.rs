@@ -1,12 +1,9 @@
 //! The `beltrami` command-line program.
 
 mod cli;
-#[cfg(target_os = "linux")]
-mod large_blocks;
 
-#[cfg(target_os = "linux")]
 #[global_allocator]
-static ALLOCATOR: large_blocks::LargeBlocks = large_blocks::LargeBlocks;
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 use std::process::ExitCode;
 

@@ -617,7 +617,7 @@ impl<'g> Dissection<'g> {
     /// separator has 182 vertices where the level sets of [`Dissection::dissect`] had
     /// 352, on 50K-vertex remeshes 4-24% fewer; on the flow's 50K-vertex graphs the
     /// whole order factors with 16-45% fewer multiply-subtracts than AMD inside the
-    /// first split's sides (docs/benchmarks.md, 2026-11-28).
+    /// first split's sides (docs/benchmarks.md, "Fill-reducing orders against METIS").
     fn split_multilevel(&mut self, reached: Vec<usize>, id: u32) {
         // No level set is computed here: the distances hold the local index.
         for (k, &v) in reached.iter().enumerate() {

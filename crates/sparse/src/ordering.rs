@@ -217,7 +217,7 @@ pub fn two_core_order(
 /// of the whole's count instead of 0.59).
 ///
 /// Inside the sides, further multilevel separators factor the flow's 50K-vertex graphs
-/// with 16-45% fewer multiply-subtracts than AMD did (docs/benchmarks.md, 2026-11-28);
+/// with 16-45% fewer multiply-subtracts than AMD did (docs/benchmarks.md, "Fill-reducing orders against METIS");
 /// on a 150 x 150 grid with diagonals, fewer than AMD on the whole grid (test
 /// `the_first_split_separates_two_balanced_sides_dissected_further`).
 pub fn first_split_order(
