@@ -188,23 +188,16 @@ mod tests {
     fn the_stored_count_is_exact_for_simplicial_factors_and_bounds_supernodal_ones() {
         // A 30 x 30 grid with diagonals in a scattered order (plenty of fill, supernodes
         // of varied structure for faer's relaxation to merge).
-        let k = 30;
-        let at = |i: usize, j: usize| i + k * j;
-        let mut edges = Vec::new();
-        for j in 0..k {
-            for i in 0..k {
-                if i + 1 < k {
-                    edges.push((at(i, j), at(i + 1, j)));
-                }
-                if j + 1 < k {
-                    edges.push((at(i, j), at(i, j + 1)));
-                }
-                if i + 1 < k && j + 1 < k {
-                    edges.push((at(i, j), at(i + 1, j + 1)));
-                }
-            }
-        }
-        let grid = pattern(k * k, &edges);
+        let (start, neighbours) = crate::vertex_separator::tests::grid(30, false);
+        let edges: Vec<(usize, usize)> = (0..start.len() - 1)
+            .flat_map(|v| {
+                neighbours[start[v]..start[v + 1]]
+                    .iter()
+                    .map(move |&w| (v, w as usize))
+            })
+            .filter(|&(v, w)| v < w)
+            .collect();
+        let grid = pattern(start.len() - 1, &edges);
         let n = grid.nrows();
         let order: Vec<usize> = (0..n).map(|i| (i * 37) % n).collect();
         let exact = factor_count(grid.as_ref(), &order)

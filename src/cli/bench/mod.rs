@@ -8,7 +8,9 @@ mod qcmc;
 mod render;
 mod spatial;
 
+use anyhow::Context;
 use clap::{Args, Subcommand};
+use std::time::Instant;
 
 #[derive(Debug, Args)]
 pub struct BenchArgs {
@@ -52,4 +54,17 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchKind::Render(a) => render::run(a),
         BenchKind::Spatial(a) => spatial::run(a),
     }
+}
+
+/// The fastest of `repeat` runs of `f`, in seconds, and its last result.
+fn fastest<T>(repeat: usize, mut f: impl FnMut() -> anyhow::Result<T>) -> anyhow::Result<(f64, T)> {
+    let mut best = f64::INFINITY;
+    let mut out = None;
+    for _ in 0..repeat.max(1) {
+        let start = Instant::now();
+        let value = f()?;
+        best = best.min(start.elapsed().as_secs_f64());
+        out = Some(value);
+    }
+    Ok((best, out.context("at least one run")?))
 }

@@ -9,9 +9,6 @@
 //! METIS is compiled only with the feature `metis-bench` (its C sources are vendored by
 //! `metis-sys`); without it the METIS rows are left out.
 
-use std::time::Instant;
-
-use anyhow::bail;
 use beltrami_fem::vertex_graph::vertex_graph_pattern;
 use beltrami_mesh::Mesh;
 use beltrami_sparse::{
@@ -22,6 +19,7 @@ use clap::Args;
 use faer::Mat;
 use faer::sparse::{SparseColMat, SymbolicSparseColMatRef};
 
+use super::fastest;
 use super::fem::{MeshCases, cases};
 
 #[derive(Debug, Args)]
@@ -71,7 +69,7 @@ fn metis_order(lower: SymbolicSparseColMatRef<'_, usize>) -> anyhow::Result<Vec<
         )
     };
     if status != metis_sys::rstatus_et_METIS_OK {
-        bail!("METIS_NodeND failed with status {status}");
+        anyhow::bail!("METIS_NodeND failed with status {status}");
     }
     Ok(perm.into_iter().map(|k| k as usize).collect())
 }
@@ -103,25 +101,6 @@ fn laplacian_plus_identity(
     Ok(SparseColMat::new(lower.to_owned()?, values))
 }
 
-/// The fastest of `rounds` runs of `work`, in seconds, with its last result.
-fn fastest<R>(
-    rounds: usize,
-    mut work: impl FnMut() -> anyhow::Result<R>,
-) -> anyhow::Result<(f64, R)> {
-    let mut best = f64::INFINITY;
-    let mut result = None;
-    for _ in 0..rounds.max(1) {
-        let t = Instant::now();
-        let r = work()?;
-        best = best.min(t.elapsed().as_secs_f64());
-        result = Some(r);
-    }
-    match result {
-        Some(r) => Ok((best, r)),
-        None => bail!("no round ran"),
-    }
-}
-
 pub fn run(args: &OrderingArgs) -> anyhow::Result<()> {
     println!(
         "| mesh | n | order | order s | multiply-subtracts / n^1.5 | factorization s | solve s | two sides: factorization s | two sides: solve s |"
@@ -139,6 +118,23 @@ fn metis() -> Option<(&'static str, Orderer)> {
     return Some(("METIS", |p| Ok(whole(metis_order(p)?))));
     #[cfg(not(feature = "metis-bench"))]
     None
+}
+
+/// The fastest numeric factorization of `matrix` by `solver` and the fastest solve of
+/// `rhs` after it, in seconds.
+fn factor_and_solve(
+    mut solver: SpdSolver<f64>,
+    matrix: &SparseColMat<usize, f64>,
+    rhs: &Mat<f64>,
+    rounds: usize,
+) -> anyhow::Result<(f64, f64)> {
+    let (factor_s, ()) = fastest(rounds, || Ok(solver.factorize(matrix.as_ref())?))?;
+    let (solve_s, _) = fastest(rounds, || {
+        let mut x = rhs.clone();
+        solver.solve_in_place(x.as_mut())?;
+        Ok(x)
+    })?;
+    Ok((factor_s, solve_s))
 }
 
 type Orderer = fn(SymbolicSparseColMatRef<'_, usize>) -> anyhow::Result<SplitOrder>;
@@ -163,22 +159,12 @@ fn row_of(name: &str, mesh: &Mesh, rounds: usize) -> anyhow::Result<()> {
         let (order_s, split) = fastest(rounds, || order_of(lower))?;
         let count = factor_count(lower, &split.order)?.multiply_subtracts / (n as f64).powf(1.5);
         let options = SolveOptions::default();
-        let mut solver = SpdSolver::<f64>::with_order(lower, &split.order, options)?;
-        let (factor_s, ()) = fastest(rounds, || Ok(solver.factorize(matrix.as_ref())?))?;
-        let (solve_s, _) = fastest(rounds, || {
-            let mut x = rhs.clone();
-            solver.solve_in_place(x.as_mut())?;
-            Ok(x)
-        })?;
+        let whole = SpdSolver::<f64>::with_order(lower, &split.order, options)?;
+        let (factor_s, solve_s) = factor_and_solve(whole, &matrix, &rhs, rounds)?;
         let sides = match split.sides {
             Some(_) => {
-                let mut solver = SpdSolver::<f64>::with_split_order(lower, &split, options)?;
-                let (factor_s, ()) = fastest(rounds, || Ok(solver.factorize(matrix.as_ref())?))?;
-                let (solve_s, _) = fastest(rounds, || {
-                    let mut x = rhs.clone();
-                    solver.solve_in_place(x.as_mut())?;
-                    Ok(x)
-                })?;
+                let sides = SpdSolver::<f64>::with_split_order(lower, &split, options)?;
+                let (factor_s, solve_s) = factor_and_solve(sides, &matrix, &rhs, rounds)?;
                 format!("{factor_s:.3} | {solve_s:.4}")
             }
             None => "- | -".to_owned(),

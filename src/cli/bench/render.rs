@@ -6,9 +6,7 @@
 //! a full-size mesh with |mu| colors or a checkerboard. It times the scene (measuring
 //! |mu| and flips through the fem crate), each picture and the PNG encoding.
 
-use std::time::Instant;
-
-use anyhow::Context as _;
+use super::fastest;
 use beltrami_mesh::primitives::{Cells, grid};
 use beltrami_mesh::{Mesh, Point3, Vector2};
 use beltrami_render::{ColorBy, Layout, Scene, Size, Style, View, render};
@@ -25,19 +23,6 @@ pub struct RenderArgs {
     /// Runs per figure; the fastest is printed.
     #[arg(long, default_value_t = 3)]
     pub repeat: usize,
-}
-
-/// The fastest of `repeat` runs of `f`, in seconds, and its last result.
-fn fastest<T>(repeat: usize, mut f: impl FnMut() -> anyhow::Result<T>) -> anyhow::Result<(f64, T)> {
-    let mut best = f64::INFINITY;
-    let mut out = None;
-    for _ in 0..repeat.max(1) {
-        let start = Instant::now();
-        let value = f()?;
-        best = best.min(start.elapsed().as_secs_f64());
-        out = Some(value);
-    }
-    Ok((best, out.context("at least one run")?))
 }
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {

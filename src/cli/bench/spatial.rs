@@ -15,8 +15,8 @@
 //!   walked on the surface (`move_all`) by the same tangent steps.
 
 use std::path::PathBuf;
-use std::time::Instant;
 
+use super::fastest;
 use anyhow::Context;
 use beltrami_mesh::primitives::{Cells, torus};
 use beltrami_mesh::{BuildOptions, FaceId, Mesh, Point3, SurfacePoint, Vector3, io};
@@ -85,19 +85,6 @@ impl Uniform {
             SurfacePoint::in_quad(f, a, b)
         }
     }
-}
-
-/// Fastest of `repeat` runs of `f`, in seconds, and the last result.
-fn fastest<T>(repeat: usize, mut f: impl FnMut() -> anyhow::Result<T>) -> anyhow::Result<(f64, T)> {
-    let mut best = f64::INFINITY;
-    let mut last = None;
-    for _ in 0..repeat.max(1) {
-        let start = Instant::now();
-        let value = f()?;
-        best = best.min(start.elapsed().as_secs_f64());
-        last = Some(value);
-    }
-    Ok((best, last.context("at least one run")?))
 }
 
 /// Timings of the flow steps on one target.
