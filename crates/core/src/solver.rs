@@ -124,6 +124,14 @@ impl<'a> Context<'a> {
         Arc::clone(&self.cancel)
     }
 
+    /// A context for a solve run inside this one (an initial map, a flattening): the
+    /// same cancellation flag, so a Ctrl-C stops the inner solve too; no progress
+    /// callback (the caller's [`stage`](Self::stage) reports the inner solve's start and
+    /// end).
+    pub fn inner(&self) -> Context<'static> {
+        Context::new().with_cancel_flag(self.cancel_flag())
+    }
+
     /// Reports progress to the callback, if any.
     pub fn report(&mut self, progress: &Progress) {
         if let Some(f) = &mut self.progress {
@@ -165,5 +173,22 @@ impl<'a> Context<'a> {
         } else {
             Ok(())
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_inner_context_is_cancelled_with_its_caller() {
+        let caller = Context::new().with_progress(|_| {});
+        let inner = caller.inner();
+        assert!(!inner.is_cancelled());
+        caller.cancel_flag().store(true, Ordering::Relaxed);
+        assert!(matches!(
+            inner.check_cancelled(),
+            Err(SolverError::Cancelled)
+        ));
     }
 }

@@ -63,7 +63,10 @@ fn flow(
 ) -> Result<Solution, SolverError> {
     let mut report = Report::new(NAME);
     let threads = settings.int("threads");
-    let initial = context.stage("initial map", &mut report, || initial_map(problem, threads))?;
+    let mut inner = context.inner();
+    let initial = context.stage("initial map", &mut report, || {
+        initial_map(problem, threads, &mut inner)
+    })?;
     beltrami_flow_engine::solve(problem, settings, initial, report, context)
 }
 
@@ -75,8 +78,13 @@ fn invalid(message: &str) -> SolverError {
 }
 
 /// The map the flow starts from, as points of R^3 (z = 0 for planar targets): the given
-/// one, or one built here. `threads` is passed to the initialization's factorizations.
-fn initial_map(problem: &Problem<'_>, threads: usize) -> Result<Vec<Point3<f64>>, SolverError> {
+/// one, or one built here. `threads` is passed to the initialization's factorizations,
+/// `context` (the caller's [`Context::inner`]) to its solve.
+fn initial_map(
+    problem: &Problem<'_>,
+    threads: usize,
+    context: &mut Context<'_>,
+) -> Result<Vec<Point3<f64>>, SolverError> {
     let mesh = problem.source;
     if let Some(given) = given_initial(problem)? {
         return Ok(given);
@@ -98,7 +106,7 @@ fn initial_map(problem: &Problem<'_>, threads: usize) -> Result<Vec<Point3<f64>>
         Target::Plane(PlanarBoundary::Keep) => Ok(identity()),
         Target::Plane(b @ (PlanarBoundary::Square { .. } | PlanarBoundary::Polygon(_))) => {
             init.target = Target::Plane(b.clone());
-            planar_points(Tutte.solve(&init, &mut Context::new())?.output)
+            planar_points(Tutte.solve(&init, context)?.output)
         }
         Target::Plane(_) | Target::Disk => {
             let on_circle = is_planar(mesh)
@@ -110,7 +118,7 @@ fn initial_map(problem: &Problem<'_>, threads: usize) -> Result<Vec<Point3<f64>>
                 return Ok(identity());
             }
             init.target = Target::Plane(PlanarBoundary::Circle);
-            planar_points(Tutte.solve(&init, &mut Context::new())?.output)
+            planar_points(Tutte.solve(&init, context)?.output)
         }
         Target::Annulus { inner_radius } => {
             let (r0, _) = annulus_of(mesh)?;
@@ -135,7 +143,7 @@ fn initial_map(problem: &Problem<'_>, threads: usize) -> Result<Vec<Point3<f64>>
             if on_sphere {
                 return Ok(mesh.positions().to_vec());
             }
-            match Sphere.solve(&init, &mut Context::new())?.output {
+            match Sphere.solve(&init, context)?.output {
                 Output::Map(Map::Spatial(p)) => Ok(p),
                 _ => Err(invalid(
                     "the sphere initialization did not give points of R^3",
@@ -146,5 +154,30 @@ fn initial_map(problem: &Problem<'_>, threads: usize) -> Result<Vec<Point3<f64>>
             solver: NAME,
             message: "no initial map for this target".to_string(),
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use beltrami_mesh::{Mesh, primitives};
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+
+    #[test]
+    fn the_initial_map_stops_when_its_caller_is_cancelled() {
+        let mut soup = primitives::icosphere(2);
+        for p in &mut soup.positions {
+            *p = Point3::from(p.coords * 2.0);
+        }
+        let mesh = Mesh::from_soup(&soup).unwrap();
+        let problem = Problem::new(&mesh, Target::Sphere);
+        let cancelled = Context::new().with_cancel_flag(Arc::new(AtomicBool::new(true)));
+        assert!(matches!(
+            initial_map(&problem, 1, &mut cancelled.inner()),
+            Err(SolverError::Cancelled)
+        ));
+        let map = initial_map(&problem, 1, &mut Context::new()).unwrap();
+        assert!(map.iter().all(|p| (p.coords.norm() - 1.0).abs() < 1e-9));
     }
 }

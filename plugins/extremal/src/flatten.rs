@@ -69,8 +69,9 @@ fn filled(mesh: &Mesh) -> Result<Mesh, SolverError> {
 
 /// Lays `mesh` (a curved disk of triangles, or a curved genus-0 surface with several
 /// boundary loops, filled first: module docs) out in the plane by LSCM; refuses a
-/// layout with flipped faces of `mesh`.
-pub fn flatten(mesh: &Mesh) -> Result<Flattening, SolverError> {
+/// layout with flipped faces of `mesh`. `context` is the caller's [`Context::inner`]:
+/// a Ctrl-C stops the LSCM solve too.
+pub fn flatten(mesh: &Mesh, context: &mut Context<'_>) -> Result<Flattening, SolverError> {
     let disk = if mesh.boundary_loop_count() > 1 {
         Some(filled(mesh)?)
     } else {
@@ -78,7 +79,7 @@ pub fn flatten(mesh: &Mesh) -> Result<Flattening, SolverError> {
     };
     let layout = disk.as_ref().unwrap_or(mesh);
     let problem = Problem::new(layout, Target::Plane(PlanarBoundary::Free));
-    let solution = Lscm.solve(&problem, &mut Context::new())?;
+    let solution = Lscm.solve(&problem, context)?;
     let uv = solution.planar().ok_or_else(|| SolverError::Unsupported {
         solver: NAME,
         message: "the conformal flattening gave no planar map".to_string(),
@@ -110,4 +111,27 @@ pub fn flatten(mesh: &Mesh) -> Result<Flattening, SolverError> {
         mu_mean: mus.iter().sum::<f64>() / mus.len().max(1) as f64,
         mu_max: mus.iter().copied().fold(0.0, f64::max),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use beltrami_mesh::primitives;
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+
+    #[test]
+    fn the_flattening_stops_when_its_caller_is_cancelled() {
+        let mut soup = primitives::disk(2);
+        for p in &mut soup.positions {
+            p.z = 0.5 * (p.x * p.x - p.y * p.y);
+        }
+        let mesh = Mesh::from_soup(&soup).unwrap();
+        let cancelled = Context::new().with_cancel_flag(Arc::new(AtomicBool::new(true)));
+        assert!(matches!(
+            flatten(&mesh, &mut cancelled.inner()),
+            Err(SolverError::Cancelled)
+        ));
+        assert!(flatten(&mesh, &mut Context::new()).is_ok());
+    }
 }

@@ -141,7 +141,8 @@ impl Solver for Extremal {
         let flat = if is_planar(mesh) {
             None
         } else {
-            let flat = context.stage("flattening", &mut report, || flatten(mesh))?;
+            let mut inner = context.inner();
+            let flat = context.stage("flattening", &mut report, || flatten(mesh, &mut inner))?;
             report.notes.push(format!(
                 "the surface was laid out in the plane by LSCM (|mu| of that layout: mean {:.2e}, max {:.2e}); mu is measured on the surface, in its face frames",
                 flat.mu_mean, flat.mu_max

@@ -66,6 +66,8 @@ use beltrami_spatial::SurfaceIndex;
 
 use crate::feature_match::Channel;
 use crate::landmarks::Resolved;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 pub use error::{RegisterError, Side};
 pub use inverse_consistency::{InverseConsistency, inverse_consistency};
@@ -134,16 +136,18 @@ pub fn initial_map(
     target: &Mesh,
     landmarks: &[Landmark],
 ) -> Result<InitialMap, RegisterError> {
-    initial_map_for(source, target, landmarks, false)
+    initial_map_for(source, target, landmarks, false, &Arc::default())
 }
 
 /// [`initial_map`], with both sphere maps conformal when `conformal_sphere` (the
-/// start of a shape or feature match on the sphere) even without landmarks.
+/// start of a shape or feature match on the sphere) even without landmarks; setting
+/// `cancel` (the caller's cancellation flag) stops the sphere maps.
 pub(crate) fn initial_map_for(
     source: &Mesh,
     target: &Mesh,
     landmarks: &[Landmark],
     conformal_sphere: bool,
+    cancel: &Arc<AtomicBool>,
 ) -> Result<InitialMap, RegisterError> {
     let topology = check_topology(source, target)?;
     let target_index = SurfaceIndex::new(target)?;
@@ -165,6 +169,7 @@ pub(crate) fn initial_map_for(
                 &target_index,
                 &marks,
                 conformal_sphere,
+                cancel,
                 &mut notes,
             )?;
             domain = TargetDomain::Sphere(routed.domain);

@@ -85,9 +85,16 @@ pub const LANDMARK_TOLERANCE: f64 = 1e-9;
 
 /// A registration error as a solver error.
 fn plugin(error: RegisterError) -> SolverError {
-    SolverError::Plugin {
-        solver: NAME,
-        error: Box::new(error),
+    match error {
+        // A Ctrl-C during an inner solve is the caller's cancellation, not a failure.
+        RegisterError::Sphere {
+            error: SolverError::Cancelled,
+            ..
+        } => SolverError::Cancelled,
+        error => SolverError::Plugin {
+            solver: NAME,
+            error: Box::new(error),
+        },
     }
 }
 
@@ -395,8 +402,9 @@ pub(crate) fn register(
     };
     let shape = settings.flag("match-shape");
     let matched = features.is_some() || shape;
+    let cancel = context.cancel_flag();
     let initial = context.stage("initial map", &mut report, || {
-        initial_map_for(source, target, &marks, matched).map_err(plugin)
+        initial_map_for(source, target, &marks, matched, &cancel).map_err(plugin)
     })?;
     report.notes.extend(initial.notes.iter().cloned());
     let mut flow = problem.clone();
@@ -469,9 +477,21 @@ mod tests {
     use beltrami_fem::distortion::measure_surface;
     use beltrami_mesh::primitives::{self, icosphere, octahedral_sphere};
     use beltrami_mesh::{PolygonSoup, VertexId};
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
 
     fn scattered(soup: &PolygonSoup) -> Mesh {
         Mesh::from_soup(&primitives::scattered(soup)).unwrap()
+    }
+
+    #[test]
+    fn a_cancelled_registration_stops_in_the_sphere_maps() {
+        let source = Mesh::from_soup(&folded(icosphere(2))).unwrap();
+        let target = Mesh::from_soup(&folded(octahedral_sphere(3))).unwrap();
+        let cancel = Arc::new(AtomicBool::new(true));
+        let error = crate::initial_map_for(&source, &target, &[], false, &cancel).unwrap_err();
+        assert!(matches!(plugin(error), SolverError::Cancelled));
+        assert!(crate::initial_map_for(&source, &target, &[], false, &Arc::default()).is_ok());
     }
 
     /// A sphere with five deep radial folds (ridges along meridians), the positions of

@@ -52,6 +52,8 @@ use crate::landmarks::{
 };
 use crate::param::{domain_mesh, each_mesh, planar_points};
 use crate::sphere_alignment::{SphereMoebius, fitted_moebius};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 /// Source vertices used by the rotation fit at most.
 const FIT_SAMPLES: usize = 4096;
@@ -71,6 +73,7 @@ pub(crate) fn map(
     target_index: &SurfaceIndex<'_>,
     marks: &[Resolved],
     conformal: bool,
+    cancel: &Arc<AtomicBool>,
     notes: &mut Vec<String>,
 ) -> Result<Routed<Vec<Vector3<f64>>>, RegisterError> {
     // The Tutte start, which the flow from a map without landmarks was tuned from;
@@ -80,7 +83,7 @@ pub(crate) fn map(
     let conformal = conformal || !marks.is_empty();
     // The two sphere maps are independent: computed at once, on two cores.
     let (source_sphere, target_sphere) = each_mesh(source, target, notes, |mesh, side, notes| {
-        sphere(mesh, side, conformal, notes)
+        sphere(mesh, side, conformal, cancel, notes)
     })?;
     let target_at =
         |p: &SurfacePoint| -> Vector3<f64> { interpolate(target, &target_sphere, p).normalize() };
@@ -499,18 +502,22 @@ fn pole_face(
 }
 
 /// The `sphere` initialization of `mesh` (its `conformal` start, or `tutte`) as unit
-/// vectors, its notes added to `notes`.
+/// vectors, its notes added to `notes`; setting `cancel` stops it.
 fn sphere(
     mesh: &Mesh,
     side: Side,
     conformal: bool,
+    cancel: &Arc<AtomicBool>,
     notes: &mut Vec<String>,
 ) -> Result<Vec<Vector3<f64>>, RegisterError> {
     let mut problem = Problem::new(mesh, Target::Sphere);
     let start = if conformal { "conformal" } else { "tutte" };
     problem.options.set_text("start", start);
     let solution = Sphere
-        .solve(&problem, &mut Context::new())
+        .solve(
+            &problem,
+            &mut Context::new().with_cancel_flag(Arc::clone(cancel)),
+        )
         .map_err(|error| RegisterError::Sphere { side, error })?;
     notes.extend(
         solution
