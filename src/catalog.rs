@@ -1,7 +1,7 @@
 //! The registered solvers as data: what each accepts and its options, for
 //! `beltrami solvers --json`, scripts and the Python package.
 
-use beltrami_core::{OptionKind, Solver};
+use beltrami_core::{Accepts, GoalKind, OptionKind, Solver, TargetKind};
 use serde_json::{Value, json};
 
 /// One solver as JSON: `name`, `description`, `accepts` (`elements`, `topologies`,
@@ -99,4 +99,19 @@ pub fn solver_text(solver: &dyn Solver) -> String {
         ));
     }
     out
+}
+
+/// The registered solvers that map into a parameter domain (any target but a mesh)
+/// and take `goal`, by name in the registry's order: `param` lists those of the
+/// conformal goal, `qc` those of a prescribed coefficient or an extremal map.
+pub fn domain_solvers(goal: impl Fn(&[GoalKind]) -> bool) -> Vec<&'static str> {
+    let onto_domain = |a: &Accepts| a.targets.iter().any(|t| *t != TargetKind::Mesh);
+    crate::registry()
+        .iter()
+        .filter(|solver| {
+            let a = solver.accepts();
+            onto_domain(&a) && goal(a.goals)
+        })
+        .map(|solver| solver.name())
+        .collect()
 }

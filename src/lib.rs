@@ -8,7 +8,9 @@
 //!   cutting and IO.
 //! - [`fem`]: P1/Q1 elements, assembled operators, Beltrami coefficients of maps,
 //!   Beltrami fields (per-face `mu` in a stated frame, with their file format),
-//!   distortion statistics, DOF maps and sparse least-squares solves.
+//!   distortion statistics, DOF maps and least-squares solves under them.
+//! - [`sparse`]: the sparse direct solvers (Cholesky with kept symbolic factorizations,
+//!   fill-reducing orders, the two-core split, saddle-point systems).
 //! - [`spatial`]: exact closest points on a target mesh through a kd-tree, tangent
 //!   frames, and moving surface points along the surface.
 //! - [`core`]: the `Solver` trait (what a solver accepts as data, its typed options, one
@@ -25,6 +27,10 @@
 //!   then the flow on the target mesh.
 //! - [`qcmc`]: circle-domain maps of multiply-connected meshes (qcmc, Ho-Lui 2016): the
 //!   unit disk minus disks whose centres and radii are found with the map.
+//! - [`extremal`]: extremal (Teichmueller) maps with prescribed boundary values or
+//!   the four-point problem (extremal).
+//! - [`qc_iteration`]: the QC iteration towards the Teichmueller map of a boundary
+//!   condition, in the plane and from surfaces into R^3 (qc-iteration).
 //! - [`remesh`]: remeshing through a parameterization (spade's constrained Delaunay
 //!   refinement of the parameter domain with a size field measured on the surface).
 //! - [`atlas`]: texture atlases of any triangle mesh (cones, cuts, boundary first
@@ -62,16 +68,19 @@ pub mod vertex_field;
 
 pub use beltrami_atlas as atlas;
 pub use beltrami_core as core;
+pub use beltrami_extremal as extremal;
 pub use beltrami_fem as fem;
 pub use beltrami_flow as flow;
 pub use beltrami_flow_engine as flow_engine;
 pub use beltrami_init as init;
 pub use beltrami_lsqc as lsqc;
 pub use beltrami_mesh as mesh;
+pub use beltrami_qc_iteration as qc_iteration;
 pub use beltrami_qcmc as qcmc;
 pub use beltrami_register as register;
 pub use beltrami_remesh as remesh;
 pub use beltrami_render as render;
+pub use beltrami_sparse as sparse;
 pub use beltrami_spatial as spatial;
 
 /// Every solver shipped with beltrami, by name.

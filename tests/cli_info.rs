@@ -119,3 +119,42 @@ fn every_command_has_help() {
         assert!(text(&out.stdout).contains("Usage"), "{args:?}");
     }
 }
+
+/// The `--solver` help of `param` and `qc` names every registered solver of their
+/// goals, as `solvers --json` describes them: a solver added to the registry shows up
+/// without editing the help.
+#[test]
+fn the_solver_help_lists_every_registered_solver_of_the_command() {
+    let out = beltrami(&["solvers", "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let solvers: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let list = |value: &serde_json::Value, key: &str| -> Vec<String> {
+        value["accepts"][key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|k| k.as_str().unwrap().to_owned())
+            .collect()
+    };
+    let mut expected = [(vec![], "param"), (vec![], "qc")];
+    for solver in solvers.as_array().unwrap() {
+        let name = solver["name"].as_str().unwrap().to_owned();
+        let goals = list(solver, "goals");
+        if list(solver, "targets") == ["mesh"] {
+            continue;
+        }
+        if goals.iter().any(|g| g == "conformal") {
+            expected[0].0.push(name.clone());
+        }
+        if goals.iter().any(|g| g == "prescribed-mu" || g == "extremal") {
+            expected[1].0.push(name);
+        }
+    }
+    assert!(expected[1].0.contains(&"qc-iteration".to_owned()));
+    for (names, command) in expected {
+        let out = beltrami(&[command, "--help"]);
+        let help = text(&out.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
+        let listed = format!("Solver name ({};", names.join(", "));
+        assert!(help.contains(&listed), "`{listed}` missing in\n{help}");
+    }
+}

@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use beltrami::map_file;
 use beltrami_core::{
-    Constraint, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind, components,
+    Constraint, GoalKind, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind,
+    components,
 };
 use clap::{Args, ValueEnum};
 
@@ -44,12 +45,20 @@ pub enum WeightsArg {
     Cotan,
 }
 
+/// The `--solver` help: the registered solvers of a conformal map into a domain.
+fn solver_help() -> String {
+    let names = beltrami::catalog::domain_solvers(|goals| goals.contains(&GoalKind::Conformal));
+    format!(
+        "Solver name ({}; `beltrami solvers` describes them)",
+        names.join(", ")
+    )
+}
+
 #[derive(Debug, Args)]
 pub struct ParamArgs {
     /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb).
     pub mesh: PathBuf,
-    /// Solver name (`beltrami solvers` lists them): tutte, harmonic, lscm, sphere, qcmc.
-    #[arg(long)]
+    #[arg(long, help = solver_help())]
     pub solver: String,
     /// Boundary of the parameter domain (default: the first of these the solver takes:
     /// circle for tutte and harmonic, free for lscm; the sphere solver maps onto the

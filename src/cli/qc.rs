@@ -57,15 +57,24 @@ pub enum QcBoundaryArg {
     Given,
 }
 
+/// The `--solver` help: the registered solvers of a prescribed or extremal map into a
+/// domain.
+fn solver_help() -> String {
+    let names = beltrami::catalog::domain_solvers(|goals| {
+        goals.contains(&GoalKind::Prescribed) || goals.contains(&GoalKind::Extremal)
+    });
+    format!(
+        "Solver name ({}; `beltrami solvers` describes them). Default: lsqc onto the plane and into space, beltrami-flow onto the disk, an annulus or the sphere",
+        names.join(", ")
+    )
+}
+
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("goal").args(["mu", "mu_expr", "conformal"])))]
 pub struct QcArgs {
     /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb).
     pub mesh: PathBuf,
-    /// Solver name: lsqc, beltrami-flow, extremal or qcmc (onto a circle domain).
-    /// Default: lsqc onto the plane, beltrami-flow onto the disk, an annulus or the
-    /// sphere.
-    #[arg(long)]
+    #[arg(long, help = solver_help())]
     pub solver: Option<String>,
     /// The Beltrami coefficient per face, in the field format (`# mu frame=... faces=N`).
     #[arg(long)]
