@@ -70,6 +70,7 @@ __all__ = [
     "remesh_in_place",
     "repair",
     "show",
+    "solve",
     "solvers",
     "sphere_map",
     "tutte",
@@ -182,6 +183,56 @@ def _solve(
 
 def _result(out: Dict[str, Any], info: bool) -> Any:
     return (out["image"], out["report"]) if info else out["image"]
+
+
+# ---- any registered solver by name --------------------------------------------------
+
+
+def solve(
+    solver: str,
+    V: ArrayLike,
+    F: ArrayLike,
+    *,
+    target: str = "plane",
+    boundary: Optional[str] = None,
+    boundary_map: Optional[ArrayLike] = None,
+    mu: Optional[ArrayLike] = None,
+    mu_expr: Optional[str] = None,
+    mu_frame: Optional[str] = None,
+    p: Optional[float] = None,
+    pins: Sequence[int] = (),
+    initial: Optional[ArrayLike] = None,
+    options: Optional[Dict[str, Any]] = None,
+    progress: Optional[Progress] = None,
+    info: bool = False,
+) -> Any:
+    """Any registered solver by its name (``beltrami.solvers()`` lists them with what
+    each accepts and its options), with the same description of the problem as the named
+    calls: ``target`` (``'plane'``, ``'disk'``, ``'annulus'``, ``'sphere'``,
+    ``'circle-domain'`` or ``'space'``), the plane's ``boundary`` (``'keep'``,
+    ``'free'``, ``'circle'``, ``'square'`` or ``'given'`` with ``boundary_map``), the
+    goal (``mu`` per face or ``mu_expr``, else the most conformal map with exponent
+    ``p``), ``pins``, an ``initial`` map, and the solver's ``options`` by name. The
+    solver refuses, before any work, what it does not accept. Returns the map (``(n, 2)``
+    or ``(n, 3)``), with the report when ``info=True``.
+
+    >>> import numpy as np, beltrami
+    >>> V, F = beltrami.read_mesh("meshes/disk_hemisphere.obj")
+    >>> UV = beltrami.solve("lscm", V, F, boundary="free")
+    >>> bool(np.array_equal(UV, beltrami.lscm(V, F)))
+    True
+    """
+    spec: Dict[str, Any] = {
+        "target": target,
+        "goal": _goal(mu, mu_expr, mu_frame, p),
+        "pins": _pins(pins),
+        "options": _options(options),
+    }
+    if boundary is not None:
+        spec["boundary"] = boundary
+    out = _solve(str(solver), V, F, spec, boundary_map=boundary_map, initial=initial, mu=mu,
+                 progress=progress)
+    return _result(out, info)
 
 
 # ---- initial maps (`beltrami param`) -------------------------------------------------

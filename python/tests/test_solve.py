@@ -1,0 +1,45 @@
+"""``beltrami.solve``: any registered solver by name, the same maps as the named calls,
+and the solver's own refusals."""
+
+import numpy as np
+import pytest
+
+import beltrami
+from conftest import MESHES
+
+
+@pytest.fixture(scope="module")
+def disk():
+    return beltrami.read_mesh(MESHES / "disk_hemisphere.obj")
+
+
+def test_every_registered_solver_is_reachable_by_name(disk):
+    V, F = disk
+    names = [s["name"] for s in beltrami.solvers()]
+    assert "qc-iteration" in names and "lscm" in names
+    for name in names:
+        try:
+            beltrami.solve(name, V, F)
+        except beltrami.BeltramiError as error:
+            # A refusal of this problem by the solver itself, never an unknown name.
+            assert "no solver named" not in str(error), name
+
+
+def test_the_same_maps_as_the_named_calls(disk):
+    V, F = disk
+    assert np.array_equal(beltrami.solve("lscm", V, F, boundary="free"), beltrami.lscm(V, F))
+    flow = beltrami.solve("beltrami-flow", V, F, target="disk",
+                          options={"tolerance": 1e-6, "max-iters": 200})
+    assert np.array_equal(flow, beltrami.beltrami_flow(V, F, target="disk"))
+    UV, report = beltrami.solve("lsqc", V * [1, 1, 0], F, mu_expr="0.3", boundary="free",
+                                info=True)
+    assert np.allclose(beltrami.beltrami_coefficient(V * [1, 1, 0], F, UV), 0.3)
+    assert report["solver"] == "lsqc"
+
+
+def test_an_unknown_name_and_a_refused_target_are_typed_errors(disk):
+    V, F = disk
+    with pytest.raises(beltrami.OptionError, match="no solver named `nosuch`; available: .*qc-iteration"):
+        beltrami.solve("nosuch", V, F)
+    with pytest.raises(beltrami.UnsupportedError, match="tutte"):
+        beltrami.solve("tutte", V, F, target="sphere")
