@@ -146,14 +146,20 @@ fn the_solver_help_lists_every_registered_solver_of_the_command() {
         if goals.iter().any(|g| g == "conformal") {
             expected[0].0.push(name.clone());
         }
-        if goals.iter().any(|g| g == "prescribed-mu" || g == "extremal") {
+        if goals
+            .iter()
+            .any(|g| g == "prescribed-mu" || g == "extremal")
+        {
             expected[1].0.push(name);
         }
     }
     assert!(expected[1].0.contains(&"qc-iteration".to_owned()));
     for (names, command) in expected {
         let out = beltrami(&[command, "--help"]);
-        let help = text(&out.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
+        let help = text(&out.stdout)
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
         let listed = format!("Solver name ({};", names.join(", "));
         assert!(help.contains(&listed), "`{listed}` missing in\n{help}");
     }
