@@ -186,3 +186,78 @@ fn a_byte_order_mark_and_flags_disguised_as_paths_or_values() {
         );
     }
 }
+
+/// The processes whose parent is `pid`, from `/proc`.
+#[cfg(target_os = "linux")]
+fn children_of(pid: u32) -> Vec<u32> {
+    let mut children = Vec::new();
+    for entry in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(child) = entry.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        let Ok(stat) = std::fs::read_to_string(entry.path().join("stat")) else {
+            continue;
+        };
+        // `pid (comm) state ppid ...`: the command name may hold spaces, so read after ')'.
+        let after = stat.rsplit_once(')').map_or("", |(_, rest)| rest);
+        if after.split_whitespace().nth(1) == Some(pid.to_string().as_str()) {
+            children.push(child);
+        }
+    }
+    children
+}
+
+/// A batch killed with SIGKILL (which it cannot catch) takes its running job with it:
+/// the job does not go on to write its output after the batch is gone.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_killed_batch_ends_its_running_jobs() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("slow.obj");
+    // A remesh that would run for minutes (two million vertices).
+    let (_jobs_dir, jobs) = jobs_file(&[format!(
+        r#"{{"command": "remesh", "input": "meshes/disk_hemisphere.obj", "output": "{}", "options": {{"vertices": 2000000, "max-vertices": 3000000}}}}"#,
+        s(&output)
+    )]);
+    let mut batch = std::process::Command::new(env!("CARGO_BIN_EXE_beltrami"))
+        .args(["batch", s(&jobs)])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let job = loop {
+        if let Some(&job) = children_of(batch.id()).first() {
+            break job;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the job never started"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    batch.kill().unwrap();
+    batch.wait().unwrap();
+    let killed = Instant::now();
+    while Path::new(&format!("/proc/{job}")).exists() {
+        // The job is reaped by init once it ends; a zombie entry is gone as soon as it is.
+        let state = std::fs::read_to_string(format!("/proc/{job}/stat")).unwrap_or_default();
+        if state
+            .rsplit_once(')')
+            .is_some_and(|(_, r)| r.trim_start().starts_with('Z'))
+        {
+            break;
+        }
+        assert!(
+            killed.elapsed() < Duration::from_secs(10),
+            "job {job} still runs 10 s after its batch was killed"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(
+        !output.exists(),
+        "the job wrote its output after the batch was killed"
+    );
+}

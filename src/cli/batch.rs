@@ -213,6 +213,8 @@ fn run_job(exe: &Path, job: &Job, resume: bool) -> Value {
         use std::os::unix::process::CommandExt as _;
         command.process_group(0);
     }
+    #[cfg(target_os = "linux")]
+    end_with_the_batch(&mut command);
     let outcome = command.output();
     let seconds = start.elapsed().as_secs_f64();
     match outcome {
@@ -239,6 +241,31 @@ fn run_job(exe: &Path, job: &Job, resume: bool) -> Value {
             "status": "error", "seconds": seconds,
             "message": format!("cannot start {}: {error}", exe.display()),
         }),
+    }
+}
+
+/// Makes the job end when the batch does, however it ends (KILL included, which the
+/// batch cannot catch): the kernel sends the job SIGTERM when the thread that started it
+/// exits (`PR_SET_PDEATHSIG`). The worker thread waits for its job, so it outlives it
+/// unless the whole batch dies. A batch that died between starting the job and the call
+/// leaves the job an orphan, so the job checks that its parent is still the batch.
+#[cfg(target_os = "linux")]
+fn end_with_the_batch(command: &mut Command) {
+    use std::os::unix::process::CommandExt as _;
+    let batch = libc::pid_t::try_from(std::process::id()).unwrap_or(libc::pid_t::MAX);
+    // SAFETY: the closure runs between fork and exec and makes only async-signal-safe
+    // system calls (prctl, getppid); its errors are raw codes, nothing is allocated.
+    unsafe {
+        command.pre_exec(move || {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGTERM) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            if libc::getppid() != batch {
+                // No allocation between fork and exec: a raw error code (no such process).
+                return Err(std::io::Error::from_raw_os_error(libc::ESRCH));
+            }
+            Ok(())
+        });
     }
 }
 
