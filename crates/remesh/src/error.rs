@@ -5,6 +5,10 @@ use beltrami_mesh::{CutError, FaceId, MeshError};
 use beltrami_spatial::SpatialError;
 use thiserror::Error;
 
+/// Fewer equilateral triangles than this covering a surface make an edge length
+/// [`RemeshError::TooCoarse`] when the remeshed surface cannot be built.
+pub const COARSE_FACES: usize = 100;
+
 /// Why a remeshing could not be done. Every variant names the option, face or solver at
 /// fault and what to do instead.
 #[derive(Debug, Error)]
@@ -74,6 +78,24 @@ pub enum RemeshError {
         /// The validation error.
         #[source]
         error: MeshError,
+    },
+    /// The asked edge length is too long for the surface: so few triangles of that size
+    /// cover it that its triangulation collapses (faces coincide, or none is left).
+    #[error(
+        "an edge length of {edge_length:e} is too long for this surface (area {area:.4e}: {faces:.2e} equilateral triangles of that side): {error}; ask for an edge length of at most about {suggested:.3e} ({COARSE_FACES} triangles)"
+    )]
+    TooCoarse {
+        /// The edge length asked (or derived from the vertex count asked).
+        edge_length: f64,
+        /// The surface's area.
+        area: f64,
+        /// The number of equilateral triangles of side `edge_length` whose area is `area`.
+        faces: f64,
+        /// The edge length of [`COARSE_FACES`] equilateral triangles of the surface's area.
+        suggested: f64,
+        /// How the triangulation collapsed.
+        #[source]
+        error: Box<RemeshError>,
     },
     /// Point location failed.
     #[error(transparent)]

@@ -64,7 +64,7 @@ use beltrami_core::{Context, Remeshed, Solver, topology::describe};
 use beltrami_mesh::{Mesh, PolygonSoup, SurfacePoint};
 
 pub use chart::Opening;
-pub use error::RemeshError;
+pub use error::{COARSE_FACES, RemeshError};
 pub use options::{FEATURE_TOLERANCE, MAX_MIN_ANGLE, RemeshOptions, Resolution, SizeField};
 pub use quality::Quality;
 
@@ -111,7 +111,8 @@ pub fn remesh(
         });
     }
     let edge_length = options.edge_length(mesh.total_area());
-    let first = remesh_at(mesh, parameterizers, options, edge_length, context)?;
+    let first = remesh_at(mesh, parameterizers, options, edge_length, context)
+        .map_err(|error| too_coarse(mesh, edge_length, error))?;
     let Resolution::Vertices(asked) = options.resolution else {
         return Ok(first);
     };
@@ -120,6 +121,35 @@ pub fn remesh(
     let n = first.remeshed.mesh.vertex_count() as f64;
     let corrected = edge_length * (n / asked as f64).sqrt();
     remesh_at(mesh, parameterizers, options, corrected, context)
+        .map_err(|error| too_coarse(mesh, corrected, error))
+}
+
+/// `error` of remeshing `mesh` at `edge_length`, as [`RemeshError::TooCoarse`] when the
+/// remeshed surface could not be built (or came out with another topology) and fewer
+/// than [`COARSE_FACES`] equilateral triangles of that side cover the surface: the
+/// asked size, not the surface, is at fault.
+fn too_coarse(mesh: &Mesh, edge_length: f64, error: RemeshError) -> RemeshError {
+    let area = mesh.total_area();
+    let triangle = |side: f64| 3f64.sqrt() / 4.0 * side * side;
+    let faces = area / triangle(edge_length);
+    let collapsed = matches!(
+        error,
+        RemeshError::Build {
+            what: "remeshed surface",
+            ..
+        } | RemeshError::TopologyChanged { .. }
+    );
+    if collapsed && faces < COARSE_FACES as f64 {
+        RemeshError::TooCoarse {
+            edge_length,
+            area,
+            faces,
+            suggested: (area / triangle(1.0) / COARSE_FACES as f64).sqrt(),
+            error: Box::new(error),
+        }
+    } else {
+        error
+    }
 }
 
 /// [`remesh`] at a given edge length.

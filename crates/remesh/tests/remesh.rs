@@ -450,3 +450,29 @@ fn the_corners_of_a_boundary_are_kept() {
         q.hausdorff
     );
 }
+
+/// An edge length too long for a closed surface is named as such, with a length that
+/// works, instead of "face 3 duplicates face 0" (torus) or "the mesh has no faces"
+/// (sphere).
+#[test]
+fn an_edge_length_too_long_for_the_surface_is_refused_with_one_that_works() {
+    let solvers: [&dyn Solver; 2] = [&Lscm, &Tutte];
+    for input in [
+        mesh(&icosphere(3)),
+        mesh(&torus(40, 20, 1.0, 0.4, Cells::Triangles)),
+    ] {
+        let options = RemeshOptions::with_edge_length(1e9);
+        match remesh(&input, &solvers, &options, &mut Context::new()) {
+            Err(RemeshError::TooCoarse {
+                edge_length,
+                suggested,
+                ..
+            }) => {
+                assert_eq!(edge_length, 1e9);
+                let result = run(&input, suggested);
+                assert_eq!(describe(&result.remeshed.mesh), describe(&input));
+            }
+            other => panic!("expected TooCoarse, got {other:?}"),
+        }
+    }
+}
