@@ -4,11 +4,11 @@
 //!
 //! The Python package owns the call signatures (keyword arguments named like the
 //! command-line flags, with the command line's defaults) and the exception hierarchy
-//! (`beltrami/_errors.py`); this module builds meshes from arrays ([`arrays`]), turns a
+//! (`beltrami/_errors.py`); this module builds meshes from arrays (`arrays`), turns a
 //! call's description into a [`beltrami_core::Problem`] and solves it with the GIL
-//! released ([`solve`]), and measures ([`measure`]), remeshes and cuts
-//! ([`surgery`]), makes texture atlases ([`atlas`]), repairs ([`repair`]) and reads and writes files ([`files`]). Errors become the package's
-//! exceptions with the command line's messages ([`errors`]).
+//! released (`solve`), and measures (`measure`), remeshes and cuts
+//! (`surgery`), makes texture atlases (`atlas`), repairs (`repair`) and reads and writes files (`files`). Errors become the package's
+//! exceptions with the command line's messages (`errors`).
 
 use pyo3::prelude::*;
 

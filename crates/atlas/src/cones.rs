@@ -10,7 +10,7 @@
 //! Springborn, Schroeder and Pinkall 2008 and Sawhney and Crane 2017 use the same
 //! linearization). The curvature a cone takes is whatever is left there; the greedy
 //! rule adds the next cone at the vertex of largest `|u|`, until the map's predicted
-//! L2 stretch `sqrt(mean_A(e^{-2u}) mean_A(e^{2u}))` (see [`crate::stretch`]) is at
+//! L2 stretch `sqrt(mean_A(e^{-2u}) mean_A(e^{2u}))` (see [`crate::stretch`](mod@crate::stretch)) is at
 //! most the goal or the count is reached.
 //!
 //! A closed surface with no cone yet first gets the scale of the metric of constant

@@ -22,7 +22,7 @@
 //! 6. **Packing** ([`pack`]): charts turned to their least bounding rectangles and
 //!    packed by a skyline into the unit square.
 //!
-//! The quality is measured by Sander et al.'s texture stretch ([`stretch`]).
+//! The quality is measured by Sander et al.'s texture stretch ([`stretch`](mod@stretch)).
 //!
 //! ```
 //! use beltrami_atlas::{AtlasOptions, atlas};
@@ -110,7 +110,7 @@ struct Piece {
 /// # Errors
 /// [`AtlasError::InvalidOption`] for options out of range, [`AtlasError::NotTriangles`]
 /// for a mesh with quads, [`AtlasError::Unflattenable`] if a piece cannot be laid flat
-/// after [`MAX_SPLITS`] splits.
+/// after `MAX_SPLITS` splits.
 pub fn atlas(mesh: &Mesh, options: &AtlasOptions) -> Result<Atlas, AtlasError> {
     options.validate()?;
     if let Some(face) = mesh.faces().find(|&f| mesh.face_degree(f) != 3) {

@@ -42,7 +42,7 @@
 //!    each image face by `t V` makes its signed area a quadratic in `t`, both in its
 //!    own frame and against its reference normal (the sum of its corners' target
 //!    normals, which the flip test reads), and their smallest positive root over the
-//!    faces not flipped now is where the first one turns over ([`first_fold`]). The
+//!    faces not flipped now is where the first one turns over (`first_fold`). The
 //!    second catches thin image triangles across a curved part of a target mesh, which
 //!    tilt over the reference while their own plane turns with them (on `mc4_face_a`
 //!    onto `mc4_face_b` remeshed to 100K faces every trial that flipped had such a face
@@ -51,7 +51,7 @@
 //!    the full search. On a target mesh most trials from `t = 1` flipped tens of faces
 //!    (`g0_koala` onto a 100K remesh of `g0_bunny_closed`: 6.5 trials a step, each a
 //!    walk of every vertex). The first size below the fold is not tried when the faces
-//!    near the fold ([`near_fold_rise`]: those whose own fold is within four times the
+//!    near the fold (`near_fold_rise`: those whose own fold is within four times the
 //!    first, their corners moved by `t V`) alone would raise `E` by more than the
 //!    Gauss-Newton model predicts it falls, `(2 t - t^2) Q`
 //!    ([`FlowSystem::model_decrease`]): on `mc4_face_a` onto `mc4_face_b` remeshed to

@@ -427,7 +427,7 @@ impl FlowSystem {
     /// coefficient would leave along the segment ahead, a first-order error of the model
     /// for every face at the vertex. Where the solved move points out of the side it was
     /// solved on, the vertex takes the other side, and when it moves by at least
-    /// [`CORNER_RESOLVE_SHARE`] of the largest move the system is solved once more (a
+    /// `CORNER_RESOLVE_SHARE` of the largest move the system is solved once more (a
     /// vertex that points out of both sides keeps its second one: its best move is to
     /// stay, and the model errs for it alone).
     ///

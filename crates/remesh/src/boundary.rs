@@ -45,7 +45,7 @@ pub struct BoundarySamples {
 /// surface vertex `v` (a chain takes the mean over its vertices). With a finite
 /// `corner_tolerance` (the feature tolerance relative to the spacing), runs of the
 /// surface's own boundary (edges with one copy in the chart) are split at their corners
-/// ([`split_at_corners`]); a chart of part of a surface, whose boundary the surface goes
+/// (`split_at_corners`); a chart of part of a surface, whose boundary the surface goes
 /// on across, passes `f64::INFINITY`.
 pub fn sample(
     chart: &Mesh,

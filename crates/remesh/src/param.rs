@@ -19,7 +19,7 @@ const PLANAR_TARGETS: [TargetKind; 5] = [
     TargetKind::PlaneSquare,
 ];
 
-/// The first target of [`PLANAR_TARGETS`] that `solver` accepts, or an error saying it
+/// The first target of `PLANAR_TARGETS` that `solver` accepts, or an error saying it
 /// does not map into the plane.
 pub fn planar_target(solver: &dyn Solver) -> Result<Target<'static>, RemeshError> {
     let accepts = solver.accepts();

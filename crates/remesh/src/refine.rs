@@ -7,7 +7,7 @@
 //!    longer than `ALPHA h` (`h` the asked length there), or whose smallest lifted angle
 //!    is below the angle limit while its longest edge is still longer than `h` (so that
 //!    an anisotropic map cannot drive it on forever), gets a new vertex
-//!    at a frontal point towards its circumcenter ([`frontal_point`]; its centroid when
+//!    at a frontal point towards its circumcenter (`frontal_point`; its centroid when
 //!    that point falls outside the domain), as in Delaunay refinement (J. Ruppert, "A Delaunay refinement algorithm for
 //!    quality 2-dimensional mesh generation", J. Algorithms 18, 1995; L. P. Chew,
 //!    "Guaranteed-quality mesh generation for curved surfaces", SoCG 1993). Measuring on

@@ -1,7 +1,7 @@
 //! Where a surface point touches the boundary of its mesh, and which way is out.
 //!
 //! A point of a face lies on the boundary when its barycentric coordinates put it on a
-//! boundary edge or at a boundary vertex, within [`VERTEX_TOLERANCE`] (the walk of
+//! boundary edge or at a boundary vertex, within `VERTEX_TOLERANCE` (the walk of
 //! [`crate::motion`] ends exactly there when it slides along the boundary). The outward
 //! direction of a boundary edge is `e x n`, `e` the unit edge of the face's halfedge
 //! along it (the face lies to its left, counter-clockwise about the face normal `n`):
@@ -24,7 +24,7 @@ pub enum OnBoundary {
     Edge(HalfedgeId, f64),
 }
 
-/// Whether `p` is on the boundary of `mesh` (coordinates within [`VERTEX_TOLERANCE`] of
+/// Whether `p` is on the boundary of `mesh` (coordinates within `VERTEX_TOLERANCE` of
 /// a boundary vertex or edge), and where.
 pub fn on_boundary(mesh: &Mesh, p: &SurfacePoint) -> Option<OnBoundary> {
     let (v, n) = mesh.face_vertex_array(p.face);

@@ -28,7 +28,7 @@ pub(crate) const NAME: &str = "extremal";
 ///
 /// Reads: `target` (`Plane(Keep | Given)`: every boundary vertex of every loop fixed;
 /// or `Disk`: the four-point problem, the boundary sliding on the unit circle with four
-/// `constraints` landmarks at points of it, [`crate::quadrilateral`]), `goal`
+/// `constraints` landmarks at points of it, the `quadrilateral` module), `goal`
 /// (`Extremal`), `initial` (a planar start map, folded or not; its boundary values are
 /// replaced by the prescribed ones) and the options `init`, `tolerance`, `max-iters`,
 /// `inner-iters`, `threads`.

@@ -18,7 +18,7 @@ use crate::{
     match_features_after,
 };
 
-/// Surface registration: the initial bijection of [`initial_map`] (through a common
+/// Surface registration: the initial bijection of `initial_map` (through a common
 /// parameter domain chosen by the topology, aligned by the landmarks), then the discrete
 /// Beltrami flow on the target mesh ([`beltrami_flow_engine::solve`] with `Target::Mesh`).
 ///

@@ -18,7 +18,7 @@
 //! `OFF`, or `STOFF` with texture coordinates, `COFF` with colors (RGBA, floats in
 //! [0, 1], alpha 1), `STCOFF` with both. Positions are written as shortest round-trip
 //! decimals, so they read back to the last bit. Vertex `k` of the file is input vertex
-//! `k` whenever no vertices were merged (see [`super::slots`]).
+//! `k` whenever no vertices were merged (see `super::slots`).
 
 use std::io::Write as _;
 use std::path::Path;

@@ -23,7 +23,7 @@
 //! texture coordinates as `double` `s t`, colors as `uchar` `red green blue`, faces as a
 //! `uchar` count and `int` indices (`uint` when a mesh has more than 2^31 vertices).
 //! Vertex `k` of the file is input vertex `k` whenever no vertices were merged (see
-//! [`super::slots`]).
+//! `super::slots`).
 
 use std::io::Write as _;
 use std::path::Path;
