@@ -208,7 +208,9 @@ pub(crate) struct SpatialMatch {
     source_center: Point3<f64>,
     target_center: Point3<f64>,
     scale: f64,
-    rotation: Matrix3<f64>,
+    /// `s R` for a similarity; any orientation-preserving linear map once refined by
+    /// [`SpatialMatch::refined_by_closest_points`].
+    linear: Matrix3<f64>,
 }
 
 impl SpatialMatch {
@@ -225,7 +227,7 @@ impl SpatialMatch {
             source_center,
             target_center,
             scale,
-            rotation: Matrix3::identity(),
+            linear: Matrix3::identity() * scale,
         }
     }
 
@@ -265,18 +267,47 @@ impl SpatialMatch {
             source_center,
             target_center,
             scale,
-            rotation,
+            linear: rotation * scale,
         })
     }
 
-    /// The scale factor `s`.
+    /// The scale factor `s` of the similarity (before any refinement).
     pub(crate) fn scale(&self) -> f64 {
         self.scale
     }
 
-    /// The similarity as an affine map `p -> M (p, 1)`.
+    /// The match refined by closest points (`crate::affine_alignment`): from this
+    /// placement, the affine map that best carries `source`'s vertices onto their
+    /// closest points on the target of `index`.
+    ///
+    /// # Errors
+    /// [`RegisterError::Spatial`] when a closest point cannot be found.
+    pub(crate) fn refined_by_closest_points(
+        self,
+        source: &Mesh,
+        index: &SurfaceIndex<'_>,
+    ) -> Result<Self, RegisterError> {
+        let samples: Vec<Point3<f64>> = crate::affine_alignment::spread_vertices(source)
+            .into_iter()
+            .map(|v| source.position(v))
+            .collect();
+        let m = crate::affine_alignment::closest_point_affine(
+            &samples,
+            index,
+            self.as_affine(),
+            self.scale,
+        )?;
+        let linear: Matrix3<f64> = m.fixed_view::<3, 3>(0, 0).into_owned();
+        Ok(Self {
+            target_center: Point3::from(linear * self.source_center.coords + m.column(3)),
+            linear,
+            ..self
+        })
+    }
+
+    /// The match as an affine map `p -> M (p, 1)`.
     pub(crate) fn as_affine(&self) -> Matrix3x4<f64> {
-        let linear = self.rotation * self.scale;
+        let linear = self.linear;
         let shift = self.target_center.coords - linear * self.source_center.coords;
         let mut m = Matrix3x4::zeros();
         m.fixed_view_mut::<3, 3>(0, 0).copy_from(&linear);
@@ -286,7 +317,7 @@ impl SpatialMatch {
 
     /// A source position moved into the target's frame.
     pub(crate) fn to_target(&self, p: &Point3<f64>) -> Point3<f64> {
-        self.target_center + self.rotation * (p - self.source_center) * self.scale
+        self.target_center + self.linear * (p - self.source_center)
     }
 }
 

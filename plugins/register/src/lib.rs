@@ -36,6 +36,7 @@
 //!
 //! See `docs/register.md` for the conventions, the choice of loops and the timings.
 
+mod affine_alignment;
 mod compose;
 mod consistency;
 mod disk;

@@ -41,7 +41,7 @@ use crate::compose;
 use crate::error::{RegisterError, Side};
 use crate::landmarks::Resolved;
 use crate::param::{arc_fractions, domain_mesh, path_fractions, planar_points, tutte};
-use crate::routing::{Drawing, Loops, Pin, forward_pins, pair_loops, placement};
+use crate::routing::{Drawing, Loops, Pin, forward_pins, pair_loops, refined_placement};
 use crate::skeleton::{Skeleton, Word, with_slits};
 
 /// [`map`] with every landmark's target point inside a target face made a vertex of
@@ -128,7 +128,7 @@ pub(crate) fn map(
     let forward = forward_pins(source, target, marks);
     let source_loops = Loops::of(source);
     let target_loops = Loops::of(target);
-    let (place, fitted) = placement(source, target, &forward);
+    let (place, fitted) = refined_placement(source, target, target_index, &forward)?;
     let paired = pair_loops(source, target, &source_loops, &target_loops, marks, &place)?;
 
     // The cut graph is the coarser mesh's, drawn onto the finer one.
@@ -148,8 +148,8 @@ pub(crate) fn map(
         for (s, &t) in paired.iter().enumerate() {
             inverse[t] = s;
         }
-        let (place, _) = placement(target, source, &backward);
         let source_index = SurfaceIndex::new(source)?;
+        let (place, _) = refined_placement(target, source, &source_index, &backward)?;
         matched_cuts(
             [target, source],
             &source_index,
@@ -194,7 +194,7 @@ pub(crate) fn map(
         if fitted {
             "the similarity fitted to the landmarks"
         } else {
-            "a rough spatial match (centroids and sizes)"
+            "closest points (an affine map fitted from the centroids and sizes)"
         },
         if paired.is_empty() {
             "(none)".to_string()

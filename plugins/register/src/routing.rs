@@ -4,8 +4,10 @@
 //!
 //! 1. **Placement.** Source positions are carried into the target's frame by a
 //!    [`SpatialMatch`]: the similarity fitted to the landmarks when at least three (not
-//!    on one line) are given, otherwise the rough match of centroids and sizes, then
-//!    warped ([`Warp`]) so that known correspondences land on their partners: the
+//!    on one line) are given, otherwise the rough match of centroids and sizes refined
+//!    by closest points (an affine map, `crate::affine_alignment`: two shapes stretched
+//!    differently along the axes overlap, so that the closest points below fall on the
+//!    right handle), then warped ([`Warp`]) so that known correspondences land on their partners: the
 //!    landmarks, points of the paired boundary loops and, on a closed surface without
 //!    the landmarks' similarity, the closest points on the target of up to
 //!    [`WARP_SURFACE_SAMPLES`] spread source vertices (two surfaces of different shapes
@@ -30,7 +32,14 @@
 //!    edge cost `|e| (1 + (d / s)^2)`: `d` the distance of the edge's far end from the
 //!    placed source arc, `s` 2% of the target's bounding-box diagonal (at least twice its
 //!    mean edge length). The penalty keeps a path in a corridor about the placed arc,
-//!    so it goes around the same handles and holes.
+//!    so it goes around the same handles and holes. The path goes through waypoints,
+//!    the target vertices nearest to the placed arc's vertices; a leg to a waypoint
+//!    longer than [`DETOUR`] times the stretch of placed arc it stands for goes round a
+//!    handle the placed arc does not (the waypoint lies across an arc drawn before):
+//!    the waypoint is skipped, and a last leg into the arc's end that is such a detour
+//!    (the legs before it reached the end from the wrong side) drops them from the end.
+//!    An arc drawn round a tube that the source's arc runs along would make the map a
+//!    twist about that tube, which no flow undoes.
 //!
 //! The word of the target's cut is then compared with the source's by the caller: a
 //! geometry too different for the placement to find the same pattern is refused there,
@@ -71,6 +80,10 @@ const CORRIDOR: f64 = 0.02;
 /// that node (or further on after a step into the ring of its end): such steps take
 /// room the node's own arcs need, and are left for when there is no other way.
 const RING_COST: f64 = 50.0;
+
+/// A leg of a drawn arc longer than this many times the stretch of the placed arc it
+/// stands for (plus two corridor widths) goes round a handle the placed arc does not.
+const DETOUR: f64 = 3.0;
 
 /// Points of every boundary loop that refine the placement ([`Warp`]), at most.
 const WARP_LOOP_SAMPLES: usize = 32;
@@ -115,13 +128,31 @@ impl Loops {
 }
 
 /// The similarity that places positions of the mesh with the cut graph in the frame of
-/// the other one (module docs), and whether the landmarks gave it.
+/// the other one, and whether the landmarks gave it: the similarity fitted to the
+/// landmarks, or else the rough match of centroids and sizes.
 pub(crate) fn placement(from: &Mesh, onto: &Mesh, pins: &[Pin]) -> (SpatialMatch, bool) {
     let a: Vec<Point3<f64>> = pins.iter().map(|p| p.from).collect();
     let b: Vec<Point3<f64>> = pins.iter().map(|p| p.onto).collect();
     match SpatialMatch::fitted(&a, &b) {
         Some(fit) => (fit, true),
         None => (SpatialMatch::new(from, onto), false),
+    }
+}
+
+/// [`placement`], the rough match refined by closest points on `onto_index`'s mesh
+/// (`crate::affine_alignment`) when no landmarks fix it (module docs, step 1).
+///
+/// # Errors
+/// [`RegisterError::Spatial`] when a closest point cannot be found.
+pub(crate) fn refined_placement(
+    from: &Mesh,
+    onto: &Mesh,
+    onto_index: &SurfaceIndex<'_>,
+    pins: &[Pin],
+) -> Result<(SpatialMatch, bool), RegisterError> {
+    match placement(from, onto, pins) {
+        (rough, false) => Ok((rough.refined_by_closest_points(from, onto_index)?, false)),
+        fitted => Ok(fitted),
     }
 }
 
@@ -433,6 +464,14 @@ impl Drawing<'_> {
                 }
             };
             let n = vertices.len();
+            if n < 2 {
+                return Ok(Err((
+                    a,
+                    self.seams(format!(
+                        "the cut graph's arc {a} was drawn as a single vertex"
+                    )),
+                )));
+            }
             for (end, pair) in [
                 (0, [vertices[0], vertices[1]]),
                 (1, [vertices[n - 1], vertices[n - 2]]),
@@ -785,7 +824,7 @@ impl Drawing<'_> {
         used_edge: &[bool],
         wedges: &[Option<Vec<HalfedgeId>>; 2],
     ) -> Result<Vec<VertexId>, RegisterError> {
-        let [first, last] = wedges.each_ref().map(Option::as_deref);
+        let [first, last_wedge] = wedges.each_ref().map(Option::as_deref);
         let arc = &self.skeleton.arcs[a];
         let corridor = Corridor::new(self, warp, arc);
         let mut blocked = blocked.to_vec();
@@ -796,8 +835,28 @@ impl Drawing<'_> {
             Some(&end) => (end, None),
             None => (from, first),
         };
-        let inner = &arc.vertices[1..arc.vertices.len().saturating_sub(1)];
-        for &v in inner {
+        // The placed arc's length from its start to each of its vertices: a leg is
+        // measured against the stretch of the placed arc it stands for.
+        let mut along = Vec::with_capacity(arc.vertices.len());
+        let mut length = 0.0;
+        let mut previous: Option<Point3<f64>> = None;
+        for &v in &arc.vertices {
+            let p = warp.to_target(&self.from.position(v));
+            length += previous.map_or(0.0, |q| (p - q).norm());
+            along.push(length);
+            previous = Some(p);
+        }
+        let detour = |leg: &[VertexId], from: usize, to: usize| {
+            let drawn: f64 = leg
+                .windows(2)
+                .map(|pair| (self.onto.position(pair[1]) - self.onto.position(pair[0])).norm())
+                .sum();
+            drawn > DETOUR * (along[to] - along[from]) + 2.0 * warp.corridor_width
+        };
+        // Each leg with the index of the arc vertex it ends at.
+        let mut ends: Vec<usize> = Vec::new();
+        let last = arc.vertices.len().saturating_sub(1);
+        for (i, &v) in arc.vertices.iter().enumerate().take(last).skip(1) {
             let p = warp.to_target(&self.from.position(v));
             let face = self.onto_index.locate(&p)?.point.face;
             // A waypoint by a node is left out: the corridor leads past it.
@@ -818,22 +877,64 @@ impl Drawing<'_> {
                 &used_edge,
                 [leaving, None],
             ) {
+                // A waypoint reached only round a handle lies across an arc drawn
+                // before (or this one): skipped, the arc would wind where the placed
+                // one does not, a twist of the map that no flow undoes.
+                if detour(&leg, ends.last().copied().unwrap_or(0), i) {
+                    continue;
+                }
                 self.take(&leg, &mut blocked, &mut used_edge, true);
                 legs.push(leg);
+                ends.push(i);
             }
         }
-        // The last leg; when the legs before wall `to` off, drop them from the end.
+        // The last leg; when the legs before wall `to` off, or leave it to be reached
+        // only round a handle (from the wrong side of its wedge), drop them from the
+        // end.
+        let mut through_middle = false;
         loop {
             let (start, leaving) = leg_start(&legs);
-            if let Some(leg) = corridor.shortest(
-                self.onto,
-                [start, to],
-                (&blocked, rings),
-                &used_edge,
-                [leaving, last],
-            ) {
-                legs.push(leg);
-                break;
+            // A loop at its node with no leg left: first through the placed arc's
+            // middle, so that the path goes round what the arc goes round.
+            if start == to && !through_middle {
+                through_middle = true;
+                let middle = last / 2;
+                let p = warp.to_target(&self.from.position(arc.vertices[middle]));
+                let face = self.onto_index.locate(&p)?.point.face;
+                let leg = self.nearest_free(&p, face, &blocked).and_then(|via| {
+                    corridor.shortest(
+                        self.onto,
+                        [start, via],
+                        (&blocked, rings),
+                        &used_edge,
+                        [leaving, None],
+                    )
+                });
+                if let Some(leg) = leg {
+                    self.take(&leg, &mut blocked, &mut used_edge, true);
+                    legs.push(leg);
+                    ends.push(middle);
+                    continue;
+                }
+            }
+            let leg = (start != to)
+                .then(|| {
+                    corridor.shortest(
+                        self.onto,
+                        [start, to],
+                        (&blocked, rings),
+                        &used_edge,
+                        [leaving, last_wedge],
+                    )
+                })
+                .flatten();
+            if let Some(leg) = leg {
+                // Nothing to drop before it: the leg is the arc's only way.
+                let only = legs.is_empty() || through_middle && legs.len() == 1;
+                if only || !detour(&leg, ends.last().copied().unwrap_or(0), last) {
+                    legs.push(leg);
+                    break;
+                }
             }
             let Some(dropped) = legs.pop() else {
                 let middle = arc.vertices[arc.vertices.len() / 2];
@@ -848,6 +949,7 @@ impl Drawing<'_> {
                     self.from.vertex_map().to_input(middle),
                 )));
             };
+            ends.pop();
             self.take(&dropped, &mut blocked, &mut used_edge, false);
         }
         let mut path = vec![from];
@@ -917,12 +1019,13 @@ impl Corridor {
         1.0 + d2 / (self.width * self.width)
     }
 
-    /// The cheapest path from `from` to `to` (`from != to`) through unblocked vertices
-    /// (a vertex of a node's 1-ring, other than as the first step from that node or the
-    /// last one into it, at [`RING_COST`] times the cost) and unused interior edges, each edge costing its length times the mean of the
-    /// penalties at its middle and far end; leaving `from` only through the halfedges of
-    /// `wedges[0]` and entering `to` only against those of `wedges[1]` (outgoing
-    /// halfedges of `to`), when given.
+    /// The cheapest path from `from` to `to` through unblocked vertices (a vertex of a
+    /// node's 1-ring, other than as the first step from that node or the last one into
+    /// it, at [`RING_COST`] times the cost) and unused interior edges, each edge costing
+    /// its length times the mean of the penalties at its middle and far end; leaving
+    /// `from` only through the halfedges of `wedges[0]` and entering `to` only against
+    /// those of `wedges[1]` (outgoing halfedges of `to`), when given; `from != to` (an
+    /// arc that is a loop at its node is drawn through a waypoint).
     fn shortest(
         &self,
         mesh: &Mesh,

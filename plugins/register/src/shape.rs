@@ -19,26 +19,12 @@
 
 use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3};
 use beltrami_spatial::SurfaceIndex;
-use nalgebra::{Matrix3, Matrix3x4, Matrix4, Matrix4x3, Vector4};
 
+use crate::affine_alignment::{apply, closest_point_affine, spread_vertices};
 use crate::error::RegisterError;
 use crate::feature_match::Channel;
 use crate::landmarks::SpatialMatch;
 use crate::nonrigid_icp::nonrigid_icp;
-
-/// Source vertices used to fit the alignment at most (evenly picked).
-const FIT_SAMPLES: usize = 2048;
-
-/// Rounds of the affine closest-point fit at most.
-const ICP_ROUNDS: usize = 30;
-
-/// Pairs farther apart than this many times the median distance are left out of an
-/// affine fit (folds and parts the other shape lacks).
-const TRIM: f64 = 2.5;
-
-/// An affine fit is kept only while its singular values stay within this factor of the
-/// similarity's scale: the closest-point fit must not flatten the source.
-const MAX_SHEAR: f64 = 2.0;
 
 /// The source placed in the target's frame (an affine map, then the non-rigid ICP's
 /// template) and its coordinate fields on both meshes.
@@ -67,49 +53,17 @@ impl Shape {
         index: &SurfaceIndex<'_>,
         points: &[SurfacePoint],
     ) -> Result<Option<Self>, RegisterError> {
-        let step = source.vertex_count().div_ceil(FIT_SAMPLES).max(1);
-        let samples: Vec<Point3<f64>> = source
-            .vertices()
-            .step_by(step)
-            .map(|v| source.position(v))
-            .collect();
-        let images: Vec<Point3<f64>> = source
-            .vertices()
-            .step_by(step)
-            .map(|v| points[v.idx()].position(target))
+        let picked = spread_vertices(source);
+        let samples: Vec<Point3<f64>> = picked.iter().map(|&v| source.position(v)).collect();
+        let images: Vec<Point3<f64>> = picked
+            .iter()
+            .map(|&v| points[v.idx()].position(target))
             .collect();
         let Some(similarity) = SpatialMatch::fitted(&samples, &images) else {
             return Ok(None);
         };
-        let mut alignment = similarity.as_affine();
-        let mut best = f64::INFINITY;
-        for _ in 0..ICP_ROUNDS {
-            let moved: Vec<Point3<f64>> = samples.iter().map(|p| apply(&alignment, p)).collect();
-            let closest = index.locate_all(&moved)?;
-            let mut distances: Vec<f64> = closest.iter().map(|l| l.distance).collect();
-            let median = median(&mut distances);
-            let kept: Vec<bool> = closest
-                .iter()
-                .map(|l| l.distance <= TRIM * median)
-                .collect();
-            let count = kept.iter().filter(|&&k| k).count().max(1);
-            let mean = closest
-                .iter()
-                .zip(&kept)
-                .filter(|(_, k)| **k)
-                .map(|(l, _)| l.distance)
-                .sum::<f64>()
-                / count as f64;
-            if mean >= best * (1.0 - 1e-3) {
-                break;
-            }
-            best = mean;
-            let partners: Vec<Point3<f64>> = closest.iter().map(|l| l.position).collect();
-            match affine_fit(&samples, &partners, &kept) {
-                Some(next) if within_shear(&next, similarity.scale()) => alignment = next,
-                _ => break,
-            }
-        }
+        let alignment =
+            closest_point_affine(&samples, index, similarity.as_affine(), similarity.scale())?;
         let (_, scale) = centroid_and_spread(target.positions());
         let affine: Vec<Point3<f64>> = source
             .positions()
@@ -180,46 +134,6 @@ pub(crate) fn vertex_normals_at(source: &Mesh, at: &[Point3<f64>]) -> Vec<Vector
     sum.into_iter()
         .map(|s| s.try_normalize(0.0).unwrap_or_default())
         .collect()
-}
-
-fn apply(m: &Matrix3x4<f64>, p: &Point3<f64>) -> Point3<f64> {
-    Point3::from(m * Vector4::new(p.x, p.y, p.z, 1.0))
-}
-
-/// The median of `values` (reordered), 0 for none.
-fn median(values: &mut [f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    let middle = values.len() / 2;
-    *values.select_nth_unstable_by(middle, f64::total_cmp).1
-}
-
-/// The affine map `M` minimizing `sum_i |M (a_i, 1) - b_i|^2` over the pairs marked
-/// `kept` (normal equations, 4 x 4 Cholesky), `None` when they do not fix one.
-fn affine_fit(from: &[Point3<f64>], to: &[Point3<f64>], kept: &[bool]) -> Option<Matrix3x4<f64>> {
-    let mut normal = Matrix4::<f64>::zeros();
-    let mut right = Matrix4x3::<f64>::zeros();
-    for ((a, b), _) in from.iter().zip(to).zip(kept).filter(|(_, k)| **k) {
-        let h = Vector4::new(a.x, a.y, a.z, 1.0);
-        normal += h * h.transpose();
-        right += h * b.coords.transpose();
-    }
-    let solved = normal.cholesky()?.solve(&right).transpose();
-    solved.iter().all(|x| x.is_finite()).then_some(solved)
-}
-
-/// Whether the linear part of `m` scales every direction by `[scale / MAX_SHEAR, scale
-/// MAX_SHEAR]` and keeps the orientation.
-fn within_shear(m: &Matrix3x4<f64>, scale: f64) -> bool {
-    let linear: Matrix3<f64> = m.fixed_view::<3, 3>(0, 0).into_owned();
-    if linear.determinant() <= 0.0 {
-        return false;
-    }
-    linear
-        .singular_values()
-        .iter()
-        .all(|&s| s >= scale / MAX_SHEAR && s <= scale * MAX_SHEAR)
 }
 
 #[cfg(test)]
