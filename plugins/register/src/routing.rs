@@ -892,6 +892,7 @@ impl Drawing<'_> {
         // only round a handle (from the wrong side of its wedge), drop them from the
         // end.
         let mut through_middle = false;
+        let mut walled = 1;
         loop {
             let (start, leaving) = leg_start(&legs);
             // A loop at its node with no leg left: first through the placed arc's
@@ -928,15 +929,21 @@ impl Drawing<'_> {
                     )
                 })
                 .flatten();
-            if let Some(leg) = leg {
+            // A detour drops one leg; no path at all drops 1, 2, 4, .. legs (each search
+            // that finds nothing explores all the mesh it can reach).
+            let drop = if let Some(leg) = leg {
                 // Nothing to drop before it: the leg is the arc's only way.
                 let only = legs.is_empty() || through_middle && legs.len() == 1;
                 if only || !detour(&leg, ends.last().copied().unwrap_or(0), last) {
                     legs.push(leg);
                     break;
                 }
-            }
-            let Some(dropped) = legs.pop() else {
+                1
+            } else {
+                walled *= 2;
+                walled / 2
+            };
+            if legs.is_empty() {
                 let middle = arc.vertices[arc.vertices.len() / 2];
                 return Err(self.seams(format!(
                     "no path on the other mesh for the cut graph's arc from vertex {} to vertex {} of the {} that avoids the arcs drawn before it (the arc goes round a handle or a hole the placement did not pair: a landmark at {} vertex {}, the arc's middle, with its partner on the other mesh ties that handle down)",
@@ -948,9 +955,13 @@ impl Drawing<'_> {
                     self.from_side,
                     self.from.vertex_map().to_input(middle),
                 )));
-            };
-            ends.pop();
-            self.take(&dropped, &mut blocked, &mut used_edge, false);
+            }
+            for _ in 0..drop.min(legs.len()) {
+                if let Some(dropped) = legs.pop() {
+                    ends.pop();
+                    self.take(&dropped, &mut blocked, &mut used_edge, false);
+                }
+            }
         }
         let mut path = vec![from];
         for leg in legs {
