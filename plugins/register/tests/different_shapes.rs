@@ -45,3 +45,40 @@ fn two_different_genus_three_surfaces_register_both_ways_without_a_flip() {
     register_without_flips(&slim, &stout);
     register_without_flips(&stout, &slim);
 }
+
+/// Not a test: writes the pairs of docs/benchmarks.md ("Any topology") as OBJ files into
+/// the directory `BELTRAMI_IMPLICIT_DIR` (run with `-- --ignored`).
+#[test]
+#[ignore = "writes benchmark meshes; run with --ignored and BELTRAMI_IMPLICIT_DIR"]
+fn write_the_benchmark_pairs() {
+    let Some(dir) = std::env::var_os("BELTRAMI_IMPLICIT_DIR") else {
+        eprintln!("BELTRAMI_IMPLICIT_DIR is not set: nothing written");
+        return;
+    };
+    let dir = std::path::PathBuf::from(dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |mesh: &Mesh, name: String| {
+        let path = dir.join(name);
+        beltrami_mesh::io::write(&path, mesh, &Default::default()).unwrap();
+    };
+    for n in [30, 36, 40, 46, 50, 56, 60, 66, 70, 80] {
+        write(
+            &implicit::pretzel(0.02, [1.0, 1.0, 1.0], 0.0, n),
+            format!("thin{n}.obj"),
+        );
+        write(
+            &implicit::pretzel(0.03, [1.15, 0.9, 1.3], 0.05, n),
+            format!("thick{n}.obj"),
+        );
+    }
+    for n in [56, 64, 84, 100] {
+        write(
+            &implicit::three_loops(0.012, [1.0, 1.0, 1.0], n),
+            format!("slim{n}.obj"),
+        );
+        write(
+            &implicit::three_loops(0.02, [1.1, 0.85, 1.4], n),
+            format!("stout{n}.obj"),
+        );
+    }
+}
