@@ -187,7 +187,7 @@ pub fn atlas(
 /// relative to the input's bounding-box diagonal), the seconds and the timings.
 pub fn remesh(
     input: &Mesh,
-    result: &beltrami_remesh::Remeshing,
+    result: &beltrami_remesh::Summary,
     q: &beltrami_remesh::Quality,
     seconds: f64,
 ) -> JsonMap<String, Value> {
@@ -199,7 +199,7 @@ pub fn remesh(
     let value = json!({
         "method": "param",
         "parameterizer": result.parameterizer,
-        "opening": result.opening.name(),
+        "opening": result.opening,
         "topology": beltrami_core::topology::describe(input),
         "input_vertices": input.vertex_count(),
         "input_faces": input.face_count(),

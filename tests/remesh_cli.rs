@@ -349,3 +349,105 @@ fn qc_angles_moves_the_vertices_towards_better_angles() {
     assert_eq!(r["constraint"], "normal");
     assert!(number(&["k"]) > 0.0 && number(&["iterations"]) >= 1.0);
 }
+
+#[test]
+fn a_mesh_in_pieces_is_remeshed_piece_by_piece_or_its_largest_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    // A disk and a torus beside it, the disk's faces first.
+    let mut soup = disk(3);
+    let disk_faces = soup.face_count();
+    let torus = torus(64, 24, 2.0, 0.6, Cells::Triangles);
+    assert!(torus.face_count() > disk_faces);
+    let offset = soup.positions.len() as u32;
+    soup.positions.extend(
+        torus
+            .positions
+            .iter()
+            .map(|p| p + beltrami_mesh::Vector3::new(5.0, 0.0, 0.0)),
+    );
+    for f in torus.faces() {
+        let f: Vec<u32> = f.iter().map(|i| i + offset).collect();
+        soup.push_face(&f);
+    }
+    let input = dir.path().join("pieces.obj");
+    let mesh = write_soup(&input, &soup);
+    assert_eq!(mesh.component_count(), 2);
+
+    // Without the flag: refused, naming the flags, nothing written.
+    let output = dir.path().join("out.obj");
+    let out = beltrami(&[
+        "remesh",
+        s(&input),
+        "--edge-length",
+        "0.15",
+        "-o",
+        s(&output),
+    ]);
+    assert!(!out.status.success());
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("2 components") && stderr.contains("--components each"),
+        "{stderr}"
+    );
+    assert!(!output.exists());
+
+    // each: both pieces, each its topology, the report listing them in order.
+    let r = remesh_and_check(&input, &mesh, 0.15, &["--components", "each"]);
+    let pieces = r["components"].as_array().unwrap();
+    assert_eq!(pieces.len(), 2);
+    assert_eq!(
+        (
+            pieces[0]["input_faces"].as_u64(),
+            pieces[1]["input_faces"].as_u64()
+        ),
+        (Some(disk_faces as u64), Some(torus.face_count() as u64))
+    );
+    assert_eq!(
+        pieces[0]["vertices"].as_u64().unwrap() + pieces[1]["vertices"].as_u64().unwrap(),
+        r["vertices"].as_u64().unwrap()
+    );
+    assert_eq!(r["opening"], "per component", "{r}");
+
+    // largest: the torus (the most faces) alone.
+    let out = beltrami(&[
+        "remesh",
+        s(&input),
+        "--edge-length",
+        "0.15",
+        "--components",
+        "largest",
+        "-o",
+        s(&output),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let result = read(&output);
+    assert_eq!(
+        describe(&result),
+        describe(&Mesh::from_soup(&torus).unwrap())
+    );
+    assert_eq!(r["input_faces"], torus.face_count());
+    assert!(
+        r["notes"].to_string().contains("largest of 2 components"),
+        "{r}"
+    );
+
+    // qc-angles keeps the input's vertices and does not read --components.
+    let out = beltrami(&[
+        "remesh",
+        s(&input),
+        "--method",
+        "qc-angles",
+        "--components",
+        "each",
+        "-o",
+        s(&output),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("--components"),
+        "{}",
+        text(&out.stderr)
+    );
+}

@@ -81,7 +81,7 @@ pub fn remesh<'py>(
     });
     let (result, quality) = result.map_err(|e| remesh_error(&e))?;
     let seconds = start.elapsed().as_secs_f64();
-    let report = beltrami::report::remesh(&mesh, &result, &quality, seconds);
+    let report = beltrami::report::remesh(&mesh, &result.summary(), &quality, seconds);
     let (v, f) = mesh_arrays(&result.remeshed.mesh)?;
     Ok((
         v.into_pyarray(py),

@@ -7,6 +7,17 @@ use anyhow::anyhow;
 use beltrami_mesh::io::{self, LoadedMesh, ReadError};
 use beltrami_mesh::{BuildOptions, MeshError, Repair};
 
+/// What `--components` does with a mesh of several connected components (a scan in
+/// pieces).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ComponentsArg {
+    /// Every component on its own, the results joined in the order of each
+    /// component's first face.
+    Each,
+    /// Only the component with the most faces; OUT holds that component alone.
+    Largest,
+}
+
 /// A loaded mesh and how long reading and building took.
 pub struct Loaded {
     pub mesh: LoadedMesh,

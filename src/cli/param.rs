@@ -9,7 +9,7 @@ use beltrami_core::{
 };
 use clap::{Args, ValueEnum};
 
-use super::load::load_mesh;
+use super::load::{ComponentsArg, load_mesh};
 use super::mapping;
 use super::pins::PinSpec;
 
@@ -22,16 +22,6 @@ pub enum BoundaryArg {
     Square,
     /// Free (LSCM).
     Free,
-}
-
-/// What `--components` does with a mesh of several connected components.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ComponentsArg {
-    /// Map every component on its own and place the maps side by side, left to right
-    /// in the order of each component's first face (maps into the plane only).
-    Each,
-    /// Map only the component with the most faces; OUT holds that component alone.
-    Largest,
 }
 
 /// Edge weights of `--weights`.
@@ -77,7 +67,9 @@ pub struct ParamArgs {
     #[arg(long = "pin")]
     pub pins: Vec<PinSpec>,
     /// A mesh in several connected components (a scan in pieces): `each` maps every
-    /// component, `largest` only the largest. Without it such a mesh is refused.
+    /// component on its own and places the maps side by side, left to right in the
+    /// order of each component's first face (maps into the plane only); `largest` maps
+    /// only the largest. Without it such a mesh is refused.
     #[arg(long, value_enum)]
     pub components: Option<ComponentsArg>,
     /// Output mesh: .obj (the input's vertices and faces, one `vt` per vertex; for the

@@ -6,15 +6,17 @@ use std::time::Instant;
 
 use anyhow::{Context as _, bail};
 use beltrami_core::Context;
+use beltrami_core::components;
 use beltrami_mesh::io::{self, VertexAttributes};
+use beltrami_remesh::components::{Joined, remesh_each};
 use beltrami_remesh::in_place::{InPlaceOptions, Keep, remesh_in_place};
 use beltrami_remesh::reference_angles::Reference;
-use beltrami_remesh::{Quality, RemeshOptions, Remeshing, Resolution, SizeField};
+use beltrami_remesh::{Quality, RemeshError, RemeshOptions, Resolution, SizeField, Summary};
 use beltrami_render::{ColorBy, Scene, Style, View};
 use clap::{Args, ValueEnum};
 use serde_json::{Value, json};
 
-use super::load::load_mesh;
+use super::load::{ComponentsArg, load_mesh};
 use super::mapping::{LateBar, check_output_format, png_path};
 
 /// Remeshing methods of `--method`.
@@ -141,6 +143,12 @@ pub struct RemeshArgs {
     /// Repair what can be repaired safely in the input (see `beltrami info --repair`).
     #[arg(long)]
     pub repair: bool,
+    /// --method param, a mesh in several connected components (a scan in pieces):
+    /// `each` remeshes every component on its own (--vertices shared out by area) and
+    /// joins the results in the order of each component's first face; `largest`
+    /// remeshes only the largest. Without it such a mesh is refused.
+    #[arg(long, value_enum)]
+    pub components: Option<ComponentsArg>,
 }
 
 impl RemeshArgs {
@@ -188,22 +196,88 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     options.validate()?;
     let registry = beltrami::registry();
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
-    let mesh = &loaded.mesh.mesh;
-    let solvers = beltrami_remesh::param::chosen(&registry, mesh, &args.param)?;
-
+    let whole = &loaded.mesh.mesh;
+    let several = whole.component_count() > 1;
+    let pieces;
+    let (mesh, largest_note) = match args.components {
+        Some(ComponentsArg::Largest) if several => {
+            pieces = components::parts(whole)?;
+            let k = components::largest(&pieces).context("the mesh has no faces")?;
+            let part = &pieces[k].mesh;
+            let note = format!(
+                "the largest of {} components remeshed ({} of {} faces); OUT holds it alone",
+                pieces.len(),
+                part.face_count(),
+                whole.face_count()
+            );
+            (part, Some(note))
+        }
+        _ => (whole, None),
+    };
     let start = Instant::now();
     let mut context = Context::new().with_cancel_flag(super::interrupt::cancel_flag());
-    let result = beltrami_remesh::remesh(mesh, &solvers, &options, &mut context)
+    let (out, mut summary, per_component) = if args.components == Some(ComponentsArg::Each) {
+        let joined = remesh_each(
+            mesh,
+            |part| beltrami_remesh::param::chosen(&registry, part, &args.param),
+            &options,
+            &mut context,
+        )
         .with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
+        let (summary, listed) = (joined.summary(), component_list(&joined));
+        (joined.remeshed.mesh, summary, Some(listed))
+    } else {
+        let solvers =
+            beltrami_remesh::param::chosen(&registry, mesh, &args.param).map_err(with_hint)?;
+        let result = beltrami_remesh::remesh(mesh, &solvers, &options, &mut context)
+            .map_err(with_hint)
+            .with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
+        let summary = result.summary();
+        (result.remeshed.mesh, summary, None)
+    };
+    summary.notes.extend(largest_note);
     let seconds = start.elapsed().as_secs_f64();
-    let out = &result.remeshed.mesh;
-    io::write(&args.output, out, &VertexAttributes::default())?;
-    let quality = beltrami_remesh::quality::measure(mesh, out)?;
-    write_png(args.png.as_deref(), out)?;
-    let report = report_json(args, mesh, &result, &quality, seconds);
+    io::write(&args.output, &out, &VertexAttributes::default())?;
+    let quality = beltrami_remesh::quality::measure(mesh, &out)?;
+    write_png(args.png.as_deref(), &out)?;
+    let mut report = report_json(args, mesh, &summary, &quality, seconds);
+    if let (Some(list), Value::Object(map)) = (per_component, &mut report) {
+        map.insert("components".into(), list);
+    }
     finish(args, &report, quiet, || {
-        print_summary(args, &result, &quality, seconds)
+        print_summary(args, &summary, &quality, seconds)
     })
+}
+
+/// `error`, with the `--components` flags named when the mesh has several components.
+fn with_hint(error: RemeshError) -> anyhow::Error {
+    match error {
+        RemeshError::Components { .. } => anyhow::anyhow!(
+            "{error}\nhint: `--components each` remeshes every connected component on its own, `--components largest` the largest alone"
+        ),
+        other => anyhow::Error::new(other),
+    }
+}
+
+/// The report's `components` of a joined remeshing: per component, its input faces,
+/// parameterizer, opening, edge length and new vertex and face counts.
+fn component_list(joined: &Joined) -> Value {
+    let list: Vec<Value> = joined
+        .components
+        .iter()
+        .map(|c| {
+            let r = &c.remeshing;
+            json!({
+                "input_faces": c.input_faces,
+                "parameterizer": r.parameterizer,
+                "opening": r.opening.name(),
+                "edge_length": r.edge_length,
+                "vertices": r.remeshed.mesh.vertex_count(),
+                "faces": r.remeshed.mesh.face_count(),
+            })
+        })
+        .collect();
+    Value::Array(list)
 }
 
 /// Refuses, before any work, the flags of the other method (they would be ignored
@@ -214,6 +288,7 @@ fn check_method_flags(args: &RemeshArgs) -> anyhow::Result<()> {
         MethodArg::QcAngles => (
             [
                 given(args.param != "auto", "--param"),
+                given(args.components.is_some(), "--components"),
                 given(args.min_angle != 30.0, "--min-angle"),
                 given(args.size_field != SizeFieldArg::Uniform, "--size-field"),
                 given(args.max_vertices != 5_000_000, "--max-vertices"),
@@ -397,7 +472,7 @@ fn finish(
 fn report_json(
     args: &RemeshArgs,
     input: &beltrami_mesh::Mesh,
-    result: &Remeshing,
+    result: &Summary,
     q: &Quality,
     seconds: f64,
 ) -> Value {
@@ -408,13 +483,13 @@ fn report_json(
     Value::Object(report)
 }
 
-fn print_summary(args: &RemeshArgs, result: &Remeshing, q: &Quality, seconds: f64) {
+fn print_summary(args: &RemeshArgs, result: &Summary, q: &Quality, seconds: f64) {
     println!(
         "{} -> {} ({}, {}, {seconds:.3} s)",
         args.mesh.display(),
         args.output.display(),
         result.parameterizer,
-        result.opening.name()
+        result.opening
     );
     println!("  vertices        {}", q.vertices);
     println!("  faces           {}", q.faces);

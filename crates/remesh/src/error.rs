@@ -22,6 +22,18 @@ pub enum RemeshError {
         /// What is wrong and the accepted range.
         message: String,
     },
+    /// Remeshing one connected component of a mesh in several failed
+    /// ([`crate::components::remesh_each`]).
+    #[error("component {component} (the one with input face {first_face}): {error}")]
+    InComponent {
+        /// The component's index, in the order of the components' first faces.
+        component: usize,
+        /// Its first face, as an input index.
+        first_face: usize,
+        /// Why its remeshing failed.
+        #[source]
+        error: Box<RemeshError>,
+    },
     /// The mesh is not a single connected surface.
     #[error("remeshing needs one connected surface; this mesh has {components} components")]
     Components {

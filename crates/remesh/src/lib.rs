@@ -44,6 +44,7 @@
 pub mod boundary;
 pub mod chart;
 pub mod circle_domain;
+pub mod components;
 pub mod domain;
 mod error;
 pub mod in_place;
@@ -86,6 +87,39 @@ pub struct Remeshing {
     pub timings: Vec<(&'static str, f64)>,
     /// Why earlier parameterizers of the list were passed over.
     pub notes: Vec<String>,
+}
+
+/// How a remeshing was made, for reports: one [`Remeshing`]'s, or the joined
+/// remeshing of several components' ([`components::Joined::summary`]).
+#[derive(Debug, Clone)]
+pub struct Summary {
+    /// The parameterizer's name, `per component` when the components used different ones.
+    pub parameterizer: &'static str,
+    /// [`Opening::name`], `per component` when the components were opened differently.
+    pub opening: &'static str,
+    /// The asked edge length; for components remeshed to a shared vertex count, the
+    /// mean of their edge lengths weighted by area.
+    pub edge_length: f64,
+    /// Size passes of the refinement (the most of any component).
+    pub size_passes: usize,
+    /// Seconds per stage (summed over components).
+    pub timings: Vec<(&'static str, f64)>,
+    /// Notes (a component's prefixed with its index).
+    pub notes: Vec<String>,
+}
+
+impl Remeshing {
+    /// This remeshing's [`Summary`].
+    pub fn summary(&self) -> Summary {
+        Summary {
+            parameterizer: self.parameterizer,
+            opening: self.opening.name(),
+            edge_length: self.edge_length,
+            size_passes: self.size_passes,
+            timings: self.timings.clone(),
+            notes: self.notes.clone(),
+        }
+    }
 }
 
 /// Remeshes `mesh` through the first of `parameterizers` whose map is one-to-one (a
