@@ -230,6 +230,28 @@ pub fn remesh(
     }
 }
 
+/// The `components` entry of the report of a remeshing piece by piece
+/// (`beltrami_remesh::components::remesh_each`): per component, in order, its input
+/// faces, parameterizer, opening, edge length and new vertex and face counts.
+pub fn remesh_components(joined: &beltrami_remesh::components::Joined) -> Value {
+    let list: Vec<Value> = joined
+        .components
+        .iter()
+        .map(|c| {
+            let r = &c.remeshing;
+            json!({
+                "input_faces": c.input_faces,
+                "parameterizer": r.parameterizer,
+                "opening": r.opening.name(),
+                "edge_length": r.edge_length,
+                "vertices": r.remeshed.mesh.vertex_count(),
+                "faces": r.remeshed.mesh.face_count(),
+            })
+        })
+        .collect();
+    Value::Array(list)
+}
+
 /// The report of an in-place remeshing by reference angles (`beltrami remesh --method
 /// qc-angles`): the reference and constraint, the angles before and after, the
 /// distance to the input (also relative to its bounding-box diagonal), the QC

@@ -1233,6 +1233,7 @@ def remesh(
     size_field: str = ...,
     max_vertices: int = ...,
     feature_tolerance: float = ...,
+    components: Optional[str] = ...,
     info: Literal[False] = ...,
 ) -> Tuple[np.ndarray, np.ndarray]: ...
 
@@ -1249,6 +1250,7 @@ def remesh(
     size_field: str = ...,
     max_vertices: int = ...,
     feature_tolerance: float = ...,
+    components: Optional[str] = ...,
     info: Literal[True],
 ) -> Tuple[np.ndarray, np.ndarray, Dict[str, Any]]: ...
 
@@ -1264,6 +1266,7 @@ def remesh(
     size_field: str = "uniform",
     max_vertices: int = 5_000_000,
     feature_tolerance: float = 0.2,
+    components: Optional[str] = None,
     info: bool = False,
 ) -> Any:
     """A new triangle mesh of the surface with the asked ``edge_length`` (or about
@@ -1271,7 +1274,10 @@ def remesh(
     for a closed genus-0 surface in two charts), triangulate the parameter domain by
     constrained Delaunay refinement with angles of at least ``min_angle`` degrees, lift
     back (docs/remesh.md); input vertices farther than ``feature_tolerance`` times the
-    edge length from the result are inserted (``inf``: none). Returns ``(V2, F2)``.
+    edge length from the result are inserted (``inf``: none). A mesh in several
+    connected pieces needs ``components``: ``"each"`` remeshes every piece on its own
+    (``vertices`` shared out by area) and joins the results in the order of each
+    piece's first face, ``"largest"`` remeshes only the largest. Returns ``(V2, F2)``.
     ``beltrami remesh``.
 
     >>> import numpy as np, beltrami
@@ -1294,6 +1300,7 @@ def remesh(
         size_field,
         int(max_vertices),
         float(feature_tolerance),
+        components,
     )
     return (V2, F2, json.loads(report)) if info else (V2, F2)
 

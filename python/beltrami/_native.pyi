@@ -48,6 +48,7 @@ def remesh(
     size_field: str = "uniform",
     max_vertices: int = 5000000,
     feature_tolerance: float = 0.2,
+    components: Optional[str] = None,
 ) -> Tuple[Floats, Ints, str]: ...
 def remesh_in_place(
     v: Floats,

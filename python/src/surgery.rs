@@ -4,7 +4,8 @@ use std::time::Instant;
 
 use beltrami_core::Context;
 use beltrami_mesh::Mesh;
-use beltrami_remesh::{RemeshOptions, Resolution, SizeField};
+use beltrami_remesh::components::{remesh_each, remesh_largest};
+use beltrami_remesh::{RemeshError, RemeshOptions, Resolution, SizeField};
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -23,7 +24,7 @@ fn mesh_arrays(mesh: &Mesh) -> PyResult<(Array2<f64>, Array2<i64>)> {
 /// `vertices` vertices), made through a parameterization (`beltrami remesh`): returns
 /// the positions, the triangles and the JSON report of `--report`.
 #[pyfunction]
-#[pyo3(signature = (v, f, edge_length=None, vertices=None, param="auto", min_angle=30.0, size_field="uniform", max_vertices=5_000_000, feature_tolerance=beltrami_remesh::FEATURE_TOLERANCE))]
+#[pyo3(signature = (v, f, edge_length=None, vertices=None, param="auto", min_angle=30.0, size_field="uniform", max_vertices=5_000_000, feature_tolerance=beltrami_remesh::FEATURE_TOLERANCE, components=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -36,6 +37,7 @@ pub fn remesh<'py>(
     size_field: &str,
     max_vertices: usize,
     feature_tolerance: f64,
+    components: Option<&str>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, String)> {
     let resolution = match (edge_length, vertices) {
         (Some(l), None) => Resolution::EdgeLength(l),
@@ -64,25 +66,69 @@ pub fn remesh<'py>(
         max_vertices,
         feature_tolerance,
     };
-    let remesh_error = |e: &beltrami_remesh::RemeshError| errors::from_error(Kind::Solver, e);
+    let remesh_error = |e: &RemeshError| match e {
+        RemeshError::Components { .. } => errors::raise(
+            Kind::Unsupported,
+            format!(
+                "{e}: pass components='each' (every piece remeshed on its own) or components='largest' (the largest alone)"
+            ),
+        ),
+        other => errors::from_error(Kind::Solver, other),
+    };
     options
         .validate()
         .map_err(|e| errors::from_error(Kind::Option, &e))?;
+    if let Some(other) = components.filter(|c| !matches!(*c, "each" | "largest")) {
+        return Err(errors::raise(
+            Kind::Option,
+            format!(
+                "components={other:?}: expected 'each' (every connected component remeshed on its own, the results joined) or 'largest' (the largest alone)"
+            ),
+        ));
+    }
     let mesh = arrays::mesh(v.as_array(), f.as_array())?;
     let registry = beltrami::registry();
-    let solvers =
-        beltrami_remesh::param::chosen(&registry, &mesh, param).map_err(|e| remesh_error(&e))?;
+    let choose = |part: &Mesh| beltrami_remesh::param::chosen(&registry, part, param);
     let start = Instant::now();
     let result = py.detach(|| {
         let mut context = Context::new();
-        let result = beltrami_remesh::remesh(&mesh, &solvers, &options, &mut context)?;
-        let quality = beltrami_remesh::quality::measure(&mesh, &result.remeshed.mesh)?;
-        Ok((result, quality))
+        let (out, summary, list, part) = match components {
+            Some("each") => {
+                let joined = remesh_each(&mesh, choose, &options, &mut context)?;
+                let list = beltrami::report::remesh_components(&joined);
+                let summary = joined.summary();
+                (joined.remeshed.mesh, summary, Some(list), None)
+            }
+            Some("largest") if mesh.component_count() > 1 => {
+                let largest = remesh_largest(&mesh, choose, &options, &mut context)?;
+                let mut summary = largest.remeshing.summary();
+                summary.notes.push(largest.note(&mesh));
+                (
+                    largest.remeshing.remeshed.mesh,
+                    summary,
+                    None,
+                    Some(largest.part.mesh),
+                )
+            }
+            _ => {
+                let solvers = choose(&mesh)?;
+                let result = beltrami_remesh::remesh(&mesh, &solvers, &options, &mut context)?;
+                let summary = result.summary();
+                (result.remeshed.mesh, summary, None, None)
+            }
+        };
+        let input = part.as_ref().unwrap_or(&mesh);
+        let quality = beltrami_remesh::quality::measure(input, &out)?;
+        Ok((out, summary, list, quality, part))
     });
-    let (result, quality) = result.map_err(|e| remesh_error(&e))?;
+    let (out, summary, list, quality, part) = result.map_err(|e| remesh_error(&e))?;
     let seconds = start.elapsed().as_secs_f64();
-    let report = beltrami::report::remesh(&mesh, &result.summary(), &quality, seconds);
-    let (v, f) = mesh_arrays(&result.remeshed.mesh)?;
+    let input = part.as_ref().unwrap_or(&mesh);
+    let mut report = beltrami::report::remesh(input, &summary, &quality, seconds);
+    if let Some(list) = list {
+        report.insert("components".into(), list);
+    }
+    let (v, f) = mesh_arrays(&out)?;
     Ok((
         v.into_pyarray(py),
         f.into_pyarray(py),

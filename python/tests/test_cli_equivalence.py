@@ -433,6 +433,33 @@ def test_components_each_and_largest_match_param(cli, hemisphere, tmp_path):
     assert any("largest of 2 components" in note for note in report["notes"])
 
 
+def test_remesh_of_a_mesh_in_pieces_matches_the_command(cli, hemisphere, tmp_path):
+    V, F = beltrami.read_mesh(hemisphere)
+    spot_V, spot_F = beltrami.read_mesh(MESHES / "spot.obj")
+    V2 = np.vstack([V, spot_V + [3.0, 0.0, 0.0]])
+    F2 = np.vstack([F, spot_F + len(V)])
+    path = tmp_path / "two.obj"
+    beltrami.write_mesh(path, V2, F2)
+    with pytest.raises(beltrami.UnsupportedError, match="2 components.*components='each'"):
+        beltrami.remesh(V2, F2, edge_length=0.1)
+    with pytest.raises(beltrami.OptionError, match="expected 'each'"):
+        beltrami.remesh(V2, F2, edge_length=0.1, components="all")
+    for which in ("each", "largest"):
+        out, r = tmp_path / f"{which}.obj", tmp_path / f"{which}.json"
+        cli("remesh", path, "--edge-length", "0.1", "--components", which, "-o", out, "--report", r)
+        W, G, report = beltrami.remesh(V2, F2, edge_length=0.1, components=which, info=True)
+        X, H = beltrami.read_mesh(out)
+        close(W, X)
+        np.testing.assert_array_equal(G, H)
+        expected = report_of(r)
+        for key in ("vertices", "faces", "input_faces", "opening", "parameterizer"):
+            assert report[key] == expected[key], key
+    # each: both pieces, listed in order; largest: spot alone (it has the most faces).
+    assert [c["input_faces"] for c in report_of(tmp_path / "each.json")["components"]] == [len(F), len(spot_F)]
+    assert report["input_faces"] == len(spot_F) > len(F)
+    assert any("largest of 2 components" in note for note in report["notes"])
+
+
 def test_atlas_matches_the_command(cli, tmp_path):
     spot = MESHES / "spot.obj"
     out, r = tmp_path / "out.obj", tmp_path / "r.json"

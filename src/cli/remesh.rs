@@ -6,9 +6,9 @@ use std::time::Instant;
 
 use anyhow::{Context as _, bail};
 use beltrami_core::Context;
-use beltrami_core::components;
+use beltrami_mesh::Mesh;
 use beltrami_mesh::io::{self, VertexAttributes};
-use beltrami_remesh::components::{Joined, remesh_each};
+use beltrami_remesh::components::{remesh_each, remesh_largest};
 use beltrami_remesh::in_place::{InPlaceOptions, Keep, remesh_in_place};
 use beltrami_remesh::reference_angles::Reference;
 use beltrami_remesh::{Quality, RemeshError, RemeshOptions, Resolution, SizeField, Summary};
@@ -197,43 +197,40 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     let registry = beltrami::registry();
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
     let whole = &loaded.mesh.mesh;
-    let several = whole.component_count() > 1;
     let pieces;
-    let (mesh, largest_note) = match args.components {
-        Some(ComponentsArg::Largest) if several => {
-            pieces = components::parts(whole)?;
-            let k = components::largest(&pieces).context("the mesh has no faces")?;
-            let part = &pieces[k].mesh;
-            let note = format!(
-                "the largest of {} components remeshed ({} of {} faces); OUT holds it alone",
-                pieces.len(),
-                part.face_count(),
-                whole.face_count()
-            );
-            (part, Some(note))
-        }
-        _ => (whole, None),
-    };
     let start = Instant::now();
     let mut context = Context::new().with_cancel_flag(super::interrupt::cancel_flag());
-    let (out, mut summary, per_component) = if args.components == Some(ComponentsArg::Each) {
-        let joined = remesh_each(
-            mesh,
-            |part| beltrami_remesh::param::chosen(&registry, part, &args.param),
-            &options,
-            &mut context,
-        )
-        .with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
-        let (summary, listed) = (joined.summary(), component_list(&joined));
-        (joined.remeshed.mesh, summary, Some(listed))
-    } else {
-        let solvers =
-            beltrami_remesh::param::chosen(&registry, mesh, &args.param).map_err(with_hint)?;
-        let result = beltrami_remesh::remesh(mesh, &solvers, &options, &mut context)
-            .map_err(with_hint)
-            .with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
-        let summary = result.summary();
-        (result.remeshed.mesh, summary, None)
+    let choose = |part: &Mesh| beltrami_remesh::param::chosen(&registry, part, &args.param);
+    let cannot = || format!("cannot remesh {}", args.mesh.display());
+    let (out, mut summary, mesh, per_component, largest_note) = match args.components {
+        Some(ComponentsArg::Each) => {
+            let joined = remesh_each(whole, choose, &options, &mut context).with_context(cannot)?;
+            let list = beltrami::report::remesh_components(&joined);
+            let summary = joined.summary();
+            (joined.remeshed.mesh, summary, whole, Some(list), None)
+        }
+        Some(ComponentsArg::Largest) if whole.component_count() > 1 => {
+            let largest =
+                remesh_largest(whole, choose, &options, &mut context).with_context(cannot)?;
+            let note = largest.note(whole);
+            let summary = largest.remeshing.summary();
+            pieces = largest.part;
+            (
+                largest.remeshing.remeshed.mesh,
+                summary,
+                &pieces.mesh,
+                None,
+                Some(note),
+            )
+        }
+        _ => {
+            let solvers = choose(whole).map_err(with_hint)?;
+            let result = beltrami_remesh::remesh(whole, &solvers, &options, &mut context)
+                .map_err(with_hint)
+                .with_context(cannot)?;
+            let summary = result.summary();
+            (result.remeshed.mesh, summary, whole, None, None)
+        }
     };
     summary.notes.extend(largest_note);
     let seconds = start.elapsed().as_secs_f64();
@@ -257,27 +254,6 @@ fn with_hint(error: RemeshError) -> anyhow::Error {
         ),
         other => anyhow::Error::new(other),
     }
-}
-
-/// The report's `components` of a joined remeshing: per component, its input faces,
-/// parameterizer, opening, edge length and new vertex and face counts.
-fn component_list(joined: &Joined) -> Value {
-    let list: Vec<Value> = joined
-        .components
-        .iter()
-        .map(|c| {
-            let r = &c.remeshing;
-            json!({
-                "input_faces": c.input_faces,
-                "parameterizer": r.parameterizer,
-                "opening": r.opening.name(),
-                "edge_length": r.edge_length,
-                "vertices": r.remeshed.mesh.vertex_count(),
-                "faces": r.remeshed.mesh.face_count(),
-            })
-        })
-        .collect();
-    Value::Array(list)
 }
 
 /// Refuses, before any work, the flags of the other method (they would be ignored

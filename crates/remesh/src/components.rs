@@ -9,7 +9,7 @@
 //! is shared out by area, `N_k = round(N A_k / A)` (at least 3), so that the joined mesh
 //! has about `N` vertices and one edge length throughout.
 
-use beltrami_core::components::{Part, parts};
+use beltrami_core::components::{Part, largest, parts};
 use beltrami_core::{Context, Remeshed, Solver};
 use beltrami_mesh::{Mesh, PolygonSoup, SurfacePoint};
 
@@ -144,6 +144,58 @@ pub fn remesh_each<'r>(
     Ok(Joined {
         remeshed,
         components,
+    })
+}
+
+/// [`remesh_largest`]'s result: the largest component and its remeshing.
+#[derive(Debug)]
+pub struct Largest {
+    /// The component with the most faces (the first of equals), as a mesh of its own.
+    pub part: Part,
+    /// How many components the mesh has.
+    pub of: usize,
+    /// Its remeshing, on the component alone.
+    pub remeshing: Remeshing,
+}
+
+impl Largest {
+    /// The note that says what was remeshed: `the largest of C components remeshed (F of
+    /// T faces)`.
+    pub fn note(&self, whole: &Mesh) -> String {
+        format!(
+            "the largest of {} components remeshed ({} of {} faces); the result holds it alone",
+            self.of,
+            self.part.mesh.face_count(),
+            whole.face_count()
+        )
+    }
+}
+
+/// Remeshes only the connected component of `mesh` with the most faces, with the
+/// parameterizers `choose` picks for it (a mesh of one component is remeshed whole).
+///
+/// # Errors
+/// The errors of [`remesh`](crate::remesh) on the component.
+pub fn remesh_largest<'r>(
+    mesh: &Mesh,
+    choose: impl Fn(&Mesh) -> Result<Vec<&'r dyn Solver>, RemeshError>,
+    options: &RemeshOptions,
+    context: &mut Context<'_>,
+) -> Result<Largest, RemeshError> {
+    options.validate()?;
+    let mut pieces = parts(mesh).map_err(|error| RemeshError::Build {
+        what: "component",
+        error,
+    })?;
+    let of = pieces.len();
+    let k = largest(&pieces).ok_or(RemeshError::Components { components: 0 })?;
+    let part = pieces.swap_remove(k);
+    let solvers = choose(&part.mesh)?;
+    let remeshing = remesh(&part.mesh, &solvers, options, context)?;
+    Ok(Largest {
+        part,
+        of,
+        remeshing,
     })
 }
 
