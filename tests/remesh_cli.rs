@@ -138,7 +138,7 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
     let output = dir.path().join("out.obj");
     write_soup(&input, &disk(3));
     write_soup(&torus_file, &torus(24, 8, 1.0, 0.4, Cells::Triangles));
-    let cases: [(&[&str], &str); 15] = [
+    let cases: [(&[&str], &str); 19] = [
         (&["--edge-length", "0"], "edge-length"),
         (
             &["--edge-length", "0.1", "--feature-tolerance", "0"],
@@ -178,6 +178,18 @@ fn bad_options_fail_with_the_option_named_and_write_nothing() {
             "--reference is a flag of --method qc-angles",
         ),
         (&[], "--edge-length L or --vertices N"),
+        // Sizes refused before any work (they ran for minutes or aborted on a 150 GB
+        // allocation).
+        (
+            &["--edge-length", "1e-9", "--max-vertices", "1000"],
+            "more than the most allowed (1000, option `max-vertices`)",
+        ),
+        (&["--edge-length", "1e-300"], "option `max-vertices`"),
+        (&["--edge-length", "1e-5"], "option `max-vertices`"),
+        (
+            &["--vertices", "1000000000000"],
+            "would make about 1.000e12 vertices",
+        ),
     ];
     for (extra, expected) in cases {
         let mut args = vec!["remesh", s(&input), "-o", s(&output)];

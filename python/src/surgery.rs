@@ -73,6 +73,7 @@ pub fn remesh<'py>(
                 "{e}: pass components='each' (every piece remeshed on its own) or components='largest' (the largest alone)"
             ),
         ),
+        RemeshError::TooFine { .. } => errors::from_error(Kind::Option, e),
         other => errors::from_error(Kind::Solver, other),
     };
     options

@@ -157,6 +157,12 @@ def test_remesh_needs_a_resolution(disk):
         beltrami.remesh(*disk, edge_length=0.1, min_angle=50.0)
     with pytest.raises(beltrami.OptionError, match="feature-tolerance"):
         beltrami.remesh(*disk, edge_length=0.1, feature_tolerance=0.0)
+    # Sizes that would make too many vertices: refused before any work (they ran past
+    # a minute).
+    with pytest.raises(beltrami.OptionError, match="more than the most allowed"):
+        beltrami.remesh(*disk, vertices=10**12)
+    with pytest.raises(beltrami.OptionError, match=r"\(100, option `max-vertices`\)"):
+        beltrami.remesh(*disk, edge_length=1e-3, max_vertices=100)
 
 
 def test_cut_to_disk_refuses_a_closed_genus_0_mesh(closed):

@@ -109,11 +109,12 @@ pub fn remesh_each<'r>(
     context: &mut Context<'_>,
 ) -> Result<Joined, RemeshError> {
     options.validate()?;
+    let total = mesh.total_area();
+    options.check_size(total)?;
     let pieces = parts(mesh).map_err(|error| RemeshError::Build {
         what: "component",
         error,
     })?;
-    let total = mesh.total_area();
     let in_component = |k: usize, part: &Part, error: RemeshError| RemeshError::InComponent {
         component: k,
         first_face: mesh.face_to_input(part.faces[0]),

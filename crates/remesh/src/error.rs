@@ -34,6 +34,23 @@ pub enum RemeshError {
         #[source]
         error: Box<RemeshError>,
     },
+    /// The asked size would make more vertices than the most allowed
+    /// ([`crate::RemeshOptions::max_vertices`]), refused before any work.
+    #[error(
+        "an edge length of {edge_length:e} would make about {estimate:.3e} vertices on this surface (area {area:.4e}), more than the most allowed ({max_vertices}, option `max-vertices`); ask for an edge length of at least about {suggested:.3e}, or allow more vertices"
+    )]
+    TooFine {
+        /// The edge length asked (or derived from the vertex count asked).
+        edge_length: f64,
+        /// The surface's area.
+        area: f64,
+        /// The vertices an equilateral mesh of that edge length would have.
+        estimate: f64,
+        /// The most vertices allowed.
+        max_vertices: usize,
+        /// The edge length of an equilateral mesh with `max_vertices` vertices.
+        suggested: f64,
+    },
     /// The mesh is not a single connected surface.
     #[error("remeshing needs one connected surface; this mesh has {components} components")]
     Components {

@@ -144,6 +144,7 @@ pub fn remesh(
             components: components.len(),
         });
     }
+    options.check_size(mesh.total_area())?;
     let edge_length = options.edge_length(mesh.total_area());
     let first = remesh_at(mesh, parameterizers, options, edge_length, context)
         .map_err(|error| too_coarse(mesh, edge_length, error))?;

@@ -125,6 +125,33 @@ impl RemeshOptions {
         Ok(())
     }
 
+    /// Refuses, before any work, a size that would make more than
+    /// [`RemeshOptions::max_vertices`] vertices on a surface of area `area`: an asked
+    /// vertex count above it, or an edge length `L` whose equilateral mesh has more,
+    /// `n = 2 A / (sqrt(3) L^2)` (each vertex of an equilateral mesh owns two triangles
+    /// of area `sqrt(3) L^2 / 4`). The estimate leaves out the boundary's vertices and a
+    /// curvature size field's shorter edges, so it refuses only what is sure to be too
+    /// many; refinement stops at the limit for the rest.
+    pub fn check_size(&self, area: f64) -> Result<(), RemeshError> {
+        let per_vertex = |l: f64| 3f64.sqrt() / 2.0 * l * l;
+        let edge_length = self.edge_length(area);
+        let estimate = match self.resolution {
+            Resolution::Vertices(n) => n as f64,
+            Resolution::EdgeLength(l) => area / per_vertex(l),
+        };
+        // NaN (an area of 0) passes: the steps name what is wrong with such a surface.
+        if estimate > self.max_vertices as f64 {
+            return Err(RemeshError::TooFine {
+                edge_length,
+                area,
+                estimate,
+                max_vertices: self.max_vertices,
+                suggested: (area / (self.max_vertices as f64 * per_vertex(1.0))).sqrt(),
+            });
+        }
+        Ok(())
+    }
+
     /// The edge length on a surface of area `area`.
     pub fn edge_length(&self, area: f64) -> f64 {
         match self.resolution {

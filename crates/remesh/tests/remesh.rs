@@ -376,6 +376,61 @@ fn two_components_are_refused() {
 }
 
 #[test]
+fn a_size_that_would_make_too_many_vertices_is_refused_before_any_work() {
+    // The unit disk (area about pi): at L = 0.0426 an equilateral mesh has
+    // 2 A / (sqrt(3) L^2) = 2000 vertices, twice the allowed 1000.
+    let input = mesh(&disk(3));
+    let area = input.total_area();
+    let solvers: [&dyn Solver; 1] = [&Lscm];
+    let run = |options: &RemeshOptions| {
+        remesh(&input, &solvers, options, &mut Context::new())
+            .map(|r| r.remeshed.mesh.vertex_count())
+    };
+    let l = (2.0 * area / (3f64.sqrt() * 2000.0)).sqrt();
+    let options = RemeshOptions {
+        max_vertices: 1000,
+        ..RemeshOptions::with_edge_length(l)
+    };
+    match run(&options) {
+        Err(RemeshError::TooFine {
+            estimate,
+            max_vertices,
+            suggested,
+            ..
+        }) => {
+            assert!((estimate - 2000.0).abs() < 1e-6, "{estimate}");
+            assert_eq!(max_vertices, 1000);
+            // The suggested length makes exactly the allowed count.
+            assert!(
+                (suggested / (l * 2f64.sqrt()) - 1.0).abs() < 1e-12,
+                "{suggested}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // Half the count passes the check and is remeshed.
+    let fits = RemeshOptions {
+        max_vertices: 1000,
+        ..RemeshOptions::with_edge_length(l * 2f64.sqrt() * 1.05)
+    };
+    assert!(run(&fits).is_ok_and(|n| n <= 1000));
+    // Far too small (these ran for minutes or aborted on a 150 GB allocation).
+    for options in [
+        RemeshOptions::with_edge_length(1e-9),
+        RemeshOptions::with_edge_length(1e-300),
+        RemeshOptions {
+            resolution: Resolution::Vertices(1_000_000_000_000),
+            ..RemeshOptions::default()
+        },
+    ] {
+        assert!(
+            matches!(run(&options), Err(RemeshError::TooFine { .. })),
+            "{options:?}"
+        );
+    }
+}
+
+#[test]
 fn every_input_vertex_of_a_rough_surface_stays_within_the_feature_tolerance() {
     // Ripples of wavelength 0.07 and height up to 0.02 (0.4 h) on a flat boundary: a
     // chord of length h = 0.05 cuts them off unless their vertices are inserted (an
