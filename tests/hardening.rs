@@ -393,3 +393,40 @@ fn a_file_size_limit_ends_in_an_error_and_leaves_no_temporary_file() {
         .collect();
     assert!(left.is_empty(), "left behind: {left:?}");
 }
+
+#[test]
+fn a_disk_far_from_the_origin_is_refused_before_any_work() {
+    // The unit disk translated by 1e15: coordinates 0.125 apart there. `remesh` hung on
+    // it, and `--method qc-angles` ended with 131 of 256 faces flipped and a face of
+    // zero area (exit 0), or with a matrix of non-finite entries.
+    let dir = tempfile::tempdir().unwrap();
+    let disk = dir.path().join("disk.obj");
+    let out = beltrami(&["-q", "generate", "disk", "--level", "3", "-o", s(&disk)]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let far = dir.path().join("far.obj");
+    let moved: String = std::fs::read_to_string(&disk)
+        .unwrap()
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(rest) => {
+                let c: Vec<f64> = rest
+                    .split_whitespace()
+                    .map(|x| x.parse().unwrap())
+                    .collect();
+                format!("v {:.17e} {} {}\n", c[0] + 1e15, c[1], c[2])
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    std::fs::write(&far, moved).unwrap();
+    let output = dir.path().join("out.obj");
+    for extra in [&["--vertices", "500"][..], &["--method", "qc-angles"][..]] {
+        let mut args = vec!["remesh", s(&far), "-o", s(&output)];
+        args.extend_from_slice(extra);
+        fails_with(
+            &args,
+            &["from the origin", "translate the mesh near the origin"],
+        );
+        assert!(!output.exists());
+    }
+}

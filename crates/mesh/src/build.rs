@@ -39,6 +39,13 @@ pub const MAX_COORDINATE: f64 = 1e75;
 /// squares do not round to zero.
 pub const MIN_EXTENT: f64 = 1e-75;
 
+/// The fewest bits of a coordinate that must resolve the mesh's extent: the spacing of
+/// `f64` values at the largest coordinate magnitude `m` (`m 2^-52`) must be at most
+/// `2^-PRECISION_BITS` of the bounding-box diagonal. A mesh far from the origin against
+/// its size (a unit disk translated by 1e15 has coordinates 0.125 apart) has vertices
+/// rounded onto one another and faces folded by rounding alone.
+pub const PRECISION_BITS: i32 = 26;
+
 /// What the builder may repair instead of failing. Nothing is repaired unless asked, and
 /// everything repaired is listed in the [`BuildReport`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -468,7 +475,8 @@ fn coincident_representatives(positions: &[Point3<f64>]) -> Vec<u32> {
 }
 
 /// Fails when a coordinate exceeds [`MAX_COORDINATE`] in magnitude (naming the first such
-/// vertex) or when the vertices, not all at one point, span less than [`MIN_EXTENT`].
+/// vertex), when the vertices, not all at one point, span less than [`MIN_EXTENT`], or
+/// when their coordinates resolve the span to fewer than [`PRECISION_BITS`] bits.
 /// All vertices count, used or not: a coordinate out of range is refused wherever it is.
 fn check_range(positions: &[Point3<f64>]) -> Result<(), MeshError> {
     for (vertex, p) in positions.iter().enumerate() {
@@ -499,6 +507,17 @@ fn check_range(positions: &[Point3<f64>]) -> Result<(), MeshError> {
         return Err(MeshError::ExtentUnderflow {
             diagonal,
             min: MIN_EXTENT,
+        });
+    }
+    let magnitude = (0..3)
+        .map(|k| lo[k].abs().max(hi[k].abs()))
+        .fold(0.0, f64::max);
+    let spacing = magnitude * f64::EPSILON;
+    if diagonal > 0.0 && spacing > diagonal * 2f64.powi(-PRECISION_BITS) {
+        return Err(MeshError::PrecisionLoss {
+            diagonal,
+            magnitude,
+            spacing,
         });
     }
     Ok(())

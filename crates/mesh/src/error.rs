@@ -82,6 +82,20 @@ pub enum MeshError {
         min: f64,
     },
 
+    /// The coordinates are so large against the mesh's extent that rounding moves
+    /// vertices by a noticeable part of it ([`crate::PRECISION_BITS`]).
+    #[error(
+        "the vertices lie up to {magnitude:e} from the origin but span a bounding box of diagonal only {diagonal:e}: coordinates there are up to {spacing:e} apart, too coarse for the mesh's size (vertices round onto one another, faces fold); translate the mesh near the origin (subtract its centroid) first"
+    )]
+    PrecisionLoss {
+        /// The bounding-box diagonal of the input vertices.
+        diagonal: f64,
+        /// The largest coordinate magnitude.
+        magnitude: f64,
+        /// The spacing of `f64` values there.
+        spacing: f64,
+    },
+
     /// A degenerate-area tolerance that is NaN or plus infinity.
     #[error(
         "the degenerate-area tolerance must be a number below infinity (negative accepts every face), got {value}"

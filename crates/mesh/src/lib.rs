@@ -49,7 +49,7 @@ pub mod surface_point;
 mod topology;
 mod vertex_map;
 
-pub use build::{BuildOptions, BuildReport, MAX_COORDINATE, MIN_EXTENT, Repair};
+pub use build::{BuildOptions, BuildReport, MAX_COORDINATE, MIN_EXTENT, PRECISION_BITS, Repair};
 pub use cut::{
     CutError, CutGraph, CutMesh, Generator, GeneratorKind, TorusSides, cut_along, cut_graph,
     cut_to_disk, shortest_path_tree, split_corners,

@@ -1044,3 +1044,33 @@ fn an_unreferenced_vertex_far_away_does_not_make_faces_degenerate() {
     assert_eq!(report.unreferenced_vertices, [4]);
     assert!((report.degenerate_area_threshold - 2e-12).abs() < 1e-24);
 }
+
+#[test]
+fn a_mesh_far_from_the_origin_against_its_size_is_refused() {
+    // A unit square translated by t: at 1e15 coordinates are 0.125 apart (a fold by
+    // rounding alone); at 1e6 they are 1.2e-10 apart and the square is kept.
+    let square = |t: f64| {
+        let positions = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+            .map(|[x, y]| Point3::new(x + t, y, 0.0))
+            .to_vec();
+        PolygonSoup::from_triangles(positions, &[[0, 1, 2], [0, 2, 3]])
+    };
+    assert!(Mesh::build(&square(1e6), &BuildOptions::default()).is_ok());
+    match Mesh::build(&square(1e15), &BuildOptions::default()) {
+        Err(MeshError::PrecisionLoss {
+            diagonal,
+            magnitude,
+            spacing,
+        }) => {
+            assert_eq!(
+                (diagonal, magnitude, spacing),
+                (2f64.sqrt(), 1e15 + 1.0, (1e15 + 1.0) * f64::EPSILON)
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // The limit: 2^26 coordinate steps across the diagonal (a translation of 9.5e7).
+    let limit = 2f64.sqrt() * 2f64.powi(-26) / f64::EPSILON;
+    assert!(Mesh::build(&square(0.9 * limit), &BuildOptions::default()).is_ok());
+    assert!(Mesh::build(&square(1.1 * limit), &BuildOptions::default()).is_err());
+}
