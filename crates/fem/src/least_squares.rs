@@ -40,7 +40,6 @@ pub use normal::normal_pattern_of_cells;
 use crate::dof::{DofMap, DofScalar};
 use beltrami_sparse::check::{check_finite, check_finite_matrix, check_finite_solution, check_len};
 use beltrami_sparse::{PlannedCholesky, SolveError, SolveOptions, SpdSolver, solve_saddle_point};
-use faer::MatMut;
 use faer::sparse::{
     SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef, Triplet,
 };
@@ -66,11 +65,6 @@ pub fn singular_at_node<T: DofScalar>(error: SolveError, dofs: &DofMap<T>) -> So
         },
         other => other,
     }
-}
-
-fn column_mut<T>(v: &mut [T]) -> MatMut<'_, T> {
-    let n = v.len();
-    MatMut::from_column_major_slice_mut(v, n, 1)
 }
 
 /// Weighted sparse least squares through an affine DOF map, with the symbolic work
@@ -236,7 +230,7 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
             cholesky
                 .factorize(self.normal.matrix())
                 .map_err(|error| singular_at_node(error, &self.dofs))?;
-            cholesky.solve_in_place(column_mut(&mut self.y))?;
+            cholesky.solve_vector_in_place(&mut self.y)?;
         }
         // Lengths were checked above, so expansion cannot fail; map for completeness.
         self.dofs
@@ -326,8 +320,8 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
         match cholesky.factorize(self.normal.matrix()) {
             Ok(()) => {
                 let mut z = kc.clone();
-                cholesky.solve_in_place(column_mut(&mut self.y))?;
-                cholesky.solve_in_place(column_mut(&mut z))?;
+                cholesky.solve_vector_in_place(&mut self.y)?;
+                cholesky.solve_vector_in_place(&mut z)?;
                 let t = (dot(&kc, &self.y) - reduced_d)
                     * faer::traits::ComplexField::recip_impl(&dot(&kc, &z));
                 for (y, z) in self.y.iter_mut().zip(&z) {

@@ -43,7 +43,6 @@ use beltrami_fem::{DofBuilder, DofMap, Elements};
 use beltrami_mesh::{FaceId, Point3, Vector3, VertexId};
 use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
 use beltrami_sparse::{SplitOrder, fill_reducing_order, two_core_order};
-use faer::MatMut;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
@@ -810,9 +809,7 @@ impl FlowSystem {
         self.solver.factorize(self.matrix.as_ref())?;
         self.factorizations += 1;
         self.kept = true;
-        let n = self.rhs.len();
-        self.solver
-            .solve_in_place(MatMut::from_column_major_slice_mut(&mut self.rhs, n, 1))?;
+        self.solver.solve_vector_in_place(&mut self.rhs)?;
         Ok(())
     }
 }

@@ -306,6 +306,12 @@ impl<T: Scalar> SpdSolver<T> {
         })
     }
 
+    /// [`SpdSolver::solve_in_place`] for one right-hand side given as a slice: `x` is
+    /// overwritten with the solution.
+    pub fn solve_vector_in_place(&mut self, x: &mut [T]) -> Result<(), SolveError> {
+        self.solve_in_place(column_mut(x))
+    }
+
     /// Overwrites the columns of `rhs` with the solutions of `matrix x = rhs` for the
     /// matrix of the last successful [`SpdSolver::factorize`] (error
     /// [`SolveError::NotFactored`] if there is none).

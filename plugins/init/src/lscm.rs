@@ -36,7 +36,6 @@ use beltrami_fem::{DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::{FaceId, Mesh, VertexId};
 use beltrami_sparse::SpdSolver;
 use beltrami_sparse::{NESTED_DISSECTION_FROM, PlannedCholesky, nested_dissection_split};
-use faer::MatMut;
 use faer::sparse::SparseColMatRef;
 use num_complex::Complex64;
 
@@ -210,8 +209,7 @@ fn by_sides(
                     .factorize(SparseColMatRef::new(pattern.as_ref(), &values))
                     .map_err(|e| singular_at_node(e, &dofs))?;
                 drop(values);
-                let n = rhs.len();
-                solver.solve_in_place(MatMut::from_column_major_slice_mut(&mut rhs, n, 1))?;
+                solver.solve_vector_in_place(&mut rhs)?;
             }
             Ok(dofs.expand(&rhs)?)
         })

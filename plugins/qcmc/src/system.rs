@@ -39,7 +39,6 @@ use beltrami_fem::Elements;
 use beltrami_fem::assembly::Pattern;
 use beltrami_mesh::VertexId;
 use beltrami_sparse::{SolveOptions, SpdSolver};
-use faer::MatMut;
 use faer::sparse::SparseColMat;
 use num_complex::Complex64;
 
@@ -325,10 +324,8 @@ impl StepSystem {
                 }
             }
         }
-        let n = self.rhs.len();
         self.solver.factorize(self.matrix.as_ref())?;
-        self.solver
-            .solve_in_place(MatMut::from_column_major_slice_mut(&mut self.rhs, n, 1))?;
+        self.solver.solve_vector_in_place(&mut self.rhs)?;
         let y = &self.rhs;
         let mut step = Step {
             vertex: vec![Complex64::new(0.0, 0.0); state.map.len()],
