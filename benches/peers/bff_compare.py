@@ -28,10 +28,9 @@ import os
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-from peer_scripts import bootstrap
+from peer_scripts import bootstrap, timed
 
 ROOT = Path(__file__).resolve().parents[2]
 CACHE = Path.home() / ".cache" / "beltrami" / "bff"
@@ -59,16 +58,6 @@ def build_bff(source: Path | None) -> Path:
     )
     subprocess.run(["make", f"-j{os.cpu_count() or 1}", "bff-command-line"], cwd=build, check=True)
     return binary
-
-
-def timed(command: list[str]) -> float:
-    """Runs `command`, failing loudly, and returns its wall-clock seconds."""
-    start = time.perf_counter()
-    run = subprocess.run(command, capture_output=True, text=True)
-    seconds = time.perf_counter() - start
-    if run.returncode != 0:
-        sys.exit(f"{' '.join(command)} failed:\n{run.stderr}")
-    return seconds
 
 
 def measure(mesh: Path, mapped: Path) -> dict:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 VENV = Path(
@@ -21,6 +22,16 @@ VENV = Path(
         "BELTRAMI_PEERS_VENV", Path.home() / ".cache" / "beltrami" / "peers-venv"
     )
 )
+
+
+def timed(command: list[str]) -> float:
+    """Runs `command`, failing loudly, and returns its wall-clock seconds."""
+    start = time.perf_counter()
+    run = subprocess.run(command, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    if run.returncode != 0:
+        sys.exit(f"{' '.join(command)} failed:\n{run.stderr}")
+    return seconds
 
 
 def bootstrap(script: str, requirements: list[str], probe: str) -> None:

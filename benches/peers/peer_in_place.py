@@ -20,7 +20,7 @@ import sys
 
 import numpy as np
 
-from peer_pymeshlab import timed
+from peer_scripts import timed
 
 
 def relax(mesh, out, iterations):

@@ -14,11 +14,11 @@ Needs `pip install pymeshlab numpy`. Prints one markdown table row per mesh and 
 import argparse
 import json
 import statistics
-import subprocess
 import sys
-import time
 
 import numpy as np
+
+from peer_scripts import timed
 
 
 def pymeshlab_remesh(mesh, out, length):
@@ -71,15 +71,6 @@ def measure(source, result):
         "hausdorff": max(there["max"], back["max"]),
         "mean_distance": (there["mean"] + back["mean"]) / 2.0,
     }
-
-
-def timed(cmd):
-    start = time.perf_counter()
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    seconds = time.perf_counter() - start
-    if done.returncode != 0:
-        sys.exit(f"{' '.join(cmd)} failed:\n{done.stderr}")
-    return seconds
 
 
 def main():
