@@ -430,3 +430,26 @@ fn a_disk_far_from_the_origin_is_refused_before_any_work() {
         assert!(!output.exists());
     }
 }
+
+#[test]
+fn a_generated_mesh_too_large_is_refused_from_its_level() {
+    // `generate circle-domain --level 10` ran for minutes (1.2e8 faces), `square --level
+    // 10` asked for 2.1e9; the face count is known from the level before any work.
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("out.obj");
+    for (shape, level, faces, finest) in [
+        ("circle-domain", "10", "1.217e8", "--level 9"),
+        ("square", "10", "2.147e9", "--level 7"),
+        ("disk", "40", "4.836e24", "--level 11"),
+        ("sphere", "18446744073709551615", "inf", "--level 11"),
+    ] {
+        fails_with(
+            &["generate", shape, "--level", level, "-o", s(&output)],
+            &[
+                &format!("about {faces} faces"),
+                &format!("at most {finest} for this shape"),
+            ],
+        );
+        assert!(!output.exists());
+    }
+}

@@ -58,11 +58,42 @@ pub struct GenerateArgs {
     pub output: PathBuf,
 }
 
+/// The most faces `generate` makes: about 2^25 (a few GB of mesh), checked from the
+/// level before any work.
+const MAX_FACES: f64 = 33_554_432.0;
+
+/// About how many faces `shape` has at `level` (exact for the primitives; for the circle
+/// domain the unit disk's area over an equilateral triangle of side `2^-(level+2)`).
+fn faces_at(shape: Shape, level: usize) -> f64 {
+    let grow = 4f64.powi(level.min(1000) as i32);
+    match shape {
+        Shape::Disk => 4.0 * grow,
+        Shape::Sphere => 8.0 * grow,
+        // 8 * 2^level sectors by 2^(level+1) rings, two triangles per cell.
+        Shape::Annulus => 32.0 * grow,
+        // (32 * 2^level)^2 cells, two triangles each.
+        Shape::Square => 2048.0 * grow,
+        Shape::Torus1 | Shape::Torus2 => 1280.0 * grow,
+        Shape::CircleDomain => {
+            let h = 0.25 * 0.5f64.powi(level.min(1000) as i32);
+            std::f64::consts::PI / (3f64.sqrt() / 4.0 * h * h)
+        }
+    }
+}
+
 pub fn run(args: &GenerateArgs, quiet: bool) -> anyhow::Result<()> {
     super::mapping::check_output_format(&args.output)?;
     super::outputs::check(&[("-o", Some(&args.output))])?;
-    if args.level > 10 {
-        bail!("--level {} is too fine (at most 10)", args.level);
+    let faces = faces_at(args.shape, args.level);
+    if faces > MAX_FACES {
+        let finest = (0..args.level.min(64))
+            .take_while(|&l| faces_at(args.shape, l) <= MAX_FACES)
+            .last()
+            .unwrap_or(0);
+        bail!(
+            "--level {} would make about {faces:.3e} faces, more than {MAX_FACES:.0}: at most --level {finest} for this shape",
+            args.level
+        );
     }
     let mesh = if args.shape == Shape::CircleDomain {
         let h = 0.25 * 0.5f64.powi(args.level as i32);
