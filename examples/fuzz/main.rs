@@ -148,6 +148,8 @@ fn builtin_seeds(target: &str) -> Vec<Vec<u8>> {
         "cut" => vec![format!("\u{0}{}", targets::torus_obj()), format!("\u{1}{square}")],
         "ply" => vec![format!("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float s\nproperty float t\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n3 0 1 2\n3 0 2 3\n")],
         "stl" => vec!["solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n".into()],
+        "circle-domain" => vec!["\u{3}\u{28}\u{3c}\u{1e}\u{4d}\u{4b}\u{14}".into()],
+        "remesh" => vec!["\u{0}\u{10}\u{1e}\u{40}\u{7}".into(), "\u{3}\u{40}\u{1e}\u{7f}\u{7}".into()],
         "off" => vec!["OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n4 0 2 3 1\n".into(), "STCOFF 3 1 0\n0 0 0 1 0 0 1 0 0\n1 0 0 0 1 0 1 1 0\n0 1 0 0 0 1 1 0 1\n3 0 1 2\n".into()],
         _ => Vec::new(),
     };

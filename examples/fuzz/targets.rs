@@ -16,7 +16,7 @@ use beltrami::mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, cut_graph,
 use num_complex::Complex64;
 
 /// The targets, by the name the driver and the corpus folders use.
-pub const TARGETS: [&str; 11] = [
+pub const TARGETS: [&str; 13] = [
     "obj",
     "gltf",
     "ply",
@@ -28,6 +28,8 @@ pub const TARGETS: [&str; 11] = [
     "landmarks",
     "correspondence",
     "cut",
+    "circle-domain",
+    "remesh",
 ];
 
 /// Runs target `name` on `data`.
@@ -44,6 +46,8 @@ pub fn run(name: &str, data: &[u8]) -> Result<(), String> {
         "landmarks" => landmarks(data),
         "correspondence" => correspondence(data),
         "cut" => cut(data),
+        "circle-domain" => circle_domain(data),
+        "remesh" => remesh(data),
         _ => Err(format!("unknown target `{name}`")),
     }
 }
@@ -238,4 +242,90 @@ fn cut(data: &[u8]) -> Result<(), String> {
     let path = Path::new("fuzz.obj");
     let raw = io::obj::parse(path, rest).map_err(|e| e.to_string())?;
     built(path, raw, &options(first))
+}
+
+/// A number read from a byte: with the high bit, a value of [`VALUES`] (the edges of
+/// the accepted ranges, NaN); otherwise `offset + step * (b & 0x7f)`.
+fn scaled(b: u8, offset: f64, step: f64) -> f64 {
+    if b & 0x80 != 0 {
+        VALUES[usize::from(b & 15)]
+    } else {
+        offset + step * f64::from(b & 0x7f)
+    }
+}
+
+/// `generate circle-domain` (`beltrami_remesh::circle_domain`): byte 0 chooses the edge
+/// length (0.05 to 0.4: a few thousand faces at most), then three bytes per hole (up to
+/// six): its centre's x and y and its radius, in steps of 0.02 from -1.2 (holes that
+/// overlap, touch, leave the disk or have no area), or values of [`VALUES`].
+fn circle_domain(data: &[u8]) -> Result<(), String> {
+    use beltrami::remesh::circle_domain::{Hole, circle_domain};
+    let mut bytes = data.iter().copied();
+    let h = 0.05 * f64::from(1 + bytes.next().unwrap_or(0) % 8);
+    let mut holes = Vec::new();
+    while holes.len() < 6 {
+        let (Some(x), Some(y), Some(r)) = (bytes.next(), bytes.next(), bytes.next()) else {
+            break;
+        };
+        holes.push(Hole {
+            center: Complex64::new(scaled(x, -1.2, 0.02), scaled(y, -1.2, 0.02)),
+            radius: scaled(r, -0.2, 0.01),
+        });
+    }
+    circle_domain(&holes, h)
+        .map(|_| ())
+        .map_err(|e| e.to_string())
+}
+
+/// A disk of 64 faces bent into a saddle (`z = x y / 2`), for the remesh target.
+fn saddle() -> &'static Mesh {
+    static SADDLE: OnceLock<Mesh> = OnceLock::new();
+    SADDLE.get_or_init(|| {
+        let mut soup = primitives::disk(2);
+        for p in &mut soup.positions {
+            p.z = 0.5 * p.x * p.y;
+        }
+        match Mesh::from_soup(&soup) {
+            Ok(mesh) => mesh,
+            Err(e) => panic!("the bent disk is a valid mesh: {e}"),
+        }
+    })
+}
+
+/// `beltrami remesh` of a small saddle under options read from bytes: byte 0 chooses an
+/// edge length or a vertex count and the size field, then the length (0.05 to 1.32) or
+/// count (0 to 2040), the smallest angle (0 to 127 degrees), the most vertices (0 to
+/// 4080) and the feature tolerance (0 to 3.8), each also from [`VALUES`].
+fn remesh(data: &[u8]) -> Result<(), String> {
+    use beltrami::remesh::{RemeshOptions, Resolution, SizeField, param, remesh};
+    let mut bytes = data.iter().copied();
+    let mut next = || bytes.next().unwrap_or(0);
+    let kind = next();
+    let resolution = if kind & 1 == 0 {
+        Resolution::EdgeLength(scaled(next(), 0.05, 0.01))
+    } else {
+        Resolution::Vertices(usize::from(next()) * 8)
+    };
+    let options = RemeshOptions {
+        resolution,
+        size_field: if kind & 2 == 0 {
+            SizeField::Uniform
+        } else {
+            SizeField::Curvature
+        },
+        min_angle: scaled(next(), 0.0, 1.0),
+        max_vertices: usize::from(next()) * 16,
+        feature_tolerance: scaled(next(), 0.0, 0.03),
+    };
+    let registry = beltrami::registry();
+    let mesh = saddle();
+    let solvers = param::chosen(&registry, mesh, "auto").map_err(|e| e.to_string())?;
+    remesh(
+        mesh,
+        &solvers,
+        &options,
+        &mut beltrami::core::Context::new(),
+    )
+    .map(|_| ())
+    .map_err(|e| e.to_string())
 }
