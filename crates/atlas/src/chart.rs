@@ -8,7 +8,8 @@ use crate::AtlasError;
 use crate::boundary_first::{FlattenFailure, flatten_disk};
 use crate::cone_cut::cone_cut;
 use crate::cones::{ConeGoal, place_cones};
-use crate::overlap::{curve_crosses_itself, folded_faces};
+use crate::overlap::folded_faces;
+use beltrami_mesh::closed_curve::crosses_itself;
 
 /// A chart laid flat.
 #[derive(Debug, Clone)]
@@ -56,7 +57,7 @@ pub fn flatten_chart(
         .next()
         .map(|b| disk.loop_vertices(b).map(|v| uv[v.idx()]).collect())
         .unwrap_or_default();
-    if curve_crosses_itself(&ring) {
+    if crosses_itself(&ring) {
         return Ok(Err(ChartFailure::Overlap));
     }
     Ok(Ok(FlatChart {

@@ -25,7 +25,7 @@ impl SeamedUv {
     /// Twice the signed area of face `f` in the UV plane (positive counter-clockwise).
     pub fn signed_double_area(&self, f: FaceId) -> f64 {
         let [a, b, c] = self.face_uvs(f);
-        crate::overlap::orient(a, b, c)
+        beltrami_mesh::closed_curve::orient(a, b, c)
     }
 
     /// The seam edges of `mesh`: interior edges whose two faces give either endpoint

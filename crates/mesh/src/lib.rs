@@ -31,6 +31,7 @@
 
 mod build;
 pub mod circulators;
+pub mod closed_curve;
 pub mod cut;
 mod error;
 pub mod frame;

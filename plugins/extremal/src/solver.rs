@@ -13,6 +13,7 @@ use beltrami_fem::{
     BoundaryMap, Distortion, DofConstraints, DofMap, EdgeWeights, Elements, Frame,
     LeastSquaresSolver, WeightedMeanSystem,
 };
+use beltrami_mesh::closed_curve::{crosses_itself, signed_area};
 use beltrami_mesh::{Mesh, VertexId};
 use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
@@ -150,6 +151,9 @@ impl Solver for Extremal {
             Some(flat)
         };
         let domain = flat.as_ref().map_or(mesh, |f| &f.mesh);
+        if let Boundary::Fixed(values) = &boundary {
+            same_turn(domain, values)?;
+        }
         let initial = context.stage("initial map", &mut report, || {
             start_map(
                 domain,
@@ -252,7 +256,17 @@ fn setup(problem: &Problem<'_>) -> Result<Boundary, SolverError> {
                 "landmarks move boundary points of the sliding disk (`--target disk`); with a prescribed boundary every boundary vertex is already placed",
             ));
         }
-        Some(values) => Boundary::Fixed(values.map_err(invalid)?),
+        Some(values) => {
+            let values = values.map_err(invalid)?;
+            for (k, curve) in loop_curves(mesh, &values).iter().enumerate() {
+                if crosses_itself(curve) {
+                    return Err(invalid(format!(
+                        "the boundary map takes boundary loop {k} onto a curve that crosses itself: the boundary of a one-to-one map is a simple curve"
+                    )));
+                }
+            }
+            Boundary::Fixed(values)
+        }
         None if matches!(problem.target, Target::Disk) => {
             Boundary::Sliding(quadrilateral(problem, invalid)?)
         }
@@ -279,6 +293,42 @@ fn setup(problem: &Problem<'_>) -> Result<Boundary, SolverError> {
         return Err(unsupported("extremal starts from a planar map"));
     }
     Ok(boundary)
+}
+
+/// The images of each boundary loop of `mesh` under the boundary values `values` (every
+/// boundary vertex has one), in the loop's order.
+fn loop_curves(mesh: &Mesh, values: &[(VertexId, Complex64)]) -> Vec<Vec<[f64; 2]>> {
+    let mut at = vec![None; mesh.vertex_count()];
+    for &(v, z) in values {
+        at[v.idx()] = Some([z.re, z.im]);
+    }
+    mesh.boundary_loop_list()
+        .iter()
+        .map(|l| l.vertices.iter().filter_map(|v| at[v.idx()]).collect())
+        .collect()
+}
+
+/// Refuses boundary values that turn a boundary loop the other way than `domain` (the
+/// planar source or its flat layout) does: the map would reverse the orientation.
+fn same_turn(domain: &Mesh, values: &[(VertexId, Complex64)]) -> Result<(), SolverError> {
+    let own: Vec<(VertexId, Complex64)> = domain
+        .vertices()
+        .filter(|&v| domain.is_boundary_vertex(v))
+        .map(|v| {
+            let p = domain.position(v);
+            (v, Complex64::new(p.x, p.y))
+        })
+        .collect();
+    let given = loop_curves(domain, values);
+    for (k, (curve, layout)) in given.iter().zip(loop_curves(domain, &own)).enumerate() {
+        let (a, b) = (signed_area(curve), signed_area(&layout));
+        if a * b < 0.0 {
+            return Err(invalid(format!(
+                "the boundary map turns boundary loop {k} the other way than the surface does (signed area {a:.3e} against {b:.3e} in the loop's order): the map would reverse the orientation; mirror the map or reverse the surface's faces"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The start map on `mesh` (the source or its flat copy): the given one with the

@@ -193,6 +193,34 @@ fn bad_problems_are_refused() {
     assert!(e.contains("lsqc"), "{e}");
 }
 
+/// A boundary map that reverses the orientation (a mirror image) or whose boundary
+/// curve crosses itself cannot be the boundary of a one-to-one map: refused, saying
+/// which (both used to end in "the solution is not finite", or in flips blamed on
+/// concave corners).
+#[test]
+fn a_mirrored_or_self_crossing_boundary_map_is_refused_as_such() {
+    let mesh = Mesh::from_soup(&primitives::disk(2)).unwrap();
+    let mut problem = Problem::new(
+        &mesh,
+        Target::Plane(PlanarBoundary::Given(image(&mesh, |z| z.conj()))),
+    );
+    problem.goal = Goal::Extremal;
+    let e = Extremal
+        .solve(&problem, &mut Context::new())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("the other way than the surface"), "{e}");
+    // The lower half folded up: the boundary runs over its upper half twice.
+    problem.target = Target::Plane(PlanarBoundary::Given(image(&mesh, |z| {
+        Complex64::new(z.re, z.im.abs() * if z.re > 0.0 { -1.0 } else { 1.0 })
+    })));
+    let e = Extremal.check(&problem).unwrap_err().to_string();
+    assert!(e.contains("crosses itself"), "{e}");
+    // The identity passes both checks.
+    problem.target = Target::Plane(PlanarBoundary::Given(image(&mesh, |z| z)));
+    assert!(Extremal.solve(&problem, &mut Context::new()).is_ok());
+}
+
 /// A cancelled run returns the start's iteration count 0 and says so.
 #[test]
 fn cancellation_stops_the_iteration() {
