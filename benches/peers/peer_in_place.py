@@ -20,7 +20,7 @@ import sys
 
 import numpy as np
 
-from peer_scripts import timed
+from peer_scripts import read_obj, timed
 
 
 def relax(mesh, out, iterations):
@@ -32,20 +32,6 @@ def relax(mesh, out, iterations):
         iterations=iterations, splitflag=False, collapseflag=False, swapflag=False,
         smoothflag=True, reprojectflag=True)
     ms.save_current_mesh(out, save_vertex_normal=False)
-
-
-def read_obj(path):
-    vertices, faces = [], []
-    with open(path) as f:
-        for line in f:
-            parts = line.split()
-            if not parts:
-                continue
-            if parts[0] == "v":
-                vertices.append([float(x) for x in parts[1:4]])
-            elif parts[0] == "f":
-                faces.append([int(p.split("/")[0]) - 1 for p in parts[1:]])
-    return np.array(vertices), faces
 
 
 def angles(path):
