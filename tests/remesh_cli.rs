@@ -463,3 +463,42 @@ fn a_mesh_in_pieces_is_remeshed_piece_by_piece_or_its_largest_alone() {
         text(&out.stderr)
     );
 }
+
+#[test]
+fn a_face_with_three_small_holes_is_remeshed_at_every_length() {
+    // The scanned face with every face removed whose centroid lies within 0.006 of the
+    // centroid of face 5000, 15000 or 25000: four boundary loops. Two flips of one sweep
+    // on the assembled surface made the same edge ("face 3051 duplicates face 3050",
+    // "edge .. is non-manifold") at every edge length from 0.002 to 0.02.
+    let Some(dir) = shared_meshes("a_face_with_three_small_holes_is_remeshed_at_every_length")
+    else {
+        return;
+    };
+    let face = read(&dir.join("disk_human_face.obj"));
+    let centroid = |f: beltrami_mesh::FaceId| face.face_centroid(f);
+    let faces: Vec<_> = face.faces().collect();
+    let centres = [5000, 15000, 25000].map(|k| centroid(faces[k]));
+    let mut soup = PolygonSoup::new(face.positions().to_vec());
+    for &f in &faces {
+        if centres.iter().all(|c| (centroid(f) - c).norm() >= 0.006) {
+            let corners: Vec<u32> = face.face_vertices(f).map(|v| v.0).collect();
+            soup.push_face(&corners);
+        }
+    }
+    let holes = Mesh::build(
+        &soup,
+        &BuildOptions {
+            repair: beltrami_mesh::Repair::ALL,
+            ..BuildOptions::default()
+        },
+    )
+    .unwrap()
+    .0;
+    assert_eq!(holes.boundary_loop_list().len(), 4);
+    let tmp = tempfile::tempdir().unwrap();
+    let input = tmp.path().join("holes.obj");
+    io::obj::write(&input, &holes, &VertexAttributes::default()).unwrap();
+    for l in [0.02, 0.005, 0.002] {
+        remesh_and_check(&input, &holes, l, &[]);
+    }
+}

@@ -13,13 +13,14 @@
 //!
 //! - that raises the smallest angle of the two faces (so each flip raises the sorted
 //!   angle vector of the mesh and the sweeps end),
-//! - `cd` is not an edge already (the result stays a manifold),
+//! - `cd` is not an edge already, nor made by another flip of the same sweep (the result
+//!   stays a manifold),
 //! - both new faces turn the way the old pair did (their normals have a positive dot
 //!   product with the sum of the old area vectors), so the flip does not fold the surface,
 //! - the midpoint of `cd` is no farther from the input surface than the midpoint of `ab`
 //!   or [`crate::refine::FLIP_DEVIATION`] `h` (a flip across a crease would cut it off).
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use beltrami_mesh::{Point3, Vector3};
 use beltrami_spatial::SurfaceIndex;
@@ -71,6 +72,7 @@ fn sweep(
         Ok(surface.locate(&mid)?.distance)
     };
     let mut changed = vec![false; faces.len()];
+    let mut made: HashSet<(u32, u32)> = HashSet::new();
     let mut flips = Vec::new();
     for (f, face) in faces.iter().enumerate() {
         for k in 0..3 {
@@ -81,7 +83,12 @@ fn sweep(
             if g < f || changed[f] || changed[g] || c == d {
                 continue;
             }
-            if across.contains_key(&(c, d)) || across.contains_key(&(d, c)) {
+            // Nor one that a flip of this sweep makes (the edge map is the sweep's
+            // start): two flips that both made `cd` would leave it with four faces.
+            if across.contains_key(&(c, d))
+                || across.contains_key(&(d, c))
+                || made.contains(&(c.min(d), c.max(d)))
+            {
                 continue;
             }
             let before = quality(a, b, c).min(quality(b, a, d));
@@ -99,6 +106,7 @@ fn sweep(
             }
             changed[f] = true;
             changed[g] = true;
+            made.insert((c.min(d), c.max(d)));
             flips.push((f, g, [a, d, c], [d, b, c]));
         }
     }
@@ -143,6 +151,31 @@ mod tests {
             flip_for_angles(&mut faces, &positions, &[1.0; 4], &index).unwrap(),
             0
         );
+    }
+
+    #[test]
+    fn two_flips_of_one_sweep_never_make_the_same_edge() {
+        // Two copies of the quad of the test above (vertices a, b and a2, b2 at the same
+        // places) sharing c and d: either flip alone makes cd; both would give cd four
+        // faces (a remesh of a face with a hole ended "face 3051 duplicates face 3050").
+        let points = [
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [2.0, 0.5, 0.0],
+            [2.0, -0.5, 0.0],
+        ];
+        let input = surface(&points, &[[0, 1, 2], [1, 0, 3]]);
+        let index = SurfaceIndex::new(&input).unwrap();
+        let mut positions: Vec<_> = input.positions().to_vec();
+        positions.extend([positions[0], positions[1]]);
+        let mut faces = [[0, 1, 2], [1, 0, 3], [4, 5, 2], [5, 4, 3]];
+        let flips = flip_for_angles(&mut faces, &positions, &[1.0; 6], &index).unwrap();
+        assert_eq!(flips, 1);
+        let on_cd = faces
+            .iter()
+            .filter(|f| f.contains(&2) && f.contains(&3))
+            .count();
+        assert_eq!(on_cd, 2, "{faces:?}");
     }
 
     #[test]
