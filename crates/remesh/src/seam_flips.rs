@@ -122,6 +122,18 @@ mod tests {
     use super::*;
     use beltrami_mesh::{Mesh, PolygonSoup};
 
+    /// The flat quad a b c d with its long diagonal ab and its short one cd, as the
+    /// two faces on ab.
+    fn flat_quad() -> Mesh {
+        let points = [
+            [0.0, 0.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [2.0, 0.5, 0.0],
+            [2.0, -0.5, 0.0],
+        ];
+        surface(&points, &[[0, 1, 2], [1, 0, 3]])
+    }
+
     fn surface(points: &[[f64; 3]], faces: &[[u32; 3]]) -> Mesh {
         let positions = points
             .iter()
@@ -132,14 +144,7 @@ mod tests {
 
     #[test]
     fn a_long_diagonal_of_a_flat_quad_is_flipped() {
-        // a b c d: the quad's long diagonal ab, its short one cd.
-        let points = [
-            [0.0, 0.0, 0.0],
-            [4.0, 0.0, 0.0],
-            [2.0, 0.5, 0.0],
-            [2.0, -0.5, 0.0],
-        ];
-        let input = surface(&points, &[[0, 1, 2], [1, 0, 3]]);
+        let input = flat_quad();
         let index = SurfaceIndex::new(&input).unwrap();
         let positions: Vec<_> = input.positions().to_vec();
         let mut faces = [[0, 1, 2], [1, 0, 3]];
@@ -158,13 +163,7 @@ mod tests {
         // Two copies of the quad of the test above (vertices a, b and a2, b2 at the same
         // places) sharing c and d: either flip alone makes cd; both would give cd four
         // faces (a remesh of a face with a hole ended "face 3051 duplicates face 3050").
-        let points = [
-            [0.0, 0.0, 0.0],
-            [4.0, 0.0, 0.0],
-            [2.0, 0.5, 0.0],
-            [2.0, -0.5, 0.0],
-        ];
-        let input = surface(&points, &[[0, 1, 2], [1, 0, 3]]);
+        let input = flat_quad();
         let index = SurfaceIndex::new(&input).unwrap();
         let mut positions: Vec<_> = input.positions().to_vec();
         positions.extend([positions[0], positions[1]]);

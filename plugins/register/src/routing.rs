@@ -826,7 +826,13 @@ impl Drawing<'_> {
     ) -> Result<Vec<VertexId>, RegisterError> {
         let [first, last_wedge] = wedges.each_ref().map(Option::as_deref);
         let arc = &self.skeleton.arcs[a];
-        let corridor = Corridor::new(self, warp, arc);
+        // The placed arc: the waypoints, the corridor and the detours' yardstick.
+        let placed: Vec<Point3<f64>> = arc
+            .vertices
+            .iter()
+            .map(|&v| warp.to_target(&self.from.position(v)))
+            .collect();
+        let corridor = Corridor::new(&placed, warp.corridor_width);
         let mut blocked = blocked.to_vec();
         let mut used_edge = used_edge.to_vec();
         let mut legs: Vec<Vec<VertexId>> = Vec::new();
@@ -837,14 +843,11 @@ impl Drawing<'_> {
         };
         // The placed arc's length from its start to each of its vertices: a leg is
         // measured against the stretch of the placed arc it stands for.
-        let mut along = Vec::with_capacity(arc.vertices.len());
+        let mut along = Vec::with_capacity(placed.len());
         let mut length = 0.0;
-        let mut previous: Option<Point3<f64>> = None;
-        for &v in &arc.vertices {
-            let p = warp.to_target(&self.from.position(v));
-            length += previous.map_or(0.0, |q| (p - q).norm());
+        for (k, p) in placed.iter().enumerate() {
+            length += k.checked_sub(1).map_or(0.0, |j| (p - placed[j]).norm());
             along.push(length);
-            previous = Some(p);
         }
         let detour = |leg: &[VertexId], from: usize, to: usize| {
             let drawn: f64 = leg
@@ -856,8 +859,7 @@ impl Drawing<'_> {
         // Each leg with the index of the arc vertex it ends at.
         let mut ends: Vec<usize> = Vec::new();
         let last = arc.vertices.len().saturating_sub(1);
-        for (i, &v) in arc.vertices.iter().enumerate().take(last).skip(1) {
-            let p = warp.to_target(&self.from.position(v));
+        for (i, &p) in placed.iter().enumerate().take(last).skip(1) {
             let face = self.onto_index.locate(&p)?.point.face;
             // A waypoint by a node is left out: the corridor leads past it.
             let Some(via) = self.nearest_free(&p, face, &blocked) else {
@@ -900,7 +902,7 @@ impl Drawing<'_> {
             if start == to && !through_middle {
                 through_middle = true;
                 let middle = last / 2;
-                let p = warp.to_target(&self.from.position(arc.vertices[middle]));
+                let p = placed[middle];
                 let face = self.onto_index.locate(&p)?.point.face;
                 let leg = self.nearest_free(&p, face, &blocked).and_then(|via| {
                     corridor.shortest(
@@ -993,14 +995,9 @@ struct Corridor {
 }
 
 impl Corridor {
-    fn new(drawing: &Drawing<'_>, warp: &Warp<'_>, arc: &Arc) -> Self {
-        let width = warp.corridor_width;
-        // The placed arc, sampled at most width / 4 apart.
-        let placed: Vec<Point3<f64>> = arc
-            .vertices
-            .iter()
-            .map(|&v| warp.to_target(&drawing.from.position(v)))
-            .collect();
+    /// The corridor of width `width` about the placed arc `placed`, sampled at most
+    /// `width / 4` apart.
+    fn new(placed: &[Point3<f64>], width: f64) -> Self {
         let mut samples: Vec<[f64; 3]> = Vec::new();
         for pair in placed.windows(2) {
             let (p, q) = (pair[0], pair[1]);
