@@ -5,8 +5,8 @@ against Boundary First Flattening (Sawhney and Crane 2017, `bff-command-line MES
 `../shared/peers/qcmeasure.py --mode vt` (per-face |mu|, mean over faces unweighted, and
 flipped faces) and by how far each boundary lies from a circle: the boundary vertices'
 largest | |p - c| - r | / r, with c and r the centre and radius of the unit circle for
-beltrami (its target) and of the least-squares circle for BFF (which scales and places
-its disk freely).
+beltrami and Choi-Lui (their target) and of the least-squares circle for BFF (which
+scales and places its disk freely).
 
 BFF is built once from source with cmake and SuiteSparse (Debian:
 `apt-get install cmake libsuitesparse-dev`) under ~/.cache/beltrami/bff: from
@@ -14,7 +14,10 @@ BFF is built once from source with cmake and SuiteSparse (Debian:
 `git clone --recursive https://github.com/GeometryCollective/boundary-first-flattening`.
 `--bff PATH` takes a built `bff-command-line` instead. Times are wall-clock seconds of
 whole processes (read, map, write) for both, alternating peer and ours, `--rounds`
-rounds; the table shows each run. Not part of CI. Usage (from the repository root):
+rounds; the table shows each run. With GNU Octave installed (`apt-get install octave`)
+the Choi-Lui disk map (`../shared/peers/choi/disk.sh`) runs as a third method, timed
+the same way (its whole process includes Octave's start-up). Not part of CI. Usage
+(from the repository root):
 
     python3 benches/peers/bff_compare.py [--meshes ../shared/meshes] [--beltrami BIN]
 """
@@ -25,6 +28,7 @@ import argparse
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -35,6 +39,7 @@ from peer_scripts import bootstrap, timed
 ROOT = Path(__file__).resolve().parents[2]
 CACHE = Path.home() / ".cache" / "beltrami" / "bff"
 QCMEASURE = ROOT.parent / "shared" / "peers" / "qcmeasure.py"
+CHOI = ROOT.parent / "shared" / "peers" / "choi" / "disk.sh"
 
 
 def build_bff(source: Path | None) -> Path:
@@ -131,9 +136,14 @@ def main() -> None:
     parser.add_argument("--bff-source", type=Path, help="a BFF checkout to build")
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--mesh", action="append", help="a mesh's name (repeatable)")
+    parser.add_argument("--choi", type=Path, default=CHOI,
+                        help="the Choi-Lui driver disk.sh (run when octave-cli is installed)")
     args = parser.parse_args()
     bff = args.bff or build_bff(args.bff_source)
     names = args.mesh or ["disk_human_face", "disk_hand"]
+    with_choi = args.choi.exists() and shutil.which("octave-cli") is not None
+    if not with_choi:
+        print(f"(Choi-Lui left out: needs {args.choi} and octave-cli)", file=sys.stderr)
     print("| mesh | method | seconds (each round) | mean / max \\|mu\\| | flips | boundary off the circle |")
     print("|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
@@ -145,13 +155,16 @@ def main() -> None:
                 "beltrami": [str(args.beltrami), "qc", str(mesh), "--target", "disk", "--conformal",
                              "-o", str(outputs["beltrami"]), "-q"],
             }
+            if with_choi:
+                outputs["Choi-Lui"] = Path(tmp) / f"{name}.choi.obj"
+                commands["Choi-Lui"] = [str(args.choi), str(mesh), str(outputs["Choi-Lui"])]
             seconds = {k: [] for k in commands}
             for _ in range(args.rounds):
                 for method, command in commands.items():
                     seconds[method].append(timed(command))
             for method, out in outputs.items():
                 m = measure(mesh, out)
-                off = boundary_off_circle(mesh, out, unit=(method == "beltrami"))
+                off = boundary_off_circle(mesh, out, unit=(method != "BFF"))
                 mean, top = m["mu_mean"], m["mu_max"]
                 flips = m["flipped"]
                 times = ", ".join(f"{s:.3f}" for s in seconds[method])

@@ -11,17 +11,19 @@
 //! rounds settle it (one factorization serves them all). The boundary vertices are then
 //! put on the unit circle at the angles `2 pi` times their share of the arc length, so
 //! the boundary lies exactly on the circle, and the interior is the harmonic extension
-//! (cotan weights) of the boundary.
+//! (cotan weights) of the boundary, solved on the Neumann problem's symbolic
+//! factorization with the boundary held by a penalty.
 
 use std::f64::consts::{PI, TAU};
 
 use beltrami_fem::operators::cotan_laplacian;
-use beltrami_mesh::Mesh;
+use beltrami_mesh::{Mesh, VertexId};
 use beltrami_sparse::{SolveOptions, SpdSolver};
 use faer::Mat;
+use faer::sparse::SparseColMat;
 
 use crate::AtlasError;
-use crate::boundary_first::{FlattenFailure, counter_clockwise_ring, extend_harmonically, is_disk};
+use crate::boundary_first::{FlattenFailure, counter_clockwise_ring, is_disk};
 use crate::overlap::folded_faces;
 
 /// Rounds of the boundary lengths and the Neumann problem.
@@ -45,15 +47,7 @@ pub fn map_to_unit_disk(disk: &Mesh) -> Result<Result<Vec<[f64; 2]>, FlattenFail
         .find(|&v| !disk.is_boundary_vertex(v))
         .unwrap_or(ring[0]);
     let mut matrix = laplacian.clone();
-    {
-        let symbolic = laplacian.symbolic();
-        let (col_ptr, rows) = (symbolic.col_ptr(), symbolic.row_idx());
-        let j = held.idx();
-        if let Some(k) = (col_ptr[j]..col_ptr[j + 1]).find(|&k| rows[k] == j) {
-            let values = matrix.val_mut();
-            values[k] += 1e10 * values[k].abs().max(f64::MIN_POSITIVE);
-        }
-    }
+    hold(&mut matrix, &[held]);
     let mut solver = SpdSolver::new(matrix.symbolic(), SolveOptions::default())?;
     solver.factorize(matrix.as_ref())?;
     let defect: Vec<f64> = disk.vertices().map(|v| disk.angle_defect(v)).collect();
@@ -90,10 +84,65 @@ pub fn map_to_unit_disk(disk: &Mesh) -> Result<Result<Vec<[f64; 2]>, FlattenFail
         position[ring[i].idx()] = [angle.cos(), angle.sin()];
         walked += lengths[i];
     }
-    extend_harmonically(disk, &laplacian, &mut position)?;
+    // The harmonic extension of the boundary on the same pattern (its symbolic
+    // factorization reused): the boundary held by the penalty. The held values miss
+    // the given ones by about 1/PENALTY of them; the extension of that miss, solved
+    // once more, is taken off, which leaves 1/PENALTY^2.
+    let mut matrix = laplacian.clone();
+    hold(&mut matrix, &ring);
+    solver.factorize(matrix.as_ref())?;
+    let weights: Vec<f64> = ring.iter().map(|v| diagonal(&matrix, v.idx())).collect();
+    let mut extension = Mat::<f64>::zeros(disk.vertex_count(), 2);
+    for (&v, &weight) in ring.iter().zip(&weights) {
+        for axis in 0..2 {
+            extension[(v.idx(), axis)] = weight * position[v.idx()][axis];
+        }
+    }
+    solver.solve_in_place(extension.as_mut())?;
+    let mut miss = Mat::<f64>::zeros(disk.vertex_count(), 2);
+    for (&v, &weight) in ring.iter().zip(&weights) {
+        for axis in 0..2 {
+            miss[(v.idx(), axis)] = weight * (extension[(v.idx(), axis)] - position[v.idx()][axis]);
+        }
+    }
+    solver.solve_in_place(miss.as_mut())?;
+    for v in disk.vertices().filter(|&v| !disk.is_boundary_vertex(v)) {
+        let i = v.idx();
+        position[i] = [
+            extension[(i, 0)] - miss[(i, 0)],
+            extension[(i, 1)] - miss[(i, 1)],
+        ];
+    }
     let folded = folded_faces(disk, &position) > 0;
     if folded {
         return Ok(Err(FlattenFailure::Folded));
     }
     Ok(Ok(position))
+}
+
+/// The penalty a held vertex's diagonal entry gains, relative to itself: the vertex's
+/// value then follows its right-hand side over the diagonal to about 1e-10.
+const PENALTY: f64 = 1e10;
+
+/// Adds the [`PENALTY`] to the diagonal entries of `vertices` in the lower or full
+/// triangle of `matrix` (a Laplacian: every vertex has its diagonal entry).
+fn hold(matrix: &mut SparseColMat<usize, f64>, vertices: &[VertexId]) {
+    for &v in vertices {
+        if let Some(k) = diagonal_slot(matrix, v.idx()) {
+            let values = matrix.val_mut();
+            values[k] += PENALTY * values[k].abs().max(f64::MIN_POSITIVE);
+        }
+    }
+}
+
+/// The index among the values of `matrix` of its diagonal entry `j`, if stored.
+fn diagonal_slot(matrix: &SparseColMat<usize, f64>, j: usize) -> Option<usize> {
+    let symbolic = matrix.symbolic();
+    let (col_ptr, rows) = (symbolic.col_ptr(), symbolic.row_idx());
+    (col_ptr[j]..col_ptr[j + 1]).find(|&k| rows[k] == j)
+}
+
+/// The diagonal entry `j` of `matrix` (0 when not stored).
+fn diagonal(matrix: &SparseColMat<usize, f64>, j: usize) -> f64 {
+    diagonal_slot(matrix, j).map_or(0.0, |k| matrix.val()[k])
 }

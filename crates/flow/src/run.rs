@@ -13,11 +13,11 @@ use beltrami_sparse::SolveOptions;
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
-use crate::flow::{self, FlowOptions, FlowRun, Stop};
+use crate::flow::{self, FlatRule, FlowOptions, FlowRun, Stop};
 use crate::measure::{Barrier, ImageFace, Objective, image_faces};
 use crate::mesh_target::MeshTarget;
 use crate::setup::{Domain, curve_roles, diagonal, domain, goals, mesh_roles, pins, region_roles};
-use crate::system::FlowSystem;
+use crate::system::{FlowSystem, VertexOrder};
 use crate::target::{INNER, OUTER, Role, TargetGeometry};
 use crate::untangle::{Untangled, untangle};
 use crate::validate::{invalid, validate};
@@ -116,11 +116,14 @@ pub const ACCEPTS: Accepts = Accepts {
 /// (`Plane(Keep | Square | Polygon | Circle)`, `Disk`, `Annulus`, `Sphere`, `Mesh` with
 /// `problem.initial` a map onto it, open feature curves and landmarks), pins without
 /// positions (held where `initial` puts them) and the options ([`OPTIONS`], resolved in
-/// `settings`). Checks the problem first ([`crate::validate()`]).
+/// `settings`). Checks the problem first ([`crate::validate()`]). `vertex_order`, when
+/// given, is the [`VertexOrder`] of the source (one the caller computed alongside its
+/// initial map); without it the flow orders the vertices itself.
 pub fn solve(
     problem: &Problem<'_>,
     settings: &Settings,
     initial: Vec<Point3<f64>>,
+    vertex_order: Option<&VertexOrder>,
     mut report: Report,
     context: &mut Context<'_>,
 ) -> Result<Solution, SolverError> {
@@ -161,6 +164,7 @@ pub fn solve(
         options,
         untangle_trials: false,
         step_threads,
+        vertex_order,
     };
     let input = |v: VertexId| mesh.vertex_map().to_input(v);
     let pins = pins(problem, &initial);
@@ -419,6 +423,8 @@ struct Runner<'a, 'p> {
     untangle_trials: bool,
     /// [`FlowOptions::threads`] of the runs (option `step-threads`, 0 resolved).
     step_threads: usize,
+    /// The source's vertex order, if the caller gave one.
+    vertex_order: Option<&'a VertexOrder>,
 }
 
 impl Runner<'_, '_> {
@@ -528,8 +534,16 @@ impl Runner<'_, '_> {
         context: &mut Context<'_>,
         report: &mut Report,
     ) -> Result<FlowSystem, SolverError> {
-        let mut system = context.stage("symbolic", report, || {
-            FlowSystem::new(self.elements, target, image, roles, self.options)
+        let mut system = context.stage("symbolic", report, || match self.vertex_order {
+            Some(order) => FlowSystem::with_vertex_order(
+                self.elements,
+                target,
+                image,
+                roles,
+                self.options,
+                order,
+            ),
+            None => FlowSystem::new(self.elements, target, image, roles, self.options),
         })?;
         if matches!(self.problem.target, Target::Mesh(_)) {
             system.set_damping(MESH_DAMPING);
@@ -590,6 +604,10 @@ impl Runner<'_, '_> {
             min_step: settings.float("min-step"),
             untangle_trials: self.untangle_trials,
             threads: self.step_threads,
+            flat: match problem.target {
+                Target::Sphere | Target::Mesh(_) => FlatRule::CURVED,
+                _ => FlatRule::PLANAR,
+            },
         };
         let run = report.time("flow", || {
         flow::run(
@@ -639,12 +657,18 @@ impl Runner<'_, '_> {
             "stopped after {} iterations: no step above the tolerance decreased the error further",
             run.iterations()
         ),
-        Stop::Flat => format!(
-            "stopped after {} iterations: the error fell by less than {:.0e} of itself over the last {} steps",
-            run.iterations(),
-            crate::flow::FLAT_DECREASE,
-            crate::flow::FLAT_STEPS
-        ),
+        Stop::Flat => match flow_options.flat.steps {
+            1 => format!(
+                "stopped after {} iterations: the error fell by less than {:.0e} of itself in the last step",
+                run.iterations(),
+                flow_options.flat.decrease,
+            ),
+            steps => format!(
+                "stopped after {} iterations: the error fell by less than {:.0e} of itself over the last {steps} steps",
+                run.iterations(),
+                flow_options.flat.decrease,
+            ),
+        },
         Stop::IterationLimit => format!(
             "stopped at the iteration limit ({}) before converging",
             run.iterations()

@@ -1,12 +1,15 @@
 //! [`BeltramiFlow`]: the solver behind `--solver beltrami-flow` (crate docs): the
-//! initial map (given, or Tutte's disk, or the sphere initialization), then the flow
+//! initial map (given, or the boundary-first or Tutte disk, or the sphere
+//! initialization), then the flow
 //! engine ([`beltrami_flow_engine::solve`]).
 
+use beltrami_atlas::unit_disk::map_to_unit_disk;
 use beltrami_core::{
     Accepts, Context, Map, OptionSpec, Output, PlanarBoundary, Problem, Report, Settings, Solution,
     Solver, SolverError, Target, solve_renumbered,
 };
 use beltrami_fem::element::is_planar;
+use beltrami_flow_engine::system::VertexOrder;
 use beltrami_flow_engine::{ACCEPTS, NAME, ON_TARGET, OPTIONS, annulus_of, given_initial};
 use beltrami_init::{Sphere, Tutte};
 use beltrami_mesh::Point3;
@@ -14,8 +17,9 @@ use beltrami_mesh::Point3;
 /// Discrete Beltrami flow onto a fixed target (crate docs).
 ///
 /// Reads what [`beltrami_flow_engine::solve`] reads; without a given initial map it
-/// starts from the source itself (a planar source already on the target), Tutte's map
-/// onto the target's polygon or circle, a radial stretch onto the annulus, or the sphere
+/// starts from the source itself (a planar source already on the target), the
+/// boundary-first conformal map onto the unit disk (Tutte's where it folds), Tutte's
+/// map onto the target's polygon, a radial stretch onto the annulus, or the sphere
 /// initialization.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BeltramiFlow;
@@ -64,10 +68,20 @@ fn flow(
     let mut report = Report::new(NAME);
     let threads = settings.int("threads");
     let mut inner = context.inner();
-    let initial = context.stage("initial map", &mut report, || {
-        initial_map(problem, threads, &mut inner)
-    })?;
-    beltrami_flow_engine::solve(problem, settings, initial, report, context)
+    // The flow's vertex order does not depend on the initial map: computed beside it,
+    // on a second core (the hand's disk map: 0.18 s of ordering beside a 0.19-s map).
+    let (initial, order) = std::thread::scope(|scope| {
+        let order = scope.spawn(|| VertexOrder::of(problem.source));
+        let initial = context.stage("initial map", &mut report, || {
+            initial_map(problem, threads, &mut inner)
+        });
+        let order = order
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (initial, order)
+    });
+    let (initial, order) = (initial?, order?);
+    beltrami_flow_engine::solve(problem, settings, initial, Some(&order), report, context)
 }
 
 fn invalid(message: &str) -> SolverError {
@@ -116,6 +130,19 @@ fn initial_map(
                     .all(|&v| (mesh.position(v).coords.xy().norm() - 1.0).abs() <= ON_TARGET);
             if on_circle {
                 return Ok(identity());
+            }
+            // The boundary-first conformal map (exactly on the circle): from it the
+            // conformal flow of the human face settles in 4 steps with max |mu| 0.255,
+            // from Tutte's map (whose max |mu| is 0.93) in 11 with 0.271.
+            let boundary_first = map_to_unit_disk(mesh).map_err(|error| SolverError::Plugin {
+                solver: NAME,
+                error: Box::new(error),
+            })?;
+            if let Ok(points) = boundary_first {
+                return Ok(points
+                    .iter()
+                    .map(|&[x, y]| Point3::new(x, y, 0.0))
+                    .collect());
             }
             init.target = Target::Plane(PlanarBoundary::Circle);
             planar_points(Tutte.solve(&init, context)?.output)

@@ -238,7 +238,7 @@ impl StepSystem {
         }
         let pattern = Pattern::new(n, n, &positions)?;
         Ok(Self {
-            slots: pattern.value_slots(&positions)?,
+            slots: pattern.slots().to_vec(),
             matrix: pattern.assemble(&vec![0.0; positions.len()])?,
             solver: SpdSolver::new(pattern.symbolic().as_ref(), options)?,
             layout,

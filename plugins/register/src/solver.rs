@@ -372,8 +372,14 @@ fn after_features(
     measure.options.set("max-iters", OptionValue::Int(0));
     let measure_settings =
         Settings::resolve(NAME, &OPTIONS, &measure.options).map_err(SolverError::from)?;
-    let mut measured =
-        beltrami_flow_engine::solve(&measure, &measure_settings, positions, report, context)?;
+    let mut measured = beltrami_flow_engine::solve(
+        &measure,
+        &measure_settings,
+        positions,
+        None,
+        report,
+        context,
+    )?;
     // The measuring run took no step by design: its stop is not news.
     measured
         .report
@@ -431,8 +437,14 @@ pub(crate) fn register(
     }
     flow.constraints = held;
     flow.initial = Some(Map::OnMesh(initial.points.clone()));
-    let mut solution =
-        beltrami_flow_engine::solve(&flow, settings, initial.positions.clone(), report, context)?;
+    let mut solution = beltrami_flow_engine::solve(
+        &flow,
+        settings,
+        initial.positions.clone(),
+        None,
+        report,
+        context,
+    )?;
     if matched {
         solution = after_features(&flow, &initial, features, shape, solution, context)?;
     }
