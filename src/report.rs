@@ -161,11 +161,16 @@ pub fn atlas(
             "overlap": atlas.splits.overlap,
             "flipped": atlas.splits.flipped,
             "stretch": atlas.splits.stretch,
+            "charts": atlas.splits.charts,
         },
         "options": {
             "cones": match options.cones {
                 beltrami_atlas::ConeCount::Auto => json!("auto"),
                 beltrami_atlas::ConeCount::Exactly(n) => json!(n),
+            },
+            "charts": match options.charts {
+                beltrami_atlas::ChartCount::Auto => json!("auto"),
+                beltrami_atlas::ChartCount::AtLeast(n) => json!(n),
             },
             "max_stretch": options.max_stretch,
             "padding": options.padding,

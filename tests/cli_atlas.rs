@@ -102,6 +102,58 @@ fn a_torus_atlas_keeps_the_vertices_and_agrees_with_its_report() {
 }
 
 #[test]
+fn charts_asks_for_at_least_that_many_charts() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("torus.obj");
+    let mesh = Mesh::from_soup(&torus(48, 16, 1.0, 0.4, Cells::Triangles)).unwrap();
+    io::obj::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let automatic = run_atlas(&input, &dir.path().join("auto.obj"), &[]);
+    let output = dir.path().join("eight.obj");
+    let report = run_atlas(&input, &output, &["--charts", "8"]);
+    let charts = report["charts"].as_u64().unwrap();
+    assert!((8..=9).contains(&charts), "{charts}");
+    assert_eq!(report["options"]["charts"], 8);
+    assert_eq!(automatic["options"]["charts"], "auto");
+    assert!(report["splits"]["charts"].as_u64().unwrap() >= 1);
+    // The written file has that many charts: pieces of faces joined across edges that
+    // are not seams.
+    let loaded = io::read(&output, &BuildOptions::default()).unwrap();
+    let (written, corner) = (&loaded.mesh, loaded.corner_uvs.as_ref().unwrap());
+    let mut chart: Vec<usize> = (0..written.face_count()).collect();
+    fn root(chart: &mut [usize], mut i: usize) -> usize {
+        while chart[i] != i {
+            chart[i] = chart[chart[i]];
+            i = chart[i];
+        }
+        i
+    }
+    for e in written.edges() {
+        let h = written.edge_halfedge(e);
+        let t = written.twin(h);
+        let (Some(f), Some(g)) = (written.face(h), written.face(t)) else {
+            continue;
+        };
+        // The corners at h's origin are h and next(t), at its target next(h) and t.
+        let joined = corner[h.idx()] == corner[written.next(t).idx()]
+            && corner[written.next(h).idx()] == corner[t.idx()];
+        if joined {
+            let (a, b) = (root(&mut chart, f.idx()), root(&mut chart, g.idx()));
+            chart[a] = b;
+        }
+    }
+    let mut roots: Vec<usize> = (0..written.face_count())
+        .map(|f| root(&mut chart, f))
+        .collect();
+    roots.sort_unstable();
+    roots.dedup();
+    assert_eq!(roots.len() as u64, charts);
+    let (written, uv) = seamed_uv(&output);
+    let measured = stretch(&written, &uv);
+    assert_eq!(measured.flipped_faces, 0);
+    assert!(measured.l2 < automatic["stretch"]["l2"].as_f64().unwrap());
+}
+
+#[test]
 fn ply_and_glb_atlases_split_the_vertices_at_the_seams() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("torus.obj");
@@ -146,6 +198,15 @@ fn outputs_without_seamed_uvs_and_bad_options_are_refused_before_work() {
         ),
         (vec!["-o", "atlas.obj", "--padding", "0.5"], "padding"),
         (vec!["-o", "atlas.obj", "--cones", "many"], "auto"),
+        (vec!["-o", "atlas.obj", "--charts", "0"], "at least 1"),
+        (
+            vec!["-o", "atlas.obj", "--charts", "some"],
+            "number of charts",
+        ),
+        (
+            vec!["-o", "atlas.obj", "--charts", "100000"],
+            "more than the mesh's 256 faces",
+        ),
         (
             vec!["quads", "-o", "atlas.obj"],
             "face 0 (0-based, in the file's order) has 4 corners",

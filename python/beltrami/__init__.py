@@ -1192,13 +1192,16 @@ def atlas(
     cones: Union[str, int] = "auto",
     max_stretch: float = 1.1,
     padding: float = 0.004,
+    charts: Union[str, int] = "auto",
 ) -> Tuple[np.ndarray, np.ndarray, Dict[str, Any]]:
     """A texture atlas of the triangle mesh ``V``, ``F`` (closed or open, any genus, any
     number of pieces): conformal charts with cone singularities (``cones``: ``"auto"``
     places them until the L2 stretch of each chart is at most ``max_stretch``, a number
     places that many per chart), cut open along trees through the cones, split where they
     would overlap, packed into the unit square with ``padding`` (a fraction of the side)
-    between charts (docs/atlas.md). Returns ``(UV, FUV, info)``: the texture coordinates
+    between charts (docs/atlas.md). ``charts``: ``"auto"`` makes as few charts as the
+    stretch limit and the overlap test leave, a number N at least N (the chart with the
+    largest share of the squared stretch split until there are). Returns ``(UV, FUV, info)``: the texture coordinates
     ``(k, 2)``, per face the row of ``UV`` of each corner ``(m, 3)`` (``FUV[i, c]`` is the
     coordinate of corner ``F[i, c]``), and the report of ``beltrami atlas --report``.
 
@@ -1217,7 +1220,13 @@ def atlas(
         count = int(cones)
     else:
         raise OptionError(f"cones={cones!r}: give 'auto' or a whole number of cones per chart")
-    UV, FUV, report = _native.atlas(V, F, count, float(max_stretch), float(padding))
+    if charts == "auto":
+        least = None
+    elif isinstance(charts, (int, np.integer)) and not isinstance(charts, bool) and charts >= 1:
+        least = int(charts)
+    else:
+        raise OptionError(f"charts={charts!r}: give 'auto' or a whole number of charts (at least 1)")
+    UV, FUV, report = _native.atlas(V, F, count, float(max_stretch), float(padding), least)
     return UV, FUV, json.loads(report)
 
 

@@ -37,6 +37,7 @@ def atlas(
     cones: Optional[int] = None,
     max_stretch: float = 1.1,
     padding: float = 0.004,
+    charts: Optional[int] = None,
 ) -> Tuple[Floats, Ints, str]: ...
 def remesh(
     v: Floats,

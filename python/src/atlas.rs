@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use beltrami_atlas::{AtlasOptions, ConeCount};
+use beltrami_atlas::{AtlasOptions, ChartCount, ConeCount};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -14,7 +14,7 @@ use crate::errors::{self, Kind};
 /// `(k, 2)`, per face the UV index of each corner `(m, 3)` (column `c` is the corner at
 /// `F[i, c]`), and the JSON report of `--report`.
 #[pyfunction]
-#[pyo3(signature = (v, f, cones=None, max_stretch=1.1, padding=0.004))]
+#[pyo3(signature = (v, f, cones=None, max_stretch=1.1, padding=0.004, charts=None))]
 #[allow(clippy::type_complexity)]
 pub fn atlas<'py>(
     py: Python<'py>,
@@ -23,9 +23,11 @@ pub fn atlas<'py>(
     cones: Option<usize>,
     max_stretch: f64,
     padding: f64,
+    charts: Option<usize>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, String)> {
     let options = AtlasOptions {
         cones: cones.map_or(ConeCount::Auto, ConeCount::Exactly),
+        charts: charts.map_or(ChartCount::Auto, ChartCount::AtLeast),
         max_stretch,
         padding,
     };

@@ -487,3 +487,13 @@ def test_atlas_matches_the_command(cli, tmp_path):
         beltrami.atlas(V, F, cones="many")
     with pytest.raises(beltrami.OptionError, match="max-stretch"):
         beltrami.atlas(V, F, max_stretch=0.5)
+    with pytest.raises(beltrami.OptionError, match="charts"):
+        beltrami.atlas(V, F, charts=0)
+    # charts=N is the command's --charts N.
+    out6, r6 = tmp_path / "six.obj", tmp_path / "six.json"
+    cli("atlas", spot, "-o", out6, "--report", r6, "--charts", "6")
+    UV6, FUV6, info6 = beltrami.atlas(V, F, charts=6)
+    assert info6["charts"] == report_of(r6)["charts"] >= 6
+    assert info6["options"]["charts"] == 6
+    lines = out6.read_text().splitlines()
+    close(UV6, np.array([[float(x) for x in l.split()[1:3]] for l in lines if l.startswith("vt ")]))

@@ -6,7 +6,7 @@ use std::str::FromStr;
 use std::time::Instant;
 
 use anyhow::{Context as _, bail};
-use beltrami_atlas::{Atlas, AtlasOptions, ConeCount};
+use beltrami_atlas::{Atlas, AtlasOptions, ChartCount, ConeCount};
 use beltrami_mesh::io::{self, CornerUvs, Format};
 use beltrami_mesh::{Mesh, Vector2};
 use beltrami_render::{ColorBy, Layout, Scene, Style, View};
@@ -35,6 +35,26 @@ impl FromStr for ConesArg {
     }
 }
 
+/// `--charts`: `auto` or the least number of charts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ChartsArg(pub ChartCount);
+
+impl FromStr for ChartsArg {
+    type Err = String;
+
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        if text == "auto" {
+            return Ok(Self(ChartCount::Auto));
+        }
+        match text.parse::<usize>() {
+            Ok(n) if n >= 1 => Ok(Self(ChartCount::AtLeast(n))),
+            _ => Err(format!(
+                "`{text}` is neither `auto` nor a whole number of charts (at least 1)"
+            )),
+        }
+    }
+}
+
 #[derive(Debug, Args)]
 pub struct AtlasArgs {
     /// Mesh file (.obj, .ply, .stl, .off, .gltf, .glb): any manifold triangle mesh,
@@ -48,6 +68,12 @@ pub struct AtlasArgs {
     /// (at most 64 per chart), a number places that many.
     #[arg(long, value_name = "auto|N", default_value = "auto")]
     pub cones: ConesArg,
+    /// Charts: `auto` makes as few as the stretch limit and the overlap test leave; a
+    /// number N makes at least N, splitting the chart with the largest share of the
+    /// squared stretch (area times its L2 stretch squared) until there are (a split
+    /// whose half falls apart may give one more).
+    #[arg(long, value_name = "auto|N", default_value = "auto")]
+    pub charts: ChartsArg,
     /// The largest L2 texture stretch (Sander et al. 2001) of a chart, at least 1; a
     /// chart above it is split.
     #[arg(
@@ -95,6 +121,7 @@ pub fn run(args: &AtlasArgs, quiet: bool) -> anyhow::Result<()> {
     ])?;
     let options = AtlasOptions {
         cones: args.cones.0,
+        charts: args.charts.0,
         max_stretch: args.max_stretch,
         padding: args.padding,
     };

@@ -53,7 +53,7 @@ use beltrami_mesh::{EdgeId, FaceId, Mesh, VertexId, cut_along};
 
 pub use chart::{ChartFailure, FlatChart, flatten_chart};
 pub use error::AtlasError;
-pub use options::{AtlasOptions, ConeCount};
+pub use options::{AtlasOptions, ChartCount, ConeCount};
 pub use seamed::SeamedUv;
 pub use stretch::{Stretch, stretch};
 
@@ -84,6 +84,9 @@ pub struct Splits {
     pub flipped: usize,
     /// The flat chart's L2 stretch was above the limit.
     pub stretch: usize,
+    /// The chart was split to reach the asked number of charts
+    /// ([`ChartCount::AtLeast`]).
+    pub charts: usize,
 }
 
 /// One chart of an [`Atlas`].
@@ -105,10 +108,14 @@ struct Piece {
     splits: usize,
 }
 
+/// A chart laid flat: the chart, its piece of the mesh and its own L2 stretch.
+type Laid = (FlatChart, Piece, f64);
+
 /// The texture atlas of `mesh` (see the crate docs).
 ///
 /// # Errors
-/// [`AtlasError::InvalidOption`] for options out of range, [`AtlasError::NotTriangles`]
+/// [`AtlasError::InvalidOption`] for options out of range, or for more charts asked
+/// than the mesh's faces can make (known after the work), [`AtlasError::NotTriangles`]
 /// for a mesh with quads, [`AtlasError::Unflattenable`] if a piece cannot be laid flat
 /// after `MAX_SPLITS` splits.
 pub fn atlas(mesh: &Mesh, options: &AtlasOptions) -> Result<Atlas, AtlasError> {
@@ -119,8 +126,18 @@ pub fn atlas(mesh: &Mesh, options: &AtlasOptions) -> Result<Atlas, AtlasError> {
             corners: mesh.face_degree(face),
         });
     }
-    let goal = options.cone_goal();
-    let mut work: Vec<Piece> = parts(mesh)?
+    if let ChartCount::AtLeast(n) = options.charts
+        && n > mesh.face_count()
+    {
+        return Err(AtlasError::InvalidOption {
+            option: "charts",
+            message: format!(
+                "{n} charts is more than the mesh's {} faces",
+                mesh.face_count()
+            ),
+        });
+    }
+    let work: Vec<Piece> = parts(mesh)?
         .into_iter()
         .map(|p| Piece {
             mesh: p.mesh,
@@ -129,18 +146,57 @@ pub fn atlas(mesh: &Mesh, options: &AtlasOptions) -> Result<Atlas, AtlasError> {
             splits: 0,
         })
         .collect();
-    let mut flat: Vec<(FlatChart, Piece)> = Vec::new();
+    let mut flat: Vec<Laid> = Vec::new();
     let mut splits = Splits::default();
+    lay_flat(mesh, work, options, &mut flat, &mut splits)?;
+    if let ChartCount::AtLeast(n) = options.charts {
+        while flat.len() < n {
+            let share = |(chart, _, l2): &Laid| chart.disk.total_area() * l2 * l2;
+            let Some(k) = (0..flat.len())
+                .filter(|&k| flat[k].1.mesh.face_count() > 2)
+                .max_by(|&a, &b| share(&flat[a]).total_cmp(&share(&flat[b])))
+            else {
+                return Err(AtlasError::InvalidOption {
+                    option: "charts",
+                    message: format!(
+                        "{n} charts is more than this mesh makes: its {} charts have at most 2 faces each",
+                        flat.len()
+                    ),
+                });
+            };
+            let (_, piece, _) = flat.swap_remove(k);
+            splits.charts += 1;
+            lay_flat(
+                mesh,
+                split_piece(mesh, piece)?,
+                options,
+                &mut flat,
+                &mut splits,
+            )?;
+        }
+    }
+    Ok(assemble(mesh, flat, options.padding, splits))
+}
+
+/// Lays every piece of `work` flat into `flat`, splitting the pieces that overlap,
+/// fold or stretch beyond the limit (counted in `splits`).
+fn lay_flat(
+    mesh: &Mesh,
+    mut work: Vec<Piece>,
+    options: &AtlasOptions,
+    flat: &mut Vec<Laid>,
+    splits: &mut Splits,
+) -> Result<(), AtlasError> {
+    let goal = options.cone_goal();
     while let Some(piece) = work.pop() {
         let laid = flatten_chart(&piece.mesh, goal)?;
         let accepted = match laid {
-            Ok(chart)
-                if within_stretch(&chart, options.max_stretch) || piece.mesh.face_count() <= 2 =>
-            {
-                flat.push((chart, piece));
-                continue;
-            }
-            Ok(_) => {
+            Ok(chart) => {
+                let l2 = stretch(&chart.disk, &disk_uv(&chart)).l2;
+                if l2 <= options.max_stretch || piece.mesh.face_count() <= 2 {
+                    flat.push((chart, piece, l2));
+                    continue;
+                }
                 splits.stretch += 1;
                 piece
             }
@@ -155,12 +211,7 @@ pub fn atlas(mesh: &Mesh, options: &AtlasOptions) -> Result<Atlas, AtlasError> {
         };
         work.extend(split_piece(mesh, accepted)?);
     }
-    Ok(assemble(mesh, flat, options.padding, splits))
-}
-
-/// Whether the chart's L2 stretch is within `limit`.
-fn within_stretch(chart: &FlatChart, limit: f64) -> bool {
-    stretch(&chart.disk, &disk_uv(chart)).l2 <= limit
+    Ok(())
 }
 
 /// The chart's flat positions as seamed UVs of its disk.
@@ -213,12 +264,12 @@ fn split_piece(mesh: &Mesh, piece: Piece) -> Result<Vec<Piece>, AtlasError> {
 }
 
 /// The atlas from the flat charts: UVs packed, corners indexed, stretch measured.
-fn assemble(mesh: &Mesh, flat: Vec<(FlatChart, Piece)>, padding: f64, splits: Splits) -> Atlas {
+fn assemble(mesh: &Mesh, flat: Vec<Laid>, padding: f64, splits: Splits) -> Atlas {
     // Every chart at the surface's scale on average, so that the texture density is the
     // same on all of them.
     let mut positions: Vec<Vec<[f64; 2]>> = flat
         .iter()
-        .map(|(c, _)| {
+        .map(|(c, _, _)| {
             let uv = disk_uv(c);
             let flat_area: f64 = c.disk.faces().map(|f| 0.5 * uv.signed_double_area(f)).sum();
             let scale = (c.disk.total_area() / flat_area).sqrt();
@@ -230,7 +281,7 @@ fn assemble(mesh: &Mesh, flat: Vec<(FlatChart, Piece)>, padding: f64, splits: Sp
     let mut corners = vec![[0u32; 3]; mesh.face_count()];
     let mut face_chart = vec![0u32; mesh.face_count()];
     let mut charts = Vec::with_capacity(flat.len());
-    for (k, ((chart, piece), placed)) in flat.iter().zip(positions).enumerate() {
+    for (k, ((chart, piece, _), placed)) in flat.iter().zip(positions).enumerate() {
         let first = uvs.len() as u32;
         uvs.extend(placed);
         for f in chart.disk.faces() {

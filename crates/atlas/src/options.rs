@@ -17,11 +17,25 @@ pub enum ConeCount {
     Exactly(usize),
 }
 
+/// How many charts the atlas has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ChartCount {
+    /// As few as the stretch limit and the overlap test leave.
+    Auto,
+    /// At least this many: after the automatic charts, the chart of the largest share
+    /// of the atlas's squared L2 stretch (its area times its own L2 stretch squared) is
+    /// split in two until there are this many or more (one split may leave a half in
+    /// pieces, so one more is possible).
+    AtLeast(usize),
+}
+
 /// The options of [`crate::atlas`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AtlasOptions {
     /// How many cones each chart gets.
     pub cones: ConeCount,
+    /// How many charts the atlas has.
+    pub charts: ChartCount,
     /// The largest L2 stretch (Sander et al. 2001) a chart may have; a chart above it is
     /// split. At least 1.
     pub max_stretch: f64,
@@ -34,6 +48,7 @@ impl Default for AtlasOptions {
     fn default() -> Self {
         Self {
             cones: ConeCount::Auto,
+            charts: ChartCount::Auto,
             max_stretch: 1.1,
             padding: 0.004,
         }
@@ -59,6 +74,14 @@ impl AtlasOptions {
                     "{} is outside [0, 0.25]: the padding is a fraction of the texture's side",
                     self.padding
                 ),
+            });
+        }
+        if let ChartCount::AtLeast(n) = self.charts
+            && n == 0
+        {
+            return Err(AtlasError::InvalidOption {
+                option: "charts",
+                message: "0 charts: ask for `auto` or at least 1".into(),
             });
         }
         if let ConeCount::Exactly(n) = self.cones
