@@ -5,7 +5,7 @@
 //! before any work. On the shared meshes (when `../shared` is there) the goals
 //! are checked against xatlas's figures measured by `benches/peers/atlas_compare.py`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use beltrami_atlas::{SeamedUv, stretch};
 use beltrami_mesh::io::{self, VertexAttributes};
@@ -36,6 +36,14 @@ fn seamed_uv(path: &Path) -> (Mesh, SeamedUv) {
     (mesh, SeamedUv { uvs, corners })
 }
 
+/// A triangulated torus of `n x m` cells (radii 1 and 0.4) written as `dir/torus.obj`.
+fn write_torus(dir: &Path, n: usize, m: usize) -> (PathBuf, Mesh) {
+    let input = dir.join("torus.obj");
+    let mesh = Mesh::from_soup(&torus(n, m, 1.0, 0.4, Cells::Triangles)).unwrap();
+    io::obj::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    (input, mesh)
+}
+
 /// Runs `atlas INPUT -o OUTPUT --report R` and returns the report.
 fn run_atlas(input: &Path, output: &Path, extra: &[&str]) -> serde_json::Value {
     let report = output.with_extension("json");
@@ -49,9 +57,7 @@ fn run_atlas(input: &Path, output: &Path, extra: &[&str]) -> serde_json::Value {
 #[test]
 fn a_torus_atlas_keeps_the_vertices_and_agrees_with_its_report() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("torus.obj");
-    let mesh = Mesh::from_soup(&torus(48, 16, 1.0, 0.4, Cells::Triangles)).unwrap();
-    io::obj::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let (input, mesh) = write_torus(dir.path(), 48, 16);
     let output = dir.path().join("atlas.obj");
     let report = run_atlas(&input, &output, &[]);
 
@@ -104,9 +110,7 @@ fn a_torus_atlas_keeps_the_vertices_and_agrees_with_its_report() {
 #[test]
 fn charts_asks_for_at_least_that_many_charts() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("torus.obj");
-    let mesh = Mesh::from_soup(&torus(48, 16, 1.0, 0.4, Cells::Triangles)).unwrap();
-    io::obj::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let (input, _) = write_torus(dir.path(), 48, 16);
     let automatic = run_atlas(&input, &dir.path().join("auto.obj"), &[]);
     let output = dir.path().join("eight.obj");
     let report = run_atlas(&input, &output, &["--charts", "8"]);
@@ -156,9 +160,7 @@ fn charts_asks_for_at_least_that_many_charts() {
 #[test]
 fn ply_and_glb_atlases_split_the_vertices_at_the_seams() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("torus.obj");
-    let mesh = Mesh::from_soup(&torus(32, 12, 1.0, 0.4, Cells::Triangles)).unwrap();
-    io::obj::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let (input, mesh) = write_torus(dir.path(), 32, 12);
     let obj = dir.path().join("atlas.obj");
     let reference = run_atlas(&input, &obj, &[]);
     for name in ["atlas.ply", "atlas.glb"] {
@@ -179,9 +181,7 @@ fn ply_and_glb_atlases_split_the_vertices_at_the_seams() {
 #[test]
 fn outputs_without_seamed_uvs_and_bad_options_are_refused_before_work() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("torus.obj");
-    let mesh = Mesh::from_soup(&torus(16, 8, 1.0, 0.4, Cells::Triangles)).unwrap();
-    io::obj::write(&input, &mesh, &VertexAttributes::default()).unwrap();
+    let (input, _) = write_torus(dir.path(), 16, 8);
     let grid = Mesh::from_soup(&torus(8, 6, 1.0, 0.4, Cells::Quads)).unwrap();
     io::obj::write(
         &dir.path().join("quads.obj"),

@@ -1185,6 +1185,15 @@ def mesh_info(V: ArrayLike, F: ArrayLike) -> Dict[str, Any]:
 # ---- new meshes ----------------------------------------------------------------------
 
 
+def _auto_or_count(name: str, value: Union[str, int], least: int, what: str) -> Optional[int]:
+    """``None`` for ``"auto"``, else ``value`` as a whole number of at least ``least``."""
+    if value == "auto":
+        return None
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool) and value >= least:
+        return int(value)
+    raise OptionError(f"{name}={value!r}: give 'auto' or a whole number of {what} (at least {least})")
+
+
 def atlas(
     V: ArrayLike,
     F: ArrayLike,
@@ -1214,18 +1223,8 @@ def atlas(
     True
     """
     V, F = _mesh(V, F)
-    if cones == "auto":
-        count = None
-    elif isinstance(cones, (int, np.integer)) and not isinstance(cones, bool) and cones >= 0:
-        count = int(cones)
-    else:
-        raise OptionError(f"cones={cones!r}: give 'auto' or a whole number of cones per chart")
-    if charts == "auto":
-        least = None
-    elif isinstance(charts, (int, np.integer)) and not isinstance(charts, bool) and charts >= 1:
-        least = int(charts)
-    else:
-        raise OptionError(f"charts={charts!r}: give 'auto' or a whole number of charts (at least 1)")
+    count = _auto_or_count("cones", cones, 0, "cones per chart")
+    least = _auto_or_count("charts", charts, 1, "charts")
     UV, FUV, report = _native.atlas(V, F, count, float(max_stretch), float(padding), least)
     return UV, FUV, json.loads(report)
 

@@ -16,6 +16,20 @@ use serde_json::{Value, json};
 use super::load::load_mesh;
 use super::mapping::png_path;
 
+/// `auto` (`None`) or a whole number of at least `least` (`what` names the count in the
+/// error).
+fn auto_or_count(text: &str, least: usize, what: &str) -> Result<Option<usize>, String> {
+    if text == "auto" {
+        return Ok(None);
+    }
+    match text.parse::<usize>() {
+        Ok(n) if n >= least => Ok(Some(n)),
+        _ => Err(format!(
+            "`{text}` is neither `auto` nor a whole number of {what} (at least {least})"
+        )),
+    }
+}
+
 /// `--cones`: `auto` or a count per chart.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ConesArg(pub ConeCount);
@@ -24,14 +38,8 @@ impl FromStr for ConesArg {
     type Err = String;
 
     fn from_str(text: &str) -> Result<Self, Self::Err> {
-        if text == "auto" {
-            return Ok(Self(ConeCount::Auto));
-        }
-        text.parse::<usize>()
-            .map(|n| Self(ConeCount::Exactly(n)))
-            .map_err(|_| {
-                format!("`{text}` is neither `auto` nor a whole number of cones per chart")
-            })
+        let count = auto_or_count(text, 0, "cones per chart")?;
+        Ok(Self(count.map_or(ConeCount::Auto, ConeCount::Exactly)))
     }
 }
 
@@ -43,15 +51,8 @@ impl FromStr for ChartsArg {
     type Err = String;
 
     fn from_str(text: &str) -> Result<Self, Self::Err> {
-        if text == "auto" {
-            return Ok(Self(ChartCount::Auto));
-        }
-        match text.parse::<usize>() {
-            Ok(n) if n >= 1 => Ok(Self(ChartCount::AtLeast(n))),
-            _ => Err(format!(
-                "`{text}` is neither `auto` nor a whole number of charts (at least 1)"
-            )),
-        }
+        let count = auto_or_count(text, 1, "charts")?;
+        Ok(Self(count.map_or(ChartCount::Auto, ChartCount::AtLeast)))
     }
 }
 
