@@ -238,9 +238,8 @@ pub fn remesh(
 /// The `components` entry of the report of a remeshing piece by piece
 /// (`beltrami_remesh::components::remesh_each`): per component, in order, its input
 /// faces, parameterizer, opening, edge length and new vertex and face counts.
-pub fn remesh_components(joined: &beltrami_remesh::components::Joined) -> Value {
-    let list: Vec<Value> = joined
-        .components
+pub fn remesh_components(components: &[beltrami_remesh::components::ComponentRemeshing]) -> Value {
+    let list: Vec<Value> = components
         .iter()
         .map(|c| {
             let r = &c.remeshing;

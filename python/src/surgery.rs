@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use beltrami_core::Context;
 use beltrami_mesh::Mesh;
-use beltrami_remesh::components::{remesh_each, remesh_largest};
+use beltrami_remesh::components::{Coverage, remesh_covering};
 use beltrami_remesh::{RemeshError, RemeshOptions, Resolution, SizeField};
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
@@ -91,44 +91,27 @@ pub fn remesh<'py>(
     let registry = beltrami::registry();
     let choose = |part: &Mesh| beltrami_remesh::param::chosen(&registry, part, param);
     let start = Instant::now();
+    let coverage = match components {
+        Some("each") => Coverage::Each,
+        Some("largest") => Coverage::Largest,
+        _ => Coverage::Whole,
+    };
     let result = py.detach(|| {
-        let mut context = Context::new();
-        let (out, summary, list, part) = match components {
-            Some("each") => {
-                let joined = remesh_each(&mesh, choose, &options, &mut context)?;
-                let list = beltrami::report::remesh_components(&joined);
-                let summary = joined.summary();
-                (joined.remeshed.mesh, summary, Some(list), None)
-            }
-            Some("largest") if mesh.component_count() > 1 => {
-                let largest = remesh_largest(&mesh, choose, &options, &mut context)?;
-                let mut summary = largest.remeshing.summary();
-                summary.notes.push(largest.note(&mesh));
-                (
-                    largest.remeshing.remeshed.mesh,
-                    summary,
-                    None,
-                    Some(largest.part.mesh),
-                )
-            }
-            _ => {
-                let solvers = choose(&mesh)?;
-                let result = beltrami_remesh::remesh(&mesh, &solvers, &options, &mut context)?;
-                let summary = result.summary();
-                (result.remeshed.mesh, summary, None, None)
-            }
-        };
-        let input = part.as_ref().unwrap_or(&mesh);
-        let quality = beltrami_remesh::quality::measure(input, &out)?;
-        Ok((out, summary, list, quality, part))
+        let covered = remesh_covering(&mesh, coverage, choose, &options, &mut Context::new())?;
+        let quality = beltrami_remesh::quality::measure(covered.input(&mesh), &covered.mesh)?;
+        Ok::<_, RemeshError>((covered, quality))
     });
-    let (out, summary, list, quality, part) = result.map_err(|e| remesh_error(&e))?;
+    let (covered, quality) = result.map_err(|e| remesh_error(&e))?;
     let seconds = start.elapsed().as_secs_f64();
-    let input = part.as_ref().unwrap_or(&mesh);
-    let mut report = beltrami::report::remesh(input, &summary, &quality, seconds);
-    if let Some(list) = list {
-        report.insert("components".into(), list);
+    let mut report =
+        beltrami::report::remesh(covered.input(&mesh), &covered.summary, &quality, seconds);
+    if !covered.components.is_empty() {
+        report.insert(
+            "components".into(),
+            beltrami::report::remesh_components(&covered.components),
+        );
     }
+    let out = covered.mesh;
     let (v, f) = mesh_arrays(&out)?;
     Ok((
         v.into_pyarray(py),

@@ -8,7 +8,7 @@ use anyhow::{Context as _, bail};
 use beltrami_core::Context;
 use beltrami_mesh::Mesh;
 use beltrami_mesh::io::{self, VertexAttributes};
-use beltrami_remesh::components::{remesh_each, remesh_largest};
+use beltrami_remesh::components::{Coverage, remesh_covering};
 use beltrami_remesh::in_place::{InPlaceOptions, Keep, remesh_in_place};
 use beltrami_remesh::reference_angles::Reference;
 use beltrami_remesh::{Quality, RemeshError, RemeshOptions, Resolution, SizeField, Summary};
@@ -197,52 +197,31 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
     let registry = beltrami::registry();
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
     let whole = &loaded.mesh.mesh;
-    let pieces;
     let start = Instant::now();
     let mut context = Context::new().with_cancel_flag(super::interrupt::cancel_flag());
     let choose = |part: &Mesh| beltrami_remesh::param::chosen(&registry, part, &args.param);
-    let cannot = || format!("cannot remesh {}", args.mesh.display());
-    let (out, mut summary, mesh, per_component, largest_note) = match args.components {
-        Some(ComponentsArg::Each) => {
-            let joined = remesh_each(whole, choose, &options, &mut context).with_context(cannot)?;
-            let list = beltrami::report::remesh_components(&joined);
-            let summary = joined.summary();
-            (joined.remeshed.mesh, summary, whole, Some(list), None)
-        }
-        Some(ComponentsArg::Largest) if whole.component_count() > 1 => {
-            let largest =
-                remesh_largest(whole, choose, &options, &mut context).with_context(cannot)?;
-            let note = largest.note(whole);
-            let summary = largest.remeshing.summary();
-            pieces = largest.part;
-            (
-                largest.remeshing.remeshed.mesh,
-                summary,
-                &pieces.mesh,
-                None,
-                Some(note),
-            )
-        }
-        _ => {
-            let solvers = choose(whole).map_err(with_hint)?;
-            let result = beltrami_remesh::remesh(whole, &solvers, &options, &mut context)
-                .map_err(with_hint)
-                .with_context(cannot)?;
-            let summary = result.summary();
-            (result.remeshed.mesh, summary, whole, None, None)
-        }
+    let coverage = match args.components {
+        None => Coverage::Whole,
+        Some(ComponentsArg::Each) => Coverage::Each,
+        Some(ComponentsArg::Largest) => Coverage::Largest,
     };
-    summary.notes.extend(largest_note);
+    let covered = remesh_covering(whole, coverage, choose, &options, &mut context)
+        .map_err(with_hint)
+        .with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
+    let (out, mesh, summary) = (&covered.mesh, covered.input(whole), &covered.summary);
     let seconds = start.elapsed().as_secs_f64();
-    io::write(&args.output, &out, &VertexAttributes::default())?;
-    let quality = beltrami_remesh::quality::measure(mesh, &out)?;
-    write_png(args.png.as_deref(), &out)?;
-    let mut report = report_json(args, mesh, &summary, &quality, seconds);
-    if let (Some(list), Value::Object(map)) = (per_component, &mut report) {
-        map.insert("components".into(), list);
+    io::write(&args.output, out, &VertexAttributes::default())?;
+    let quality = beltrami_remesh::quality::measure(mesh, out)?;
+    write_png(args.png.as_deref(), out)?;
+    let mut report = report_json(args, mesh, summary, &quality, seconds);
+    if let (false, Value::Object(map)) = (covered.components.is_empty(), &mut report) {
+        map.insert(
+            "components".into(),
+            beltrami::report::remesh_components(&covered.components),
+        );
     }
     finish(args, &report, quiet, || {
-        print_summary(args, &summary, &quality, seconds)
+        print_summary(args, summary, &quality, seconds)
     })
 }
 

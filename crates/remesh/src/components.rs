@@ -229,3 +229,84 @@ fn join(pieces: &[Part], components: &[ComponentRemeshing]) -> Result<Remeshed, 
     })?;
     Ok(Remeshed { mesh, on_source })
 }
+
+/// Which connected components a remeshing covers (`beltrami remesh --components`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Coverage {
+    /// The mesh as one surface: a mesh in several components is refused
+    /// ([`RemeshError::Components`]).
+    Whole,
+    /// Every component on its own, the results joined ([`remesh_each`]).
+    Each,
+    /// The component with the most faces alone ([`remesh_largest`]); a mesh in one
+    /// piece is remeshed whole.
+    Largest,
+}
+
+/// What [`remesh_covering`] made.
+#[derive(Debug)]
+pub struct Covered {
+    /// The new mesh.
+    pub mesh: Mesh,
+    /// The remeshing's summary; with [`Coverage::Largest`] of a mesh in pieces its notes
+    /// say what was remeshed ([`Largest::note`]).
+    pub summary: Summary,
+    /// Per component, in order ([`Coverage::Each`]; empty otherwise).
+    pub components: Vec<ComponentRemeshing>,
+    /// The component remeshed alone ([`Coverage::Largest`] of a mesh in pieces), the
+    /// input the new mesh is to be measured against; `None` when that is the whole.
+    pub part: Option<Part>,
+}
+
+impl Covered {
+    /// The input the new mesh replaces: the remeshed component, or `whole`.
+    pub fn input<'a>(&'a self, whole: &'a Mesh) -> &'a Mesh {
+        self.part.as_ref().map_or(whole, |part| &part.mesh)
+    }
+}
+
+/// Remeshes the components of `mesh` that `coverage` names, with the parameterizers
+/// `choose` picks for each surface remeshed (the one dispatch of the command line and
+/// the Python binding).
+pub fn remesh_covering<'r>(
+    mesh: &Mesh,
+    coverage: Coverage,
+    choose: impl Fn(&Mesh) -> Result<Vec<&'r dyn Solver>, RemeshError>,
+    options: &RemeshOptions,
+    context: &mut Context<'_>,
+) -> Result<Covered, RemeshError> {
+    match coverage {
+        Coverage::Each => {
+            let joined = remesh_each(mesh, choose, options, context)?;
+            let summary = joined.summary();
+            Ok(Covered {
+                mesh: joined.remeshed.mesh,
+                summary,
+                components: joined.components,
+                part: None,
+            })
+        }
+        Coverage::Largest if mesh.component_count() > 1 => {
+            let largest = remesh_largest(mesh, choose, options, context)?;
+            let mut summary = largest.remeshing.summary();
+            summary.notes.push(largest.note(mesh));
+            Ok(Covered {
+                mesh: largest.remeshing.remeshed.mesh,
+                summary,
+                components: Vec::new(),
+                part: Some(largest.part),
+            })
+        }
+        Coverage::Whole | Coverage::Largest => {
+            let solvers = choose(mesh)?;
+            let result = remesh(mesh, &solvers, options, context)?;
+            let summary = result.summary();
+            Ok(Covered {
+                mesh: result.remeshed.mesh,
+                summary,
+                components: Vec::new(),
+                part: None,
+            })
+        }
+    }
+}

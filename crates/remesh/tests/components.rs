@@ -5,7 +5,7 @@ use beltrami_core::{Context, Solver};
 use beltrami_init::{Lscm, Sphere, Tutte};
 use beltrami_mesh::primitives::{Cells, grid, icosphere};
 use beltrami_mesh::{Mesh, PolygonSoup, Vector3};
-use beltrami_remesh::components::remesh_each;
+use beltrami_remesh::components::{Coverage, remesh_covering, remesh_each};
 use beltrami_remesh::{RemeshError, RemeshOptions, Resolution, remesh};
 
 /// `a` and `b` in one soup, `b` moved by `shift`, `a`'s faces first.
@@ -135,4 +135,49 @@ fn a_component_that_fails_is_named() {
             .starts_with("component 1 (the one with input face 1280): "),
         "{error}"
     );
+}
+
+#[test]
+fn the_coverage_dispatch_remeshes_the_whole_each_or_the_largest() {
+    let (_, sphere, both) = square_and_sphere();
+    let options = RemeshOptions::with_edge_length(0.1);
+    let run = |mesh: &Mesh, coverage| {
+        remesh_covering(mesh, coverage, chosen, &options, &mut Context::new())
+    };
+    // The whole of a mesh in pieces is refused, naming the count.
+    assert!(matches!(
+        run(&both, Coverage::Whole),
+        Err(RemeshError::Components { components: 2 })
+    ));
+    // Each: remesh_each's mesh and per-component list.
+    let each = run(&both, Coverage::Each).unwrap();
+    let joined = remesh_each(&both, chosen, &options, &mut Context::new()).unwrap();
+    assert_eq!(each.mesh.positions(), joined.remeshed.mesh.positions());
+    assert_eq!(each.components.len(), 2);
+    assert!(each.part.is_none());
+    assert!(std::ptr::eq(each.input(&both), &both));
+    // Largest of the pieces: the sphere (more faces than the 8 x 8 square's 128), alone,
+    // measured against itself, and said so in the notes.
+    let largest = run(&both, Coverage::Largest).unwrap();
+    let part = largest.part.as_ref().expect("the largest component");
+    assert_eq!(part.mesh.face_count(), sphere.face_count());
+    assert_eq!(largest.input(&both).face_count(), sphere.face_count());
+    assert!(largest.components.is_empty());
+    assert!(
+        largest
+            .summary
+            .notes
+            .iter()
+            .any(|n| n.contains("largest of 2")),
+        "{:?}",
+        largest.summary.notes
+    );
+    // Largest of a mesh in one piece: the whole, as Whole remeshes it.
+    let one = Mesh::from_soup(&sphere).unwrap();
+    let (a, b) = (
+        run(&one, Coverage::Largest).unwrap(),
+        run(&one, Coverage::Whole).unwrap(),
+    );
+    assert!(a.part.is_none());
+    assert_eq!(a.mesh.positions(), b.mesh.positions());
 }
