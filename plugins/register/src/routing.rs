@@ -130,7 +130,7 @@ impl Loops {
 /// The similarity that places positions of the mesh with the cut graph in the frame of
 /// the other one, and whether the landmarks gave it: the similarity fitted to the
 /// landmarks, or else the rough match of centroids and sizes.
-pub(crate) fn placement(from: &Mesh, onto: &Mesh, pins: &[Pin]) -> (SpatialMatch, bool) {
+fn placement(from: &Mesh, onto: &Mesh, pins: &[Pin]) -> (SpatialMatch, bool) {
     let a: Vec<Point3<f64>> = pins.iter().map(|p| p.from).collect();
     let b: Vec<Point3<f64>> = pins.iter().map(|p| p.onto).collect();
     match SpatialMatch::fitted(&a, &b) {
@@ -156,7 +156,8 @@ pub(crate) fn refined_placement(
     }
 }
 
-/// The target loop paired with every source loop (module docs).
+/// The target loop paired with every source loop (module docs): the loops the
+/// landmarks pair ([`pair_marked_loops`]), the others by their distance once `place`d.
 ///
 /// # Errors
 /// [`RegisterError::Landmark`] for a landmark with one end on a boundary loop and the
@@ -169,6 +170,55 @@ pub(crate) fn pair_loops(
     marks: &[Resolved],
     place: &SpatialMatch,
 ) -> Result<Vec<usize>, RegisterError> {
+    let k = source_loops.vertices.len();
+    let pair = pair_marked_loops(target, source_loops, target_loops, marks)?;
+    let mut taken = vec![false; k];
+    for &(t, _) in pair.iter().flatten() {
+        taken[t] = true;
+    }
+    let samples = |mesh: &Mesh, vertices: &[VertexId], moved: bool| -> Vec<Point3<f64>> {
+        let step = vertices.len().div_ceil(LOOP_SAMPLES).max(1);
+        vertices
+            .iter()
+            .step_by(step)
+            .map(|&v| {
+                let p = mesh.position(v);
+                if moved { place.to_target(&p) } else { p }
+            })
+            .collect()
+    };
+    let free_sources: Vec<usize> = (0..k).filter(|&s| pair[s].is_none()).collect();
+    let free_targets: Vec<usize> = (0..k).filter(|&t| !taken[t]).collect();
+    let target_samples: Vec<Vec<Point3<f64>>> = free_targets
+        .iter()
+        .map(|&t| samples(target, &target_loops.vertices[t], false))
+        .collect();
+    let cost: Vec<Vec<f64>> = free_sources
+        .iter()
+        .map(|&s| {
+            let a = samples(source, &source_loops.vertices[s], true);
+            target_samples.iter().map(|b| chamfer(&a, b)).collect()
+        })
+        .collect();
+    let chosen = cheapest_assignment(&cost);
+    let mut out: Vec<usize> = pair.iter().map(|p| p.map_or(usize::MAX, |p| p.0)).collect();
+    for (i, &s) in free_sources.iter().enumerate() {
+        out[s] = free_targets[chosen[i]];
+    }
+    Ok(out)
+}
+
+/// Per source loop, the target loop a landmark pairs it with and the first such
+/// landmark's index, if any.
+///
+/// # Errors
+/// As [`pair_loops`].
+fn pair_marked_loops(
+    target: &Mesh,
+    source_loops: &Loops,
+    target_loops: &Loops,
+    marks: &[Resolved],
+) -> Result<Vec<Option<(usize, usize)>>, RegisterError> {
     let k = source_loops.vertices.len();
     let mut pair: Vec<Option<(usize, usize)>> = vec![None; k];
     let mut taken: Vec<Option<usize>> = vec![None; k];
@@ -212,36 +262,7 @@ pub(crate) fn pair_loops(
             }
         }
     }
-    let samples = |mesh: &Mesh, vertices: &[VertexId], moved: bool| -> Vec<Point3<f64>> {
-        let step = vertices.len().div_ceil(LOOP_SAMPLES).max(1);
-        vertices
-            .iter()
-            .step_by(step)
-            .map(|&v| {
-                let p = mesh.position(v);
-                if moved { place.to_target(&p) } else { p }
-            })
-            .collect()
-    };
-    let free_sources: Vec<usize> = (0..k).filter(|&s| pair[s].is_none()).collect();
-    let free_targets: Vec<usize> = (0..k).filter(|&t| taken[t].is_none()).collect();
-    let target_samples: Vec<Vec<Point3<f64>>> = free_targets
-        .iter()
-        .map(|&t| samples(target, &target_loops.vertices[t], false))
-        .collect();
-    let cost: Vec<Vec<f64>> = free_sources
-        .iter()
-        .map(|&s| {
-            let a = samples(source, &source_loops.vertices[s], true);
-            target_samples.iter().map(|b| chamfer(&a, b)).collect()
-        })
-        .collect();
-    let chosen = cheapest_assignment(&cost);
-    let mut out: Vec<usize> = pair.iter().map(|p| p.map_or(usize::MAX, |p| p.0)).collect();
-    for (i, &s) in free_sources.iter().enumerate() {
-        out[s] = free_targets[chosen[i]];
-    }
-    Ok(out)
+    Ok(pair)
 }
 
 /// The symmetric mean distance between two point sets: the mean distance from each
@@ -1307,9 +1328,13 @@ pub(crate) fn check_boundary_landmarks(
     let pins = forward_pins(source, target, marks);
     let source_loops = Loops::of(source);
     let target_loops = Loops::of(target);
-    let (place, _) = placement(source, target, &pins);
-    let paired = pair_loops(source, target, &source_loops, &target_loops, marks, &place)?;
-    for (s, &t) in paired.iter().enumerate() {
+    // Only loops with landmarks have anchors to check: those the landmarks pair.
+    let paired = pair_marked_loops(target, &source_loops, &target_loops, marks)?;
+    for (s, t) in paired
+        .iter()
+        .enumerate()
+        .filter_map(|(s, pair)| pair.map(|(t, _)| (s, t)))
+    {
         let (a, b) = (&source_loops.vertices[s], &target_loops.vertices[t]);
         let fractions = [arc_fractions(source, a), arc_fractions(target, b)];
         loop_anchors(
