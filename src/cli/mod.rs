@@ -16,6 +16,7 @@ mod param;
 mod picture;
 mod pins;
 mod qc;
+mod reference;
 mod register;
 mod remesh;
 mod render;
@@ -81,6 +82,9 @@ pub enum Command {
     /// Run many param, qc, register and remesh jobs (one JSON object per line) in
     /// parallel, one JSON report line per job; `--resume` skips finished outputs.
     Batch(batch::BatchArgs),
+    /// Print the command-line reference (docs/reference.md) as Markdown.
+    #[command(hide = true)]
+    Reference(reference::ReferenceArgs),
 }
 
 /// Runs the parsed command.
@@ -101,5 +105,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Remesh(args) => remesh::run(&args, cli.quiet),
         Command::Atlas(args) => atlas::run(&args, cli.quiet),
         Command::Batch(args) => batch::run(&args, cli.quiet),
+        Command::Reference(args) => reference::run(&args),
     }
 }
