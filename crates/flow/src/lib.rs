@@ -27,6 +27,7 @@ pub mod extension;
 pub mod flow;
 pub mod measure;
 pub mod mesh_target;
+mod patch_embedding;
 mod run;
 mod setup;
 pub mod system;

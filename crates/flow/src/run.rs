@@ -19,7 +19,7 @@ use crate::mesh_target::MeshTarget;
 use crate::setup::{Domain, curve_roles, diagonal, domain, goals, mesh_roles, pins, region_roles};
 use crate::system::{FlowSystem, VertexOrder};
 use crate::target::{INNER, OUTER, Role, TargetGeometry};
-use crate::untangle::{Untangled, untangle};
+use crate::untangle::{Untangled, untangle, untangle_patches};
 use crate::validate::{invalid, validate};
 
 /// The flow's options.
@@ -227,6 +227,43 @@ pub fn solve(
             ));
             if better {
                 run = again;
+            }
+        }
+        // The last resort for the faces still flipped: their patches untangled at once,
+        // then the flow again from there (kept with fewer flips, or as few and lower).
+        let before = left(&run);
+        if before > 0 && !context.is_cancelled() {
+            let mut image = run.image.clone();
+            let mut faces = run.faces.clone();
+            let mut normals: Vec<_> = image.iter().map(|p| geometry.normal(p)).collect();
+            let done = untangle_patches(
+                &elements,
+                &geometry,
+                &roles,
+                &mut image,
+                &mut normals,
+                &mut faces,
+            );
+            report.notes.push(format!(
+                "untangled the {} faces the flow left flipped to {} by moving {} vertices of the patches around them at once",
+                done.before, done.after, done.moves
+            ));
+            if done.after < done.before {
+                let again = runner.run_on_mesh(
+                    &mut system,
+                    &geometry,
+                    &roles,
+                    image,
+                    scale,
+                    None,
+                    context,
+                    (&mut report, &mut metrics),
+                )?;
+                let after = left(&again);
+                if after < before || (after == before && again.final_energy() < run.final_energy())
+                {
+                    run = again;
+                }
             }
         }
         let points = geometry.locate_all(&run.image)?;

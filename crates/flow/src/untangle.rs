@@ -25,12 +25,15 @@
 //! unchanged too (a flip that passes to another face of the star can be removed there
 //! by the next vertex; the count of flips never grows, and the rounds are bounded). Boundary,
 //! curve and fixed vertices never move. The flow runs again afterwards to restore
-//! conformality, from a map with fewer flips, and keeps them at most as many.
+//! conformality, from a map with fewer flips, and keeps them at most as many. Faces the
+//! flow still leaves flipped get their surrounding patches untangled at once
+//! ([`untangle_patches`], [`crate::patch_embedding`]).
 
 use beltrami_fem::Elements;
 use beltrami_mesh::{FaceId, Point3, Vector2, Vector3};
 
 use crate::measure::{ImageFace, image_face, triangle};
+use crate::patch_embedding::{Mapped, reembed_patch};
 use crate::target::{Role, TargetGeometry, orthonormal_basis};
 
 /// What [`untangle`] did.
@@ -75,6 +78,15 @@ impl Stars {
     pub(crate) fn of(&self, v: usize) -> &[usize] {
         &self.faces[self.start[v]..self.start[v + 1]]
     }
+}
+
+/// The elements' triangles (vertex indices) and the faces around each of `vertices`.
+fn triangles_and_stars(elements: &Elements, vertices: usize) -> (Vec<[usize; 3]>, Stars) {
+    let triangles: Vec<[usize; 3]> = (0..elements.face_count())
+        .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
+        .collect();
+    let stars = Stars::new(&triangles, vertices);
+    (triangles, stars)
 }
 
 /// The part of convex polygon `polygon` left of the directed line `a -> b` (closed
@@ -123,10 +135,7 @@ pub fn untangle<G: TargetGeometry>(
     rounds: usize,
     previous: Option<&[Point3<f64>]>,
 ) -> Untangled {
-    let triangles: Vec<[usize; 3]> = (0..elements.face_count())
-        .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
-        .collect();
-    let stars = Stars::new(&triangles, image.len());
+    let (triangles, stars) = triangles_and_stars(elements, image.len());
     let count = |faces: &[ImageFace]| faces.iter().filter(|f| f.flipped()).count();
     let mut done = Untangled {
         before: count(faces),
@@ -241,6 +250,48 @@ pub fn untangle<G: TargetGeometry>(
     done.after = count(faces);
     done
 }
+
+/// The last resort after [`untangle`] and the flow: the patch around each flipped face
+/// untangled at once ([`crate::patch_embedding`]), from one to [`PATCH_RINGS`] rings;
+/// `faces` and `normals` are updated with `image`. The patches are not conformal: the
+/// flow has to run again from the result. Kept for the faces the flow and the
+/// vertex-by-vertex untangling leave: used on every flip, it left the genus-3 maps of
+/// docs/register.md 5-40% higher in mean `|mu|` where they had none anyway.
+pub fn untangle_patches<G: TargetGeometry>(
+    elements: &Elements,
+    target: &G,
+    roles: &[Role],
+    image: &mut [Point3<f64>],
+    normals: &mut [Vector3<f64>],
+    faces: &mut [ImageFace],
+) -> Untangled {
+    let (triangles, stars) = triangles_and_stars(elements, image.len());
+    let count = |faces: &[ImageFace]| faces.iter().filter(|f| f.flipped()).count();
+    let mut done = Untangled {
+        before: count(faces),
+        ..Untangled::default()
+    };
+    let mut mapped = Mapped {
+        image,
+        normals,
+        faces,
+    };
+    for f in 0..triangles.len() {
+        if !mapped.faces[f].flipped() {
+            continue;
+        }
+        let laid = (&triangles[..], &stars);
+        done.moves += (1..=PATCH_RINGS)
+            .map(|rings| reembed_patch(elements, target, roles, laid, &mut mapped, f, rings))
+            .find(|&moved| moved > 0)
+            .unwrap_or(0);
+    }
+    done.after = count(mapped.faces);
+    done
+}
+
+/// Rings of faces around a face still flipped that [`reembed_patch`] tries, from one.
+const PATCH_RINGS: usize = 3;
 
 #[cfg(test)]
 mod tests {
