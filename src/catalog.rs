@@ -10,7 +10,6 @@ use serde_json::{Value, json};
 /// `min` and `max` for numbers, `choices` for choices, `help`).
 pub fn solver_json(solver: &dyn Solver) -> Value {
     let a = solver.accepts();
-    let names = |list: Vec<&'static str>| json!(list);
     let options: Vec<Value> = solver
         .options()
         .iter()
@@ -43,15 +42,30 @@ pub fn solver_json(solver: &dyn Solver) -> Value {
     json!({
         "name": solver.name(),
         "description": solver.description(),
-        "accepts": {
-            "elements": names(a.elements.iter().map(|e| e.name()).collect()),
-            "topologies": names(a.topologies.iter().map(|t| t.name()).collect()),
-            "targets": names(a.targets.iter().map(|t| t.name()).collect()),
-            "goals": names(a.goals.iter().map(|g| g.name()).collect()),
-            "constraints": names(a.constraints.iter().map(|c| c.name()).collect()),
-        },
+        "accepts": accepted_kinds(&a)
+            .into_iter()
+            .map(|(what, list)| (what.to_string(), json!(list)))
+            .collect::<serde_json::Map<String, Value>>(),
         "options": options,
     })
+}
+
+/// What a solver accepts, kind by kind: `(what, names)` for its elements, topologies,
+/// targets, goals and constraints, in that order.
+pub fn accepted_kinds(a: &Accepts) -> [(&'static str, Vec<&'static str>); 5] {
+    [
+        ("elements", a.elements.iter().map(|e| e.name()).collect()),
+        (
+            "topologies",
+            a.topologies.iter().map(|t| t.name()).collect(),
+        ),
+        ("targets", a.targets.iter().map(|t| t.name()).collect()),
+        ("goals", a.goals.iter().map(|g| g.name()).collect()),
+        (
+            "constraints",
+            a.constraints.iter().map(|c| c.name()).collect(),
+        ),
+    ]
 }
 
 /// One solver in text: its name and description, then one line per accepted kind list
@@ -66,19 +80,7 @@ pub fn solver_text(solver: &dyn Solver) -> String {
         }
     };
     let mut out = format!("{:<14} {}\n", solver.name(), solver.description());
-    for (what, list) in [
-        ("elements", a.elements.iter().map(|e| e.name()).collect()),
-        (
-            "topologies",
-            a.topologies.iter().map(|t| t.name()).collect(),
-        ),
-        ("targets", a.targets.iter().map(|t| t.name()).collect()),
-        ("goals", a.goals.iter().map(|g| g.name()).collect()),
-        (
-            "constraints",
-            a.constraints.iter().map(|c| c.name()).collect(),
-        ),
-    ] {
+    for (what, list) in accepted_kinds(&a) {
         out.push_str(&format!("{:<14} {what}: {}\n", "", join(list)));
     }
     for spec in solver.options() {

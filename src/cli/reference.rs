@@ -197,19 +197,7 @@ fn solver_section(solver: &dyn Solver) -> String {
         solver.name(),
         one_line(solver.description())
     );
-    for (what, list) in [
-        ("elements", a.elements.iter().map(|e| e.name()).collect()),
-        (
-            "topologies",
-            a.topologies.iter().map(|t| t.name()).collect(),
-        ),
-        ("targets", a.targets.iter().map(|t| t.name()).collect()),
-        ("goals", a.goals.iter().map(|g| g.name()).collect()),
-        (
-            "constraints",
-            a.constraints.iter().map(|c| c.name()).collect(),
-        ),
-    ] {
+    for (what, list) in beltrami::catalog::accepted_kinds(&a) {
         out.push_str(&format!("- {what}: {}\n", join(list)));
     }
     if solver.options().is_empty() {
