@@ -34,6 +34,8 @@ fn main() -> ExitCode {
     unsafe {
         libc::prctl(libc::PR_SET_THP_DISABLE, 1, 0, 0, 0);
     }
+    #[cfg(unix)]
+    end_on_sigterm();
     let args = cli::Cli::parse();
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
@@ -42,4 +44,35 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Ends the program on `SIGTERM` (what a batch job gets when its batch dies, and what
+/// `kill` sends) without leaving the temporary files of writes in progress: the signal
+/// is blocked in every thread and taken by one that removes them
+/// (`beltrami_mesh::io::remove_in_flight`) and exits with 128 + 15, the status of a
+/// process the signal ended. Child processes start with the signal unblocked (the
+/// standard library resets their signal mask).
+#[cfg(unix)]
+fn end_on_sigterm() {
+    // SAFETY: `set` is initialized by sigemptyset before use; the mask is changed before
+    // any other thread starts, so every later thread inherits it.
+    let set = unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        libc::sigaddset(&mut set, libc::SIGTERM);
+        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+            return;
+        }
+        set
+    };
+    std::thread::spawn(move || {
+        let mut signal = 0;
+        // SAFETY: sigwait reads the initialized set and writes the signal number.
+        if unsafe { libc::sigwait(&set, &mut signal) } == 0 {
+            beltrami_mesh::io::remove_in_flight();
+            // SAFETY: ends the process at once; nothing is left to flush that matters
+            // for a process being terminated.
+            unsafe { libc::_exit(128 + libc::SIGTERM) };
+        }
+    });
 }

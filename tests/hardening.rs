@@ -453,3 +453,49 @@ fn a_generated_mesh_too_large_is_refused_from_its_level() {
         assert!(!output.exists());
     }
 }
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_process_ended_while_writing_leaves_no_temporary_file() {
+    use std::time::{Duration, Instant};
+    // SIGTERM (what a batch job gets when its batch dies) in the middle of writing a
+    // 44-MB mesh: the process removes the temporary file it is writing and exits with
+    // 128 + 15; the destination is never created. Before, the temporary file stayed
+    // until the next write into the folder.
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("d9.obj");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_beltrami"))
+        .args(["generate", "disk", "--level", "9", "-o", s(&output), "-q"])
+        .spawn()
+        .unwrap();
+    let writing = |dir: &Path| {
+        std::fs::read_dir(dir).unwrap().flatten().any(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            name.starts_with(".beltrami-") && e.metadata().is_ok_and(|m| m.len() > 0)
+        })
+    };
+    let start = Instant::now();
+    while !writing(dir.path()) {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the temporary file never appeared"
+        );
+        if child.try_wait().unwrap().is_some() {
+            // The write ended between two looks (a fast disk): nothing to interrupt.
+            println!("the write ended before it could be interrupted: not checked");
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let pid = libc::pid_t::try_from(child.id()).unwrap();
+    // SAFETY: signals the child process started above.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(143), "{status:?}");
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert!(left.is_empty(), "left behind: {left:?}");
+}

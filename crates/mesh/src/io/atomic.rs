@@ -5,11 +5,14 @@
 //! syncing or renaming; a full disk; a file-size limit, once the program ignores
 //! `SIGXFSZ` so that the write fails with `EFBIG` instead of killing it). A process that
 //! is killed outright cannot clean up: the next write into the same folder removes the
-//! temporary files of processes that no longer run ([`remove_stale`]).
+//! temporary files of processes that no longer run ([`remove_stale`]). A process asked
+//! to end (the command line's `SIGTERM`, which a batch job gets when its batch dies)
+//! removes the temporary files it is writing first ([`remove_in_flight`]).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use super::WriteError;
 
@@ -17,6 +20,43 @@ use super::WriteError;
 const PREFIX: &str = ".beltrami-";
 /// The end of every temporary file name.
 const SUFFIX: &str = ".tmp";
+
+/// The temporary files this process is writing (registered while they exist).
+static IN_FLIGHT: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Keeps a temporary file's path in [`IN_FLIGHT`] while it lives.
+struct InFlight(PathBuf);
+
+impl InFlight {
+    fn new(path: &Path) -> Self {
+        if let Ok(mut list) = IN_FLIGHT.lock() {
+            list.push(path.to_path_buf());
+        }
+        Self(path.to_path_buf())
+    }
+}
+
+impl Drop for InFlight {
+    fn drop(&mut self) {
+        if let Ok(mut list) = IN_FLIGHT.lock()
+            && let Some(k) = list.iter().position(|p| *p == self.0)
+        {
+            list.swap_remove(k);
+        }
+    }
+}
+
+/// Removes the temporary files this process is writing now, and returns how many: for
+/// a process about to end on a signal (the writes in progress never finish). Their
+/// destinations are left as they were.
+pub fn remove_in_flight() -> usize {
+    let Ok(list) = IN_FLIGHT.lock() else {
+        return 0;
+    };
+    list.iter()
+        .filter(|path| std::fs::remove_file(path).is_ok())
+        .count()
+}
 
 /// Writes a file through `fill` so that `path` either gets the complete content or is left
 /// as it was.
@@ -43,6 +83,7 @@ pub fn write_atomically(
         .suffix(SUFFIX)
         .tempfile_in(dir)
         .map_err(io)?;
+    let _registered = InFlight::new(tmp.path());
     // Temporary files are private (0600); the output gets the usual 0644.
     #[cfg(unix)]
     {

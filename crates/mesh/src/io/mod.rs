@@ -33,7 +33,7 @@ use thiserror::Error;
 
 use crate::{BuildOptions, BuildReport, Mesh, MeshError, PolygonSoup};
 
-pub use atomic::write_atomically;
+pub use atomic::{remove_in_flight, write_atomically};
 pub use seamed::{CornerUvs, write_seamed};
 
 /// The content of a mesh file before validation.
