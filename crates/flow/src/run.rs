@@ -260,8 +260,13 @@ pub fn solve(
                     (&mut report, &mut metrics),
                 )?;
                 let after = left(&again);
-                if after < before || (after == before && again.final_energy() < run.final_energy())
-                {
+                let kept = after < before
+                    || (after == before && again.final_energy() < run.final_energy());
+                report.notes.push(format!(
+                    "the flow from the untangled patches left {after} flipped faces: kept {}",
+                    if kept { "it" } else { "the map before" }
+                ));
+                if kept {
                     run = again;
                 }
             }

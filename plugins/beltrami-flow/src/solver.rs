@@ -131,9 +131,9 @@ fn initial_map(
             if on_circle {
                 return Ok(identity());
             }
-            // The boundary-first conformal map (exactly on the circle): from it the
-            // conformal flow of the human face settles in 4 steps with max |mu| 0.255,
-            // from Tutte's map (whose max |mu| is 0.93) in 11 with 0.271.
+            // The boundary-first conformal map (exactly on the circle): on the human
+            // face the flow's error starts at 2.4e-5 from it (2.2e-5 at the end), at
+            // 4.5e-2 from Tutte's map, whose max |mu| is 0.93.
             let boundary_first = map_to_unit_disk(mesh).map_err(|error| SolverError::Plugin {
                 solver: NAME,
                 error: Box::new(error),
