@@ -1,5 +1,5 @@
 //! Unfolding a flipped face by untangling the patch around it at once (the last
-//! resort of [`crate::untangle`]).
+//! resort of a flow on a target mesh, [`crate::untangle::untangle_patches`]).
 //!
 //! One vertex at a time cannot unfold a face whose fold runs through several stars: on
 //! the genus-3 pair `slim64` onto `stout64` (docs/register.md) the kernel moves left
@@ -26,7 +26,8 @@ use crate::measure::{ImageFace, image_face};
 use crate::target::{Role, TargetGeometry, orthonormal_basis};
 use crate::untangle::Stars;
 
-/// Sweeps over the moving vertices of [`untangle_in_plane`].
+/// Sweeps over the moving vertices of [`untangle_in_plane`] and of
+/// [`polish_on_surface`].
 const SWEEPS: usize = 60;
 
 /// Backtracking halvings of one vertex's step in [`untangle_in_plane`].

@@ -896,7 +896,7 @@ fn triangles(elements: &Elements) -> Vec<[usize; 3]> {
 /// while it builds the initial map (on two cores the hand's disk map overlaps its
 /// 0.18-s order with its 0.19-s initial map).
 ///
-/// From [`TWO_SIDES_FROM`] vertices the order is [`two_core_order`]'s, and its two
+/// From `TWO_SIDES_FROM` (20,000) vertices the order is [`two_core_order`]'s, and its two
 /// sides, if it has them, carry over to the unknowns (the shared ones join the
 /// separator); below, it is [`fill_reducing_order`]'s, one whole.
 #[derive(Debug, Clone)]

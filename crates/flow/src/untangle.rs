@@ -27,7 +27,7 @@
 //! curve and fixed vertices never move. The flow runs again afterwards to restore
 //! conformality, from a map with fewer flips, and keeps them at most as many. Faces the
 //! flow still leaves flipped get their surrounding patches untangled at once
-//! ([`untangle_patches`], [`crate::patch_embedding`]).
+//! ([`untangle_patches`], `patch_embedding.rs`).
 
 use beltrami_fem::Elements;
 use beltrami_mesh::{FaceId, Point3, Vector2, Vector3};
@@ -252,7 +252,7 @@ pub fn untangle<G: TargetGeometry>(
 }
 
 /// The last resort after [`untangle`] and the flow: the patch around each flipped face
-/// untangled at once ([`crate::patch_embedding`]), from one to [`PATCH_RINGS`] rings;
+/// untangled at once (`patch_embedding.rs`), from one to `PATCH_RINGS` (3) rings;
 /// `faces` and `normals` are updated with `image`. The patches are not conformal: the
 /// flow has to run again from the result. Kept for the faces the flow and the
 /// vertex-by-vertex untangling leave: used on every flip, it left the genus-3 maps of

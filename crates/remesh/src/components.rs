@@ -1,5 +1,5 @@
 //! Meshes in several connected pieces (a scan in parts): every component remeshed on its
-//! own ([`remesh`](crate::remesh) takes one connected surface), and the results joined.
+//! own ([`remesh`] takes one connected surface), and the results joined.
 //!
 //! The components are those of [`beltrami_core::components::parts`], in the order of
 //! their first face; the joined mesh holds component `k`'s new vertices and faces after
@@ -176,7 +176,7 @@ impl Largest {
 /// parameterizers `choose` picks for it (a mesh of one component is remeshed whole).
 ///
 /// # Errors
-/// The errors of [`remesh`](crate::remesh) on the component.
+/// The errors of [`remesh`] on the component.
 pub fn remesh_largest<'r>(
     mesh: &Mesh,
     choose: impl Fn(&Mesh) -> Result<Vec<&'r dyn Solver>, RemeshError>,
