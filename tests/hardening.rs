@@ -12,6 +12,15 @@ use std::path::{Path, PathBuf};
 
 use common::{beltrami, s, text};
 
+/// The names of the files in `dir`.
+fn entries(dir: &Path) -> Vec<std::ffi::OsString> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .collect()
+}
+
 fn corpus(target: &str) -> Vec<PathBuf> {
     let folder = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/corpus")
@@ -386,11 +395,7 @@ fn a_file_size_limit_ends_in_an_error_and_leaves_no_temporary_file() {
         text(&status.stderr)
     );
     assert!(!out.exists());
-    let left: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name())
-        .collect();
+    let left = entries(dir.path());
     assert!(left.is_empty(), "left behind: {left:?}");
 }
 
@@ -492,10 +497,6 @@ fn a_process_ended_while_writing_leaves_no_temporary_file() {
     assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(143), "{status:?}");
-    let left: Vec<_> = std::fs::read_dir(dir.path())
-        .unwrap()
-        .flatten()
-        .map(|e| e.file_name())
-        .collect();
+    let left = entries(dir.path());
     assert!(left.is_empty(), "left behind: {left:?}");
 }

@@ -32,9 +32,7 @@ use faer::Mat;
 use faer::sparse::SparseColMat;
 
 use crate::AtlasError;
-
-/// The relative size of the penalty that holds a vertex's scale at zero.
-const PENALTY: f64 = 1e10;
+use crate::held::{PENALTY, diagonal_slots};
 
 /// Cones of a chart and the log scale factor of its flattening.
 #[derive(Debug, Clone, PartialEq)]
@@ -190,14 +188,7 @@ impl ScaleSystem {
     fn new(mesh: &Mesh) -> Result<Self, AtlasError> {
         let laplacian = cotan_laplacian(mesh)?;
         let symbolic = laplacian.symbolic();
-        let (col_ptr, rows) = (symbolic.col_ptr(), symbolic.row_idx());
-        let diagonal: Vec<usize> = (0..laplacian.ncols())
-            .map(|j| {
-                (col_ptr[j]..col_ptr[j + 1])
-                    .find(|&k| rows[k] == j)
-                    .unwrap_or(col_ptr[j])
-            })
-            .collect();
+        let diagonal = diagonal_slots(&laplacian);
         let values = laplacian.val();
         let largest = diagonal.iter().map(|&k| values[k]).fold(0.0, f64::max);
         let solver = SpdSolver::new(symbolic, SolveOptions::default())?;

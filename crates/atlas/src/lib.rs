@@ -39,6 +39,7 @@ pub mod chart;
 pub mod cone_cut;
 pub mod cones;
 mod error;
+mod held;
 pub mod options;
 pub mod overlap;
 pub mod pack;

@@ -24,6 +24,7 @@ use faer::sparse::SparseColMat;
 
 use crate::AtlasError;
 use crate::boundary_first::{FlattenFailure, counter_clockwise_ring, is_disk};
+use crate::held::{PENALTY, diagonal_slots};
 use crate::overlap::folded_faces;
 
 /// Rounds of the boundary lengths and the Neumann problem.
@@ -36,6 +37,7 @@ pub fn map_to_unit_disk(disk: &Mesh) -> Result<Result<Vec<[f64; 2]>, FlattenFail
         return Ok(Err(FlattenFailure::NotADisk));
     }
     let laplacian = cotan_laplacian(disk)?;
+    let slots = diagonal_slots(&laplacian);
     let ring = counter_clockwise_ring(disk);
     let n = ring.len();
     let rest: Vec<f64> = (0..n)
@@ -47,7 +49,7 @@ pub fn map_to_unit_disk(disk: &Mesh) -> Result<Result<Vec<[f64; 2]>, FlattenFail
         .find(|&v| !disk.is_boundary_vertex(v))
         .unwrap_or(ring[0]);
     let mut matrix = laplacian.clone();
-    hold(&mut matrix, &[held]);
+    hold(&mut matrix, &slots, &[held]);
     let mut solver = SpdSolver::new(matrix.symbolic(), SolveOptions::default())?;
     solver.factorize(matrix.as_ref())?;
     let defect: Vec<f64> = disk.vertices().map(|v| disk.angle_defect(v)).collect();
@@ -89,9 +91,9 @@ pub fn map_to_unit_disk(disk: &Mesh) -> Result<Result<Vec<[f64; 2]>, FlattenFail
     // the given ones by about 1/PENALTY of them; the extension of that miss, solved
     // once more, is taken off, which leaves 1/PENALTY^2.
     let mut matrix = laplacian.clone();
-    hold(&mut matrix, &ring);
+    hold(&mut matrix, &slots, &ring);
     solver.factorize(matrix.as_ref())?;
-    let weights: Vec<f64> = ring.iter().map(|v| diagonal(&matrix, v.idx())).collect();
+    let weights: Vec<f64> = ring.iter().map(|v| matrix.val()[slots[v.idx()]]).collect();
     let mut extension = Mat::<f64>::zeros(disk.vertex_count(), 2);
     for (&v, &weight) in ring.iter().zip(&weights) {
         for axis in 0..2 {
@@ -120,29 +122,12 @@ pub fn map_to_unit_disk(disk: &Mesh) -> Result<Result<Vec<[f64; 2]>, FlattenFail
     Ok(Ok(position))
 }
 
-/// The penalty a held vertex's diagonal entry gains, relative to itself: the vertex's
-/// value then follows its right-hand side over the diagonal to about 1e-10.
-const PENALTY: f64 = 1e10;
-
-/// Adds the [`PENALTY`] to the diagonal entries of `vertices` in the lower or full
-/// triangle of `matrix` (a Laplacian: every vertex has its diagonal entry).
-fn hold(matrix: &mut SparseColMat<usize, f64>, vertices: &[VertexId]) {
+/// Adds the [`PENALTY`] relative to each entry to the diagonal entries of `vertices`.
+/// `slots` are the matrix's [`diagonal_slots`].
+fn hold(matrix: &mut SparseColMat<usize, f64>, slots: &[usize], vertices: &[VertexId]) {
+    let values = matrix.val_mut();
     for &v in vertices {
-        if let Some(k) = diagonal_slot(matrix, v.idx()) {
-            let values = matrix.val_mut();
-            values[k] += PENALTY * values[k].abs().max(f64::MIN_POSITIVE);
-        }
+        let k = slots[v.idx()];
+        values[k] += PENALTY * values[k].abs().max(f64::MIN_POSITIVE);
     }
-}
-
-/// The index among the values of `matrix` of its diagonal entry `j`, if stored.
-fn diagonal_slot(matrix: &SparseColMat<usize, f64>, j: usize) -> Option<usize> {
-    let symbolic = matrix.symbolic();
-    let (col_ptr, rows) = (symbolic.col_ptr(), symbolic.row_idx());
-    (col_ptr[j]..col_ptr[j + 1]).find(|&k| rows[k] == j)
-}
-
-/// The diagonal entry `j` of `matrix` (0 when not stored).
-fn diagonal(matrix: &SparseColMat<usize, f64>, j: usize) -> f64 {
-    diagonal_slot(matrix, j).map_or(0.0, |k| matrix.val()[k])
 }

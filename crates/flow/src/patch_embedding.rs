@@ -317,7 +317,7 @@ mod tests {
     use beltrami_mesh::primitives::{Cells, grid};
 
     use super::*;
-    use crate::measure::{image_faces, triangle};
+    use crate::measure::image_faces;
     use crate::target::PlaneRegion;
 
     /// On a regular grid every interior star is centrally symmetric, so the grid is a
@@ -339,9 +339,7 @@ mod tests {
                 }
             })
             .collect();
-        let triangles: Vec<[usize; 3]> = (0..elements.face_count())
-            .map(|f| triangle(&elements, FaceId(f as u32)).map(|v| v.idx()))
-            .collect();
+        let triangles = crate::system::triangles(&elements);
         let stars = Stars::new(&triangles, flat.len());
         // The interior vertex nearest the grid's centroid and its neighbour of largest x
         // swap places (and a little more): their faces fold.
@@ -407,9 +405,7 @@ mod tests {
         image.swap(0, 1);
         let before = image.clone();
         let roles = vec![Role::Fixed; image.len()];
-        let triangles: Vec<[usize; 3]> = (0..elements.face_count())
-            .map(|f| triangle(&elements, FaceId(f as u32)).map(|v| v.idx()))
-            .collect();
+        let triangles = crate::system::triangles(&elements);
         let stars = Stars::new(&triangles, image.len());
         let mut normals = vec![Vector3::z(); image.len()];
         let mut faces = Vec::new();

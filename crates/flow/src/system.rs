@@ -231,7 +231,7 @@ impl FlowSystem {
     ) -> Result<Self, SolverError> {
         let faces = triangles(elements);
         let order = VertexOrder::of_triangles(&faces, roles.len())?;
-        Self::with_vertex_order(elements, target, image, roles, options, &order)
+        Self::build(faces, target, image, roles, (options, &order))
     }
 
     /// [`FlowSystem::new`] with the unknowns ordered after `order`, a
@@ -243,6 +243,18 @@ impl FlowSystem {
         roles: Vec<Role>,
         options: SolveOptions,
         order: &VertexOrder,
+    ) -> Result<Self, SolverError> {
+        let faces = triangles(elements);
+        Self::build(faces, target, image, roles, (options, order))
+    }
+
+    /// [`FlowSystem::with_vertex_order`] on the elements' `faces` ([`triangles`]).
+    fn build<G: TargetGeometry>(
+        faces: Vec<[usize; 3]>,
+        target: &G,
+        image: &[Point3<f64>],
+        roles: Vec<Role>,
+        (options, order): (SolveOptions, &VertexOrder),
     ) -> Result<Self, SolverError> {
         let mut builder = DofBuilder::<f64>::new(roles.len(), 3)?;
         let origin = [0.0; 3];
@@ -276,7 +288,6 @@ impl FlowSystem {
                 message: "every vertex is fixed: there is nothing to flow".into(),
             });
         }
-        let faces = triangles(elements);
         // The local unknowns of each face in the order its vertices' terms name them
         // (each vertex's own unknowns, then an offset not met yet), and its terms.
         // A face has at most 6 local unknowns and terms (two per vertex; a shared offset
@@ -881,7 +892,7 @@ fn area_rates(
 const TWO_SIDES_FROM: usize = 20_000;
 
 /// The vertices of each of the elements' triangles.
-fn triangles(elements: &Elements) -> Vec<[usize; 3]> {
+pub(crate) fn triangles(elements: &Elements) -> Vec<[usize; 3]> {
     (0..elements.face_count())
         .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
         .collect()

@@ -32,7 +32,7 @@
 use beltrami_fem::Elements;
 use beltrami_mesh::{FaceId, Point3, Vector2, Vector3};
 
-use crate::measure::{ImageFace, image_face, triangle};
+use crate::measure::{ImageFace, image_face};
 use crate::patch_embedding::{Mapped, reembed_patch};
 use crate::target::{Role, TargetGeometry, orthonormal_basis};
 
@@ -82,9 +82,7 @@ impl Stars {
 
 /// The elements' triangles (vertex indices) and the faces around each of `vertices`.
 fn triangles_and_stars(elements: &Elements, vertices: usize) -> (Vec<[usize; 3]>, Stars) {
-    let triangles: Vec<[usize; 3]> = (0..elements.face_count())
-        .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
-        .collect();
+    let triangles = crate::system::triangles(elements);
     let stars = Stars::new(&triangles, vertices);
     (triangles, stars)
 }
