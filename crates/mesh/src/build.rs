@@ -215,23 +215,35 @@ fn corner_faces(faces: &WorkFaces) -> (Vec<u32>, Vec<u32>) {
     (corner_face, next_corner)
 }
 
-fn group_edges(
-    faces: &WorkFaces,
-    corner_face: &[u32],
-    next_corner: &[u32],
-    vertex_count: usize,
-) -> Result<Grouping, MeshError> {
-    let idx = &faces.indices;
-    let nc = idx.len();
-    let ends = |c: usize| {
-        let (u, w) = (idx[c], idx[next_corner[c] as usize]);
-        (u.min(w), u.max(w))
-    };
+/// The side of each corner as an undirected edge key: corner `c` runs from vertex
+/// `indices[c]` to vertex `indices[next_corner[c]]`.
+#[derive(Clone, Copy)]
+struct CornerSides<'a> {
+    indices: &'a [u32],
+    next_corner: &'a [u32],
+}
 
-    // Counting sort of corners by their edge's smaller endpoint.
+impl CornerSides<'_> {
+    /// The endpoints of corner `c`'s side as `(smaller, larger)`.
+    fn ends(&self, c: usize) -> (u32, u32) {
+        let (u, w) = (self.indices[c], self.indices[self.next_corner[c] as usize]);
+        (u.min(w), u.max(w))
+    }
+
+    /// The larger endpoint of corner `c`'s side: the key within a bucket.
+    fn hi(&self, c: &u32) -> u32 {
+        self.ends(*c as usize).1
+    }
+}
+
+/// Counting sort of the corners by their side's smaller endpoint: returns `start` (the
+/// first position of vertex `v`'s bucket is `start[v]`, `start[vertex_count]` is the
+/// corner count) and the corners in bucket order, each bucket in corner order.
+fn corners_by_low_end(sides: CornerSides, vertex_count: usize) -> (Vec<u32>, Vec<u32>) {
+    let nc = sides.indices.len();
     let mut start = vec![0u32; vertex_count + 1];
     for c in 0..nc {
-        start[ends(c).0 as usize + 1] += 1;
+        start[sides.ends(c).0 as usize + 1] += 1;
     }
     for v in 0..vertex_count {
         start[v + 1] += start[v];
@@ -239,11 +251,82 @@ fn group_edges(
     let mut fill = start.clone();
     let mut by_lo = vec![0u32; nc];
     for c in 0..nc {
-        let lo = ends(c).0 as usize;
+        let lo = sides.ends(c).0 as usize;
         by_lo[fill[lo] as usize] = c as u32;
         fill[lo] += 1;
     }
-    drop(fill);
+    (start, by_lo)
+}
+
+/// Where [`match_edge_group`] records its findings: the twin of each corner (atomics, as
+/// the vertex ranges are matched on several threads, each writing only its own corners)
+/// and the duplicate face pairs found so far in the range.
+struct TwinMatches<'a> {
+    corner_twin: &'a [AtomicU32],
+    duplicates: Vec<(usize, usize)>,
+}
+
+/// Matches the corners of one edge (a group of corners with the same side, at least one):
+/// faces with equal vertex sets on it are recorded as duplicates `(later, earlier)`;
+/// without duplicates, two corners become twins and more than two make the edge
+/// non-manifold (the error names the edge's input faces in increasing order).
+fn match_edge_group(
+    group: &[u32],
+    faces: &WorkFaces,
+    corner_face: &[u32],
+    sides: CornerSides,
+    matches: &mut TwinMatches,
+) -> Result<(), MeshError> {
+    if group.len() == 1 {
+        return Ok(());
+    }
+    let mut found_duplicate = false;
+    for (i, &a) in group.iter().enumerate() {
+        let fa = corner_face[a as usize] as usize;
+        for &b in &group[i + 1..] {
+            let fb = corner_face[b as usize] as usize;
+            if vertex_set(faces.face(fa)) == vertex_set(faces.face(fb)) {
+                found_duplicate = true;
+                matches.duplicates.push((fa.max(fb), fa.min(fb)));
+            }
+        }
+    }
+    if found_duplicate {
+        return Ok(());
+    }
+    if group.len() > 2 {
+        let (a, b) = sides.ends(group[0] as usize);
+        let mut on_edge: Vec<usize> = group
+            .iter()
+            .map(|&c| faces.input[corner_face[c as usize] as usize] as usize)
+            .collect();
+        on_edge.sort_unstable();
+        return Err(MeshError::NonManifoldEdge {
+            a: a as usize,
+            b: b as usize,
+            faces: on_edge,
+        });
+    }
+    matches.corner_twin[group[0] as usize].store(group[1], Ordering::Relaxed);
+    matches.corner_twin[group[1] as usize].store(group[0], Ordering::Relaxed);
+    Ok(())
+}
+
+/// Groups the corners of the work faces into undirected edges (bucketed by their smaller
+/// endpoint, sorted by the larger), or returns the duplicate face pairs found; fails on
+/// the first non-manifold edge in vertex order.
+fn group_edges(
+    faces: &WorkFaces,
+    corner_face: &[u32],
+    next_corner: &[u32],
+    vertex_count: usize,
+) -> Result<Grouping, MeshError> {
+    let sides = CornerSides {
+        indices: &faces.indices,
+        next_corner,
+    };
+    let nc = faces.indices.len();
+    let (start, mut by_lo) = corners_by_low_end(sides, vertex_count);
 
     // The buckets in ranges of vertices, one per thread (sorting them and matching their
     // corners is most of the grouping): first each range's buckets sorted and its edges
@@ -257,7 +340,7 @@ fn group_edges(
         parts.push((range.clone(), part));
         rest = tail;
     }
-    let by_hi = |c: &u32| ends(*c as usize).1;
+    let by_hi = |c: &u32| sides.hi(c);
     let threads = parts.len();
     let counts = in_turns(parts.iter_mut().collect(), threads, |(range, part)| {
         let base = start[range.start] as usize;
@@ -284,7 +367,10 @@ fn group_edges(
         |((range, part), first)| {
             let base = start[range.start] as usize;
             let mut e = *first as u32;
-            let mut duplicates = Vec::new();
+            let mut matches = TwinMatches {
+                corner_twin: &corner_twin,
+                duplicates: Vec::new(),
+            };
             for v in range.clone() {
                 let bucket = &part[start[v] as usize - base..start[v + 1] as usize - base];
                 for group in bucket.chunk_by(|a, b| by_hi(a) == by_hi(b)) {
@@ -292,41 +378,10 @@ fn group_edges(
                         corner_edge[c as usize].store(e, Ordering::Relaxed);
                     }
                     e += 1;
-                    if group.len() == 1 {
-                        continue;
-                    }
-                    let mut found_duplicate = false;
-                    for (i, &a) in group.iter().enumerate() {
-                        let fa = corner_face[a as usize] as usize;
-                        for &b in &group[i + 1..] {
-                            let fb = corner_face[b as usize] as usize;
-                            if vertex_set(faces.face(fa)) == vertex_set(faces.face(fb)) {
-                                found_duplicate = true;
-                                duplicates.push((fa.max(fb), fa.min(fb)));
-                            }
-                        }
-                    }
-                    if found_duplicate {
-                        continue;
-                    }
-                    if group.len() > 2 {
-                        let (a, b) = ends(group[0] as usize);
-                        let mut on_edge: Vec<usize> = group
-                            .iter()
-                            .map(|&c| faces.input[corner_face[c as usize] as usize] as usize)
-                            .collect();
-                        on_edge.sort_unstable();
-                        return Err(MeshError::NonManifoldEdge {
-                            a: a as usize,
-                            b: b as usize,
-                            faces: on_edge,
-                        });
-                    }
-                    corner_twin[group[0] as usize].store(group[1], Ordering::Relaxed);
-                    corner_twin[group[1] as usize].store(group[0], Ordering::Relaxed);
+                    match_edge_group(group, faces, corner_face, sides, &mut matches)?;
                 }
             }
-            Ok(duplicates)
+            Ok(matches.duplicates)
         },
     );
     // The first non-manifold edge in vertex order, as one pass over the buckets finds.
@@ -650,20 +705,48 @@ pub(crate) fn build(
         .merge_coincident_vertices
         .then(|| coincident_representatives(&soup.positions));
 
-    let mut faces = collect_faces(
+    let faces = collect_faces(
         soup,
         representative.as_deref(),
         threshold,
         repair,
         &mut report,
     )?;
+    let oriented = group_and_orient(faces, nv, repair, &mut report)?;
+    report.dropped_degenerate_faces.sort_unstable();
+    report.dropped_duplicate_faces.sort_unstable();
 
-    let (groups, orientation, corner_face, next_corner) = loop {
+    assemble(soup, oriented, representative.as_deref(), report)
+}
+
+/// Work faces grouped into edges and consistently oriented: what [`assemble`] builds the
+/// halfedge arrays from.
+struct OrientedFaces {
+    faces: WorkFaces,
+    groups: EdgeGroups,
+    orientation: Orientation,
+    /// Face of each corner.
+    corner_face: Vec<u32>,
+    /// The next corner around its face of each corner.
+    next_corner: Vec<u32>,
+}
+
+/// Groups the faces' sides into edges and orients every component, until a pass finds
+/// nothing to change: duplicate faces are dropped (when repairing; otherwise the first
+/// pair is the error) and the grouping redone; reversed faces are flipped and the
+/// grouping redone, whose orientation then flips nothing.
+fn group_and_orient(
+    mut faces: WorkFaces,
+    vertex_count: usize,
+    repair: Repair,
+    report: &mut BuildReport,
+) -> Result<OrientedFaces, MeshError> {
+    loop {
         if faces.len() == 0 {
             return Err(MeshError::NoFaces);
         }
         let (corner_face, next_corner) = corner_faces(&faces);
-        let groups = match group_edges(&faces, &corner_face, &next_corner, nv)? {
+        let groups = match group_edges(&faces, &corner_face, &next_corner, vertex_count)? {
             Grouping::Edges(groups) => groups,
             Grouping::Duplicates(pairs) => {
                 if !repair.drop_duplicate_faces {
@@ -689,7 +772,13 @@ pub(crate) fn build(
         let orientation = orient(&faces, &groups, &corner_face)?;
         let flips = orientation.flip.iter().filter(|&&f| f).count();
         if flips == 0 {
-            break (groups, orientation, corner_face, next_corner);
+            return Ok(OrientedFaces {
+                faces,
+                groups,
+                orientation,
+                corner_face,
+                next_corner,
+            });
         }
         report.faces_reoriented += flips;
         for (f, &flip) in orientation.flip.iter().enumerate() {
@@ -697,40 +786,32 @@ pub(crate) fn build(
                 faces.reverse(f);
             }
         }
-    };
-    report.dropped_degenerate_faces.sort_unstable();
-    report.dropped_duplicate_faces.sort_unstable();
-
-    assemble(
-        soup,
-        faces,
-        groups,
-        orientation,
-        &corner_face,
-        &next_corner,
-        representative.as_deref(),
-        report,
-    )
+    }
 }
 
-/// Creates the halfedge arrays from oriented, manifold-edged faces, checks the vertex
-/// fans and links boundary loops.
-#[allow(clippy::too_many_arguments)]
-fn assemble(
-    soup: &PolygonSoup,
-    faces: WorkFaces,
-    groups: EdgeGroups,
-    orientation: Orientation,
-    corner_face: &[u32],
-    next_corner: &[u32],
-    representative: Option<&[u32]>,
-    mut report: BuildReport,
-) -> Result<(Mesh, BuildReport), MeshError> {
-    let nv_in = soup.vertex_count();
-    let nc = faces.indices.len();
-    let nf = faces.len();
+/// The mesh's vertices: the input vertices the faces use, in input order.
+struct CompactVertices {
+    /// Mesh index of each input vertex (`NO_VERTEX` when no face uses it).
+    new_id: Vec<u32>,
+    /// Input index of each mesh vertex.
+    to_input: Vec<u32>,
+    /// Mesh index of each input vertex through its representative when merging.
+    from_input: Vec<u32>,
+    /// Position of each mesh vertex.
+    positions: Vec<Point3<f64>>,
+    /// The input vertices no face uses, with their positions.
+    unreferenced: Vec<(u32, Point3<f64>)>,
+}
 
-    // Compact the vertices, keeping the input's relative order.
+/// Compacts the vertices, keeping the input's relative order, and records merged and
+/// unreferenced vertices in the report.
+fn compact_vertices(
+    soup: &PolygonSoup,
+    faces: &WorkFaces,
+    representative: Option<&[u32]>,
+    report: &mut BuildReport,
+) -> CompactVertices {
+    let nv_in = soup.vertex_count();
     let mut referenced = vec![false; nv_in];
     for &v in &faces.indices {
         referenced[v as usize] = true;
@@ -760,93 +841,170 @@ fn assemble(
         Some(r) => (0..nv_in).map(|i| new_id[r[i] as usize]).collect(),
         None => new_id.clone(),
     };
-    let nv = to_input.len();
+    CompactVertices {
+        new_id,
+        to_input,
+        from_input,
+        positions,
+        unreferenced,
+    }
+}
 
-    // Interior halfedges are the face corners; boundary halfedges follow them.
-    let boundary_count = groups.corner_twin.iter().filter(|&&t| t == NONE).count();
-    let nh = nc + boundary_count;
-    let mut origin = Vec::with_capacity(nh);
-    origin.extend(faces.indices.iter().map(|&v| new_id[v as usize]));
-    let mut next: Vec<u32> = next_corner.to_vec();
-    let mut prev = vec![0u32; nh];
-    for c in 0..nc {
-        prev[next[c] as usize] = c as u32;
-    }
-    let mut twin = groups.corner_twin;
-    let mut edge = groups.corner_edge;
-    let mut face_or_loop: Vec<u32> = corner_face.to_vec();
+/// Halfedge connectivity as [`assemble`] builds it: the face corners are the interior
+/// halfedges `0..interior`, the boundary halfedges follow them.
+struct HalfedgeArrays {
+    origin: Vec<u32>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    twin: Vec<u32>,
+    edge: Vec<u32>,
+    /// The number of interior halfedges (face corners).
+    interior: usize,
+}
 
-    let mut out_boundary = vec![NONE; nv];
-    for c in 0..nc {
-        if twin[c] != NONE {
-            continue;
+impl HalfedgeArrays {
+    /// The interior halfedges of the oriented faces (`next` is `next_corner`), with
+    /// `prev` already sized for the boundary halfedges to come (one per corner without
+    /// a twin).
+    fn interior(
+        faces: &WorkFaces,
+        next_corner: Vec<u32>,
+        groups: EdgeGroups,
+        new_id: &[u32],
+    ) -> Self {
+        let nc = faces.indices.len();
+        let boundary_count = groups.corner_twin.iter().filter(|&&t| t == NONE).count();
+        let nh = nc + boundary_count;
+        let mut origin = Vec::with_capacity(nh);
+        origin.extend(faces.indices.iter().map(|&v| new_id[v as usize]));
+        let next = next_corner;
+        let mut prev = vec![0u32; nh];
+        for c in 0..nc {
+            prev[next[c] as usize] = c as u32;
         }
-        let b = origin.len() as u32;
-        let w = origin[next[c] as usize];
-        if out_boundary[w as usize] != NONE {
-            return Err(non_manifold_vertex(nc, &origin, &twin, &prev, &to_input, w));
-        }
-        out_boundary[w as usize] = b;
-        origin.push(w);
-        twin[c] = b;
-        twin.push(c as u32);
-        edge.push(edge[c]);
-    }
-    next.resize(nh, NONE);
-    for b in nc..nh {
-        // Boundary halfedge b runs from target(c) back to origin(c).
-        let u = origin[twin[b] as usize];
-        let nb = out_boundary[u as usize];
-        if nb == NONE {
-            return Err(non_manifold_vertex(nc, &origin, &twin, &prev, &to_input, u));
-        }
-        next[b] = nb;
-        prev[nb as usize] = b as u32;
-    }
-
-    // Outgoing halfedge per vertex: the boundary one on the boundary, so that circulating
-    // from it visits the fan of faces in order.
-    let mut vertex_halfedge = vec![NONE; nv];
-    for c in 0..nc {
-        vertex_halfedge[origin[c] as usize] = c as u32;
-    }
-    for v in 0..nv {
-        if out_boundary[v] != NONE {
-            vertex_halfedge[v] = out_boundary[v];
+        HalfedgeArrays {
+            origin,
+            next,
+            prev,
+            twin: groups.corner_twin,
+            edge: groups.corner_edge,
+            interior: nc,
         }
     }
 
-    // One fan per vertex: circulating must visit every outgoing halfedge.
-    let mut degree = vec![0u32; nv];
-    for &o in &origin {
-        degree[o as usize] += 1;
+    /// Creates one boundary halfedge opposite each corner without a twin and links the
+    /// boundary halfedges into loops; returns the outgoing boundary halfedge of each of
+    /// the `vertex_count` vertices (`NONE` for interior vertices). Fails on a vertex with
+    /// two outgoing boundary halfedges or an incoming one without an outgoing one.
+    fn add_boundary(
+        &mut self,
+        vertex_count: usize,
+        to_input: &[u32],
+    ) -> Result<Vec<u32>, MeshError> {
+        let nc = self.interior;
+        let nh = self.prev.len();
+        let mut out_boundary = vec![NONE; vertex_count];
+        for c in 0..nc {
+            if self.twin[c] != NONE {
+                continue;
+            }
+            let b = self.origin.len() as u32;
+            let w = self.origin[self.next[c] as usize];
+            if out_boundary[w as usize] != NONE {
+                return Err(self.non_manifold_vertex(to_input, w));
+            }
+            out_boundary[w as usize] = b;
+            self.origin.push(w);
+            self.twin[c] = b;
+            self.twin.push(c as u32);
+            self.edge.push(self.edge[c]);
+        }
+        self.next.resize(nh, NONE);
+        for b in nc..nh {
+            // Boundary halfedge b runs from target(c) back to origin(c).
+            let u = self.origin[self.twin[b] as usize];
+            let nb = out_boundary[u as usize];
+            if nb == NONE {
+                return Err(self.non_manifold_vertex(to_input, u));
+            }
+            self.next[b] = nb;
+            self.prev[nb as usize] = b as u32;
+        }
+        Ok(out_boundary)
     }
-    for v in 0..nv {
-        let start = vertex_halfedge[v];
-        let mut h = start;
-        let mut count = 0u32;
-        loop {
-            count += 1;
-            h = twin[prev[h as usize] as usize];
-            if h == start || count > degree[v] {
-                break;
+
+    /// Outgoing halfedge per vertex: the boundary one on the boundary, so that
+    /// circulating from it visits the fan of faces in order.
+    fn vertex_halfedges(&self, out_boundary: &[u32]) -> Vec<u32> {
+        let nv = out_boundary.len();
+        let mut vertex_halfedge = vec![NONE; nv];
+        for c in 0..self.interior {
+            vertex_halfedge[self.origin[c] as usize] = c as u32;
+        }
+        for v in 0..nv {
+            if out_boundary[v] != NONE {
+                vertex_halfedge[v] = out_boundary[v];
             }
         }
-        if count != degree[v] {
-            return Err(non_manifold_vertex(
-                nc, &origin, &twin, &prev, &to_input, v as u32,
-            ));
-        }
+        vertex_halfedge
     }
 
-    // Boundary loops, in order of their first boundary halfedge.
+    /// Checks for one fan per vertex: circulating (`h -> twin(prev(h))`) from the
+    /// vertex's halfedge must visit every outgoing halfedge.
+    fn check_fans(&self, vertex_halfedge: &[u32], to_input: &[u32]) -> Result<(), MeshError> {
+        let nv = vertex_halfedge.len();
+        let mut degree = vec![0u32; nv];
+        for &o in &self.origin {
+            degree[o as usize] += 1;
+        }
+        for v in 0..nv {
+            let start = vertex_halfedge[v];
+            let mut h = start;
+            let mut count = 0u32;
+            loop {
+                count += 1;
+                h = self.twin[self.prev[h as usize] as usize];
+                if h == start || count > degree[v] {
+                    break;
+                }
+            }
+            if count != degree[v] {
+                return Err(self.non_manifold_vertex(to_input, v as u32));
+            }
+        }
+        Ok(())
+    }
+
+    /// The error for mesh vertex `v`: see [`non_manifold_vertex`].
+    fn non_manifold_vertex(&self, to_input: &[u32], v: u32) -> MeshError {
+        non_manifold_vertex(
+            self.interior,
+            &self.origin,
+            &self.twin,
+            &self.prev,
+            to_input,
+            v,
+        )
+    }
+}
+
+/// The face or boundary loop of every halfedge: corner `c` keeps its face, boundary
+/// halfedges get loop ids `face_count, face_count + 1, ..` in order of each loop's first
+/// boundary halfedge. Returns it with each loop's first halfedge.
+fn boundary_loops(
+    corner_face: Vec<u32>,
+    next: &[u32],
+    face_count: usize,
+) -> (Vec<u32>, Vec<HalfedgeId>) {
+    let (nc, nh) = (corner_face.len(), next.len());
+    let mut face_or_loop = corner_face;
     let mut loop_halfedge = Vec::new();
     face_or_loop.resize(nh, NONE);
     for b in nc..nh {
         if face_or_loop[b] != NONE {
             continue;
         }
-        let id = (nf + loop_halfedge.len()) as u32;
+        let id = (face_count + loop_halfedge.len()) as u32;
         loop_halfedge.push(HalfedgeId(b as u32));
         let mut h = b;
         loop {
@@ -857,19 +1015,48 @@ fn assemble(
             }
         }
     }
+    (face_or_loop, loop_halfedge)
+}
 
-    let vertex_map = VertexMap::new(to_input, from_input, unreferenced);
+/// Creates the halfedge arrays from oriented, manifold-edged faces, checks the vertex
+/// fans and links boundary loops.
+fn assemble(
+    soup: &PolygonSoup,
+    oriented: OrientedFaces,
+    representative: Option<&[u32]>,
+    mut report: BuildReport,
+) -> Result<(Mesh, BuildReport), MeshError> {
+    let OrientedFaces {
+        faces,
+        groups,
+        orientation,
+        corner_face,
+        next_corner,
+    } = oriented;
+    let vertices = compact_vertices(soup, &faces, representative, &mut report);
+    let edge_count = groups.edge_count;
+    let mut halfedges = HalfedgeArrays::interior(&faces, next_corner, groups, &vertices.new_id);
+    let out_boundary = halfedges.add_boundary(vertices.to_input.len(), &vertices.to_input)?;
+    let vertex_halfedge = halfedges.vertex_halfedges(&out_boundary);
+    halfedges.check_fans(&vertex_halfedge, &vertices.to_input)?;
+    let (face_or_loop, loop_halfedge) = boundary_loops(corner_face, &halfedges.next, faces.len());
+
+    let vertex_map = VertexMap::new(
+        vertices.to_input,
+        vertices.from_input,
+        vertices.unreferenced,
+    );
     let data = MeshData {
-        positions,
-        next: into_ids(next, HalfedgeId),
-        prev: into_ids(prev, HalfedgeId),
-        twin: into_ids(twin, HalfedgeId),
-        origin: into_ids(origin, VertexId),
-        edge: into_ids(edge, EdgeId),
+        positions: vertices.positions,
+        next: into_ids(halfedges.next, HalfedgeId),
+        prev: into_ids(halfedges.prev, HalfedgeId),
+        twin: into_ids(halfedges.twin, HalfedgeId),
+        origin: into_ids(halfedges.origin, VertexId),
+        edge: into_ids(halfedges.edge, EdgeId),
         face_or_loop,
         vertex_halfedge: into_ids(vertex_halfedge, HalfedgeId),
         face_offsets: faces.offsets,
-        edge_count: groups.edge_count,
+        edge_count,
         loop_halfedge,
         face_component: into_ids(orientation.face_component, ComponentId),
         component_count: orientation.component_count,

@@ -52,9 +52,43 @@ pub fn parse(bytes: &[u8]) -> Result<RawMesh, super::SyntaxError> {
 /// A syntax error: the 1-based line and what is wrong.
 type Fail = (usize, String);
 
+/// The counts the header announces, and the line they are on (where a file that ends
+/// too early is reported).
+struct Counts {
+    vertices: usize,
+    faces: usize,
+    line: usize,
+}
+
+/// Parses the text of an OFF file: the header, then the vertex lines, then the face lines.
 fn parse_lines(bytes: &[u8]) -> Result<RawMesh, Fail> {
     let text = as_text(bytes).map_err(|line| (line, "the file is not UTF-8 text".into()))?;
     let mut lines = Lines::new(text, Some('#'), 1);
+    let (variant, counts) = read_header(&mut lines)?;
+    // Every vertex and face line holds at least two bytes: reserve no more than that.
+    let room = bytes.len() / 2;
+    let VertexLines { positions, uvs } = read_vertices(&mut lines, variant, &counts, room)?;
+    let mut soup = PolygonSoup::new(positions);
+    let face_lines = read_faces(&mut lines, &mut soup, &counts, room)?;
+    let corner_uvs = variant.texture.then(|| {
+        soup.faces()
+            .flat_map(|f| {
+                f.iter()
+                    .map(|&v| uvs.get(v as usize).copied().unwrap_or_default())
+            })
+            .collect()
+    });
+    Ok(RawMesh {
+        soup,
+        corner_uvs,
+        face_lines: Some(face_lines),
+        weld: None,
+        obj_groups: Vec::new(),
+    })
+}
+
+/// Reads the header word and the vertex and face counts, on its line or the next.
+fn read_header(lines: &mut Lines) -> Result<(Variant, Counts), Fail> {
     let Some((header_line, header)) = lines.next() else {
         return Err((1, "the file is empty".into()));
     };
@@ -84,10 +118,35 @@ fn parse_lines(bytes: &[u8]) -> Result<RawMesh, Fail> {
             )
         })
     };
-    let vertex_count = count(0, "vertex")?;
-    let face_count = count(1, "face")?;
-    // Every vertex and face line holds at least two bytes: reserve no more than that.
-    let room = bytes.len() / 2;
+    let vertices = count(0, "vertex")?;
+    let faces = count(1, "face")?;
+    Ok((
+        variant,
+        Counts {
+            vertices,
+            faces,
+            line: counts_line,
+        },
+    ))
+}
+
+/// What the vertex lines hold.
+struct VertexLines {
+    positions: Vec<Point3<f64>>,
+    /// The texture coordinates with the `ST` prefix; empty without.
+    uvs: Vec<Vector2<f64>>,
+}
+
+/// Reads the vertex lines: the positions, and with the `ST` prefix the texture
+/// coordinates (the last two numbers of each line; empty otherwise). At most `room`
+/// entries are reserved ahead.
+fn read_vertices(
+    lines: &mut Lines,
+    variant: Variant,
+    counts: &Counts,
+    room: usize,
+) -> Result<VertexLines, Fail> {
+    let vertex_count = counts.vertices;
     let mut positions = Vec::with_capacity(vertex_count.min(room));
     let mut uvs = Vec::with_capacity(if variant.texture {
         vertex_count.min(room)
@@ -97,7 +156,7 @@ fn parse_lines(bytes: &[u8]) -> Result<RawMesh, Fail> {
     for k in 0..vertex_count {
         let (line, content) = lines.next().ok_or_else(|| {
             (
-                counts_line,
+                counts.line,
                 format!("the header announces {vertex_count} vertices but the file ends after {k}"),
             )
         })?;
@@ -118,60 +177,61 @@ fn parse_lines(bytes: &[u8]) -> Result<RawMesh, Fail> {
             uvs.push(Vector2::new(numbers[n - 2], numbers[n - 1]));
         }
     }
-    let mut soup = PolygonSoup::new(positions);
+    Ok(VertexLines { positions, uvs })
+}
+
+/// Reads the face lines into `soup`; returns the line of each face. At most `room`
+/// entries are reserved ahead.
+fn read_faces(
+    lines: &mut Lines,
+    soup: &mut PolygonSoup,
+    counts: &Counts,
+    room: usize,
+) -> Result<Vec<u32>, Fail> {
+    let face_count = counts.faces;
     let mut face_lines = Vec::with_capacity(face_count.min(room));
     let mut face = Vec::new();
     for k in 0..face_count {
         let (line, content) = lines.next().ok_or_else(|| {
             (
-                counts_line,
+                counts.line,
                 format!("the header announces {face_count} faces but the file ends after {k}"),
             )
         })?;
-        let mut words = content.split_ascii_whitespace();
-        let size = words.next().unwrap_or("");
-        let size: usize = size.parse().map_err(|_| {
-            (
-                line,
-                format!("face {k} starts with `{size}`, not a vertex count"),
-            )
-        })?;
         face.clear();
-        for j in 0..size {
-            let word = words.next().ok_or_else(|| {
-                (
-                    line,
-                    format!("face {k} announces {size} vertices but lists {j}"),
-                )
-            })?;
-            let index = word.parse::<u32>().map_err(|_| {
-                (
-                    line,
-                    format!(
-                        "face {k} refers to vertex `{word}`: indices are whole numbers 0..{vertex_count}"
-                    ),
-                )
-            })?;
-            face.push(index);
-        }
+        face_indices(content, k, counts.vertices, &mut face).map_err(|message| (line, message))?;
         soup.push_face(&face);
         face_lines.push(line as u32);
     }
-    let corner_uvs = variant.texture.then(|| {
-        soup.faces()
-            .flat_map(|f| {
-                f.iter()
-                    .map(|&v| uvs.get(v as usize).copied().unwrap_or_default())
-            })
-            .collect()
-    });
-    Ok(RawMesh {
-        soup,
-        corner_uvs,
-        face_lines: Some(face_lines),
-        weld: None,
-        obj_groups: Vec::new(),
-    })
+    Ok(face_lines)
+}
+
+/// Parses face `k`'s line `n i_1 .. i_n` (anything after is its color, skipped) and
+/// appends the indices to `face`, or says what is wrong; `vertex_count` only words the
+/// message.
+fn face_indices(
+    content: &str,
+    k: usize,
+    vertex_count: usize,
+    face: &mut Vec<u32>,
+) -> Result<(), String> {
+    let mut words = content.split_ascii_whitespace();
+    let size = words.next().unwrap_or("");
+    let size: usize = size
+        .parse()
+        .map_err(|_| format!("face {k} starts with `{size}`, not a vertex count"))?;
+    for j in 0..size {
+        let word = words
+            .next()
+            .ok_or_else(|| format!("face {k} announces {size} vertices but lists {j}"))?;
+        let index = word.parse::<u32>().map_err(|_| {
+            format!(
+                "face {k} refers to vertex `{word}`: indices are whole numbers 0..{vertex_count}"
+            )
+        })?;
+        face.push(index);
+    }
+    Ok(())
 }
 
 /// The variant named by the header word, or why it is not one that is read.
