@@ -470,153 +470,8 @@ impl Constraints {
         let mut point_constraint: Vec<Option<usize>> = vec![None; source.vertex_count()];
         for (index, constraint) in self.list.iter().enumerate() {
             let kind = constraint.kind();
-            let exists = |mesh: &Mesh, side: &'static str, vertex: VertexId| {
-                if vertex.idx() < mesh.vertex_count() {
-                    Ok(())
-                } else {
-                    Err(ConstraintError::MissingVertex {
-                        index,
-                        kind,
-                        side,
-                        vertex,
-                        count: mesh.vertex_count(),
-                    })
-                }
-            };
-            let finite = |vertex: VertexId, what: &'static str, ok: bool| {
-                if ok {
-                    Ok(())
-                } else {
-                    Err(ConstraintError::NonFinite {
-                        index,
-                        kind,
-                        vertex,
-                        what,
-                    })
-                }
-            };
-            let point_vertex = match constraint {
-                Constraint::Pin(pin) => {
-                    exists(source, "source", pin.vertex)?;
-                    if let Some(p) = pin.position {
-                        finite(pin.vertex, "point", p.is_finite())?;
-                    }
-                    Some(pin.vertex)
-                }
-                Constraint::Landmark(mark) => {
-                    exists(source, "source", mark.vertex)?;
-                    finite(mark.vertex, "point", mark.position.is_finite())?;
-                    Some(mark.vertex)
-                }
-                Constraint::Slide(slide) => {
-                    exists(source, "source", slide.vertex)?;
-                    let (ok, zero) = match slide.direction {
-                        Direction::Planar(d) => (d.is_finite(), d.norm_sqr() == 0.0),
-                        Direction::Spatial(d) => {
-                            (d.iter().all(|x| x.is_finite()), d.norm_squared() == 0.0)
-                        }
-                    };
-                    finite(slide.vertex, "direction", ok)?;
-                    if zero {
-                        return Err(ConstraintError::ZeroDirection {
-                            index,
-                            vertex: slide.vertex,
-                        });
-                    }
-                    Some(slide.vertex)
-                }
-                Constraint::Curve(curve) => {
-                    let needed = if curve.closed { 3 } else { 2 };
-                    for (side, chain) in [("source", &curve.source), ("target", &curve.target)] {
-                        if chain.len() < needed {
-                            return Err(ConstraintError::ShortChain {
-                                index,
-                                kind,
-                                side,
-                                got: chain.len(),
-                                needed,
-                            });
-                        }
-                    }
-                    for (side, chain) in [("source", &curve.source), ("target", &curve.target)] {
-                        let mut seen = std::collections::HashMap::with_capacity(chain.len());
-                        for (second, &vertex) in chain.iter().enumerate() {
-                            if let Some(first) = seen.insert(vertex, second) {
-                                return Err(ConstraintError::RepeatedChainVertex {
-                                    index,
-                                    kind,
-                                    side,
-                                    vertex,
-                                    first,
-                                    second,
-                                });
-                            }
-                        }
-                    }
-                    for &v in &curve.source {
-                        exists(source, "source", v)?;
-                    }
-                    let target_mesh = target.unwrap_or(source);
-                    for &v in &curve.target {
-                        exists(target_mesh, "target", v)?;
-                    }
-                    None
-                }
-                Constraint::LoopMatch(m) => {
-                    let Some(target) = target else {
-                        return Err(ConstraintError::NoTargetMesh { index, kind });
-                    };
-                    for (side, mesh, l) in
-                        [("source", source, m.source), ("target", target, m.target)]
-                    {
-                        let count = mesh.boundary_loop_count();
-                        if l >= count {
-                            return Err(ConstraintError::MissingLoop {
-                                index,
-                                side,
-                                boundary_loop: l,
-                                count,
-                            });
-                        }
-                    }
-                    None
-                }
-                Constraint::Normal { weight } => {
-                    if !(*weight > 0.0 && *weight <= MAX_NORMAL_WEIGHT) {
-                        return Err(ConstraintError::Weight {
-                            index,
-                            weight: *weight,
-                        });
-                    }
-                    None
-                }
-                Constraint::Area => None,
-                Constraint::ReferenceAngles(angles) => {
-                    let corners: Vec<HalfedgeId> = source
-                        .faces()
-                        .flat_map(|f| source.face_halfedges(f))
-                        .collect();
-                    if angles.len() != source.halfedge_count() {
-                        return Err(ConstraintError::AngleCount {
-                            index,
-                            got: angles.len(),
-                            expected: source.halfedge_count(),
-                        });
-                    }
-                    for corner in corners {
-                        let angle = angles[corner.idx()];
-                        if !(angle > 0.0 && angle < std::f64::consts::PI) {
-                            return Err(ConstraintError::Angle {
-                                index,
-                                corner,
-                                angle,
-                            });
-                        }
-                    }
-                    None
-                }
-            };
-            if let Some(v) = point_vertex {
+            let check = Checked { index, kind };
+            if let Some(v) = check.point_vertex(constraint, source, target)? {
                 if let Some(first) = point_constraint[v.idx()] {
                     return Err(ConstraintError::Repeated {
                         index,
@@ -626,6 +481,220 @@ impl Constraints {
                     });
                 }
                 point_constraint[v.idx()] = Some(index);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The constraint [`Constraints::validate`] checks: its index in the list and its kind,
+/// which the errors name.
+#[derive(Clone, Copy)]
+struct Checked {
+    index: usize,
+    kind: ConstraintKind,
+}
+
+impl Checked {
+    /// Fails unless `vertex` is a vertex of `mesh` (`side` names the mesh in the error).
+    fn exists(
+        self,
+        mesh: &Mesh,
+        side: &'static str,
+        vertex: VertexId,
+    ) -> Result<(), ConstraintError> {
+        if vertex.idx() < mesh.vertex_count() {
+            Ok(())
+        } else {
+            Err(ConstraintError::MissingVertex {
+                index: self.index,
+                kind: self.kind,
+                side,
+                vertex,
+                count: mesh.vertex_count(),
+            })
+        }
+    }
+
+    /// Fails unless `ok`, naming `what` at `vertex` as not finite.
+    fn finite(self, vertex: VertexId, what: &'static str, ok: bool) -> Result<(), ConstraintError> {
+        if ok {
+            Ok(())
+        } else {
+            Err(ConstraintError::NonFinite {
+                index: self.index,
+                kind: self.kind,
+                vertex,
+                what,
+            })
+        }
+    }
+
+    /// Checks `constraint` on its own; returns the vertex it holds to a point (pin,
+    /// landmark, slide), if any, for the check across constraints.
+    fn point_vertex(
+        self,
+        constraint: &Constraint,
+        source: &Mesh,
+        target: Option<&Mesh>,
+    ) -> Result<Option<VertexId>, ConstraintError> {
+        let index = self.index;
+        Ok(match constraint {
+            Constraint::Pin(pin) => {
+                self.exists(source, "source", pin.vertex)?;
+                if let Some(p) = pin.position {
+                    self.finite(pin.vertex, "point", p.is_finite())?;
+                }
+                Some(pin.vertex)
+            }
+            Constraint::Landmark(mark) => {
+                self.exists(source, "source", mark.vertex)?;
+                self.finite(mark.vertex, "point", mark.position.is_finite())?;
+                Some(mark.vertex)
+            }
+            Constraint::Slide(slide) => {
+                self.slide(slide, source)?;
+                Some(slide.vertex)
+            }
+            Constraint::Curve(curve) => {
+                self.curve(curve, source, target)?;
+                None
+            }
+            Constraint::LoopMatch(m) => {
+                self.loop_match(m, source, target)?;
+                None
+            }
+            Constraint::Normal { weight } => {
+                if !(*weight > 0.0 && *weight <= MAX_NORMAL_WEIGHT) {
+                    return Err(ConstraintError::Weight {
+                        index,
+                        weight: *weight,
+                    });
+                }
+                None
+            }
+            Constraint::Area => None,
+            Constraint::ReferenceAngles(angles) => {
+                self.reference_angles(angles, source)?;
+                None
+            }
+        })
+    }
+
+    /// A slide: its vertex exists and its direction is finite and not zero.
+    fn slide(self, slide: &Slide, source: &Mesh) -> Result<(), ConstraintError> {
+        self.exists(source, "source", slide.vertex)?;
+        let (ok, zero) = match slide.direction {
+            Direction::Planar(d) => (d.is_finite(), d.norm_sqr() == 0.0),
+            Direction::Spatial(d) => (d.iter().all(|x| x.is_finite()), d.norm_squared() == 0.0),
+        };
+        self.finite(slide.vertex, "direction", ok)?;
+        if zero {
+            return Err(ConstraintError::ZeroDirection {
+                index: self.index,
+                vertex: slide.vertex,
+            });
+        }
+        Ok(())
+    }
+
+    /// A curve: both chains long enough (2 vertices open, 3 closed), without a repeated
+    /// vertex, their vertices existing in `source` and in `target` (`source` when there
+    /// is none).
+    fn curve(
+        self,
+        curve: &Curve,
+        source: &Mesh,
+        target: Option<&Mesh>,
+    ) -> Result<(), ConstraintError> {
+        let (index, kind) = (self.index, self.kind);
+        let needed = if curve.closed { 3 } else { 2 };
+        for (side, chain) in [("source", &curve.source), ("target", &curve.target)] {
+            if chain.len() < needed {
+                return Err(ConstraintError::ShortChain {
+                    index,
+                    kind,
+                    side,
+                    got: chain.len(),
+                    needed,
+                });
+            }
+        }
+        for (side, chain) in [("source", &curve.source), ("target", &curve.target)] {
+            let mut seen = std::collections::HashMap::with_capacity(chain.len());
+            for (second, &vertex) in chain.iter().enumerate() {
+                if let Some(first) = seen.insert(vertex, second) {
+                    return Err(ConstraintError::RepeatedChainVertex {
+                        index,
+                        kind,
+                        side,
+                        vertex,
+                        first,
+                        second,
+                    });
+                }
+            }
+        }
+        for &v in &curve.source {
+            self.exists(source, "source", v)?;
+        }
+        let target_mesh = target.unwrap_or(source);
+        for &v in &curve.target {
+            self.exists(target_mesh, "target", v)?;
+        }
+        Ok(())
+    }
+
+    /// A loop match: a target mesh is given and both boundary loops exist.
+    fn loop_match(
+        self,
+        m: &LoopMatch,
+        source: &Mesh,
+        target: Option<&Mesh>,
+    ) -> Result<(), ConstraintError> {
+        let Some(target) = target else {
+            return Err(ConstraintError::NoTargetMesh {
+                index: self.index,
+                kind: self.kind,
+            });
+        };
+        for (side, mesh, l) in [("source", source, m.source), ("target", target, m.target)] {
+            let count = mesh.boundary_loop_count();
+            if l >= count {
+                return Err(ConstraintError::MissingLoop {
+                    index: self.index,
+                    side,
+                    boundary_loop: l,
+                    count,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Reference angles: one per halfedge of `source`, those of face corners in `(0, pi)`
+    /// (the first one outside named, in face order).
+    fn reference_angles(self, angles: &[f64], source: &Mesh) -> Result<(), ConstraintError> {
+        let index = self.index;
+        let corners: Vec<HalfedgeId> = source
+            .faces()
+            .flat_map(|f| source.face_halfedges(f))
+            .collect();
+        if angles.len() != source.halfedge_count() {
+            return Err(ConstraintError::AngleCount {
+                index,
+                got: angles.len(),
+                expected: source.halfedge_count(),
+            });
+        }
+        for corner in corners {
+            let angle = angles[corner.idx()];
+            if !(angle > 0.0 && angle < std::f64::consts::PI) {
+                return Err(ConstraintError::Angle {
+                    index,
+                    corner,
+                    angle,
+                });
             }
         }
         Ok(())
