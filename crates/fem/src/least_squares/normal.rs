@@ -403,6 +403,29 @@ struct Output<'a, T> {
     rhs: &'a mut [T],
 }
 
+/// The pattern of `B` row by row, as [`Maps::new`] builds it.
+struct BRows<I> {
+    /// `m + 1` pointers into `col`.
+    row_ptr: Vec<I>,
+    /// The reduced column of each entry, increasing within a row.
+    col: Vec<I>,
+    /// For each row, the start of its block of pairs (shared by a run of equal rows).
+    pair_start: Vec<I>,
+    /// True for the first row of each run of rows with equal columns (a leader).
+    leader: Vec<bool>,
+    /// The length of the blocks of pairs together: `r (r + 1) / 2` per leader of `r`
+    /// entries.
+    pair_len: usize,
+}
+
+/// `B` column by column, leaders only (the other rows repeat their columns): for each
+/// reduced column `d`, the `(row, entry of B)` having it are
+/// `entries[ptr[d]..ptr[d + 1]]`, rows increasing.
+struct LeaderColumns<I> {
+    ptr: Vec<usize>,
+    entries: Vec<(I, I)>,
+}
+
 impl<I: Index> Maps<I> {
     /// The maps and the lower pattern of `N` (module docs). `k_rows` is the pattern of
     /// `K` row by row, `row_len[i]` the number of products (entry of row `i` of `A`, entry
@@ -413,12 +436,34 @@ impl<I: Index> Maps<I> {
         row_len: &[usize],
         dofs: &DofMap<T>,
     ) -> Result<(Self, SymbolicSparseColMat<usize>), SolveError> {
-        let (m, n) = (a.nrows(), dofs.reduced_len());
+        let n = dofs.reduced_len();
+        let (a_row_end, b_col) = Self::product_columns(a, k_rows, row_len)?;
+        let total = b_col.len();
+        let b = Self::merge_rows(b_col, a_row_end)?;
+        let b_target = Self::product_targets(a, k_rows, &b, total)?;
+        let columns = Self::leader_columns(&b, dofs)?;
+        let (pairs, pattern) = Self::lower_pattern(&b, &columns, n)?;
+        Ok((
+            Self {
+                b_target,
+                b_row_ptr: b.row_ptr,
+                b_col: b.col,
+                pair_start: b.pair_start,
+                pairs,
+            },
+            pattern,
+        ))
+    }
 
-        // The reduced columns of the products reaching B, row by row; each row is then
-        // sorted and its repeated columns merged in place, which leaves the columns of B
-        // row by row in the same buffer (merging only moves entries left).
-        let mut a_row_end = try_vec(m, 0usize)?;
+    /// The reduced columns of the products reaching `B`, row by row: row `i`'s are
+    /// `b_col[a_row_end[i] - row_len[i]..a_row_end[i]]`, unsorted and with repeats.
+    /// Returns `(a_row_end, b_col)`.
+    fn product_columns(
+        a: SymbolicSparseColMatRef<'_, usize>,
+        k_rows: KRows<'_>,
+        row_len: &[usize],
+    ) -> Result<(Vec<usize>, Vec<I>), SolveError> {
+        let mut a_row_end = try_vec(a.nrows(), 0usize)?;
         let mut total = 0;
         for (end, &r) in a_row_end.iter_mut().zip(row_len) {
             total += r;
@@ -434,10 +479,15 @@ impl<I: Index> Maps<I> {
                 }
             }
         }
-        drop(next);
+        Ok((a_row_end, b_col))
+    }
 
-        // A row with the columns of the previous row shares its block of pairs; only
-        // the first row of a run (a leader) is swept below.
+    /// Sorts each row of `b_col` (ending at `a_row_end`) and merges its repeated columns
+    /// in place, which leaves the columns of `B` row by row in the same buffer (merging
+    /// only moves entries left). A row with the columns of the previous row shares its
+    /// block of pairs; only the first row of a run (a leader) is swept later.
+    fn merge_rows(mut b_col: Vec<I>, a_row_end: Vec<usize>) -> Result<BRows<I>, SolveError> {
+        let m = a_row_end.len();
         let mut b_row_ptr = try_vec(m + 1, I::new(0))?;
         let mut pair_start = try_vec(m, I::new(0))?;
         let mut leader = vec![false; m];
@@ -467,28 +517,50 @@ impl<I: Index> Maps<I> {
         drop(a_row_end);
         b_col.truncate(end);
         b_col.shrink_to_fit();
+        Ok(BRows {
+            row_ptr: b_row_ptr,
+            col: b_col,
+            pair_start,
+            leader,
+            pair_len,
+        })
+    }
 
-        // The entry of B each product adds into: its reduced column within its row, in
-        // the order of the numeric pass.
+    /// The entry of `B` each of the `total` products adds into: its reduced column
+    /// within its row, in the order of the numeric pass.
+    fn product_targets(
+        a: SymbolicSparseColMatRef<'_, usize>,
+        k_rows: KRows<'_>,
+        b: &BRows<I>,
+        total: usize,
+    ) -> Result<Vec<I>, SolveError> {
         let mut b_target = try_vec(total, I::new(0))?;
         let mut target = 0;
         for l in 0..a.ncols() {
             for i in a.row_idx_of_col(l) {
-                let (start, end) = (b_row_ptr[i].get(), b_row_ptr[i + 1].get());
+                let (start, end) = (b.row_ptr[i].get(), b.row_ptr[i + 1].get());
                 for &j in k_rows.row(l) {
                     let j = I::new(j);
-                    let p = b_col[start..end].partition_point(|&c| c < j);
+                    let p = b.col[start..end].partition_point(|&c| c < j);
                     b_target[target] = I::new(start + p);
                     target += 1;
                 }
             }
         }
+        Ok(b_target)
+    }
 
-        // B column by column, leaders only (the other rows repeat their columns): for
-        // each reduced column, the (row, entry of B) having it.
+    /// `B` column by column, leaders only. Fails with [`SolveError::Unconstrained`] on
+    /// the first reduced unknown no row of `B` has.
+    fn leader_columns<T: DofScalar>(
+        b: &BRows<I>,
+        dofs: &DofMap<T>,
+    ) -> Result<LeaderColumns<I>, SolveError> {
+        let n = dofs.reduced_len();
+        let m = b.leader.len();
         let mut bt_ptr = vec![0usize; n + 1];
-        for i in (0..m).filter(|&i| leader[i]) {
-            for c in &b_col[b_row_ptr[i].get()..b_row_ptr[i + 1].get()] {
+        for i in (0..m).filter(|&i| b.leader[i]) {
+            for c in &b.col[b.row_ptr[i].get()..b.row_ptr[i + 1].get()] {
                 bt_ptr[c.get() + 1] += 1;
             }
         }
@@ -503,30 +575,43 @@ impl<I: Index> Maps<I> {
         }
         let mut bt = try_vec(bt_ptr[n], (I::new(0), I::new(0)))?;
         let mut next = bt_ptr[..n].to_vec();
-        for i in (0..m).filter(|&i| leader[i]) {
-            let (start, end) = (b_row_ptr[i].get(), b_row_ptr[i + 1].get());
-            for (e, c) in (start..end).zip(&b_col[start..end]) {
+        for i in (0..m).filter(|&i| b.leader[i]) {
+            let (start, end) = (b.row_ptr[i].get(), b.row_ptr[i + 1].get());
+            for (e, c) in (start..end).zip(&b.col[start..end]) {
                 bt[next[c.get()]] = (I::new(i), I::new(e));
                 next[c.get()] += 1;
             }
         }
-        drop(next);
+        Ok(LeaderColumns {
+            ptr: bt_ptr,
+            entries: bt,
+        })
+    }
 
-        // Lower pattern of N and positions of the pairs, column by column.
+    /// The lower pattern of `N` (`n x n`) and the positions of the pairs, column by
+    /// column: column `d` is the union of the columns `c >= d` of the leaders having
+    /// `d`, sorted; the pairs whose smaller column is `d` get their positions in it.
+    /// Returns `(pairs, pattern)`.
+    fn lower_pattern(
+        b: &BRows<I>,
+        columns: &LeaderColumns<I>,
+        n: usize,
+    ) -> Result<(Vec<I>, SymbolicSparseColMat<usize>), SolveError> {
+        let (b_row_ptr, b_col) = (&b.row_ptr, &b.col);
         let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0usize);
         // At most one entry per pair of a leader: reserving that much (address space,
         // untouched beyond the final length) avoids copies on growth.
         let mut row_idx: Vec<usize> = Vec::new();
         row_idx
-            .try_reserve_exact(pair_len)
+            .try_reserve_exact(b.pair_len)
             .map_err(|_| FaerError::OutOfMemory)?;
-        let mut pairs = try_vec(pair_len, I::new(0))?;
+        let mut pairs = try_vec(b.pair_len, I::new(0))?;
         // `mark[c] == d`: row c is already in column d; `slot[c]`: its position there.
         let mut mark = vec![usize::MAX; n];
         let mut slot = vec![0usize; n];
         for d in 0..n {
-            let column = &bt[bt_ptr[d]..bt_ptr[d + 1]];
+            let column = &columns.entries[columns.ptr[d]..columns.ptr[d + 1]];
             let begin = row_idx.len();
             for &(i, e) in column {
                 // Entries from e on have columns >= d.
@@ -545,7 +630,7 @@ impl<I: Index> Maps<I> {
             for &(i, e) in column {
                 let (i, e) = (i.get(), e.get());
                 let q = e - b_row_ptr[i].get();
-                let block = pair_start[i].get();
+                let block = b.pair_start[i].get();
                 for (p, c) in b_col[e..b_row_ptr[i + 1].get()]
                     .iter()
                     .enumerate()
@@ -558,16 +643,7 @@ impl<I: Index> Maps<I> {
         }
         row_idx.shrink_to_fit();
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        Ok((
-            Self {
-                b_target,
-                b_row_ptr,
-                b_col,
-                pair_start,
-                pairs,
-            },
-            pattern,
-        ))
+        Ok((pairs, pattern))
     }
 
     /// The numeric phase of [`NormalEquations::assemble`]; `k` is `K` row by row
