@@ -329,11 +329,14 @@ struct TargetField<'d> {
 }
 
 /// The target's fields and their gradients at the images of the source's vertices (per
-/// channel, per vertex), and the faces the images are in.
+/// channel, per vertex), and where the images are.
 struct Probe {
     values: Vec<Vec<f64>>,
     gradients: Vec<Vec<Complex64>>,
-    faces: Vec<FaceId>,
+    /// The images probed.
+    images: Vec<Complex64>,
+    /// Their points on the chart.
+    points: Vec<SurfacePoint>,
 }
 
 impl<'d> TargetField<'d> {
@@ -350,14 +353,22 @@ impl<'d> TargetField<'d> {
         }
     }
 
-    /// The fields and their gradients at the images `map`: each image found by a walk
-    /// from its face in `near` (the last probe's, when given), or by the index.
+    /// The fields and their gradients at the images `map`. An image where it was in
+    /// `near` (the last probe, when given) keeps its point; another is found by a walk
+    /// from its last face, or by the index. Held vertices never move, and those outside
+    /// the chart (a held cap) are the index's slowest searches: each is searched once.
     fn probe(&self, map: &[Complex64], near: Option<&Probe>) -> Result<Probe, RegisterError> {
         let walked: Vec<Option<SurfacePoint>> = match near {
             Some(near) => map
                 .iter()
-                .zip(&near.faces)
-                .map(|(&z, &face)| walk(self.domain, z, face))
+                .zip(near.images.iter().zip(&near.points))
+                .map(|(&z, (&before, point))| {
+                    if z == before {
+                        Some(*point)
+                    } else {
+                        walk(self.domain, z, point.face)
+                    }
+                })
                 .collect(),
             None => vec![None; map.len()],
         };
@@ -369,13 +380,15 @@ impl<'d> TargetField<'d> {
         for (&i, l) in lost.iter().zip(found) {
             points[i] = Some(l.point);
         }
+        let points: Vec<SurfacePoint> = points.into_iter().flatten().collect();
         let channels = self.values.len();
         let mut probe = Probe {
             values: vec![Vec::with_capacity(map.len()); channels],
             gradients: vec![Vec::with_capacity(map.len()); channels],
-            faces: Vec::with_capacity(map.len()),
+            images: map.to_vec(),
+            points: Vec::new(),
         };
-        for point in points.into_iter().flatten() {
+        for point in &points {
             let (vs, degree) = self.domain.face_vertex_array(point.face);
             for c in 0..channels {
                 probe.values[c].push(
@@ -385,8 +398,8 @@ impl<'d> TargetField<'d> {
                 );
                 probe.gradients[c].push(self.gradients[c][point.face.idx()]);
             }
-            probe.faces.push(point.face);
         }
+        probe.points = points;
         Ok(probe)
     }
 }

@@ -18,15 +18,23 @@
 //! falls over the rounds (`STIFFNESS`, times `sqrt(n)` so that a schedule means the same
 //! smoothness at any resolution), each held until the maps change little.
 //!
+//! The weights are judged at the first round of each stiffness and kept for its other
+//! rounds, which then only move the closest points `U`: one numeric factorization per
+//! stiffness instead of one per round. Measured against judging them every round (the
+//! paper's loop): `g0_spot` onto its deformation 0.0147 from the truth either way;
+//! fsaverage5 pial onto white 1.7213 against 1.7207 mm (0.5674 against 0.5681 mm with
+//! the sulcal depth), the whole registration 9.3 s instead of 14.6 s.
+//!
 //! Positions are taken relative to the placed source's centroid and divided by its
 //! root-mean-square radius, so that `gamma = 1` weighs the translations like the linear
 //! parts.
 
+use beltrami_fem::FemError;
+use beltrami_fem::assembly::Pattern;
 use beltrami_mesh::{Mesh, Point3, Vector3};
 use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
-use beltrami_spatial::SurfaceIndex;
+use beltrami_spatial::{Located, SurfaceIndex};
 use faer::Mat;
-use faer::sparse::{CreationError, FaerError, SparseColMat, Triplet};
 
 use crate::error::{RegisterError, Side};
 use crate::shape::{centroid_and_spread, vertex_normals_at};
@@ -55,122 +63,200 @@ pub(crate) fn nonrigid_icp(
     index: &SurfaceIndex<'_>,
     placed: &[Point3<f64>],
 ) -> Result<Vec<Point3<f64>>, RegisterError> {
-    let n = source.vertex_count();
     let (centre, radius) = centroid_and_spread(placed);
     if radius.is_nan() || radius <= 0.0 {
         return Ok(placed.to_vec());
     }
     let to_unit = |p: &Point3<f64>| (p.coords - centre) / radius;
     let from_unit = |x: &Vector3<f64>| Point3::from(x * radius + centre);
-    let homogeneous: Vec<[f64; 4]> = placed
-        .iter()
-        .map(|p| {
-            let x = to_unit(p);
-            [x.x, x.y, x.z, 1.0]
-        })
-        .collect();
-    let edges: Vec<(usize, usize)> = source
-        .edges()
-        .map(|e| {
-            let [a, b] = source.edge_vertices(e);
-            (a.idx(), b.idx())
-        })
-        .collect();
-    let mut degree = vec![0.0; n];
-    for &(a, b) in &edges {
-        degree[a] += 1.0;
-        degree[b] += 1.0;
-    }
-    let target = index.mesh();
-    let solve_error = |error| RegisterError::Solve {
-        side: Side::Source,
-        error,
-    };
+    let mut equations = NormalEquations::new(source, placed.iter().map(to_unit))?;
     let mut images: Vec<Vector3<f64>> = placed.iter().map(to_unit).collect();
-    let mut solver: Option<SpdSolver<f64>> = None;
+    let n = images.len();
     for stiffness in STIFFNESS {
         let alpha2 = (stiffness * stiffness) * n as f64;
+        let mut weights = None;
         for _ in 0..ROUNDS {
             let positions: Vec<Point3<f64>> = images.iter().map(from_unit).collect();
             let closest = index.locate_all(&positions)?;
-            let normals = vertex_normals_at(source, &positions);
-            let weights: Vec<f64> = closest
-                .iter()
-                .zip(&normals)
-                .map(|(l, normal)| {
-                    if target.face_normal(l.point.face).dot(normal) >= NORMAL_AGREEMENT {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            // Every block's 16 entries are written, zero weights too, so that the
-            // pattern is that of every round.
-            let mut triplets = Vec::with_capacity(16 * (n + 2 * edges.len()));
-            for (i, h) in homogeneous.iter().enumerate() {
-                for r in 0..4 {
-                    for c in 0..4 {
-                        let stiff = if r == c { alpha2 * degree[i] } else { 0.0 };
-                        triplets.push(Triplet::new(
-                            4 * i + r,
-                            4 * i + c,
-                            stiff + weights[i] * h[r] * h[c],
-                        ));
-                    }
+            let weights = match &weights {
+                Some(w) => w,
+                None => {
+                    let judged = agreeing_pairs(source, index.mesh(), &positions, &closest);
+                    equations.factorize(alpha2, &judged)?;
+                    weights.insert(judged)
                 }
-            }
-            for &(a, b) in &edges {
-                for r in 0..4 {
-                    for c in 0..4 {
-                        let value = if r == c { -alpha2 } else { 0.0 };
-                        triplets.push(Triplet::new(4 * a + r, 4 * b + c, value));
-                        triplets.push(Triplet::new(4 * b + r, 4 * a + c, value));
-                    }
-                }
-            }
-            let matrix =
-                SparseColMat::try_new_from_triplets(4 * n, 4 * n, &triplets).map_err(|e| {
-                    solve_error(SolveError::Faer(match e {
-                        CreationError::Generic(e) => e,
-                        // Indices are below 4n by construction.
-                        CreationError::OutOfBounds { .. } => FaerError::IndexOverflow,
-                    }))
-                })?;
-            let mut rhs = Mat::<f64>::zeros(4 * n, 3);
-            for (i, h) in homogeneous.iter().enumerate() {
-                if weights[i] == 0.0 {
-                    continue;
-                }
-                let u = to_unit(&closest[i].position);
-                for r in 0..4 {
-                    for c in 0..3 {
-                        rhs[(4 * i + r, c)] += weights[i] * h[r] * u[c];
-                    }
-                }
-            }
-            let spd = match &mut solver {
-                Some(spd) => spd,
-                None => solver.insert(
-                    SpdSolver::new(matrix.symbolic(), SolveOptions::default())
-                        .map_err(solve_error)?,
-                ),
             };
-            spd.factorize(matrix.as_ref()).map_err(solve_error)?;
-            spd.solve_in_place(rhs.as_mut()).map_err(solve_error)?;
-            let mut moved: f64 = 0.0;
-            for (i, h) in homogeneous.iter().enumerate() {
-                let image =
-                    Vector3::from_fn(|c, _| (0..4).map(|r| h[r] * rhs[(4 * i + r, c)]).sum());
-                moved = moved.max((image - images[i]).norm());
-                images[i] = image;
-            }
+            let goals: Vec<Vector3<f64>> = closest.iter().map(|l| to_unit(&l.position)).collect();
+            let next = equations.solve(weights, &goals)?;
+            let moved = next
+                .iter()
+                .zip(&images)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            images = next;
             if moved < SETTLED {
                 break;
             }
         }
     }
     Ok(images.iter().map(from_unit).collect())
+}
+
+/// The weight `w_i` of each pair (module docs): 1 where the target's face at the closest
+/// point faces the way the source does at the vertex (`NORMAL_AGREEMENT`), else 0.
+fn agreeing_pairs(
+    source: &Mesh,
+    target: &Mesh,
+    positions: &[Point3<f64>],
+    closest: &[Located],
+) -> Vec<f64> {
+    let normals = vertex_normals_at(source, positions);
+    closest
+        .iter()
+        .zip(&normals)
+        .map(|(l, normal)| {
+            if target.face_normal(l.point.face).dot(normal) >= NORMAL_AGREEMENT {
+                1.0
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// The normal equations of a round (module docs): their pattern, the source's
+/// homogeneous coordinates, edges and degrees, and the factorization of the last
+/// stiffness and weights given.
+struct NormalEquations {
+    pattern: Pattern,
+    homogeneous: Vec<[f64; 4]>,
+    edges: Vec<(usize, usize)>,
+    degree: Vec<f64>,
+    solver: SpdSolver<f64>,
+}
+
+impl NormalEquations {
+    /// The equations of `source` with its vertices at `unit` (unit-radius coordinates).
+    fn new(source: &Mesh, unit: impl Iterator<Item = Vector3<f64>>) -> Result<Self, RegisterError> {
+        let homogeneous: Vec<[f64; 4]> = unit.map(|x| [x.x, x.y, x.z, 1.0]).collect();
+        let n = homogeneous.len();
+        let edges: Vec<(usize, usize)> = source
+            .edges()
+            .map(|e| {
+                let [a, b] = source.edge_vertices(e);
+                (a.idx(), b.idx())
+            })
+            .collect();
+        let mut degree = vec![0.0; n];
+        for &(a, b) in &edges {
+            degree[a] += 1.0;
+            degree[b] += 1.0;
+        }
+        let pattern = block_pattern(n, &edges).map_err(assembly_error)?;
+        let solver = SpdSolver::new(pattern.symbolic().as_ref(), SolveOptions::default())
+            .map_err(solve_error)?;
+        Ok(Self {
+            pattern,
+            homogeneous,
+            edges,
+            degree,
+            solver,
+        })
+    }
+
+    /// Assembles and factors the matrix `alpha^2 L (x) I + blockdiag(w_i h_i h_i^T)`.
+    fn factorize(&mut self, alpha2: f64, weights: &[f64]) -> Result<(), RegisterError> {
+        let mut values = Vec::with_capacity(self.pattern.entry_count());
+        for (i, h) in self.homogeneous.iter().enumerate() {
+            for r in 0..4 {
+                for c in 0..4 {
+                    let stiff = if r == c { alpha2 * self.degree[i] } else { 0.0 };
+                    values.push(stiff + weights[i] * h[r] * h[c]);
+                }
+            }
+        }
+        for _ in &self.edges {
+            for r in 0..4 {
+                for c in 0..4 {
+                    let value = if r == c { -alpha2 } else { 0.0 };
+                    values.push(value);
+                    values.push(value);
+                }
+            }
+        }
+        let matrix = self.pattern.assemble(&values).map_err(assembly_error)?;
+        self.solver.factorize(matrix.as_ref()).map_err(solve_error)
+    }
+
+    /// The images `h_i^T X_i` of the affine maps that solve the factored equations with
+    /// right-hand side `blockdiag(w_i h_i) U`, `U` the closest points `goals`.
+    fn solve(
+        &mut self,
+        weights: &[f64],
+        goals: &[Vector3<f64>],
+    ) -> Result<Vec<Vector3<f64>>, RegisterError> {
+        let mut rhs = Mat::<f64>::zeros(4 * self.homogeneous.len(), 3);
+        for (i, h) in self.homogeneous.iter().enumerate() {
+            if weights[i] == 0.0 {
+                continue;
+            }
+            for r in 0..4 {
+                for c in 0..3 {
+                    rhs[(4 * i + r, c)] += weights[i] * h[r] * goals[i][c];
+                }
+            }
+        }
+        self.solver
+            .solve_in_place(rhs.as_mut())
+            .map_err(solve_error)?;
+        Ok(self
+            .homogeneous
+            .iter()
+            .enumerate()
+            .map(|(i, h)| Vector3::from_fn(|c, _| (0..4).map(|r| h[r] * rhs[(4 * i + r, c)]).sum()))
+            .collect())
+    }
+}
+
+/// A failed solve of the source's equations.
+fn solve_error(error: SolveError) -> RegisterError {
+    RegisterError::Solve {
+        side: Side::Source,
+        error,
+    }
+}
+
+/// A failed assembly: the pattern's positions lie inside the matrix and its values are
+/// as many as its positions by construction, so this would be the source's elements'.
+fn assembly_error(error: FemError) -> RegisterError {
+    RegisterError::Elements {
+        side: Side::Source,
+        error,
+    }
+}
+
+/// The positions of the normal equations' entries, in the order their values are
+/// written: each vertex's 4 x 4 diagonal block, then each edge's two off-diagonal
+/// blocks, entry by entry. Every block's 16 entries are kept, zeros too, so that one
+/// pattern serves every round whatever the weights.
+fn block_pattern(n: usize, edges: &[(usize, usize)]) -> Result<Pattern, FemError> {
+    let mut positions = Vec::with_capacity(16 * (n + 2 * edges.len()));
+    for i in 0..n {
+        for r in 0..4 {
+            for c in 0..4 {
+                positions.push((4 * i + r, 4 * i + c));
+            }
+        }
+    }
+    for &(a, b) in edges {
+        for r in 0..4 {
+            for c in 0..4 {
+                positions.push((4 * a + r, 4 * b + c));
+                positions.push((4 * b + r, 4 * a + c));
+            }
+        }
+    }
+    Pattern::new(4 * n, 4 * n, &positions)
 }
 
 #[cfg(test)]
