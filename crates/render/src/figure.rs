@@ -3,7 +3,7 @@
 
 use std::borrow::Cow;
 
-use beltrami_mesh::{Point3, Vector2};
+use beltrami_mesh::{Mesh, Point3, Vector2};
 
 use crate::colormap::INK;
 use crate::scene::{Layout, Scene};
@@ -93,48 +93,7 @@ pub fn render(scene: &Scene<'_>, style: &Style) -> Result<Picture, RenderError> 
     let mesh = scene.mesh();
     let distortion = scene.distortion();
     let coloring = coloring(scene, style)?;
-    let source_flat = || -> Result<Cow<'_, [Vector2<f64>]>, RenderError> {
-        let xy: Vec<Vector2<f64>> = mesh
-            .positions()
-            .iter()
-            .map(|p| Vector2::new(p.x, p.y))
-            .collect();
-        match Layout::plane_from_vertices(mesh, &xy)? {
-            Layout::Plane(c) => Ok(Cow::Owned(c)),
-            Layout::Space(_) => unreachable!("plane_from_vertices makes a planar layout"),
-        }
-    };
-    let panels: Vec<(Panel<'_>, &str)> = match style.view {
-        View::Uv => match scene.image() {
-            Some(Layout::Plane(c)) => {
-                vec![(Panel::Flat(Cow::Borrowed(c)), "parameter domain (uv)")]
-            }
-            None if scene.planar_source() => vec![(Panel::Flat(source_flat()?), "mesh (plane)")],
-            _ => {
-                return Err(RenderError::Missing(
-                    "the uv view needs texture coordinates (vt): give a map into the plane".into(),
-                ));
-            }
-        },
-        View::Surface => match scene.image() {
-            Some(Layout::Space(p)) => vec![(Panel::Surface(p), "image (3D)")],
-            _ => vec![(Panel::Surface(mesh.positions()), "surface (3D)")],
-        },
-        View::Both => {
-            let Some(image) = scene.image() else {
-                return Err(RenderError::Missing(
-                    "the side-by-side view needs a map: texture coordinates (vt) or mapped positions"
-                        .into(),
-                ));
-            };
-            let source = if scene.planar_source() {
-                (Panel::Flat(source_flat()?), "source (plane)")
-            } else {
-                (Panel::Surface(mesh.positions()), "source (3D)")
-            };
-            vec![source, image_panel(image)]
-        }
-    };
+    let panels = panels(scene, style.view)?;
 
     let size = style.size;
     let mut picture = Picture::new(size);
@@ -215,6 +174,61 @@ pub fn render(scene: &Scene<'_>, style: &Style) -> Result<Picture, RenderError> 
         scale,
     );
     Ok(picture)
+}
+
+/// The panels of `view` for `scene`, left to right, with their titles; fails when the
+/// view needs a map the scene does not have.
+fn panels<'s>(
+    scene: &'s Scene<'_>,
+    view: View,
+) -> Result<Vec<(Panel<'s>, &'static str)>, RenderError> {
+    let mesh = scene.mesh();
+    Ok(match view {
+        View::Uv => match scene.image() {
+            Some(Layout::Plane(c)) => {
+                vec![(Panel::Flat(Cow::Borrowed(c)), "parameter domain (uv)")]
+            }
+            None if scene.planar_source() => {
+                vec![(Panel::Flat(source_flat(mesh)?), "mesh (plane)")]
+            }
+            _ => {
+                return Err(RenderError::Missing(
+                    "the uv view needs texture coordinates (vt): give a map into the plane".into(),
+                ));
+            }
+        },
+        View::Surface => match scene.image() {
+            Some(Layout::Space(p)) => vec![(Panel::Surface(p), "image (3D)")],
+            _ => vec![(Panel::Surface(mesh.positions()), "surface (3D)")],
+        },
+        View::Both => {
+            let Some(image) = scene.image() else {
+                return Err(RenderError::Missing(
+                    "the side-by-side view needs a map: texture coordinates (vt) or mapped positions"
+                        .into(),
+                ));
+            };
+            let source = if scene.planar_source() {
+                (Panel::Flat(source_flat(mesh)?), "source (plane)")
+            } else {
+                (Panel::Surface(mesh.positions()), "source (3D)")
+            };
+            vec![source, image_panel(image)]
+        }
+    })
+}
+
+/// The mesh, lying in the plane z = 0, as a planar layout of its vertices' `(x, y)`.
+fn source_flat(mesh: &Mesh) -> Result<Cow<'static, [Vector2<f64>]>, RenderError> {
+    let xy: Vec<Vector2<f64>> = mesh
+        .positions()
+        .iter()
+        .map(|p| Vector2::new(p.x, p.y))
+        .collect();
+    match Layout::plane_from_vertices(mesh, &xy)? {
+        Layout::Plane(c) => Ok(Cow::Owned(c)),
+        Layout::Space(_) => unreachable!("plane_from_vertices makes a planar layout"),
+    }
 }
 
 /// The panel of a map's image and its title.

@@ -3,6 +3,8 @@
 //! (or of source area) per bar in percent, and a separate red bar for the values at or
 //! beyond the top of the range (with the default range, the flipped and collapsed faces).
 
+use beltrami_fem::distortion::DistortionStats;
+
 use crate::colorbar::tick_label;
 use crate::colormap::{INK, MuRange, WARNING};
 use crate::legend::number;
@@ -142,6 +144,90 @@ fn nice_step(max: f64) -> f64 {
         .unwrap_or(10.0 * power)
 }
 
+/// Where the parts of a histogram go, in pixels: the plot area `[left, right] x [top,
+/// bottom]` (y down), the beyond bar right of it, and the text scale.
+struct HistogramLayout {
+    /// Text magnification: one per 400 pixels of the shorter side.
+    scale: u32,
+    /// `scale` as a pixel multiplier.
+    k: i64,
+    /// Height of a text line.
+    line: i64,
+    /// Width of the axis strokes: one per 600 pixels of the shorter side, at least 1.
+    unit: f32,
+    left: i64,
+    top: i64,
+    bottom: i64,
+    right: i64,
+    /// Width of the beyond bar.
+    beyond_width: i64,
+    plot_w: f64,
+    plot_h: f64,
+}
+
+impl HistogramLayout {
+    /// The layout of a picture of `size`: room for the y labels on the left, the x labels
+    /// and axis title below, the title above and the beyond bar on the right. `None` when
+    /// no plot area is left.
+    fn new(size: Size) -> Option<Self> {
+        let short = size.width().min(size.height());
+        let scale = (short / 400).max(1);
+        let k = i64::from(scale);
+        let line = text::height(scale);
+        let unit = (short as f32 / 600.0).max(1.0);
+        let left = text::width("100.0%", scale) + 6 * k;
+        let top = 3 * line;
+        let bottom = i64::from(size.height()) - 5 * line;
+        let beyond_width = (i64::from(size.width()) / 14).max(4 * line);
+        let right = i64::from(size.width()) - beyond_width - 4 * line;
+        if right <= left || bottom <= top {
+            return None;
+        }
+        let (plot_w, plot_h) = ((right - left) as f64, (bottom - top) as f64);
+        Some(Self {
+            scale,
+            k,
+            line,
+            unit,
+            left,
+            top,
+            bottom,
+            right,
+            beyond_width,
+            plot_w,
+            plot_h,
+        })
+    }
+}
+
+/// The vertical scale of the bars: fractions `0..=top_value` over the plot's height,
+/// with a grid line every `step`.
+struct ValueAxis {
+    step: f64,
+    top_value: f64,
+}
+
+impl ValueAxis {
+    /// A nice step for the highest bar (the beyond bar included) and the first multiple
+    /// of it at or above the highest bar (at least one step).
+    fn new(bars: &Bars) -> Self {
+        let peak = bars
+            .fractions
+            .iter()
+            .copied()
+            .chain([bars.beyond])
+            .fold(0.0, f64::max);
+        let step = nice_step(if peak > 0.0 { peak } else { 1.0 });
+        let top_value = (peak / step).ceil().max(1.0) * step;
+        Self { step, top_value }
+    }
+
+    /// The picture row of fraction `v`: `bottom - v / top_value * plot_h`.
+    fn y_of(&self, layout: &HistogramLayout, v: f64) -> f64 {
+        layout.bottom as f64 - v / self.top_value * layout.plot_h
+    }
+}
+
 /// Draws the histogram of `distortion`'s `|mu|` in `style`.
 pub fn render_histogram(
     distortion: &FaceDistortion,
@@ -154,45 +240,39 @@ pub fn render_histogram(
     let bars = Bars::new(&distortion.modulus, weights, style.bins, style.range)?;
     let size = style.size;
     let mut picture = Picture::new(size);
-    let short = size.width().min(size.height());
-    let scale = (short / 400).max(1);
-    let k = i64::from(scale);
-    let line = text::height(scale);
-    let unit = (short as f32 / 600.0).max(1.0);
-
-    // Plot area: room for the y labels on the left, the x labels and axis title below,
-    // the title above and the beyond bar on the right.
-    let left = text::width("100.0%", scale) + 6 * k;
-    let top = 3 * line;
-    let bottom = i64::from(size.height()) - 5 * line;
-    let beyond_width = (i64::from(size.width()) / 14).max(4 * line);
-    let right = i64::from(size.width()) - beyond_width - 4 * line;
-    if right <= left || bottom <= top {
+    let Some(layout) = HistogramLayout::new(size) else {
         return Ok(picture);
-    }
-    let (plot_w, plot_h) = ((right - left) as f64, (bottom - top) as f64);
+    };
 
     let what = match style.weighting {
         Weighting::Faces => "faces",
         Weighting::Area => "area",
     };
     let title = format!("|\u{b5}| histogram ({} bins, share of {what})", style.bins);
-    picture.text(left, line, &title, scale, INK);
+    picture.text(layout.left, layout.line, &title, layout.scale, INK);
 
-    let peak = bars
-        .fractions
-        .iter()
-        .copied()
-        .chain([bars.beyond])
-        .fold(0.0, f64::max);
-    let step = nice_step(if peak > 0.0 { peak } else { 1.0 });
-    let top_value = (peak / step).ceil().max(1.0) * step;
-    let y_of = |v: f64| bottom as f64 - v / top_value * plot_h;
+    let axis = ValueAxis::new(&bars);
+    draw_grid(&mut picture, &layout, &axis);
+    draw_bars(&mut picture, &layout, &axis, &bars);
+    draw_axes(&mut picture, &layout, &bars);
+    draw_legend(&mut picture, &layout, size, &distortion.stats, &bars);
+    Ok(picture)
+}
 
-    // Grid lines and y labels (percent).
+/// Draws the horizontal grid lines and their labels (percent), from 0 up to the top
+/// value.
+fn draw_grid(picture: &mut Picture, layout: &HistogramLayout, axis: &ValueAxis) {
+    let HistogramLayout {
+        scale,
+        k,
+        line,
+        left,
+        right,
+        ..
+    } = *layout;
     let mut v = 0.0;
-    while v <= top_value * (1.0 + 1e-9) {
-        let y = y_of(v) as f32;
+    while v <= axis.top_value * (1.0 + 1e-9) {
+        let y = axis.y_of(layout, v) as f32;
         picture.stroke(
             &[vec![[left as f32, y], [right as f32, y]]],
             1.0,
@@ -202,10 +282,23 @@ pub fn render_histogram(
         let label = format!("{}%", tick_label(100.0 * v));
         let w = text::width(&label, scale);
         picture.text(left - w - 4 * k, y as i64 - line / 2, &label, scale, INK);
-        v += step;
+        v += axis.step;
     }
+}
 
-    // Bars.
+/// Draws the bars colored by the `|mu|` at their centers, then the beyond bar and its
+/// label in the warning color.
+fn draw_bars(picture: &mut Picture, layout: &HistogramLayout, axis: &ValueAxis, bars: &Bars) {
+    let HistogramLayout {
+        scale,
+        line,
+        left,
+        bottom,
+        right,
+        beyond_width,
+        plot_w,
+        ..
+    } = *layout;
     let n = bars.fractions.len();
     let bar_w = plot_w / n as f64;
     for (i, &f) in bars.fractions.iter().enumerate() {
@@ -214,7 +307,7 @@ pub fn render_histogram(
         }
         let center = bars.range.lo + (i as f64 + 0.5) * (bars.range.hi - bars.range.lo) / n as f64;
         let x0 = left as f64 + i as f64 * bar_w;
-        let y = y_of(f);
+        let y = axis.y_of(layout, f);
         let gap = if bar_w > 4.0 { 1.0 } else { 0.0 };
         picture.fill_rect(
             x0 as f32,
@@ -224,10 +317,9 @@ pub fn render_histogram(
             bars.range.color(center),
         );
     }
-    // The beyond bar.
     let bx = right + 2 * line;
     if bars.beyond > 0.0 {
-        let y = y_of(bars.beyond);
+        let y = axis.y_of(layout, bars.beyond);
         picture.fill_rect(
             bx as f32,
             y as f32,
@@ -244,8 +336,22 @@ pub fn render_histogram(
         scale,
         WARNING,
     );
+}
 
-    // Axes, x ticks and labels.
+/// Draws the axes, six x ticks with their `|mu|` labels, and the x axis title.
+fn draw_axes(picture: &mut Picture, layout: &HistogramLayout, bars: &Bars) {
+    let HistogramLayout {
+        scale,
+        k,
+        line,
+        unit,
+        left,
+        top,
+        bottom,
+        right,
+        plot_w,
+        ..
+    } = *layout;
     let axes = vec![
         [left as f32, top as f32],
         [left as f32, bottom as f32],
@@ -276,9 +382,25 @@ pub fn render_histogram(
         scale,
         INK,
     );
+}
 
-    // Legend.
-    let s = &distortion.stats;
+/// Draws the legend along the bottom edge: face and flipped counts (the latter in the
+/// warning color when nonzero), the mean, max and area-weighted L2 of `|mu|`, and the
+/// share below the range when there is one.
+fn draw_legend(
+    picture: &mut Picture,
+    layout: &HistogramLayout,
+    size: Size,
+    s: &DistortionStats,
+    bars: &Bars,
+) {
+    let HistogramLayout {
+        scale,
+        k,
+        line,
+        left,
+        ..
+    } = *layout;
     let mut items = vec![
         format!("faces {}", s.faces),
         format!("flipped {}", s.flipped),
@@ -303,5 +425,4 @@ pub fn render_histogram(
         };
         x += picture.text(x, y, item, scale, color) + 2 * text::GLYPH * k;
     }
-    Ok(picture)
 }
