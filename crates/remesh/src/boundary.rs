@@ -79,14 +79,16 @@ pub fn sample(
     }
     let is_node = |v: VertexId| degree.get(&original(v).0) != Some(&2);
 
-    let mut out = BoundarySamples {
-        points: Vec::new(),
-        vertex: Vec::new(),
-        vertex_count: 0,
-        edges: Vec::new(),
+    let mut sampling = Sampling {
+        out: BoundarySamples {
+            points: Vec::new(),
+            vertex: Vec::new(),
+            vertex_count: 0,
+            edges: Vec::new(),
+        },
+        ids: HashMap::new(),
+        chains: HashMap::new(),
     };
-    let mut ids: HashMap<SeamPoint, u32> = HashMap::new();
-    let mut chains: HashMap<Vec<u32>, (usize, usize)> = HashMap::new();
     for b in chart.boundary_loops() {
         let mut hs: Vec<HalfedgeId> = chart.loop_halfedges(b).collect();
         let start = hs
@@ -98,7 +100,7 @@ pub fn sample(
                     .unwrap_or(0)
             });
         hs.rotate_left(start);
-        let first = out.points.len();
+        let first = sampling.out.points.len();
         let mut run: Vec<HalfedgeId> = Vec::new();
         for (i, &h) in hs.iter().enumerate() {
             run.push(h);
@@ -118,26 +120,32 @@ pub fn sample(
                     pieces.push(run.clone());
                 }
                 for piece in &pieces {
-                    sample_run(
-                        chart,
-                        uv,
-                        &original,
-                        piece,
-                        &spacing,
-                        &mut chains,
-                        &mut ids,
-                        &mut out,
-                    );
+                    sample_run(chart, uv, &original, piece, &spacing, &mut sampling);
                 }
                 run.clear();
             }
         }
-        let count = out.points.len() - first;
-        out.edges
+        let count = sampling.out.points.len() - first;
+        sampling
+            .out
+            .edges
             .extend((0..count).map(|i| [first + i, first + (i + 1) % count]));
     }
-    out.vertex_count = ids.len();
+    let mut out = sampling.out;
+    out.vertex_count = sampling.ids.len();
     out
+}
+
+/// What sampling the runs builds up, run after run.
+struct Sampling {
+    /// The samples so far (their vertex count is set at the end).
+    out: BoundarySamples,
+    /// The result vertex of each seam point sampled so far.
+    ids: HashMap<SeamPoint, u32>,
+    /// The chains met so far, keyed by their surface vertex sequence in their own
+    /// direction (the lexicographically smaller of the two): their index and number of
+    /// pieces, which every later copy reuses.
+    chains: HashMap<Vec<u32>, (usize, usize)>,
 }
 
 /// The lengths of the edges of `run`, their sum and the number of pieces the run is
@@ -226,17 +234,15 @@ fn split_at_corners(
 }
 
 /// Adds the samples of one run (all but its last point, which starts the next run).
-#[allow(clippy::too_many_arguments)]
 fn sample_run(
     chart: &Mesh,
     uv: &[Complex64],
     original: &impl Fn(VertexId) -> VertexId,
     run: &[HalfedgeId],
     spacing: &impl Fn(VertexId) -> f64,
-    chains: &mut HashMap<Vec<u32>, (usize, usize)>,
-    ids: &mut HashMap<SeamPoint, u32>,
-    out: &mut BoundarySamples,
+    sampling: &mut Sampling,
 ) {
+    let Sampling { out, ids, chains } = sampling;
     let mut sequence: Vec<u32> = run.iter().map(|&h| original(chart.origin(h)).0).collect();
     sequence.push(original(chart.target(run[run.len() - 1])).0);
     let reversed: Vec<u32> = sequence.iter().rev().copied().collect();

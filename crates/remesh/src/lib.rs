@@ -345,9 +345,7 @@ pub(crate) fn triangulate_chart(
         &samples,
         &inner,
         &size_at,
-        options.min_angle,
-        options.max_vertices,
-        options.feature_tolerance,
+        options,
         parameterizer,
         context,
     )?;

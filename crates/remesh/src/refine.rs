@@ -47,9 +47,9 @@ use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation as _,
 };
 
-use crate::RemeshError;
 use crate::boundary::BoundarySamples;
 use crate::domain::{Domain, cross};
+use crate::{RemeshError, RemeshOptions};
 
 /// Longest lifted edge, relative to the asked length, that is not split.
 const ALPHA: f64 = 1.65;
@@ -82,22 +82,22 @@ pub struct Triangulation {
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 /// Triangulates and refines the domain (module docs). `size(p)` is the asked edge
-/// length at surface point `p` of the chart; `min_angle` in degrees. `inner` lists the
-/// interior vertices of the chart as their parameter point and surface position;
-/// `tolerance` is the feature tolerance relative to the asked length (the module docs'
-/// `0.2`, [`crate::RemeshOptions::feature_tolerance`]).
-#[allow(clippy::too_many_arguments)]
+/// length at surface point `p` of the chart. `inner` lists the interior vertices of the
+/// chart as their parameter point and surface position. Of `options`, three count:
+/// [`RemeshOptions::min_angle`] (degrees), [`RemeshOptions::max_vertices`] and
+/// [`RemeshOptions::feature_tolerance`] (relative to the asked length, the module docs'
+/// `0.2`).
 pub fn triangulate(
     domain: &Domain<'_>,
     samples: &BoundarySamples,
     inner: &[(Complex64, Point3<f64>)],
     size: &impl Fn(&SurfacePoint) -> f64,
-    min_angle: f64,
-    max_vertices: usize,
-    tolerance: f64,
+    options: &RemeshOptions,
     solver: &'static str,
     context: &mut Context<'_>,
 ) -> Result<Triangulation, RemeshError> {
+    let (min_angle, max_vertices) = (options.min_angle, options.max_vertices);
+    let tolerance = options.feature_tolerance;
     let mut cdt = load(&samples.points, &samples.edges, solver)?;
     let mut tri = Triangulation {
         uv: Vec::with_capacity(samples.points.len()),
@@ -123,35 +123,7 @@ pub fn triangulate(
             return Err(RemeshError::Cancelled);
         }
         tri.passes = pass + 1;
-        let inside = inside_faces(&cdt);
-        // (circumradius in the plane, point to insert)
-        let mut wanted: Vec<(f64, Complex64)> = Vec::new();
-        for face in cdt.inner_faces() {
-            if !inside[face.fix().index()] {
-                continue;
-            }
-            let idx = face.vertices().map(|v| v.fix().index());
-            let h = idx.iter().map(|&i| tri.size[i]).sum::<f64>() / 3.0;
-            let p = idx.map(|i| tri.position[i]);
-            let longest = (0..3)
-                .map(|k| (p[(k + 1) % 3] - p[k]).norm())
-                .fold(0.0, f64::max);
-            let too_long = longest > ALPHA * h;
-            let skinny = longest > h && smallest_sine(&p) < sin_limit;
-            if !(too_long || skinny) {
-                continue;
-            }
-            let z = idx.map(|i| tri.uv[i]);
-            let (c, r) = frontal_point(&z, &p, h);
-            let hint = Some(tri.on_chart[idx[0]].face);
-            let q = if c.is_finite() && domain.lift(c, hint)?.is_some() {
-                c
-            } else {
-                let m = face.center();
-                Complex64::new(m.x, m.y)
-            };
-            wanted.push((r, q));
-        }
+        let mut wanted = oversized_faces(&cdt, &tri, domain, sin_limit)?;
         wanted.sort_by(|a, b| b.0.total_cmp(&a.0));
         let mut inserted = insert_all(&mut cdt, &mut tri, domain, size, wanted, false)?;
         if inserted == 0 {
@@ -199,6 +171,48 @@ pub fn triangulate(
         }
     }
     Ok(tri)
+}
+
+/// The points a size pass inserts, as `(circumradius in the plane, point)`, in face
+/// order: one per inner face that is too long (its longest edge on the surface over
+/// `ALPHA` times the mean asked length `h` at its corners) or skinny (longer than `h`,
+/// the sine of its smallest angle below `sin_limit`). The point is the frontal point of
+/// the face when it is finite and lifts onto the chart, else the face's center.
+fn oversized_faces(
+    cdt: &Cdt,
+    tri: &Triangulation,
+    domain: &Domain<'_>,
+    sin_limit: f64,
+) -> Result<Vec<(f64, Complex64)>, RemeshError> {
+    let inside = inside_faces(cdt);
+    let mut wanted: Vec<(f64, Complex64)> = Vec::new();
+    for face in cdt.inner_faces() {
+        if !inside[face.fix().index()] {
+            continue;
+        }
+        let idx = face.vertices().map(|v| v.fix().index());
+        let h = idx.iter().map(|&i| tri.size[i]).sum::<f64>() / 3.0;
+        let p = idx.map(|i| tri.position[i]);
+        let longest = (0..3)
+            .map(|k| (p[(k + 1) % 3] - p[k]).norm())
+            .fold(0.0, f64::max);
+        let too_long = longest > ALPHA * h;
+        let skinny = longest > h && smallest_sine(&p) < sin_limit;
+        if !(too_long || skinny) {
+            continue;
+        }
+        let z = idx.map(|i| tri.uv[i]);
+        let (c, r) = frontal_point(&z, &p, h);
+        let hint = Some(tri.on_chart[idx[0]].face);
+        let q = if c.is_finite() && domain.lift(c, hint)?.is_some() {
+            c
+        } else {
+            let m = face.center();
+            Complex64::new(m.x, m.y)
+        };
+        wanted.push((r, q));
+    }
+    Ok(wanted)
 }
 
 /// Rounds of the feature check after the smoothing at most (each inserts the input
