@@ -78,7 +78,7 @@ use crate::measure::{
 };
 use crate::system::{Flow, FlowInput, FlowSystem};
 use crate::target::{Role, TargetGeometry};
-use crate::untangle::untangle;
+use crate::untangle::{UntangleRounds, untangle};
 
 /// Rounds of the untangling of a trial step's flips (item 3).
 const REPAIR_ROUNDS: usize = 4;
@@ -324,23 +324,33 @@ fn first_fold(
     first
 }
 
+/// An image of the source vertices with the target's normals there and its image faces.
+#[derive(Clone, Copy)]
+struct ImageView<'a> {
+    image: &'a [Point3<f64>],
+    normals: &'a [Vector3<f64>],
+    faces: &'a [ImageFace],
+}
+
 /// How much the faces `near` (from [`first_fold`]) alone raise `E` when their corners
-/// move by `t V` (before any projection onto the target, at the present normals);
-/// `None` when one of them turns over (the trial itself decides then). `probe` is
-/// scratch as long as `image`: only the near faces' corners are read from it, each
-/// written first and put back to `image` afterwards.
-#[allow(clippy::too_many_arguments)]
+/// move by `t V` (before any projection onto the target, at the present normals of
+/// `map`); `None` when one of them turns over (the trial itself decides then). `probe`
+/// is scratch as long as `map.image`: only the near faces' corners are read from it,
+/// each written first and put back to `map.image` afterwards.
 fn near_fold_rise(
     elements: &Elements,
     objective: &Objective,
-    faces: &[ImageFace],
+    map: ImageView<'_>,
     near: &[(f64, usize)],
-    image: &[Point3<f64>],
-    normals: &[Vector3<f64>],
     flow: &[Vector3<f64>],
     t: f64,
     probe: &mut Vec<Point3<f64>>,
 ) -> Option<f64> {
+    let ImageView {
+        image,
+        normals,
+        faces,
+    } = map;
     if probe.len() != image.len() {
         probe.clear();
         probe.extend_from_slice(image);
@@ -387,11 +397,24 @@ fn smallest_positive_root(c0: f64, c1: f64, c2: f64) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// `P(Y + t V)`: the stepped images, projected by role onto `target` moved by the
-/// offsets `t delta`, the boundary's projection spread into the interior
-/// ([`HarmonicExtension`]) before the interior is projected. A curve vertex slides
-/// along its curve by `t V` ([`TargetGeometry::slide`]).
-#[allow(clippy::too_many_arguments)]
+/// A trial step's map and the scratch of its making, kept from trial to trial.
+#[derive(Default)]
+struct Trial {
+    /// The stepped images.
+    image: Vec<Point3<f64>>,
+    /// The target's normals at them.
+    normals: Vec<Vector3<f64>>,
+    /// Their image faces.
+    faces: Vec<ImageFace>,
+    /// The moves of the curve vertices by their slides (zero elsewhere), which the
+    /// harmonic extension spreads into the interior.
+    delta: Vec<Vector3<f64>>,
+}
+
+/// `P(Y + t V)`: the stepped images (into `trial`'s images and normals), projected by
+/// role onto `target` moved by the offsets `t delta`, the boundary's projection spread
+/// into the interior ([`HarmonicExtension`]) before the interior is projected. A curve
+/// vertex slides along its curve by `t V` ([`TargetGeometry::slide`]).
 fn step<G: TargetGeometry>(
     target: &G,
     roles: &[Role],
@@ -399,10 +422,14 @@ fn step<G: TargetGeometry>(
     flow: &Flow,
     t: f64,
     extension: Option<&mut HarmonicExtension>,
-    delta: &mut Vec<Vector3<f64>>,
-    out: &mut Vec<Point3<f64>>,
-    normals: &mut Vec<Vector3<f64>>,
+    trial: &mut Trial,
 ) -> Result<G, SolverError> {
+    let Trial {
+        image: out,
+        normals,
+        delta,
+        ..
+    } = trial;
     let mut moved = target.clone();
     for (c, &d) in flow.offset.iter().enumerate() {
         if d != 0.0 {
@@ -432,108 +459,208 @@ fn step<G: TargetGeometry>(
     Ok(moved)
 }
 
-/// Runs the flow from `image` (one point per source vertex, projected onto `target`
-/// first) with the unknowns of `system`, for `objective` measured on the source
-/// `elements`. A system that served an earlier run serves again (its first solve
-/// factors afresh); the run's work counts only its own.
-#[allow(clippy::too_many_arguments)]
-pub fn run<G: TargetGeometry>(
-    elements: &Elements,
-    mut target: G,
-    system: &mut FlowSystem,
-    mut image: Vec<Point3<f64>>,
-    goals: &[Option<Point3<f64>>],
-    objective: &Objective,
-    options: FlowOptions,
-    context: &mut Context<'_>,
-) -> Result<FlowRun<G>, SolverError> {
-    system.forget_factorization();
-    let (factorizations, cg_iterations) = system.work();
-    // Fixed vertices pulled towards a goal move by a known flow and are projected onto
-    // the target like free ones.
-    let pulled: Vec<bool> = (0..image.len())
-        .map(|v| goals.get(v).is_some_and(|g| g.is_some()))
-        .collect();
-    let step_roles: Vec<Role> = system
-        .roles()
-        .iter()
-        .zip(&pulled)
-        .map(|(&role, &pulled)| if pulled { Role::Free } else { role })
-        .collect();
-    let mut prescribed = vec![Vector3::zeros(); image.len()];
-    let triangles: Vec<[usize; 3]> = (0..elements.face_count())
-        .map(|f| triangle(elements, FaceId(f as u32)).map(|v| v.idx()))
-        .collect();
-    let mut extension = if target.curved() {
-        HarmonicExtension::new(
-            &triangles,
-            system.roles(),
-            target.correction_rings(),
-            options.solve,
-        )?
-    } else {
-        None
-    };
-    let mut delta = Vec::new();
-    let mut normals = Vec::new();
-    target.project_all(system.roles(), None, &mut image, &mut normals)?;
-    let mut faces = Vec::with_capacity(elements.face_count());
-    image_faces(elements, &normals, &image, &mut faces, options.threads);
-    let (mut energy, mut flipped) = objective.evaluate(&faces, options.threads);
-    let mut energy_history = vec![energy];
-    let (mut step_sizes, mut updates) = (Vec::new(), Vec::new());
-    let (mut weights, mut rho) = (Vec::new(), Vec::new());
-    let mut flow = Flow::default();
-    let (mut trial, mut trial_faces, mut trial_normals) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut near, mut probe) = (Vec::new(), Vec::new());
-    let report = |context: &mut Context<'_>, done: usize, energy: f64| {
-        context.report(&Progress {
-            stage: "flow",
-            done,
-            total: Some(options.max_iterations),
-            energy: Some(energy),
-        });
-    };
-    report(context, 0, energy);
-    let mut stop = Stop::IterationLimit;
-    let (mut solve_seconds, mut step_seconds) = (0.0, 0.0);
-    for iteration in 0..options.max_iterations {
-        if context.is_cancelled() {
-            stop = Stop::Cancelled;
-            break;
+/// What a flow run minimizes: `objective`, measured on the source `elements`, with
+/// `goals` pulling fixed vertices (one per source vertex, `None` for a vertex without
+/// one; an empty list for none at all).
+#[derive(Clone, Copy)]
+pub struct FlowProblem<'a> {
+    /// The source's elements.
+    pub elements: &'a Elements,
+    /// The error `E` the flow decreases.
+    pub objective: &'a Objective,
+    /// The goal of each fixed vertex that a known flow pulls towards one.
+    pub goals: &'a [Option<Point3<f64>>],
+}
+
+/// The goals of a run that pull fixed vertices (landmarks away from their place).
+struct Pull<'a> {
+    goals: &'a [Option<Point3<f64>>],
+    /// Per vertex, whether a goal pulls it.
+    pulled: Vec<bool>,
+    /// The flow prescribed to the pulled vertices (zero elsewhere).
+    prescribed: Vec<Vector3<f64>>,
+}
+
+impl<'a> Pull<'a> {
+    /// The goals of the `vertices` source vertices.
+    fn new(goals: &'a [Option<Point3<f64>>], vertices: usize) -> Self {
+        let pulled: Vec<bool> = (0..vertices)
+            .map(|v| goals.get(v).is_some_and(|g| g.is_some()))
+            .collect();
+        Self {
+            goals,
+            pulled,
+            prescribed: vec![Vector3::zeros(); vertices],
         }
-        let clock = Instant::now();
-        weights_and_targets(objective, &faces, &mut weights, &mut rho);
-        // While a landmark is away from its goal, a step that brings it closer is
-        // accepted even if the distortion grows (the constraint comes first).
+    }
+
+    /// The roles in a step: fixed vertices pulled towards a goal move by a known flow
+    /// and are projected onto the target like free ones.
+    fn step_roles(&self, roles: &[Role]) -> Vec<Role> {
+        roles
+            .iter()
+            .zip(&self.pulled)
+            .map(|(&role, &pulled)| if pulled { Role::Free } else { role })
+            .collect()
+    }
+
+    /// Prescribes to `system` the flow of each pulled vertex: the tangential part (at
+    /// `normals`) of its way from `image` to its goal; the projection brings the point
+    /// back. True while one of them is `tolerance` or farther from its goal: then a
+    /// step that brings it closer is accepted even if the distortion grows (the
+    /// constraint comes first).
+    fn prescribe(
+        &mut self,
+        image: &[Point3<f64>],
+        normals: &[Vector3<f64>],
+        tolerance: f64,
+        system: &mut FlowSystem,
+    ) -> Result<bool, SolverError> {
         let mut pulling = false;
-        if pulled.iter().any(|&p| p) {
-            for (v, goal) in goals.iter().enumerate() {
+        if self.pulled.iter().any(|&p| p) {
+            for (v, goal) in self.goals.iter().enumerate() {
                 if let Some(goal) = goal {
                     let d = goal - image[v];
-                    pulling |= d.norm() >= options.tolerance;
-                    // The tangential part: the projection brings the point back.
-                    prescribed[v] = d - normals[v] * normals[v].dot(&d);
+                    pulling |= d.norm() >= tolerance;
+                    self.prescribed[v] = d - normals[v] * normals[v].dot(&d);
                 }
             }
-            system.set_prescribed(&prescribed)?;
+            system.set_prescribed(&self.prescribed)?;
         }
-        system.solve(
-            FlowInput {
-                elements,
-                target: &target,
-                image: &image,
-                normals: &normals,
-                faces: &faces,
-                weights: &weights,
-                rho: &rho,
-            },
-            &mut flow,
-        )?;
-        solve_seconds += clock.elapsed().as_secs_f64();
-        let clock = Instant::now();
-        let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
-        target.prepare_step(&image)?;
+        Ok(pulling)
+    }
+}
+
+/// The map a run has accepted last: the target it lies on (a free annulus radius
+/// moves), the images, the target's normals there, the image faces, and their `E`
+/// and flips.
+struct Accepted<G> {
+    target: G,
+    image: Vec<Point3<f64>>,
+    normals: Vec<Vector3<f64>>,
+    faces: Vec<ImageFace>,
+    energy: f64,
+    flipped: usize,
+}
+
+impl<G: TargetGeometry> Accepted<G> {
+    /// The start of a run: `image` projected onto `target` by `roles`, measured.
+    fn start(
+        problem: FlowProblem<'_>,
+        target: G,
+        mut image: Vec<Point3<f64>>,
+        roles: &[Role],
+        threads: usize,
+    ) -> Result<Self, SolverError> {
+        let mut normals = Vec::new();
+        target.project_all(roles, None, &mut image, &mut normals)?;
+        let mut faces = Vec::with_capacity(problem.elements.face_count());
+        image_faces(problem.elements, &normals, &image, &mut faces, threads);
+        let (energy, flipped) = problem.objective.evaluate(&faces, threads);
+        Ok(Self {
+            target,
+            image,
+            normals,
+            faces,
+            energy,
+            flipped,
+        })
+    }
+
+    /// The images, normals and faces.
+    fn view(&self) -> ImageView<'_> {
+        ImageView {
+            image: &self.image,
+            normals: &self.normals,
+            faces: &self.faces,
+        }
+    }
+
+    /// Takes the step found: its target, `E` and flips, and the map in `trial` (which
+    /// gets the buffers of the map it replaces, to be overwritten by the next trial).
+    fn take(&mut self, step: FoundStep<G>, trial: &mut Trial) {
+        self.target = step.target;
+        std::mem::swap(&mut self.image, &mut trial.image);
+        std::mem::swap(&mut self.faces, &mut trial.faces);
+        std::mem::swap(&mut self.normals, &mut trial.normals);
+        (self.energy, self.flipped) = (step.energy, step.flips);
+    }
+}
+
+/// The step a search accepts: the target moved with it, its `E`, flips and size `t`
+/// (its map is the search's trial).
+struct FoundStep<G> {
+    target: G,
+    energy: f64,
+    flips: usize,
+    t: f64,
+}
+
+/// The step-size search of a run (module docs, item 3): what stays the same through the
+/// run and the scratch of its trials.
+struct StepSearch<'a> {
+    problem: FlowProblem<'a>,
+    options: FlowOptions,
+    /// Roles in the steps ([`Pull::step_roles`]).
+    step_roles: Vec<Role>,
+    /// The spread of the curve vertices' slides into the interior, on curved targets
+    /// with curve vertices.
+    extension: Option<HarmonicExtension>,
+    trial: Trial,
+    /// The faces near the first fold ([`first_fold`]).
+    near: Vec<(f64, usize)>,
+    /// Scratch of [`near_fold_rise`].
+    probe: Vec<Point3<f64>>,
+}
+
+impl<'a> StepSearch<'a> {
+    /// The search of a run onto `target` with unknowns of `roles` (curve vertices slide,
+    /// and on a curved target their slides spread into the interior) and steps moving
+    /// the vertices by `step_roles`.
+    fn new<G: TargetGeometry>(
+        problem: FlowProblem<'a>,
+        options: FlowOptions,
+        target: &G,
+        roles: &[Role],
+        step_roles: Vec<Role>,
+    ) -> Result<Self, SolverError> {
+        let extension = if target.curved() {
+            HarmonicExtension::new(
+                &crate::system::triangles(problem.elements),
+                roles,
+                target.correction_rings(),
+                options.solve,
+            )?
+        } else {
+            None
+        };
+        Ok(Self {
+            problem,
+            options,
+            step_roles,
+            extension,
+            trial: Trial::default(),
+            near: Vec::new(),
+            probe: Vec::new(),
+        })
+    }
+
+    /// Tries the step sizes `first 2^-j` (`first` keeps the largest move within
+    /// `max_move`), usable while `t max |V|` is at least the tolerance and `t` at least
+    /// the smallest step: from the first below the predicted fold, skipping it when the
+    /// near faces alone already raise `E` more than the model's decrease (a size the
+    /// pull of a landmark does not need), then the larger ones; then, if asked, all of
+    /// them again with each trial's new flips untangled. The first trial with no more
+    /// flips than `map` and a lower `E` (any `E` while `pulling`) is the step.
+    fn search<G: TargetGeometry>(
+        &mut self,
+        system: &FlowSystem,
+        map: &Accepted<G>,
+        flow: &Flow,
+        largest: f64,
+        pulling: bool,
+    ) -> Result<Option<FoundStep<G>>, SolverError> {
+        let options = self.options;
         let first = if largest > options.max_move {
             options.max_move / largest
         } else {
@@ -544,83 +671,177 @@ pub fn run<G: TargetGeometry>(
             let t = ladder(halvings);
             t * largest >= options.tolerance && t >= options.min_step
         };
-        let fold = first_fold(elements, &faces, &flow.vertex, &image, &normals, &mut near);
+        let elements = self.problem.elements;
+        let fold = first_fold(
+            elements,
+            &map.faces,
+            &flow.vertex,
+            &map.image,
+            &map.normals,
+            &mut self.near,
+        );
         let below_fold = (0..MAX_HALVINGS)
             .find(|&j| ladder(j) < fold)
             .unwrap_or(MAX_HALVINGS);
         // The plain search, then (item 3) the search that untangles a trial's flips.
-        let mut accepted = None;
         for repair in [false, true] {
             if repair && !options.untangle_trials {
                 break;
             }
             let start = if repair { 0 } else { below_fold };
-            let mut sizes = (start..)
+            let sizes = (start..)
                 .take_while(usable)
                 .chain((0..start).filter(usable));
-            accepted = loop {
-                let Some(j) = sizes.next() else {
-                    break None;
-                };
+            for j in sizes {
                 let t = ladder(j);
                 if !repair && !pulling && j == start && start > 0 {
                     let rise = near_fold_rise(
                         elements,
-                        objective,
-                        &faces,
-                        &near,
-                        &image,
-                        &normals,
+                        self.problem.objective,
+                        map.view(),
+                        &self.near,
                         &flow.vertex,
                         t,
-                        &mut probe,
+                        &mut self.probe,
                     );
                     if rise.is_some_and(|rise| rise > (2.0 * t - t * t) * system.model_decrease()) {
                         continue;
                     }
                 }
-                let moved = step(
-                    &target,
-                    &step_roles,
-                    &image,
-                    &flow,
-                    t,
-                    extension.as_mut(),
-                    &mut delta,
-                    &mut trial,
-                    &mut trial_normals,
-                )?;
-                image_faces(
-                    elements,
-                    &trial_normals,
-                    &trial,
-                    &mut trial_faces,
-                    options.threads,
-                );
-                let (mut e, mut flips) = objective.evaluate(&trial_faces, options.threads);
-                if repair && flips > flipped {
-                    untangle(
-                        elements,
-                        &moved,
-                        system.roles(),
-                        &mut trial,
-                        &mut trial_normals,
-                        &mut trial_faces,
-                        REPAIR_ROUNDS,
-                        Some(&image),
-                    );
-                    (e, flips) = objective.evaluate(&trial_faces, options.threads);
+                let (moved, e, flips) = self.trial(system, map, flow, t, repair)?;
+                if flips <= map.flipped && (pulling || e < map.energy) {
+                    return Ok(Some(FoundStep {
+                        target: moved,
+                        energy: e,
+                        flips,
+                        t,
+                    }));
                 }
-                if flips <= flipped && (pulling || e < energy) {
-                    break Some((moved, e, flips, t));
-                }
-            };
-            if accepted.is_some() {
-                break;
             }
         }
+        Ok(None)
+    }
+
+    /// The trial step of size `t` from `map` into `self.trial`, measured: returns the
+    /// moved target, `E` and the flips. With `repair`, a trial with more flips than
+    /// `map` has them untangled first (each vertex trying its image in `map` first),
+    /// and is measured again.
+    fn trial<G: TargetGeometry>(
+        &mut self,
+        system: &FlowSystem,
+        map: &Accepted<G>,
+        flow: &Flow,
+        t: f64,
+        repair: bool,
+    ) -> Result<(G, f64, usize), SolverError> {
+        let FlowProblem {
+            elements,
+            objective,
+            ..
+        } = self.problem;
+        let threads = self.options.threads;
+        let moved = step(
+            &map.target,
+            &self.step_roles,
+            &map.image,
+            flow,
+            t,
+            self.extension.as_mut(),
+            &mut self.trial,
+        )?;
+        let trial = &mut self.trial;
+        image_faces(
+            elements,
+            &trial.normals,
+            &trial.image,
+            &mut trial.faces,
+            threads,
+        );
+        let (mut e, mut flips) = objective.evaluate(&trial.faces, threads);
+        if repair && flips > map.flipped {
+            untangle(
+                elements,
+                &moved,
+                system.roles(),
+                &mut trial.image,
+                &mut trial.normals,
+                &mut trial.faces,
+                UntangleRounds {
+                    rounds: REPAIR_ROUNDS,
+                    previous: Some(&map.image),
+                },
+            );
+            (e, flips) = objective.evaluate(&trial.faces, threads);
+        }
+        Ok((moved, e, flips))
+    }
+}
+
+/// Runs the flow from `image` (one point per source vertex, projected onto `target`
+/// first) with the unknowns of `system`, for `problem`'s objective measured on its
+/// source elements. A system that served an earlier run serves again (its first solve
+/// factors afresh); the run's work counts only its own.
+pub fn run<G: TargetGeometry>(
+    problem: FlowProblem<'_>,
+    target: G,
+    system: &mut FlowSystem,
+    image: Vec<Point3<f64>>,
+    options: FlowOptions,
+    context: &mut Context<'_>,
+) -> Result<FlowRun<G>, SolverError> {
+    let FlowProblem {
+        elements,
+        objective,
+        goals,
+    } = problem;
+    system.forget_factorization();
+    let (factorizations, cg_iterations) = system.work();
+    let mut pull = Pull::new(goals, image.len());
+    let step_roles = pull.step_roles(system.roles());
+    let mut search = StepSearch::new(problem, options, &target, system.roles(), step_roles)?;
+    let mut map = Accepted::start(problem, target, image, system.roles(), options.threads)?;
+    let mut energy_history = vec![map.energy];
+    let (mut step_sizes, mut updates) = (Vec::new(), Vec::new());
+    let (mut weights, mut rho) = (Vec::new(), Vec::new());
+    let mut flow = Flow::default();
+    let report = |context: &mut Context<'_>, done: usize, energy: f64| {
+        context.report(&Progress {
+            stage: "flow",
+            done,
+            total: Some(options.max_iterations),
+            energy: Some(energy),
+        });
+    };
+    report(context, 0, map.energy);
+    let mut stop = Stop::IterationLimit;
+    let (mut solve_seconds, mut step_seconds) = (0.0, 0.0);
+    for iteration in 0..options.max_iterations {
+        if context.is_cancelled() {
+            stop = Stop::Cancelled;
+            break;
+        }
+        let clock = Instant::now();
+        weights_and_targets(objective, &map.faces, &mut weights, &mut rho);
+        let pulling = pull.prescribe(&map.image, &map.normals, options.tolerance, system)?;
+        system.solve(
+            FlowInput {
+                elements,
+                target: &map.target,
+                image: &map.image,
+                normals: &map.normals,
+                faces: &map.faces,
+                weights: &weights,
+                rho: &rho,
+            },
+            &mut flow,
+        )?;
+        solve_seconds += clock.elapsed().as_secs_f64();
+        let clock = Instant::now();
+        let largest = flow.vertex.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        map.target.prepare_step(&map.image)?;
+        let accepted = search.search(system, &map, &flow, largest, pulling)?;
         step_seconds += clock.elapsed().as_secs_f64();
-        let Some((moved, e, flips, t)) = accepted else {
+        let Some(found) = accepted else {
             stop = if largest < options.tolerance {
                 Stop::Converged
             } else {
@@ -628,15 +849,12 @@ pub fn run<G: TargetGeometry>(
             };
             break;
         };
-        target = moved;
-        std::mem::swap(&mut image, &mut trial);
-        std::mem::swap(&mut faces, &mut trial_faces);
-        std::mem::swap(&mut normals, &mut trial_normals);
-        (energy, flipped) = (e, flips);
-        energy_history.push(energy);
+        let t = found.t;
+        map.take(found, &mut search.trial);
+        energy_history.push(map.energy);
         step_sizes.push(t);
         updates.push(t * largest);
-        report(context, iteration + 1, energy);
+        report(context, iteration + 1, map.energy);
         if t * largest < options.tolerance {
             stop = Stop::Converged;
             break;
@@ -647,9 +865,9 @@ pub fn run<G: TargetGeometry>(
         }
     }
     Ok(FlowRun {
-        image,
-        target,
-        faces,
+        image: map.image,
+        target: map.target,
+        faces: map.faces,
         energy_history,
         step_sizes,
         updates,
@@ -1009,9 +1227,12 @@ mod tests {
         assert!(near.windows(2).all(|w| w[0].0 <= w[1].0));
         let mut probe = Vec::new();
         let mut rise = |t: f64| {
-            near_fold_rise(
-                &elements, &objective, &faces, &near, &image, &normals, &flow, t, &mut probe,
-            )
+            let map = ImageView {
+                image: &image,
+                normals: &normals,
+                faces: &faces,
+            };
+            near_fold_rise(&elements, &objective, map, &near, &flow, t, &mut probe)
         };
         let (early, late) = (rise(0.05).unwrap(), rise(0.45).unwrap());
         assert!(early > 0.0 && late > 100.0 * early, "{early:e}, {late:e}");
@@ -1043,13 +1264,16 @@ mod tests {
         };
         let target = crate::target::UnitDisk;
         let flow_from = |system: &mut FlowSystem| {
+            let problem = FlowProblem {
+                elements: &elements,
+                objective: &objective,
+                goals: &[],
+            };
             run(
-                &elements,
+                problem,
                 target,
                 system,
                 image.clone(),
-                &[],
-                &objective,
                 options,
                 &mut Context::new(),
             )

@@ -8,18 +8,18 @@ use beltrami_core::{
     Target, TargetKind, Topology,
 };
 use beltrami_fem::{BeltramiField, DistortionStats, Elements, Frame, MuError};
-use beltrami_mesh::{Point3, VertexId};
+use beltrami_mesh::{Mesh, Point3, VertexId};
 use beltrami_sparse::SolveOptions;
 use beltrami_spatial::SurfaceIndex;
 use num_complex::Complex64;
 
-use crate::flow::{self, FlatRule, FlowOptions, FlowRun, Stop};
+use crate::flow::{self, FlatRule, FlowOptions, FlowProblem, FlowRun, Stop};
 use crate::measure::{Barrier, ImageFace, Objective, image_faces};
 use crate::mesh_target::MeshTarget;
 use crate::setup::{Domain, curve_roles, diagonal, domain, goals, mesh_roles, pins, region_roles};
 use crate::system::{FlowSystem, VertexOrder};
 use crate::target::{INNER, OUTER, Role, TargetGeometry};
-use crate::untangle::{Untangled, untangle, untangle_patches};
+use crate::untangle::{UntangleRounds, Untangled, untangle, untangle_patches};
 use crate::validate::{invalid, validate};
 
 /// The flow's options.
@@ -155,7 +155,6 @@ pub fn solve(
         threads,
         ..SolveOptions::default()
     };
-    let planar = !matches!(problem.target, Target::Sphere);
     let runner = Runner {
         elements: &elements,
         objective: &objective,
@@ -176,147 +175,17 @@ pub fn solve(
                 names.join(", ")
             ));
     }
-    if let Target::Mesh(target) = &problem.target {
-        let index = context.stage("target index", &mut report, || {
-            SurfaceIndex::new(target)
-                .map(|index| index.with_threads(step_threads))
-                .map_err(|e| invalid(format!("the target mesh: {e}")))
-        })?;
-        let (curves, roles) = mesh_roles(problem, target, &initial, &pins)?;
-        let geometry = MeshTarget::new(&index, curves);
-        let scale = diagonal(target.positions());
-        // The flow takes no step that flips a face, so from a map without flips it keeps
-        // none: a flipped initial map is untangled first. From the flipped start itself
-        // the flow ended no lower on 6 of the 10 registration pairs of docs/register.md
-        // and took up to four times as long (the bent 100K `g4_fertility` pair: 54 s
-        // against 14 s, its flow dragging a flipped face's neighbours the wrong way past
-        // a fixed landmark for 55 steps); it stays the fallback when flips remain.
-        let faces = mesh_image_faces(&elements, &geometry, &initial);
-        let flipped_start = faces.iter().any(ImageFace::flipped);
-        // One symbolic factorization serves every flow below (the roles do not change).
-        let mut system = runner.system(&geometry, &initial, roles.clone(), context, &mut report)?;
-        let mut run = runner.run_on_mesh(
-            &mut system,
-            &geometry,
-            &roles,
-            initial.clone(),
-            scale,
-            flipped_start.then_some(faces),
+    let (map, faces_mu, flipped) = if let Target::Mesh(target) = &problem.target {
+        runner.solve_on_mesh(target, initial, &pins, context, (&mut report, &mut metrics))?
+    } else {
+        runner.solve_on_domain(
+            initial,
+            &pins,
             context,
             (&mut report, &mut metrics),
-        )?;
-        let left = |run: &FlowRun<MeshTarget<'_>>| run.faces.iter().filter(|f| f.flipped()).count();
-        let first = left(&run);
-        if first > 0 && flipped_start && !context.is_cancelled() {
-            let again = runner.run_on_mesh(
-                &mut system,
-                &geometry,
-                &roles,
-                initial,
-                scale,
-                None,
-                context,
-                (&mut report, &mut metrics),
-            )?;
-            let second = left(&again);
-            let better =
-                second < first || (second == first && again.final_energy() < run.final_energy());
-            report.notes.push(format!(
-                "the flow from the initial map untangled first left {first} flipped faces; from the initial map as it was, {second}: kept the {}",
-                if better { "second" } else { "first" }
-            ));
-            if better {
-                run = again;
-            }
-        }
-        // The last resort for the faces still flipped: their patches untangled at once,
-        // then the flow again from there (kept with fewer flips, or as few and lower).
-        let before = left(&run);
-        if before > 0 && !context.is_cancelled() {
-            let mut image = run.image.clone();
-            let mut faces = run.faces.clone();
-            let mut normals: Vec<_> = image.iter().map(|p| geometry.normal(p)).collect();
-            let done = untangle_patches(
-                &elements,
-                &geometry,
-                &roles,
-                &mut image,
-                &mut normals,
-                &mut faces,
-            );
-            report.notes.push(format!(
-                "untangled the {} faces the flow left flipped to {} by moving {} vertices of the patches around them at once",
-                done.before, done.after, done.moves
-            ));
-            if done.after < done.before {
-                let again = runner.run_on_mesh(
-                    &mut system,
-                    &geometry,
-                    &roles,
-                    image,
-                    scale,
-                    None,
-                    context,
-                    (&mut report, &mut metrics),
-                )?;
-                let after = left(&again);
-                let kept = after < before
-                    || (after == before && again.final_energy() < run.final_energy());
-                report.notes.push(format!(
-                    "the flow from the untangled patches left {after} flipped faces: kept {}",
-                    if kept { "it" } else { "the map before" }
-                ));
-                if kept {
-                    run = again;
-                }
-            }
-        }
-        let points = geometry.locate_all(&run.image)?;
-        let (_, faces_mu, flipped) = run.finish(false);
-        return finish_solution(
-            (report, metrics, extras),
-            goal.frame,
-            &objective,
-            faces_mu,
-            &flipped,
-            Map::OnMesh(points),
-        );
-    }
-    let domain = domain(problem, &initial)?;
-    let image = initial;
-    let outcome = match domain {
-        Domain::Region(g) => {
-            let scale = diagonal(&image);
-            let roles = region_roles(mesh, &g, &image, &pins);
-            runner
-                .run(g, roles, image, scale, context, (&mut report, &mut metrics))?
-                .finish(planar)
-        }
-        Domain::Disk(g) => {
-            let roles = curve_roles(mesh, &pins, |_| 0);
-            runner
-                .run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?
-                .finish(planar)
-        }
-        Domain::Annulus(g, outer) => {
-            let roles = curve_roles(mesh, &pins, |l| if l == outer { OUTER } else { INNER });
-            let run = runner.run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?;
-            if g.free_inner {
-                extras.annulus_radius = Some(AnnulusRadius {
-                    radius: run.target.inner_radius,
-                    initial: g.inner_radius,
-                });
-            }
-            run.finish(planar)
-        }
-        Domain::Sphere(g) => {
-            let roles = curve_roles(mesh, &pins, |_| 0);
-            runner
-                .run(g, roles, image, 1.0, context, (&mut report, &mut metrics))?
-                .finish(planar)
-        }
+            &mut extras,
+        )?
     };
-    let (map, faces_mu, flipped) = outcome;
     finish_solution(
         (report, metrics, extras),
         goal.frame,
@@ -325,6 +194,11 @@ pub fn solve(
         &flipped,
         map,
     )
+}
+
+/// The number of faces `run` leaves flipped.
+fn flipped_faces(run: &FlowRun<MeshTarget<'_>>) -> usize {
+    run.faces.iter().filter(|f| f.flipped()).count()
 }
 
 /// Whether the error fell by at least [`STILL_FALLING`] of itself over the last
@@ -395,8 +269,10 @@ fn untangle_noted(
         image,
         &mut normals,
         faces,
-        UNTANGLE_ROUNDS,
-        None,
+        UntangleRounds {
+            rounds: UNTANGLE_ROUNDS,
+            previous: None,
+        },
     );
     report.notes.push(format!(
         "untangled {}{which} faces to {} by moving {} vertices into the kernels of their stars",
@@ -469,23 +345,197 @@ struct Runner<'a, 'p> {
     vertex_order: Option<&'a VertexOrder>,
 }
 
+/// What the flows onto a target mesh in one solve share besides their unknowns: the
+/// target, the roles of the source's vertices, and the target's bounding-box diagonal
+/// (the tolerances are relative to it).
+struct MeshFlow<'a, 't> {
+    geometry: &'a MeshTarget<'t>,
+    roles: &'a [Role],
+    scale: f64,
+}
+
+/// The map a solve found, ready for [`finish_solution`]: the map, the per-face `mu`
+/// and flip flags.
+type Outcome = (Map, Vec<Complex64>, Vec<bool>);
+
 impl Runner<'_, '_> {
+    /// Flows `initial` on the target mesh `target` (pinning `pins`): from the initial
+    /// map untangled first when it has flips, and from it as it was if that leaves
+    /// flips ([`Runner::run_on_mesh`]); then the patches of the faces still flipped
+    /// ([`Runner::untangle_patches_and_flow`]).
+    fn solve_on_mesh(
+        &self,
+        target: &Mesh,
+        initial: Vec<Point3<f64>>,
+        pins: &[VertexId],
+        context: &mut Context<'_>,
+        (report, metrics): (&mut Report, &mut Metrics),
+    ) -> Result<Outcome, SolverError> {
+        let index = context.stage("target index", report, || {
+            SurfaceIndex::new(target)
+                .map(|index| index.with_threads(self.step_threads))
+                .map_err(|e| invalid(format!("the target mesh: {e}")))
+        })?;
+        let (curves, roles) = mesh_roles(self.problem, target, &initial, pins)?;
+        let geometry = MeshTarget::new(&index, curves);
+        let scale = diagonal(target.positions());
+        // The flow takes no step that flips a face, so from a map without flips it keeps
+        // none: a flipped initial map is untangled first. From the flipped start itself
+        // the flow ended no lower on 6 of the 10 registration pairs of docs/register.md
+        // and took up to four times as long (the bent 100K `g4_fertility` pair: 54 s
+        // against 14 s, its flow dragging a flipped face's neighbours the wrong way past
+        // a fixed landmark for 55 steps); it stays the fallback when flips remain.
+        let faces = mesh_image_faces(self.elements, &geometry, &initial);
+        let flipped_start = faces.iter().any(ImageFace::flipped);
+        // One symbolic factorization serves every flow below (the roles do not change).
+        let mut system = self.system(&geometry, &initial, roles.clone(), context, report)?;
+        let mesh = MeshFlow {
+            geometry: &geometry,
+            roles: &roles,
+            scale,
+        };
+        let mut run = self.run_on_mesh(
+            &mut system,
+            &mesh,
+            initial.clone(),
+            flipped_start.then_some(faces),
+            context,
+            (report, metrics),
+        )?;
+        let first = flipped_faces(&run);
+        if first > 0 && flipped_start && !context.is_cancelled() {
+            let again = self.run_on_mesh(
+                &mut system,
+                &mesh,
+                initial,
+                None,
+                context,
+                (report, metrics),
+            )?;
+            let second = flipped_faces(&again);
+            let better =
+                second < first || (second == first && again.final_energy() < run.final_energy());
+            report.notes.push(format!(
+                "the flow from the initial map untangled first left {first} flipped faces; from the initial map as it was, {second}: kept the {}",
+                if better { "second" } else { "first" }
+            ));
+            if better {
+                run = again;
+            }
+        }
+        let run =
+            self.untangle_patches_and_flow(&mut system, &mesh, run, context, (report, metrics))?;
+        let points = geometry.locate_all(&run.image)?;
+        let (_, faces_mu, flipped) = run.finish(false);
+        Ok((Map::OnMesh(points), faces_mu, flipped))
+    }
+
+    /// The last resort for the faces `run` leaves flipped: their patches untangled at
+    /// once, then the flow again from there, kept with fewer flips, or as few and a
+    /// lower error; `run` otherwise.
+    fn untangle_patches_and_flow<'t>(
+        &self,
+        system: &mut FlowSystem,
+        mesh: &MeshFlow<'_, 't>,
+        run: FlowRun<MeshTarget<'t>>,
+        context: &mut Context<'_>,
+        (report, metrics): (&mut Report, &mut Metrics),
+    ) -> Result<FlowRun<MeshTarget<'t>>, SolverError> {
+        let before = flipped_faces(&run);
+        if before == 0 || context.is_cancelled() {
+            return Ok(run);
+        }
+        let mut image = run.image.clone();
+        let mut faces = run.faces.clone();
+        let mut normals: Vec<_> = image.iter().map(|p| mesh.geometry.normal(p)).collect();
+        let done = untangle_patches(
+            self.elements,
+            mesh.geometry,
+            mesh.roles,
+            &mut image,
+            &mut normals,
+            &mut faces,
+        );
+        report.notes.push(format!(
+            "untangled the {} faces the flow left flipped to {} by moving {} vertices of the patches around them at once",
+            done.before, done.after, done.moves
+        ));
+        if done.after >= done.before {
+            return Ok(run);
+        }
+        let again = self.run_on_mesh(system, mesh, image, None, context, (report, metrics))?;
+        let after = flipped_faces(&again);
+        let kept = after < before || (after == before && again.final_energy() < run.final_energy());
+        report.notes.push(format!(
+            "the flow from the untangled patches left {after} flipped faces: kept {}",
+            if kept { "it" } else { "the map before" }
+        ));
+        Ok(if kept { again } else { run })
+    }
+
+    /// Flows `initial` on the region, disk, annulus or sphere of the problem's target
+    /// (pinning `pins`); a free inner radius of an annulus goes to `extras`.
+    fn solve_on_domain(
+        &self,
+        initial: Vec<Point3<f64>>,
+        pins: &[VertexId],
+        context: &mut Context<'_>,
+        (report, metrics): (&mut Report, &mut Metrics),
+        extras: &mut Extras,
+    ) -> Result<Outcome, SolverError> {
+        let (problem, mesh) = (self.problem, self.problem.source);
+        let planar = !matches!(problem.target, Target::Sphere);
+        let domain = domain(problem, &initial)?;
+        let image = initial;
+        Ok(match domain {
+            Domain::Region(g) => {
+                let scale = diagonal(&image);
+                let roles = region_roles(mesh, &g, &image, pins);
+                self.run(g, roles, image, scale, context, (report, metrics))?
+                    .finish(planar)
+            }
+            Domain::Disk(g) => {
+                let roles = curve_roles(mesh, pins, |_| 0);
+                self.run(g, roles, image, 1.0, context, (report, metrics))?
+                    .finish(planar)
+            }
+            Domain::Annulus(g, outer) => {
+                let roles = curve_roles(mesh, pins, |l| if l == outer { OUTER } else { INNER });
+                let run = self.run(g, roles, image, 1.0, context, (report, metrics))?;
+                if g.free_inner {
+                    extras.annulus_radius = Some(AnnulusRadius {
+                        radius: run.target.inner_radius,
+                        initial: g.inner_radius,
+                    });
+                }
+                run.finish(planar)
+            }
+            Domain::Sphere(g) => {
+                let roles = curve_roles(mesh, pins, |_| 0);
+                self.run(g, roles, image, 1.0, context, (report, metrics))?
+                    .finish(planar)
+            }
+        })
+    }
+
     /// Runs the flow on a target mesh from `image`, untangling its flips (the image's
     /// before the flow when `untangle_first` gives its image faces) and flowing again
     /// while the untangling removes some ([`UNTANGLE_RESTARTS`] times at most), every
-    /// flow with the unknowns of `system` (built for `roles`).
-    #[allow(clippy::too_many_arguments)]
+    /// flow with the unknowns of `system` (built for `mesh.roles`).
     fn run_on_mesh<'t>(
         &self,
         system: &mut FlowSystem,
-        geometry: &MeshTarget<'t>,
-        roles: &[Role],
+        mesh: &MeshFlow<'_, 't>,
         mut image: Vec<Point3<f64>>,
-        scale: f64,
         untangle_first: Option<Vec<ImageFace>>,
         context: &mut Context<'_>,
         (report, metrics): (&mut Report, &mut Metrics),
     ) -> Result<FlowRun<MeshTarget<'t>>, SolverError> {
+        let MeshFlow {
+            geometry,
+            roles,
+            scale,
+        } = *mesh;
         let elements = self.elements;
         // The first flow may untangle the flips of its trial steps: a sliver near a fold
         // blocks every step size otherwise. The flows after an untangling go without:
@@ -627,17 +677,35 @@ impl Runner<'_, '_> {
         context: &mut Context<'_>,
         (report, metrics): (&mut Report, &mut Metrics),
     ) -> Result<FlowRun<G>, SolverError> {
-        let (elements, objective, problem, settings, options) = (
-            self.elements,
-            self.objective,
-            self.problem,
-            self.settings,
-            self.options,
-        );
-        let flow_options = FlowOptions {
+        let (elements, objective, problem) = (self.elements, self.objective, self.problem);
+        let flow_options = self.flow_options(scale);
+        let run = report.time("flow", || {
+            flow::run(
+                FlowProblem {
+                    elements,
+                    objective,
+                    goals: &goals(problem),
+                },
+                target,
+                system,
+                image,
+                flow_options,
+                context,
+            )
+        });
+        let run = run.map_err(undetermined)?;
+        record_run(&run, &flow_options, report, metrics);
+        Ok(run)
+    }
+
+    /// The options of a flow from the settings, with the tolerance and (on a target
+    /// mesh) the largest move relative to `scale`.
+    fn flow_options(&self, scale: f64) -> FlowOptions {
+        let (problem, settings) = (self.problem, self.settings);
+        FlowOptions {
             tolerance: settings.float("tolerance") * scale,
             max_iterations: settings.int("max-iters"),
-            solve: options,
+            solve: self.options,
             max_move: if matches!(problem.target, Target::Mesh(_)) {
                 settings.float("max-move") * scale
             } else {
@@ -650,46 +718,58 @@ impl Runner<'_, '_> {
                 Target::Sphere | Target::Mesh(_) => FlatRule::CURVED,
                 _ => FlatRule::PLANAR,
             },
-        };
-        let run = report.time("flow", || {
-        flow::run(
-            elements,
-            target,
-            system,
-            image,
-            &goals(problem),
-            objective,
-            flow_options,
-            context,
-        )
-    })
-    .map_err(|e| match e {
-        SolverError::Solve(beltrami_sparse::SolveError::Singular { .. } | beltrami_sparse::SolveError::NotPositiveDefinite { .. }) => invalid(
+        }
+    }
+}
+
+/// A singular or indefinite flow system: too few vertices are pinned, which the error
+/// says; other errors pass unchanged.
+fn undetermined(e: SolverError) -> SolverError {
+    match e {
+        SolverError::Solve(
+            beltrami_sparse::SolveError::Singular { .. }
+            | beltrami_sparse::SolveError::NotPositiveDefinite { .. },
+        ) => invalid(
             "the flow is not determined: pin more vertices (disk: one interior and one boundary vertex; annulus: one boundary vertex; sphere: three vertices)",
         ),
         e => e,
-    })?;
-        report
-            .timings
-            .push(("flow: solves".into(), run.solve_seconds));
-        report
-            .timings
-            .push(("flow: steps".into(), run.step_seconds));
-        // A restarted flow (after untangling) continues the history of the first.
-        metrics.iterations += run.iterations();
-        metrics.factorizations = Some(metrics.factorizations.unwrap_or(0) + run.factorizations);
-        metrics.cg_iterations = Some(metrics.cg_iterations.unwrap_or(0) + run.cg_iterations);
-        metrics.energy_history.extend(&run.energy_history);
-        metrics.step_sizes.extend(&run.step_sizes);
-        metrics.stop = Some(match run.stop {
-            Stop::Converged => beltrami_core::Stop::Converged {
-                tolerance: flow_options.tolerance,
-            },
-            Stop::Stalled | Stop::Flat => beltrami_core::Stop::Stalled,
-            Stop::IterationLimit => beltrami_core::Stop::IterationLimit,
-            Stop::Cancelled => beltrami_core::Stop::Cancelled,
-        });
-        report.notes.push(match run.stop {
+    }
+}
+
+/// Records `run` (made with `flow_options`): its timings and stop note in `report`, its
+/// work, history and stop in `metrics` (a restarted flow, after untangling, continues
+/// the history of the first).
+fn record_run<G>(
+    run: &FlowRun<G>,
+    flow_options: &FlowOptions,
+    report: &mut Report,
+    metrics: &mut Metrics,
+) {
+    report
+        .timings
+        .push(("flow: solves".into(), run.solve_seconds));
+    report
+        .timings
+        .push(("flow: steps".into(), run.step_seconds));
+    metrics.iterations += run.iterations();
+    metrics.factorizations = Some(metrics.factorizations.unwrap_or(0) + run.factorizations);
+    metrics.cg_iterations = Some(metrics.cg_iterations.unwrap_or(0) + run.cg_iterations);
+    metrics.energy_history.extend(&run.energy_history);
+    metrics.step_sizes.extend(&run.step_sizes);
+    metrics.stop = Some(match run.stop {
+        Stop::Converged => beltrami_core::Stop::Converged {
+            tolerance: flow_options.tolerance,
+        },
+        Stop::Stalled | Stop::Flat => beltrami_core::Stop::Stalled,
+        Stop::IterationLimit => beltrami_core::Stop::IterationLimit,
+        Stop::Cancelled => beltrami_core::Stop::Cancelled,
+    });
+    report.notes.push(stop_note(run, flow_options));
+}
+
+/// What the report says about why `run` (made with `flow_options`) stopped.
+fn stop_note<G>(run: &FlowRun<G>, flow_options: &FlowOptions) -> String {
+    match run.stop {
         Stop::Converged => format!(
             "converged after {} iterations: largest vertex update below {:.1e}",
             run.iterations(),
@@ -719,8 +799,6 @@ impl Runner<'_, '_> {
             "cancelled after {} iterations: the map is the best one so far",
             run.iterations()
         ),
-    });
-        Ok(run)
     }
 }
 

@@ -256,31 +256,7 @@ impl FlowSystem {
         roles: Vec<Role>,
         (options, order): (SolveOptions, &VertexOrder),
     ) -> Result<Self, SolverError> {
-        let mut builder = DofBuilder::<f64>::new(roles.len(), 3)?;
-        let origin = [0.0; 3];
-        for (v, &role) in roles.iter().enumerate() {
-            let count = match role {
-                Role::Free => 2,
-                Role::Curve(_) => 1,
-                Role::Fixed => 0,
-            };
-            builder.span(VertexId::from_usize(v), &origin, &AXES[..count])?;
-        }
-        let mut offset = vec![None; target.curve_count()];
-        for (&role, p) in roles.iter().zip(image) {
-            if let Role::Curve(c) = role
-                && offset[c].is_none()
-                && target.curve_offset_direction(c, p).is_some()
-            {
-                let members = roles
-                    .iter()
-                    .enumerate()
-                    .filter(|&(_, &r)| r == role)
-                    .map(|(v, _)| (VertexId::from_usize(v), AXES[1]));
-                offset[c] = Some(builder.unknown(members)?);
-            }
-        }
-        let dofs = builder.build()?;
+        let (dofs, offset) = declare_unknowns(target, image, &roles)?;
         let n = dofs.reduced_len();
         if n == 0 {
             return Err(SolverError::InvalidInput {
@@ -288,50 +264,13 @@ impl FlowSystem {
                 message: "every vertex is fixed: there is nothing to flow".into(),
             });
         }
-        // The local unknowns of each face in the order its vertices' terms name them
-        // (each vertex's own unknowns, then an offset not met yet), and its terms.
-        // A face has at most 6 local unknowns and terms (two per vertex; a shared offset
-        // replaces a vertex's own), so at most 21 lower-triangle entries.
-        let mut local_ptr = Vec::with_capacity(faces.len() + 1);
-        let mut term_ptr = Vec::with_capacity(faces.len() + 1);
-        local_ptr.push(0);
-        term_ptr.push(0);
-        let mut local = Vec::with_capacity(6 * faces.len());
-        let mut face_terms = Vec::with_capacity(6 * faces.len());
-        let mut positions = Vec::with_capacity(21 * faces.len() + n);
-        for face in &faces {
-            let start = local.len();
-            for (k, &v) in face.iter().enumerate() {
-                for (term, t) in dofs.node_terms(VertexId::from_usize(v))? {
-                    let at = match local[start..].iter().position(|&d| d == t.dof) {
-                        Some(at) => at,
-                        None => {
-                            local.push(t.dof);
-                            local.len() - start - 1
-                        }
-                    };
-                    let term = u32::try_from(term).map_err(|_| SolverError::InvalidInput {
-                        solver: crate::NAME,
-                        message: format!("{term} flow terms exceed the u32 index range"),
-                    })?;
-                    // At most three vertices with two terms each: the casts are exact.
-                    face_terms.push(FaceTerm {
-                        k: k as u8,
-                        local: at as u8,
-                        term,
-                    });
-                }
-            }
-            let list = &local[start..];
-            for a in 0..list.len() {
-                for b in 0..=a {
-                    let (da, db) = (list[a], list[b]);
-                    positions.push((da.max(db), da.min(db)));
-                }
-            }
-            local_ptr.push(local.len());
-            term_ptr.push(face_terms.len());
-        }
+        let FaceLayout {
+            local_ptr,
+            local,
+            term_ptr,
+            face_terms,
+            mut positions,
+        } = FaceLayout::new(&faces, &dofs)?;
         let longest = local_ptr.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0);
         let faces_end = positions.len();
         positions.extend((0..n).map(|i| (i, i)));
@@ -600,6 +539,59 @@ impl FlowSystem {
         flow: &mut Flow,
         turned: usize,
     ) -> Result<(), SolverError> {
+        self.refill_directions(at.target, at.image, at.normals)?;
+        self.assemble_normal_equations(at);
+        let values = self.matrix.val_mut();
+        if self.damping > 0.0 {
+            let mean =
+                self.diagonal.iter().map(|&d| values[d]).sum::<f64>() / self.diagonal.len() as f64;
+            let lambda = self.damping * mean;
+            for &d in &self.diagonal {
+                values[d] += lambda;
+            }
+        }
+        for v in 0..self.roles.len() {
+            if self.contact[v] {
+                // The held unknown has no direction, so its row and column are empty:
+                // the diagonal entry of its vertex's other unknown keeps the scale.
+                let [along, held] = self.free_unknowns(v)?;
+                let values = self.matrix.val_mut();
+                values[self.diagonal[held]] = values[self.diagonal[along]];
+            }
+        }
+        self.rhs_before.clear();
+        self.rhs_before.extend_from_slice(&self.rhs);
+        match self.solve_normal_equations(turned) {
+            Err(SolverError::Solve(SolveError::Singular { .. })) if self.damping > 0.0 => {
+                let values = self.matrix.val_mut();
+                for &d in &self.diagonal {
+                    values[d] *= 1.0 + OWN_DAMPING;
+                }
+                self.solve_normal_equations(turned)?;
+            }
+            outcome => outcome?,
+        }
+        self.dofs.expand_into(&self.rhs, &mut self.flow)?;
+        flow.vertex.clear();
+        flow.vertex.extend(
+            self.flow
+                .chunks_exact(3)
+                .map(|v| Vector3::new(v[0], v[1], v[2])),
+        );
+        flow.offset.clear();
+        flow.offset
+            .extend(self.offset.iter().map(|o| o.map_or(0.0, |o| self.rhs[o])));
+        Ok(())
+    }
+
+    /// Fills the right-hand side and the normal matrix (lower triangle) of `E_V` at
+    /// `at`, face by face, with the tilt penalty ([`FlowSystem::set_tilt_penalty`]):
+    /// face `T` with weight `w_T`, coefficients `beta_a` of its local unknowns in
+    /// `V_zbar(T)` and known part `rho_T` (less the prescribed flow's share) adds
+    /// `w_T Re(conj(beta_a) rho_T)` to the right-hand side and
+    /// `w_T Re(conj(beta_a) beta_b)` to the matrix. The directions are those
+    /// [`FlowSystem::refill_directions`] stated for `at`.
+    fn assemble_normal_equations<G: TargetGeometry>(&mut self, at: FlowInput<'_, G>) {
         let FlowInput {
             elements,
             target,
@@ -609,7 +601,6 @@ impl FlowSystem {
             weights,
             rho,
         } = at;
-        self.refill_directions(target, image, normals)?;
         self.rhs.iter_mut().for_each(|r| *r = 0.0);
         let values = self.matrix.val_mut();
         values.iter_mut().for_each(|v| *v = 0.0);
@@ -686,46 +677,6 @@ impl FlowSystem {
                 }
             }
         }
-        if self.damping > 0.0 {
-            let mean =
-                self.diagonal.iter().map(|&d| values[d]).sum::<f64>() / self.diagonal.len() as f64;
-            let lambda = self.damping * mean;
-            for &d in &self.diagonal {
-                values[d] += lambda;
-            }
-        }
-        for v in 0..self.roles.len() {
-            if self.contact[v] {
-                // The held unknown has no direction, so its row and column are empty:
-                // the diagonal entry of its vertex's other unknown keeps the scale.
-                let [along, held] = self.free_unknowns(v)?;
-                let values = self.matrix.val_mut();
-                values[self.diagonal[held]] = values[self.diagonal[along]];
-            }
-        }
-        self.rhs_before.clear();
-        self.rhs_before.extend_from_slice(&self.rhs);
-        match self.solve_normal_equations(turned) {
-            Err(SolverError::Solve(SolveError::Singular { .. })) if self.damping > 0.0 => {
-                let values = self.matrix.val_mut();
-                for &d in &self.diagonal {
-                    values[d] *= 1.0 + OWN_DAMPING;
-                }
-                self.solve_normal_equations(turned)?;
-            }
-            outcome => outcome?,
-        }
-        self.dofs.expand_into(&self.rhs, &mut self.flow)?;
-        flow.vertex.clear();
-        flow.vertex.extend(
-            self.flow
-                .chunks_exact(3)
-                .map(|v| Vector3::new(v[0], v[1], v[2])),
-        );
-        flow.offset.clear();
-        flow.offset
-            .extend(self.offset.iter().map(|o| o.map_or(0.0, |o| self.rhs[o])));
-        Ok(())
     }
 
     /// States the directions of the current image in the DOF map: the tangent basis of
@@ -890,6 +841,113 @@ fn area_rates(
 /// Vertex count from which the flow's normal equations may be factored in two sides at
 /// once ([`two_core_order`]); below it one thread factors the whole.
 const TWO_SIDES_FROM: usize = 20_000;
+
+/// Declares the flow's unknowns for `roles` on `target` (the order of
+/// [`FlowSystem::new`]): two per free vertex, one per curve vertex, then one per curve
+/// with a free offset at `image`, in the order its first vertex comes. Returns the DOF
+/// map and each curve's offset unknown.
+fn declare_unknowns<G: TargetGeometry>(
+    target: &G,
+    image: &[Point3<f64>],
+    roles: &[Role],
+) -> Result<(DofMap<f64>, Vec<Option<usize>>), SolverError> {
+    let mut builder = DofBuilder::<f64>::new(roles.len(), 3)?;
+    let origin = [0.0; 3];
+    for (v, &role) in roles.iter().enumerate() {
+        let count = match role {
+            Role::Free => 2,
+            Role::Curve(_) => 1,
+            Role::Fixed => 0,
+        };
+        builder.span(VertexId::from_usize(v), &origin, &AXES[..count])?;
+    }
+    let mut offset = vec![None; target.curve_count()];
+    for (&role, p) in roles.iter().zip(image) {
+        if let Role::Curve(c) = role
+            && offset[c].is_none()
+            && target.curve_offset_direction(c, p).is_some()
+        {
+            let members = roles
+                .iter()
+                .enumerate()
+                .filter(|&(_, &r)| r == role)
+                .map(|(v, _)| (VertexId::from_usize(v), AXES[1]));
+            offset[c] = Some(builder.unknown(members)?);
+        }
+    }
+    Ok((builder.build()?, offset))
+}
+
+/// The local unknowns of each face in the order its vertices' terms name them (each
+/// vertex's own unknowns, then an offset not met yet), and its terms. A face has at
+/// most 6 local unknowns and terms (two per vertex; a shared offset replaces a vertex's
+/// own), so at most 21 lower-triangle entries.
+struct FaceLayout {
+    /// The local unknowns of face `f` are `local[local_ptr[f]..local_ptr[f + 1]]`.
+    local_ptr: Vec<usize>,
+    local: Vec<usize>,
+    /// The terms of face `f` are `face_terms[term_ptr[f]..term_ptr[f + 1]]`.
+    term_ptr: Vec<usize>,
+    face_terms: Vec<FaceTerm>,
+    /// The lower-triangle entries `(row, column)` the faces fill, face after face, each
+    /// face's local pairs `(a, b)`, `b <= a`, in order; room is reserved for the
+    /// diagonal after them.
+    positions: Vec<(usize, usize)>,
+}
+
+impl FaceLayout {
+    /// The layout of `faces` with the unknowns of `dofs`.
+    fn new(faces: &[[usize; 3]], dofs: &DofMap<f64>) -> Result<Self, SolverError> {
+        let n = dofs.reduced_len();
+        let mut local_ptr = Vec::with_capacity(faces.len() + 1);
+        let mut term_ptr = Vec::with_capacity(faces.len() + 1);
+        local_ptr.push(0);
+        term_ptr.push(0);
+        let mut local = Vec::with_capacity(6 * faces.len());
+        let mut face_terms = Vec::with_capacity(6 * faces.len());
+        let mut positions = Vec::with_capacity(21 * faces.len() + n);
+        for face in faces {
+            let start = local.len();
+            for (k, &v) in face.iter().enumerate() {
+                for (term, t) in dofs.node_terms(VertexId::from_usize(v))? {
+                    let at = match local[start..].iter().position(|&d| d == t.dof) {
+                        Some(at) => at,
+                        None => {
+                            local.push(t.dof);
+                            local.len() - start - 1
+                        }
+                    };
+                    let term = u32::try_from(term).map_err(|_| SolverError::InvalidInput {
+                        solver: crate::NAME,
+                        message: format!("{term} flow terms exceed the u32 index range"),
+                    })?;
+                    // At most three vertices with two terms each: the casts are exact.
+                    face_terms.push(FaceTerm {
+                        k: k as u8,
+                        local: at as u8,
+                        term,
+                    });
+                }
+            }
+            let list = &local[start..];
+            for a in 0..list.len() {
+                for b in 0..=a {
+                    let (da, db) = (list[a], list[b]);
+                    positions.push((da.max(db), da.min(db)));
+                }
+            }
+            local_ptr.push(local.len());
+            term_ptr.push(face_terms.len());
+        }
+        Ok(Self {
+            local_ptr,
+            local,
+            term_ptr,
+            face_terms,
+            positions,
+        })
+    }
+}
 
 /// The vertices of each of the elements' triangles.
 pub(crate) fn triangles(elements: &Elements) -> Vec<[usize; 3]> {

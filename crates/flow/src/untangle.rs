@@ -118,11 +118,21 @@ fn centroid(polygon: &[Vector2<f64>]) -> Option<Vector2<f64>> {
     (area > 0.0).then(|| sum / (3.0 * area))
 }
 
+/// How [`untangle`] runs.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct UntangleRounds<'a> {
+    /// The most rounds.
+    pub rounds: usize,
+    /// The images before a trial step of the flow, when untangling that step: a vertex
+    /// first tries its image there (the least move that can unfold a face the step
+    /// folded).
+    pub previous: Option<&'a [Point3<f64>]>,
+}
+
 /// Moves free vertices of flipped faces into the kernels of their stars (module docs),
-/// for at most `rounds` rounds; `faces` and `normals` are updated with `image`. With
-/// `previous` (the images before a trial step of the flow), a vertex first tries its
-/// previous image: the least move that can unfold a face the step folded.
-#[allow(clippy::too_many_arguments)]
+/// for at most `how.rounds` rounds; `faces` and `normals` are updated with `image`.
+/// With `how.previous` (the images before a trial step of the flow), a vertex first
+/// tries its previous image: the least move that can unfold a face the step folded.
 pub fn untangle<G: TargetGeometry>(
     elements: &Elements,
     target: &G,
@@ -130,26 +140,97 @@ pub fn untangle<G: TargetGeometry>(
     image: &mut [Point3<f64>],
     normals: &mut [Vector3<f64>],
     faces: &mut [ImageFace],
-    rounds: usize,
-    previous: Option<&[Point3<f64>]>,
+    how: UntangleRounds<'_>,
 ) -> Untangled {
     let (triangles, stars) = triangles_and_stars(elements, image.len());
+    let star_moves = StarMoves {
+        elements,
+        target,
+        triangles: &triangles,
+        stars: &stars,
+    };
     let count = |faces: &[ImageFace]| faces.iter().filter(|f| f.flipped()).count();
     let mut done = Untangled {
         before: count(faces),
         ..Untangled::default()
     };
-    let (mut polygon, mut clipped) = (Vec::new(), Vec::new());
+    let mut kernel = KernelBuffers::default();
     let mut visit = vec![false; image.len()];
-    for round in 0..rounds {
+    let mut map = Mapped {
+        image,
+        normals,
+        faces,
+    };
+    for round in 0..how.rounds {
+        let queue = star_moves.queue(roles, map.faces, round, &mut visit);
+        if queue.is_empty() {
+            break;
+        }
+        for &v in &queue {
+            visit[v] = false;
+            let flips = star_moves.flips(v, map.faces);
+            if flips == 0 && round == 0 {
+                continue;
+            }
+            let Some(candidates) = star_moves.candidates(v, &map, how.previous, &mut kernel) else {
+                continue;
+            };
+            if star_moves.try_candidates(v, candidates, flips, round, &mut map) {
+                done.moves += 1;
+            }
+        }
+        if count(map.faces) == 0 {
+            break;
+        }
+    }
+    done.after = count(map.faces);
+    done
+}
+
+/// The polygons the kernel of a star is clipped in, kept between vertices.
+#[derive(Default)]
+struct KernelBuffers {
+    polygon: Vec<Vector2<f64>>,
+    clipped: Vec<Vector2<f64>>,
+}
+
+/// What moving a vertex within its star reads: the elements, the target, the faces'
+/// triangles and the faces around each vertex.
+struct StarMoves<'a, G> {
+    elements: &'a Elements,
+    target: &'a G,
+    triangles: &'a [[usize; 3]],
+    stars: &'a Stars,
+}
+
+impl<G: TargetGeometry> StarMoves<'_, G> {
+    /// The flipped faces around vertex `v`.
+    fn flips(&self, v: usize, faces: &[ImageFace]) -> usize {
+        self.stars
+            .of(v)
+            .iter()
+            .filter(|&&f| faces[f].flipped())
+            .count()
+    }
+
+    /// The free vertices a round visits, in face order: those of every flipped face, and
+    /// from the second round on also those of the faces around them. `visit` marks the
+    /// vertices queued (all false on entry; the caller clears each as it visits it).
+    fn queue(
+        &self,
+        roles: &[Role],
+        faces: &[ImageFace],
+        round: usize,
+        visit: &mut [bool],
+    ) -> Vec<usize> {
         let mut queue = Vec::new();
-        for (f, t) in triangles.iter().enumerate() {
+        for (f, t) in self.triangles.iter().enumerate() {
             if !faces[f].flipped() {
                 continue;
             }
             for &v in t {
-                let ring: &[usize] = if round == 0 { &[] } else { stars.of(v) };
-                let near = ring.iter().flat_map(|&g| triangles[g]);
+                let ring: &[usize] = if round == 0 { &[] } else { self.stars.of(v) };
+                let near = ring.iter().flat_map(|&g| self.triangles[g]);
                 for u in std::iter::once(v).chain(near) {
                     if roles[u] == Role::Free && !visit[u] {
                         visit[u] = true;
@@ -158,95 +239,109 @@ pub fn untangle<G: TargetGeometry>(
                 }
             }
         }
-        if queue.is_empty() {
-            break;
-        }
-        for &v in &queue {
-            visit[v] = false;
-            let star = stars.of(v);
-            let flips = star.iter().filter(|&&f| faces[f].flipped()).count();
-            if flips == 0 && round == 0 {
-                continue;
-            }
-            let origin = image[v];
-            let [u, w] = orthonormal_basis(&normals[v]);
-            let plane = |p: &Point3<f64>| {
-                let d = p - origin;
-                Vector2::new(d.dot(&u), d.dot(&w))
-            };
-            let mut reach: f64 = 0.0;
-            for &f in star {
-                for &k in &triangles[f] {
-                    reach = reach.max(plane(&image[k]).norm());
-                }
-            }
-            if reach == 0.0 {
-                continue;
-            }
-            polygon.clear();
-            polygon.extend(
-                [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                    .map(|(x, y)| Vector2::new(x, y) * (2.0 * reach)),
-            );
-            for &f in star {
-                let t = triangles[f];
-                let at = t.iter().position(|&k| k == v).unwrap_or(0);
-                let (a, b) = (t[(at + 1) % 3], t[(at + 2) % 3]);
-                clip(&polygon, plane(&image[a]), plane(&image[b]), &mut clipped);
-                std::mem::swap(&mut polygon, &mut clipped);
-                if polygon.is_empty() {
-                    break;
-                }
-            }
-            // Candidates: the previous image (when given), the kernel's centroid in the
-            // tangent plane at the image, then the mean of the link's images (across a
-            // fold of the target the tangent plane at one corner says little about the
-            // others).
-            let kernel = centroid(&polygon).map(|p| origin + u * p.x + w * p.y);
-            let mut link = Vector3::zeros();
-            let mut links = 0usize;
-            for &f in star {
-                for &k in &triangles[f] {
-                    if k != v {
-                        link += image[k].coords;
-                        links += 1;
-                    }
-                }
-            }
-            let mean = (links > 0).then(|| Point3::from(link / links as f64));
-            let back = previous.and_then(|p| p.get(v).copied());
-            for candidate in [back, kernel, mean].into_iter().flatten() {
-                let moved = target.project(Role::Free, &candidate);
-                let (old_normal, old_faces): (Vector3<f64>, Vec<ImageFace>) =
-                    (normals[v], star.iter().map(|&f| faces[f]).collect());
-                image[v] = moved;
-                normals[v] = target.normal(&moved);
-                for &f in star {
-                    faces[f] = image_face(elements, normals, image, FaceId(f as u32));
-                }
-                let after = star.iter().filter(|&&f| faces[f].flipped()).count();
-                // From the second round a move that keeps the star's count is kept as
-                // well: across a fold narrower than the star, a flip only passes between
-                // two faces of one vertex, and the neighbour visited next can remove it
-                // from the other face (hemisphere onto the human face: 1 flip -> 0).
-                let sideways = round > 0 && after == flips;
-                if after < flips || sideways || (flips == 0 && after == 0) {
-                    done.moves += 1;
-                    break;
-                }
-                image[v] = origin;
-                normals[v] = old_normal;
-                for (&f, face) in star.iter().zip(old_faces) {
-                    faces[f] = face;
-                }
-            }
-        }
-        if count(faces) == 0 {
-            break;
-        }
+        queue
     }
-    done.after = count(faces);
-    done
+
+    /// Where vertex `v` may move, in the order tried: its previous image (when given),
+    /// the centroid of its star's kernel in the tangent plane at its image (module
+    /// docs), then the mean of its link's images (across a fold of the target the
+    /// tangent plane at one corner says little about the others); a candidate that does
+    /// not exist is `None`. `None` altogether when the star has no extent in the plane.
+    fn candidates(
+        &self,
+        v: usize,
+        map: &Mapped<'_>,
+        previous: Option<&[Point3<f64>]>,
+        kernel: &mut KernelBuffers,
+    ) -> Option<[Option<Point3<f64>>; 3]> {
+        let (image, star) = (&*map.image, self.stars.of(v));
+        let origin = image[v];
+        let [u, w] = orthonormal_basis(&map.normals[v]);
+        let plane = |p: &Point3<f64>| {
+            let d = p - origin;
+            Vector2::new(d.dot(&u), d.dot(&w))
+        };
+        let mut reach: f64 = 0.0;
+        for &f in star {
+            for &k in &self.triangles[f] {
+                reach = reach.max(plane(&image[k]).norm());
+            }
+        }
+        if reach == 0.0 {
+            return None;
+        }
+        let KernelBuffers { polygon, clipped } = kernel;
+        polygon.clear();
+        polygon.extend(
+            [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .map(|(x, y)| Vector2::new(x, y) * (2.0 * reach)),
+        );
+        for &f in star {
+            let t = self.triangles[f];
+            let at = t.iter().position(|&k| k == v).unwrap_or(0);
+            let (a, b) = (t[(at + 1) % 3], t[(at + 2) % 3]);
+            clip(polygon, plane(&image[a]), plane(&image[b]), clipped);
+            std::mem::swap(polygon, clipped);
+            if polygon.is_empty() {
+                break;
+            }
+        }
+        let kernel = centroid(polygon).map(|p| origin + u * p.x + w * p.y);
+        let mut link = Vector3::zeros();
+        let mut links = 0usize;
+        for &f in star {
+            for &k in &self.triangles[f] {
+                if k != v {
+                    link += image[k].coords;
+                    links += 1;
+                }
+            }
+        }
+        let mean = (links > 0).then(|| Point3::from(link / links as f64));
+        let back = previous.and_then(|p| p.get(v).copied());
+        Some([back, kernel, mean])
+    }
+
+    /// Tries the candidates of vertex `v` in order, each projected onto the target, and
+    /// keeps the first that leaves its star fewer flips than `flips` (from the second
+    /// round, as many; with none before, none after); undoes the others. True if a move
+    /// was kept.
+    fn try_candidates(
+        &self,
+        v: usize,
+        candidates: [Option<Point3<f64>>; 3],
+        flips: usize,
+        round: usize,
+        map: &mut Mapped<'_>,
+    ) -> bool {
+        let star = self.stars.of(v);
+        let origin = map.image[v];
+        for candidate in candidates.into_iter().flatten() {
+            let moved = self.target.project(Role::Free, &candidate);
+            let (old_normal, old_faces): (Vector3<f64>, Vec<ImageFace>) =
+                (map.normals[v], star.iter().map(|&f| map.faces[f]).collect());
+            map.image[v] = moved;
+            map.normals[v] = self.target.normal(&moved);
+            for &f in star {
+                map.faces[f] = image_face(self.elements, map.normals, map.image, FaceId(f as u32));
+            }
+            let after = star.iter().filter(|&&f| map.faces[f].flipped()).count();
+            // From the second round a move that keeps the star's count is kept as
+            // well: across a fold narrower than the star, a flip only passes between
+            // two faces of one vertex, and the neighbour visited next can remove it
+            // from the other face (hemisphere onto the human face: 1 flip -> 0).
+            let sideways = round > 0 && after == flips;
+            if after < flips || sideways || (flips == 0 && after == 0) {
+                return true;
+            }
+            map.image[v] = origin;
+            map.normals[v] = old_normal;
+            for (&f, face) in star.iter().zip(old_faces) {
+                map.faces[f] = face;
+            }
+        }
+        false
+    }
 }
 
 /// The last resort after [`untangle`] and the flow: the patch around each flipped face

@@ -51,6 +51,16 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
         )));
     }
     let planar = is_planar(mesh);
+    check_target(problem, planar)?;
+    check_constraints(problem)?;
+    check_initial(problem)?;
+    check_goal(problem, planar)
+}
+
+/// The target: one the flow maps onto, and a source whose topology (and, for the plane
+/// keeping its region, position) fits it.
+fn check_target(problem: &Problem<'_>, planar: bool) -> Result<(), SolverError> {
+    let mesh = problem.source;
     match &problem.target {
         Target::Plane(PlanarBoundary::Keep) => {
             if !planar {
@@ -79,27 +89,7 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
                 "the flow needs a target region; for a free or given boundary use lsqc",
             ));
         }
-        Target::Annulus { inner_radius } => {
-            if mesh.boundary_loop_count() != 2
-                || mesh.component_count() != 1
-                || mesh.genus() != Some(0)
-            {
-                return Err(unsupported(format!(
-                    "the annulus target needs a connected genus-0 mesh with two boundary loops; this mesh has {}",
-                    topology::describe(mesh)
-                )));
-            }
-            if let Some(r) = inner_radius
-                && !(*r > 0.0 && *r < 1.0)
-            {
-                return Err(invalid(format!(
-                    "the inner radius must be in (0, 1), got {r}"
-                )));
-            }
-            if problem.initial.is_none() {
-                annulus_of(mesh)?;
-            }
-        }
+        Target::Annulus { inner_radius } => check_annulus(problem, *inner_radius)?,
         Target::Sphere => {
             topology::require_sphere(
                 NAME,
@@ -107,54 +97,90 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
                 "use the disk or annulus targets for meshes with boundary",
             )?;
         }
-        Target::Mesh(target) => {
-            if target.boundary_loop_count() != mesh.boundary_loop_count()
-                || target.genus() != mesh.genus()
-                || target.component_count() != mesh.component_count()
-            {
-                return Err(unsupported(format!(
-                    "the source and the target mesh differ in topology: source has {}, target has {}",
-                    topology::describe(mesh),
-                    topology::describe(target)
-                )));
-            }
-            if problem.initial.is_none() {
-                return Err(unsupported(
-                    "a target mesh needs an initial map onto it: use the register solver, which builds one",
-                ));
-            }
-            if let Some(f) = target.faces().find(|&f| target.face_degree(f) != 3) {
-                return Err(unsupported(format!(
-                    "the target mesh must be made of triangles; its face {} (input index) is not",
-                    target.face_to_input(f)
-                )));
-            }
-            // Lengths and vertex ids were checked with every constraint
-            // (`Constraints::validate`).
-            for (k, curve) in problem.constraints.curves().enumerate() {
-                if curve.closed {
-                    return Err(unsupported(format!(
-                        "curve {k} is closed; the flow slides open feature curves with fixed ends"
-                    )));
-                }
-                // The chain slides along its segments, which must lie on the target.
-                for pair in curve.target.windows(2) {
-                    if !target.vertex_neighbors(pair[0]).any(|w| w == pair[1]) {
-                        return Err(invalid(format!(
-                            "curve {k}: target vertices {} and {} (input indices) are not joined by an edge",
-                            target.vertex_map().to_input(pair[0]),
-                            target.vertex_map().to_input(pair[1])
-                        )));
-                    }
-                }
-            }
-        }
+        Target::Mesh(target) => check_target_mesh(problem, target)?,
         Target::CircleDomain | Target::Surface => {
             return Err(unsupported(
                 "targets here: plane, disk, annulus, sphere, a target mesh (circle domains come with another solver)",
             ));
         }
     }
+    Ok(())
+}
+
+/// The annulus target: a connected genus-0 source with two boundary loops, an inner
+/// radius (when given) in `(0, 1)`, and without an initial map a source already in
+/// the annulus ([`annulus_of`]).
+fn check_annulus(problem: &Problem<'_>, inner_radius: Option<f64>) -> Result<(), SolverError> {
+    let mesh = problem.source;
+    if mesh.boundary_loop_count() != 2 || mesh.component_count() != 1 || mesh.genus() != Some(0) {
+        return Err(unsupported(format!(
+            "the annulus target needs a connected genus-0 mesh with two boundary loops; this mesh has {}",
+            topology::describe(mesh)
+        )));
+    }
+    if let Some(r) = inner_radius
+        && !(r > 0.0 && r < 1.0)
+    {
+        return Err(invalid(format!(
+            "the inner radius must be in (0, 1), got {r}"
+        )));
+    }
+    if problem.initial.is_none() {
+        annulus_of(mesh)?;
+    }
+    Ok(())
+}
+
+/// A target mesh: the source's topology, an initial map onto it, triangles, and open
+/// feature curves whose target chains follow its edges.
+fn check_target_mesh(problem: &Problem<'_>, target: &Mesh) -> Result<(), SolverError> {
+    let mesh = problem.source;
+    if target.boundary_loop_count() != mesh.boundary_loop_count()
+        || target.genus() != mesh.genus()
+        || target.component_count() != mesh.component_count()
+    {
+        return Err(unsupported(format!(
+            "the source and the target mesh differ in topology: source has {}, target has {}",
+            topology::describe(mesh),
+            topology::describe(target)
+        )));
+    }
+    if problem.initial.is_none() {
+        return Err(unsupported(
+            "a target mesh needs an initial map onto it: use the register solver, which builds one",
+        ));
+    }
+    if let Some(f) = target.faces().find(|&f| target.face_degree(f) != 3) {
+        return Err(unsupported(format!(
+            "the target mesh must be made of triangles; its face {} (input index) is not",
+            target.face_to_input(f)
+        )));
+    }
+    // Lengths and vertex ids were checked with every constraint
+    // (`Constraints::validate`).
+    for (k, curve) in problem.constraints.curves().enumerate() {
+        if curve.closed {
+            return Err(unsupported(format!(
+                "curve {k} is closed; the flow slides open feature curves with fixed ends"
+            )));
+        }
+        // The chain slides along its segments, which must lie on the target.
+        for pair in curve.target.windows(2) {
+            if !target.vertex_neighbors(pair[0]).any(|w| w == pair[1]) {
+                return Err(invalid(format!(
+                    "curve {k}: target vertices {} and {} (input indices) are not joined by an edge",
+                    target.vertex_map().to_input(pair[0]),
+                    target.vertex_map().to_input(pair[1])
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The constraints: pins without positions, landmarks (at points in space) and curves
+/// only on a target mesh.
+fn check_constraints(problem: &Problem<'_>) -> Result<(), SolverError> {
     let on_mesh = matches!(problem.target, Target::Mesh(_));
     for constraint in problem.constraints.iter() {
         let refused = match constraint {
@@ -175,6 +201,12 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
             "curve constraints come with target meshes (register)",
         ));
     }
+    Ok(())
+}
+
+/// The initial map, when given: one image per source vertex.
+fn check_initial(problem: &Problem<'_>) -> Result<(), SolverError> {
+    let mesh = problem.source;
     if let Some(initial) = &problem.initial {
         let n = match initial {
             Map::Planar(z) => z.len(),
@@ -188,6 +220,14 @@ pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError
             )));
         }
     }
+    Ok(())
+}
+
+/// The goal: conformal with `2 <= p <= MAX_P`, or a prescribed field (in the global
+/// frame only on a planar source, `planar`); checked into the frame, the target `mu`
+/// per face and `p`.
+fn check_goal(problem: &Problem<'_>, planar: bool) -> Result<CheckedGoal, SolverError> {
+    let mesh = problem.source;
     match &problem.goal {
         Goal::Conformal { p } => {
             if !(*p >= 2.0 && *p <= MAX_P) {

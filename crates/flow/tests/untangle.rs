@@ -5,7 +5,7 @@ use beltrami_fem::{Elements, Frame};
 use beltrami_flow_engine::measure::{ImageFace, image_faces};
 use beltrami_flow_engine::mesh_target::{MeshTarget, TargetCurve};
 use beltrami_flow_engine::target::{Role, TargetGeometry};
-use beltrami_flow_engine::untangle::untangle;
+use beltrami_flow_engine::untangle::{UntangleRounds, untangle};
 use beltrami_mesh::primitives::{Cells, grid};
 use beltrami_mesh::{Mesh, Point3, Vector3};
 use beltrami_spatial::SurfaceIndex;
@@ -69,8 +69,10 @@ fn a_vertex_dragged_across_its_neighbour_comes_back_into_its_star() {
             &mut image,
             &mut normals,
             &mut faces,
-            8,
-            None,
+            UntangleRounds {
+                rounds: 8,
+                previous: None,
+            },
         );
         assert_eq!(done.before, before);
         assert_eq!(done.after, 0, "c = {c}: {done:?}");
@@ -126,8 +128,10 @@ fn a_vertex_a_step_folded_goes_back_to_its_place_before_the_step() {
         &mut image,
         &mut normals,
         &mut faces,
-        4,
-        Some(&before_step),
+        UntangleRounds {
+            rounds: 4,
+            previous: Some(&before_step),
+        },
     );
     assert_eq!(done.after, 0, "{done:?}");
     assert_eq!(done.moves, 1, "{done:?}");
