@@ -57,6 +57,23 @@ struct Outline {
 }
 
 impl Outline {
+    /// The target's boundary loop onto the unit circle by arc length, clockwise in loop
+    /// order (module docs): the outline both Tutte maps share.
+    fn of(target: &Mesh) -> Self {
+        let target_loop: Vec<VertexId> = target.loop_vertices(BoundaryLoopId(0)).collect();
+        let fractions = arc_fractions(target, &target_loop);
+        let images: Vec<Complex64> = fractions
+            .iter()
+            .map(|&t| Complex64::from_polar(1.0, -TAU * t))
+            .collect();
+        Outline {
+            positions: target_loop.iter().map(|&v| target.position(v)).collect(),
+            vertices: target_loop,
+            fractions,
+            images,
+        }
+    }
+
     /// The side `j` (from vertex `j` to `j + 1`) holding fraction `tau` in `[0, 1)` and
     /// the linear parameter along it.
     fn side(&self, tau: f64) -> (usize, f64) {
@@ -92,6 +109,34 @@ impl Outline {
     }
 }
 
+/// The source's boundary loop: its vertices in loop order, each vertex's position in it
+/// (`usize::MAX` off the loop) and their arc-length fractions.
+struct SourceLoop {
+    /// The loop's vertices in loop order.
+    vertices: Vec<VertexId>,
+    /// Every source vertex's position in `vertices`, `usize::MAX` off the loop.
+    index: Vec<usize>,
+    /// The arc-length fraction before each vertex of `vertices`.
+    sigma: Vec<f64>,
+}
+
+impl SourceLoop {
+    /// The first boundary loop of `source`.
+    fn of(source: &Mesh) -> Self {
+        let vertices: Vec<VertexId> = source.loop_vertices(BoundaryLoopId(0)).collect();
+        let mut index = vec![usize::MAX; source.vertex_count()];
+        for (i, v) in vertices.iter().enumerate() {
+            index[v.idx()] = i;
+        }
+        let sigma = arc_fractions(source, &vertices);
+        Self {
+            vertices,
+            index,
+            sigma,
+        }
+    }
+}
+
 /// The source's images on the target, the landmarks honoured exactly (indices into
 /// `marks`) and the target's disk (its Tutte map, per target vertex).
 pub(crate) fn map(
@@ -100,52 +145,28 @@ pub(crate) fn map(
     marks: &[Resolved],
     notes: &mut Vec<String>,
 ) -> Result<Routed<Vec<Complex64>>, RegisterError> {
-    let target_loop: Vec<VertexId> = target.loop_vertices(BoundaryLoopId(0)).collect();
-    let fractions = arc_fractions(target, &target_loop);
-    let images: Vec<Complex64> = fractions
-        .iter()
-        .map(|&t| Complex64::from_polar(1.0, -TAU * t))
-        .collect();
-    let outline = Outline {
-        positions: target_loop.iter().map(|&v| target.position(v)).collect(),
-        vertices: target_loop,
-        fractions,
-        images,
-    };
+    let outline = Outline::of(target);
     let target_boundary = BoundaryMap {
         vertices: outline.vertices.clone(),
         positions: outline.images.clone(),
     };
-
-    let source_loop: Vec<VertexId> = source.loop_vertices(BoundaryLoopId(0)).collect();
-    let mut loop_index = vec![usize::MAX; source.vertex_count()];
-    for (i, v) in source_loop.iter().enumerate() {
-        loop_index[v.idx()] = i;
-    }
-    let sigma = arc_fractions(source, &source_loop);
+    let source_loop = SourceLoop::of(source);
 
     // A landmark with one end on the boundary and the other inside, or boundary
     // landmarks in another cyclic order on the two loops, are refused before either
     // Tutte map is computed.
-    let pinned = boundary_landmarks(source, target, &outline, marks, &loop_index)?;
+    let pinned = boundary_landmarks(source, target, &outline, marks, &source_loop.index)?;
 
-    let tau: Vec<f64> = if pinned.is_empty() {
-        let delta = best_rotation(source, target, &source_loop, &sigma, &outline);
-        notes.push(format!(
-            "disk: no boundary landmark; boundary rotated by {delta:.4} turns, the best of {ROTATIONS} for a rough spatial match (centroids and sizes)"
-        ));
-        sigma.iter().map(|s| s + delta).collect()
-    } else {
-        notes.push(format!(
-            "disk: boundary laid so that landmarks {} land on their targets, by arc length between them",
-            pinned
-                .iter()
-                .map(|p| marks[p.0].index.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
-        between_landmarks(&sigma, &pinned)
-    };
+    let tau = boundary_fractions(
+        source,
+        target,
+        &source_loop,
+        &outline,
+        marks,
+        &pinned,
+        notes,
+    );
+    let source_loop = source_loop.vertices;
     let collapsed = collapsed_ears(source, &source_loop, &tau, &outline);
     if collapsed > 0 {
         notes.push(format!(
@@ -168,42 +189,15 @@ pub(crate) fn map(
     for &(m, _, _) in &pinned {
         source_param[marks[m].source.idx()] = interpolate(target, &target_param, &marks[m].target);
     }
-    let interior: Vec<usize> = (0..marks.len())
-        .filter(|&m| !source.is_boundary_vertex(marks[m].source))
-        .collect();
-    if !interior.is_empty() {
-        let fixed: Vec<(VertexId, Complex64)> = source_loop
-            .iter()
-            .map(|&v| (v, source_param[v.idx()]))
-            .chain(interior.iter().map(|&m| {
-                (
-                    marks[m].source,
-                    interpolate(target, &target_param, &marks[m].target),
-                )
-            }))
-            .collect();
-        let matched = match_landmarks(
-            source,
-            Frame::Face,
-            &source_param,
-            &fixed,
-            &[],
-            Side::Source,
-        )?;
-        if matched.flipped > 0 {
-            return Err(RegisterError::LandmarkFolds {
-                domain: "disk",
-                flipped: matched.flipped,
-                steps: matched.steps,
-            });
-        }
-        notes.push(format!(
-            "disk: {} interior landmarks matched in the disk ({} smoothing steps)",
-            interior.len(),
-            matched.steps
-        ));
-        source_param = matched.map;
-    }
+    let source_param = match_interior_landmarks(
+        source,
+        target,
+        &target_param,
+        &source_loop,
+        marks,
+        source_param,
+        notes,
+    )?;
     let domain = domain_mesh(target, planar_points(&target_param), Side::Target)?;
     let (points, gap) = compose::locate(&domain, &planar_points(&source_param))?;
     if gap > 1e-12 {
@@ -216,6 +210,93 @@ pub(crate) fn map(
         honoured: (0..marks.len()).collect(),
         domain: target_param,
     })
+}
+
+/// The fraction of the target's boundary every source boundary vertex goes to (module
+/// docs): the best rotation without boundary landmarks, else by arc length between the
+/// `pinned` ones; the choice is noted.
+fn boundary_fractions(
+    source: &Mesh,
+    target: &Mesh,
+    source_loop: &SourceLoop,
+    outline: &Outline,
+    marks: &[Resolved],
+    pinned: &[(usize, usize, f64)],
+    notes: &mut Vec<String>,
+) -> Vec<f64> {
+    let sigma = &source_loop.sigma;
+    if pinned.is_empty() {
+        let delta = best_rotation(source, target, &source_loop.vertices, sigma, outline);
+        notes.push(format!(
+            "disk: no boundary landmark; boundary rotated by {delta:.4} turns, the best of {ROTATIONS} for a rough spatial match (centroids and sizes)"
+        ));
+        sigma.iter().map(|s| s + delta).collect()
+    } else {
+        notes.push(format!(
+            "disk: boundary laid so that landmarks {} land on their targets, by arc length between them",
+            pinned
+                .iter()
+                .map(|p| marks[p.0].index.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        between_landmarks(sigma, pinned)
+    }
+}
+
+/// The source's Tutte map `source_param` bent so that the interior landmarks land on
+/// their targets in the target's disk `target_param` (module docs), the whole boundary
+/// held; unchanged without interior landmarks.
+///
+/// # Errors
+/// [`RegisterError::LandmarkFolds`] when the matching leaves flipped faces; the errors
+/// of [`match_landmarks`].
+fn match_interior_landmarks(
+    source: &Mesh,
+    target: &Mesh,
+    target_param: &[Complex64],
+    source_loop: &[VertexId],
+    marks: &[Resolved],
+    source_param: Vec<Complex64>,
+    notes: &mut Vec<String>,
+) -> Result<Vec<Complex64>, RegisterError> {
+    let interior: Vec<usize> = (0..marks.len())
+        .filter(|&m| !source.is_boundary_vertex(marks[m].source))
+        .collect();
+    if interior.is_empty() {
+        return Ok(source_param);
+    }
+    let fixed: Vec<(VertexId, Complex64)> = source_loop
+        .iter()
+        .map(|&v| (v, source_param[v.idx()]))
+        .chain(interior.iter().map(|&m| {
+            (
+                marks[m].source,
+                interpolate(target, target_param, &marks[m].target),
+            )
+        }))
+        .collect();
+    let matched = match_landmarks(
+        source,
+        Frame::Face,
+        &source_param,
+        &fixed,
+        &[],
+        Side::Source,
+    )?;
+    if matched.flipped > 0 {
+        return Err(RegisterError::LandmarkFolds {
+            domain: "disk",
+            flipped: matched.flipped,
+            steps: matched.steps,
+        });
+    }
+    notes.push(format!(
+        "disk: {} interior landmarks matched in the disk ({} smoothing steps)",
+        interior.len(),
+        matched.steps
+    ));
+    Ok(matched.map)
 }
 
 /// The registration `points` (a bijection of the disks, the landmarks exact) bent in the

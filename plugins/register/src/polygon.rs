@@ -134,31 +134,12 @@ pub(crate) fn map(
     // The cut graph is the coarser mesh's, drawn onto the finer one.
     let swapped = target.vertex_count() < source.vertex_count();
     let cut = if swapped {
-        let backward: Vec<Pin> = forward
-            .iter()
-            .map(|p| Pin {
-                from: p.onto,
-                from_vertex: p.onto_vertex,
-                onto: p.from,
-                onto_vertex: p.from_vertex,
-                ..*p
-            })
-            .collect();
-        let mut inverse = vec![usize::MAX; paired.len()];
-        for (s, &t) in paired.iter().enumerate() {
-            inverse[t] = s;
-        }
-        let source_index = SurfaceIndex::new(source)?;
-        let (place, _) = refined_placement(target, source, &source_index, &backward)?;
-        matched_cuts(
-            [target, source],
-            &source_index,
-            &backward,
-            &place,
-            [&target_loops, &source_loops],
-            &inverse,
+        target_cut_drawn_on_source(
+            [source, target],
+            &forward,
+            [&source_loops, &target_loops],
+            &paired,
         )?
-        .reversed()
     } else {
         matched_cuts(
             [source, target],
@@ -169,12 +150,64 @@ pub(crate) fn map(
             &paired,
         )?
     };
-    let MatchedCuts {
-        skeletons: [source_skeleton, target_skeleton],
-        cuts: [source_cut, target_cut],
-        words: [source_word, target_word],
-        shift,
-    } = cut;
+    notes.push(cut_graphs_note(
+        [source, target],
+        &cut,
+        swapped,
+        fitted,
+        &paired,
+    ));
+    let points = polygon_images(source.vertex_count(), &cut, notes)?;
+    let honoured = honoured_landmarks(target, marks, &points);
+    Ok((points, honoured))
+}
+
+/// The matched cuts with the target's cut graph drawn onto the source (the target is
+/// the coarser mesh), the source's roles and the target's exchanged back: the
+/// landmarks and the loops' pairing read backwards, the placement fitted the other way.
+fn target_cut_drawn_on_source(
+    [source, target]: [&Mesh; 2],
+    forward: &[Pin],
+    [source_loops, target_loops]: [&Loops; 2],
+    paired: &[usize],
+) -> Result<MatchedCuts, RegisterError> {
+    let backward: Vec<Pin> = forward
+        .iter()
+        .map(|p| Pin {
+            from: p.onto,
+            from_vertex: p.onto_vertex,
+            onto: p.from,
+            onto_vertex: p.from_vertex,
+            ..*p
+        })
+        .collect();
+    let mut inverse = vec![usize::MAX; paired.len()];
+    for (s, &t) in paired.iter().enumerate() {
+        inverse[t] = s;
+    }
+    let source_index = SurfaceIndex::new(source)?;
+    let (place, _) = refined_placement(target, source, &source_index, &backward)?;
+    Ok(matched_cuts(
+        [target, source],
+        &source_index,
+        &backward,
+        &place,
+        [target_loops, source_loops],
+        &inverse,
+    )?
+    .reversed())
+}
+
+/// The note on the cut graphs: whose was drawn onto whose, their size and lengths, the
+/// placement (`fitted` to the landmarks or not) and the loops' pairing.
+fn cut_graphs_note(
+    [source, target]: [&Mesh; 2],
+    cut: &MatchedCuts,
+    swapped: bool,
+    fitted: bool,
+    paired: &[usize],
+) -> String {
+    let [source_skeleton, target_skeleton] = &cut.skeletons;
     let length = |mesh: &Mesh, skeleton: &Skeleton| -> f64 {
         skeleton
             .edges(mesh)
@@ -182,15 +215,15 @@ pub(crate) fn map(
             .map(|&e| mesh.edge_length(e))
             .sum()
     };
-    notes.push(format!(
+    format!(
         "cut graphs: the {}'s, drawn onto the {}: {} nodes and {} arcs on each mesh (source length {:.6}, target {:.6}), a disk whose boundary has {} sides; placed by {}; boundary loops paired {}",
         if swapped { "target" } else { "source" },
         if swapped { "source" } else { "target" },
         source_skeleton.nodes.len(),
         source_skeleton.arcs.len(),
-        length(source, &source_skeleton),
-        length(target, &target_skeleton),
-        source_word.letters.len(),
+        length(source, source_skeleton),
+        length(target, target_skeleton),
+        cut.words[0].letters.len(),
         if fitted {
             "the similarity fitted to the landmarks"
         } else {
@@ -206,9 +239,21 @@ pub(crate) fn map(
                 .collect::<Vec<_>>()
                 .join(", ")
         }
-    ));
+    )
+}
 
-    let angles: Vec<f64> = arc_fractions(&target_cut, &target_word.vertices)
+/// The images of the source's `n` vertices on the target (module docs): both cut disks
+/// onto the target's inscribed polygon by Tutte's embedding, sides matched, the
+/// source's images located in the target's embedding; an image outside is moved onto
+/// it and noted.
+fn polygon_images(
+    n: usize,
+    cut: &MatchedCuts,
+    notes: &mut Vec<String>,
+) -> Result<Vec<SurfacePoint>, RegisterError> {
+    let [source_cut, target_cut] = &cut.cuts;
+    let [source_word, target_word] = &cut.words;
+    let angles: Vec<f64> = arc_fractions(target_cut, &target_word.vertices)
         .iter()
         .map(|&t| -TAU * t)
         .collect();
@@ -220,52 +265,53 @@ pub(crate) fn map(
             .collect(),
     };
     let boundary = source_boundary(
-        &source_cut,
-        &source_word,
-        &target_cut,
-        &target_word,
+        source_cut,
+        source_word,
+        target_cut,
+        target_word,
         &angles,
-        shift,
+        cut.shift,
     );
     // The two Tutte maps are independent: both at once, on two cores.
     let (target_param, source_param) = parallel::join(
-        || tutte(&target_cut, &target_boundary, Side::Target),
-        || tutte(&source_cut, &boundary, Side::Source),
+        || tutte(target_cut, &target_boundary, Side::Target),
+        || tutte(source_cut, &boundary, Side::Source),
     );
     let target_param = target_param?;
     let radial = Radial::new(&angles).ok_or_else(|| RegisterError::Seams {
         reason: "one side of the target's cut disk is longer than half its boundary".to_string(),
     })?;
     let source_param = source_param?;
-    let images: Vec<Complex64> = source_param[..source.vertex_count()]
-        .iter()
-        .map(|&z| radial.apply(z))
-        .collect();
-    let domain = domain_mesh(&target_cut, planar_points(&target_param), Side::Target)?;
+    let images: Vec<Complex64> = source_param[..n].iter().map(|&z| radial.apply(z)).collect();
+    let domain = domain_mesh(target_cut, planar_points(&target_param), Side::Target)?;
     let (points, gap) = compose::locate(&domain, &planar_points(&images))?;
     if gap > 1e-12 {
         notes.push(format!(
             "cut graphs: the farthest source image was {gap:.3e} outside the target's polygon and was moved onto it"
         ));
     }
-    // Every landmark is a node of the cut graphs: on the target at its own vertex, or
-    // for a point inside a face at the nearest vertex. A point target is then taken
-    // exactly when the vertex is a corner of a face next to the point's (the move stays
-    // within the image's star; the flow mends a fold it makes); a landmark drawn
-    // elsewhere is left to the flow, and the registration fails if it is missed.
+    Ok(points)
+}
+
+/// The landmarks honoured exactly (indices into `marks`). Every landmark is a node of
+/// the cut graphs: on the target at its own vertex, or for a point inside a face at
+/// the nearest vertex. A point target is then taken exactly when the vertex is a
+/// corner of a face next to the point's (the move stays within the image's star; the
+/// flow mends a fold it makes); a landmark drawn elsewhere is left to the flow, and
+/// the registration fails if it is missed.
+fn honoured_landmarks(target: &Mesh, marks: &[Resolved], points: &[SurfacePoint]) -> Vec<usize> {
     let near = |a: &SurfacePoint, b: &SurfacePoint| {
         a.face == b.face
             || target
                 .face_vertices(a.face)
                 .any(|v| target.face_vertices(b.face).any(|w| w == v))
     };
-    let honoured = marks
+    marks
         .iter()
         .enumerate()
         .filter(|(_, mark)| near(&points[mark.source.idx()], &mark.target))
         .map(|(k, _)| k)
-        .collect();
-    Ok((points, honoured))
+        .collect()
 }
 
 /// Both meshes' skeletons (numbered alike), cuts, words, and the shift of the second

@@ -583,91 +583,140 @@ impl Drawing<'_> {
         let mut pairs: Vec<(Point3<f64>, Point3<f64>)> =
             self.pins.iter().map(|p| (p.from, p.onto)).collect();
         // Nodes on boundary loops, loop by loop.
-        for (s, loop_vertices) in self.from_loops.vertices.iter().enumerate() {
-            let target_loop = &self.onto_loops.vertices[self.paired[s]];
-            let sigma = arc_fractions(self.from, loop_vertices);
-            let tau = arc_fractions(self.onto, target_loop);
-            let anchors = loop_anchors(
-                self.onto,
-                self.pins,
-                &LoopPair {
-                    indices: [s, self.paired[s]],
-                    vertices: [loop_vertices, target_loop],
-                    fractions: [&sigma, &tau],
-                },
-            )?;
-            let shift = if anchors.is_empty() {
-                self.best_rotation(loop_vertices, &sigma, target_loop, &tau)
-            } else {
-                0.0
-            };
-            let fraction = |position: usize| {
-                if anchors.is_empty() {
-                    (sigma[position] + shift).rem_euclid(1.0)
-                } else {
-                    along_anchors(&anchors, &sigma, &tau, sigma[position])
-                }
-            };
-            let step = loop_vertices.len().div_ceil(WARP_LOOP_SAMPLES).max(1);
-            for position in (0..loop_vertices.len()).step_by(step) {
-                pairs.push((
-                    self.from.position(loop_vertices[position]),
-                    loop_point(self.onto, target_loop, &tau, fraction(position)),
-                ));
-            }
-            let on_loop: Vec<(usize, usize)> = self
-                .skeleton
-                .nodes
-                .iter()
-                .enumerate()
-                .filter_map(|(n, v)| {
-                    loop_vertices
-                        .iter()
-                        .position(|w| w == v)
-                        .map(|position| (n, position))
-                })
-                .collect();
-            for &(_, position) in &on_loop {
-                if let Some(a) = anchors.iter().find(|a| a.position == position) {
-                    taken[target_loop[a.target].idx()] = true;
-                }
-            }
-            for (n, position) in on_loop {
-                if let Some(a) = anchors.iter().find(|a| a.position == position) {
-                    out[n] = Some(target_loop[a.target]);
-                    continue;
-                }
-                let want = fraction(position);
-                let nearest = (0..target_loop.len())
-                    .filter(|&j| !taken[target_loop[j].idx()])
-                    .min_by(|&i, &j| {
-                        circular(tau[i], want).total_cmp(&circular(tau[j], want))
-                    })
-                    .ok_or_else(|| self.seams(format!(
-                        "target boundary loop {} has fewer vertices than the source's cut graph meets it",
-                        self.paired[s]
-                    )))?;
-                taken[target_loop[nearest].idx()] = true;
-                out[n] = Some(target_loop[nearest]);
-            }
+        for s in 0..self.from_loops.vertices.len() {
+            self.loop_nodes(s, &mut out, &mut taken, &mut pairs)?;
         }
         if self.pins.len() < 3 && self.from_loops.vertices.is_empty() {
-            // A closed surface with no similarity from landmarks (nor boundary loops to
-            // anchor it): the rough placement is pulled onto the other surface by the
-            // closest points of spread samples.
-            let step = self
-                .from
-                .vertex_count()
-                .div_ceil(WARP_SURFACE_SAMPLES)
-                .max(1);
-            for v in self.from.vertices().step_by(step) {
-                let p = self.from.position(v);
-                let located = self.onto_index.locate(&self.place.to_target(&p))?;
-                pairs.push((p, located.position));
-            }
+            self.surface_pairs(&mut pairs)?;
         }
         let warp = Warp::new(self.place, &pairs, self.onto);
-        // Landmarks inside: at their partners' vertices.
+        self.landmark_nodes(&mut out, &mut taken);
+        // Other interior nodes: the nearest free interior vertex, by rings around the
+        // located face.
+        for (n, &v) in self.skeleton.nodes.iter().enumerate() {
+            if out[n].is_some() {
+                continue;
+            }
+            let p = warp.to_target(&self.from.position(v));
+            let face = self.onto_index.locate(&p)?.point.face;
+            let chosen = self.nearest_free(&p, face, &taken).ok_or_else(|| {
+                self.seams(format!(
+                    "no free interior target vertex for the cut graph's node at source vertex {}",
+                    self.from.vertex_map().to_input(v)
+                ))
+            })?;
+            taken[chosen.idx()] = true;
+            out[n] = Some(chosen);
+        }
+        Ok((out.into_iter().flatten().collect(), warp))
+    }
+
+    /// The target vertices of the nodes on boundary loop `s` (into `out`, marked in
+    /// `taken`), at their anchored arc-length fractions along the paired loop, and
+    /// spread points of the loop with their partners for the warp (into `pairs`).
+    ///
+    /// # Errors
+    /// The errors of [`loop_anchors`]; [`RegisterError::Seams`] when the paired loop
+    /// has fewer free vertices than the loop has nodes.
+    fn loop_nodes(
+        &self,
+        s: usize,
+        out: &mut [Option<VertexId>],
+        taken: &mut [bool],
+        pairs: &mut Vec<(Point3<f64>, Point3<f64>)>,
+    ) -> Result<(), RegisterError> {
+        let loop_vertices = &self.from_loops.vertices[s];
+        let target_loop = &self.onto_loops.vertices[self.paired[s]];
+        let sigma = arc_fractions(self.from, loop_vertices);
+        let tau = arc_fractions(self.onto, target_loop);
+        let anchors = loop_anchors(
+            self.onto,
+            self.pins,
+            &LoopPair {
+                indices: [s, self.paired[s]],
+                vertices: [loop_vertices, target_loop],
+                fractions: [&sigma, &tau],
+            },
+        )?;
+        let shift = if anchors.is_empty() {
+            self.best_rotation(loop_vertices, &sigma, target_loop, &tau)
+        } else {
+            0.0
+        };
+        let fraction = |position: usize| {
+            if anchors.is_empty() {
+                (sigma[position] + shift).rem_euclid(1.0)
+            } else {
+                along_anchors(&anchors, &sigma, &tau, sigma[position])
+            }
+        };
+        let step = loop_vertices.len().div_ceil(WARP_LOOP_SAMPLES).max(1);
+        for position in (0..loop_vertices.len()).step_by(step) {
+            pairs.push((
+                self.from.position(loop_vertices[position]),
+                loop_point(self.onto, target_loop, &tau, fraction(position)),
+            ));
+        }
+        let on_loop: Vec<(usize, usize)> = self
+            .skeleton
+            .nodes
+            .iter()
+            .enumerate()
+            .filter_map(|(n, v)| {
+                loop_vertices
+                    .iter()
+                    .position(|w| w == v)
+                    .map(|position| (n, position))
+            })
+            .collect();
+        for &(_, position) in &on_loop {
+            if let Some(a) = anchors.iter().find(|a| a.position == position) {
+                taken[target_loop[a.target].idx()] = true;
+            }
+        }
+        for (n, position) in on_loop {
+            if let Some(a) = anchors.iter().find(|a| a.position == position) {
+                out[n] = Some(target_loop[a.target]);
+                continue;
+            }
+            let want = fraction(position);
+            let nearest = (0..target_loop.len())
+                .filter(|&j| !taken[target_loop[j].idx()])
+                .min_by(|&i, &j| circular(tau[i], want).total_cmp(&circular(tau[j], want)))
+                .ok_or_else(|| self.seams(format!(
+                    "target boundary loop {} has fewer vertices than the source's cut graph meets it",
+                    self.paired[s]
+                )))?;
+            taken[target_loop[nearest].idx()] = true;
+            out[n] = Some(target_loop[nearest]);
+        }
+        Ok(())
+    }
+
+    /// For a closed surface with no similarity from landmarks (nor boundary loops to
+    /// anchor it): spread samples with their closest points on the other surface (into
+    /// `pairs`), which pull the rough placement onto it.
+    fn surface_pairs(
+        &self,
+        pairs: &mut Vec<(Point3<f64>, Point3<f64>)>,
+    ) -> Result<(), RegisterError> {
+        let step = self
+            .from
+            .vertex_count()
+            .div_ceil(WARP_SURFACE_SAMPLES)
+            .max(1);
+        for v in self.from.vertices().step_by(step) {
+            let p = self.from.position(v);
+            let located = self.onto_index.locate(&self.place.to_target(&p))?;
+            pairs.push((p, located.position));
+        }
+        Ok(())
+    }
+
+    /// The interior nodes at landmarks (into `out`, marked in `taken`): at their
+    /// partners' vertices, or the interior vertex nearest to a partner point; a vertex
+    /// already taken is left to the other interior nodes' search.
+    fn landmark_nodes(&self, out: &mut [Option<VertexId>], taken: &mut [bool]) {
         for (n, &v) in self.skeleton.nodes.iter().enumerate() {
             if out[n].is_some() {
                 continue;
@@ -689,24 +738,6 @@ impl Drawing<'_> {
                 }
             }
         }
-        // Other interior nodes: the nearest free interior vertex, by rings around the
-        // located face.
-        for (n, &v) in self.skeleton.nodes.iter().enumerate() {
-            if out[n].is_some() {
-                continue;
-            }
-            let p = warp.to_target(&self.from.position(v));
-            let face = self.onto_index.locate(&p)?.point.face;
-            let chosen = self.nearest_free(&p, face, &taken).ok_or_else(|| {
-                self.seams(format!(
-                    "no free interior target vertex for the cut graph's node at source vertex {}",
-                    self.from.vertex_map().to_input(v)
-                ))
-            })?;
-            taken[chosen.idx()] = true;
-            out[n] = Some(chosen);
-        }
-        Ok((out.into_iter().flatten().collect(), warp))
     }
 
     /// The shift of arc-length fractions from a source loop onto its target loop that
@@ -853,144 +884,24 @@ impl Drawing<'_> {
             .iter()
             .map(|&v| warp.to_target(&self.from.position(v)))
             .collect();
-        let corridor = Corridor::new(&placed, warp.corridor_width);
-        let mut blocked = blocked.to_vec();
-        let mut used_edge = used_edge.to_vec();
-        let mut legs: Vec<Vec<VertexId>> = Vec::new();
-        // Where the next leg starts, and the wedge it must leave by (only at `from`).
-        let leg_start = |legs: &[Vec<VertexId>]| match legs.last().and_then(|l| l.last()) {
-            Some(&end) => (end, None),
-            None => (from, first),
+        let mut route = ArcRoute {
+            drawing: self,
+            arc,
+            from,
+            first,
+            corridor: Corridor::new(&placed, warp.corridor_width),
+            corridor_width: warp.corridor_width,
+            along: lengths_along(&placed),
+            placed,
+            rings,
+            blocked: blocked.to_vec(),
+            used_edge: used_edge.to_vec(),
+            legs: Vec::new(),
+            ends: Vec::new(),
         };
-        // The placed arc's length from its start to each of its vertices: a leg is
-        // measured against the stretch of the placed arc it stands for.
-        let mut along = Vec::with_capacity(placed.len());
-        let mut length = 0.0;
-        for (k, p) in placed.iter().enumerate() {
-            length += k.checked_sub(1).map_or(0.0, |j| (p - placed[j]).norm());
-            along.push(length);
-        }
-        let detour = |leg: &[VertexId], from: usize, to: usize| {
-            let drawn: f64 = leg
-                .windows(2)
-                .map(|pair| (self.onto.position(pair[1]) - self.onto.position(pair[0])).norm())
-                .sum();
-            drawn > DETOUR * (along[to] - along[from]) + 2.0 * warp.corridor_width
-        };
-        // Each leg with the index of the arc vertex it ends at.
-        let mut ends: Vec<usize> = Vec::new();
-        let last = arc.vertices.len().saturating_sub(1);
-        for (i, &p) in placed.iter().enumerate().take(last).skip(1) {
-            let face = self.onto_index.locate(&p)?.point.face;
-            // A waypoint by a node is left out: the corridor leads past it.
-            let Some(via) = self.nearest_free(&p, face, &blocked) else {
-                continue;
-            };
-            if rings.contains_key(&via) {
-                continue;
-            }
-            let (start, leaving) = leg_start(&legs);
-            if via == start {
-                continue;
-            }
-            if let Some(leg) = corridor.shortest(
-                self.onto,
-                [start, via],
-                (&blocked, rings),
-                &used_edge,
-                [leaving, None],
-            ) {
-                // A waypoint reached only round a handle lies across an arc drawn
-                // before (or this one): skipped, the arc would wind where the placed
-                // one does not, a twist of the map that no flow undoes.
-                if detour(&leg, ends.last().copied().unwrap_or(0), i) {
-                    continue;
-                }
-                self.take(&leg, &mut blocked, &mut used_edge, true);
-                legs.push(leg);
-                ends.push(i);
-            }
-        }
-        // The last leg; when the legs before wall `to` off, or leave it to be reached
-        // only round a handle (from the wrong side of its wedge), drop them from the
-        // end.
-        let mut through_middle = false;
-        let mut walled = 1;
-        loop {
-            let (start, leaving) = leg_start(&legs);
-            // A loop at its node with no leg left: first through the placed arc's
-            // middle, so that the path goes round what the arc goes round.
-            if start == to && !through_middle {
-                through_middle = true;
-                let middle = last / 2;
-                let p = placed[middle];
-                let face = self.onto_index.locate(&p)?.point.face;
-                let leg = self.nearest_free(&p, face, &blocked).and_then(|via| {
-                    corridor.shortest(
-                        self.onto,
-                        [start, via],
-                        (&blocked, rings),
-                        &used_edge,
-                        [leaving, None],
-                    )
-                });
-                if let Some(leg) = leg {
-                    self.take(&leg, &mut blocked, &mut used_edge, true);
-                    legs.push(leg);
-                    ends.push(middle);
-                    continue;
-                }
-            }
-            let leg = (start != to)
-                .then(|| {
-                    corridor.shortest(
-                        self.onto,
-                        [start, to],
-                        (&blocked, rings),
-                        &used_edge,
-                        [leaving, last_wedge],
-                    )
-                })
-                .flatten();
-            // A detour drops one leg; no path at all drops 1, 2, 4, .. legs (each search
-            // that finds nothing explores all the mesh it can reach).
-            let drop = if let Some(leg) = leg {
-                // Nothing to drop before it: the leg is the arc's only way.
-                let only = legs.is_empty() || through_middle && legs.len() == 1;
-                if only || !detour(&leg, ends.last().copied().unwrap_or(0), last) {
-                    legs.push(leg);
-                    break;
-                }
-                1
-            } else {
-                walled *= 2;
-                walled / 2
-            };
-            if legs.is_empty() {
-                let middle = arc.vertices[arc.vertices.len() / 2];
-                return Err(self.seams(format!(
-                    "no path on the other mesh for the cut graph's arc from vertex {} to vertex {} of the {} that avoids the arcs drawn before it (the arc goes round a handle or a hole the placement did not pair: a landmark at {} vertex {}, the arc's middle, with its partner on the other mesh ties that handle down)",
-                    self.from.vertex_map().to_input(arc.vertices[0]),
-                    self.from
-                        .vertex_map()
-                        .to_input(*arc.vertices.last().unwrap_or(&arc.vertices[0])),
-                    self.from_side,
-                    self.from_side,
-                    self.from.vertex_map().to_input(middle),
-                )));
-            }
-            for _ in 0..drop.min(legs.len()) {
-                if let Some(dropped) = legs.pop() {
-                    ends.pop();
-                    self.take(&dropped, &mut blocked, &mut used_edge, false);
-                }
-            }
-        }
-        let mut path = vec![from];
-        for leg in legs {
-            path.extend_from_slice(&leg[1..]);
-        }
-        Ok(path)
+        route.through_waypoints()?;
+        route.last_leg(to, last_wedge)?;
+        Ok(route.path())
     }
 
     /// Marks the vertices (but the first) and edges of `leg` as drawn, or, with
@@ -1006,6 +917,231 @@ impl Drawing<'_> {
 
     fn seams(&self, reason: String) -> RegisterError {
         RegisterError::Seams { reason }
+    }
+}
+
+/// The length of a polyline from its start to each of its points: a leg is measured
+/// against the stretch of the placed arc it stands for.
+fn lengths_along(placed: &[Point3<f64>]) -> Vec<f64> {
+    let mut along = Vec::with_capacity(placed.len());
+    let mut length = 0.0;
+    for (k, p) in placed.iter().enumerate() {
+        length += k.checked_sub(1).map_or(0.0, |j| (p - placed[j]).norm());
+        along.push(length);
+    }
+    along
+}
+
+/// One interior arc's path on the other mesh while it is drawn ([`Drawing::route`]):
+/// the placed arc, its corridor, the legs drawn so far and what they and the arcs
+/// drawn before block.
+struct ArcRoute<'d, 'a> {
+    /// The drawing the arc belongs to.
+    drawing: &'d Drawing<'a>,
+    /// The source arc.
+    arc: &'d Arc,
+    /// The target vertex the path starts at.
+    from: VertexId,
+    /// The outgoing halfedges at `from` the path may leave by, when restricted.
+    first: Option<&'d [HalfedgeId]>,
+    /// The placed arc: the waypoints, the corridor and the detours' yardstick.
+    placed: Vec<Point3<f64>>,
+    /// The placed arc's length from its start to each of its vertices.
+    along: Vec<f64>,
+    /// The corridor about the placed arc.
+    corridor: Corridor,
+    /// The corridor's width.
+    corridor_width: f64,
+    /// The target vertices in the 1-rings of nodes, with their nodes.
+    rings: &'d HashMap<VertexId, Vec<VertexId>>,
+    /// The target vertices drawn through, the legs' included.
+    blocked: Vec<bool>,
+    /// The target edges drawn along, the legs' included.
+    used_edge: Vec<bool>,
+    /// The legs drawn so far, each from the end of the one before.
+    legs: Vec<Vec<VertexId>>,
+    /// The index of the arc vertex each leg ends at.
+    ends: Vec<usize>,
+}
+
+impl<'d> ArcRoute<'d, '_> {
+    /// Where the next leg starts, and the wedge it must leave by (only at `from`).
+    fn leg_start(&self) -> (VertexId, Option<&'d [HalfedgeId]>) {
+        match self.legs.last().and_then(|l| l.last()) {
+            Some(&end) => (end, None),
+            None => (self.from, self.first),
+        }
+    }
+
+    /// Whether `leg`, standing for the placed arc from its vertex `from` to `to`, is
+    /// longer than [`DETOUR`] times that stretch (plus two corridor widths): it goes
+    /// round a handle the placed arc does not.
+    fn detour(&self, leg: &[VertexId], from: usize, to: usize) -> bool {
+        let onto = self.drawing.onto;
+        let drawn: f64 = leg
+            .windows(2)
+            .map(|pair| (onto.position(pair[1]) - onto.position(pair[0])).norm())
+            .sum();
+        drawn > DETOUR * (self.along[to] - self.along[from]) + 2.0 * self.corridor_width
+    }
+
+    /// The cheapest leg from `start` to `end` in the corridor that avoids what is
+    /// drawn, leaving and entering through `wedges` when given ([`Corridor::shortest`]).
+    fn shortest(
+        &self,
+        [start, end]: [VertexId; 2],
+        wedges: [Option<&[HalfedgeId]>; 2],
+    ) -> Option<Vec<VertexId>> {
+        self.corridor.shortest(
+            self.drawing.onto,
+            [start, end],
+            (&self.blocked, self.rings),
+            &self.used_edge,
+            wedges,
+        )
+    }
+
+    /// Draws `leg`, which ends at arc vertex `end`, after the legs before.
+    fn push(&mut self, leg: Vec<VertexId>, end: usize) {
+        let drawing = self.drawing;
+        drawing.take(&leg, &mut self.blocked, &mut self.used_edge, true);
+        self.legs.push(leg);
+        self.ends.push(end);
+    }
+
+    /// The legs through the waypoints, the free target vertices nearest to the placed
+    /// interior vertices of the arc in order; a waypoint by a node, unreachable, or
+    /// reached only by a detour is skipped.
+    fn through_waypoints(&mut self) -> Result<(), RegisterError> {
+        let last = self.arc.vertices.len().saturating_sub(1);
+        for i in 1..last {
+            let p = self.placed[i];
+            let face = self.drawing.onto_index.locate(&p)?.point.face;
+            // A waypoint by a node is left out: the corridor leads past it.
+            let Some(via) = self.drawing.nearest_free(&p, face, &self.blocked) else {
+                continue;
+            };
+            if self.rings.contains_key(&via) {
+                continue;
+            }
+            let (start, leaving) = self.leg_start();
+            if via == start {
+                continue;
+            }
+            if let Some(leg) = self.shortest([start, via], [leaving, None]) {
+                // A waypoint reached only round a handle lies across an arc drawn
+                // before (or this one): skipped, the arc would wind where the placed
+                // one does not, a twist of the map that no flow undoes.
+                if self.detour(&leg, self.ends.last().copied().unwrap_or(0), i) {
+                    continue;
+                }
+                self.push(leg, i);
+            }
+        }
+        Ok(())
+    }
+
+    /// The last leg, into `to` through `last_wedge` when given; when the legs before
+    /// wall `to` off, or leave it to be reached only round a handle (from the wrong
+    /// side of its wedge), they are dropped from the end.
+    ///
+    /// # Errors
+    /// [`RegisterError::Seams`] when no leg is left and `to` still cannot be reached.
+    fn last_leg(
+        &mut self,
+        to: VertexId,
+        last_wedge: Option<&[HalfedgeId]>,
+    ) -> Result<(), RegisterError> {
+        let last = self.arc.vertices.len().saturating_sub(1);
+        let mut through_middle = false;
+        let mut walled = 1;
+        loop {
+            let (start, leaving) = self.leg_start();
+            // A loop at its node with no leg left: first through the placed arc's
+            // middle, so that the path goes round what the arc goes round.
+            if start == to && !through_middle {
+                through_middle = true;
+                if self.through_middle(start, leaving, last / 2)? {
+                    continue;
+                }
+            }
+            let leg = (start != to)
+                .then(|| self.shortest([start, to], [leaving, last_wedge]))
+                .flatten();
+            // A detour drops one leg; no path at all drops 1, 2, 4, .. legs (each search
+            // that finds nothing explores all the mesh it can reach).
+            let drop = if let Some(leg) = leg {
+                // Nothing to drop before it: the leg is the arc's only way.
+                let only = self.legs.is_empty() || through_middle && self.legs.len() == 1;
+                if only || !self.detour(&leg, self.ends.last().copied().unwrap_or(0), last) {
+                    self.legs.push(leg);
+                    return Ok(());
+                }
+                1
+            } else {
+                walled *= 2;
+                walled / 2
+            };
+            if self.legs.is_empty() {
+                return Err(self.no_path());
+            }
+            for _ in 0..drop.min(self.legs.len()) {
+                if let Some(dropped) = self.legs.pop() {
+                    self.ends.pop();
+                    let drawing = self.drawing;
+                    drawing.take(&dropped, &mut self.blocked, &mut self.used_edge, false);
+                }
+            }
+        }
+    }
+
+    /// For an arc that is a loop at its node: a leg from `start` (leaving by
+    /// `leaving`) to the free target vertex nearest to the placed arc's vertex
+    /// `middle`, drawn when there is one; whether it was.
+    fn through_middle(
+        &mut self,
+        start: VertexId,
+        leaving: Option<&[HalfedgeId]>,
+        middle: usize,
+    ) -> Result<bool, RegisterError> {
+        let p = self.placed[middle];
+        let face = self.drawing.onto_index.locate(&p)?.point.face;
+        let leg = self
+            .drawing
+            .nearest_free(&p, face, &self.blocked)
+            .and_then(|via| self.shortest([start, via], [leaving, None]));
+        let Some(leg) = leg else {
+            return Ok(false);
+        };
+        self.push(leg, middle);
+        Ok(true)
+    }
+
+    /// Why the arc has no path: it goes round a handle or a hole the placement did
+    /// not pair, with the landmark that ties it down.
+    fn no_path(&self) -> RegisterError {
+        let arc = self.arc;
+        let from = self.drawing.from;
+        let side = self.drawing.from_side;
+        let middle = arc.vertices[arc.vertices.len() / 2];
+        self.drawing.seams(format!(
+            "no path on the other mesh for the cut graph's arc from vertex {} to vertex {} of the {} that avoids the arcs drawn before it (the arc goes round a handle or a hole the placement did not pair: a landmark at {} vertex {}, the arc's middle, with its partner on the other mesh ties that handle down)",
+            from.vertex_map().to_input(arc.vertices[0]),
+            from.vertex_map()
+                .to_input(*arc.vertices.last().unwrap_or(&arc.vertices[0])),
+            side,
+            side,
+            from.vertex_map().to_input(middle),
+        ))
+    }
+
+    /// The whole path: the legs joined, from `from`.
+    fn path(self) -> Vec<VertexId> {
+        let mut path = vec![self.from];
+        for leg in self.legs {
+            path.extend_from_slice(&leg[1..]);
+        }
+        path
     }
 }
 

@@ -106,25 +106,8 @@ pub(crate) fn map(
         Side::Target,
     )?;
     let s_param = &source_square.param[..source.vertex_count()];
-    let (source_periods, target_periods) = parallel::join(
-        || {
-            periods(
-                source,
-                &source_square.cut,
-                &source_square.param,
-                Side::Source,
-            )
-        },
-        || {
-            periods(
-                target,
-                &target_square.cut,
-                &target_square.param,
-                Side::Target,
-            )
-        },
-    );
-    let (source_periods, target_periods) = (source_periods?, target_periods?);
+    let (source_periods, target_periods) =
+        both_periods(source, target, &source_square, &target_square)?;
     let tau = source_periods.tau();
 
     // Each landmark's target in the target's square.
@@ -133,59 +116,18 @@ pub(crate) fn map(
         .map(|m| interpolate(&target_square.cut.mesh, &target_square.param, &m.target))
         .collect();
     let (map, honoured) = if marks.is_empty() {
-        let (candidates, identity) = least_distortion_classes(tau, &target_periods);
-        let map = best_by_space(source, target, &domain, s_param, &candidates)?;
-        notes.push(format!(
-            "torus: no landmark; {} (the homotopy class of least Teichmueller bound{}), translation ({:.3}, {:.3}) of the square chosen by a rough spatial match",
-            map.linear.describe(),
-            if candidates.contains(&LatticeMap::IDENTITY) {
-                String::new()
-            } else {
-                format!("; pairing a with a and b with b would have {identity:.4}")
-            },
-            map.shift.re,
-            map.shift.im
-        ));
+        let map = map_by_space(
+            source,
+            target,
+            &domain,
+            s_param,
+            tau,
+            &target_periods,
+            notes,
+        )?;
         (map, Vec::new())
     } else {
-        let s: Vec<Complex64> = marks.iter().map(|m| s_param[m.source.idx()]).collect();
-        let turns: &[u8] = if marks.len() == 1 {
-            &[0]
-        } else {
-            &[0, 1, 2, 3]
-        };
-        let mut best: Option<(f64, SquareMap)> = None;
-        for &quarter_turns in turns {
-            let mut map = SquareMap {
-                linear: LatticeMap::quarter_turns(quarter_turns),
-                shift: Complex64::new(0.0, 0.0),
-            };
-            map.shift = t[0] - map.turn(s[0]);
-            let residual: f64 = s
-                .iter()
-                .zip(&t)
-                .skip(1)
-                .map(|(&a, &b)| periodic_distance(map.apply(a), b))
-                .sum();
-            if best.is_none_or(|(r, _)| residual < r - 1e-12) {
-                best = Some((residual, map));
-            }
-        }
-        let Some((_, map)) = best else {
-            return Err(RegisterError::NoSquare { side: Side::Source });
-        };
-        let honoured: Vec<usize> = (0..marks.len())
-            .filter(|&k| periodic_distance(map.apply(s[k]), t[k]) <= HONOURED)
-            .collect();
-        notes.push(format!(
-            "torus: {} and translation ({:.4}, {:.4}) of the square from the landmarks ({} of {} honoured exactly)",
-            map.linear.describe(),
-            map.shift.re,
-            map.shift.im,
-            honoured.len(),
-            marks.len(),
-        ));
-        (map, honoured)
+        map_by_landmarks(marks, s_param, &t, notes)?
     };
     let (images, honoured): (Vec<Complex64>, Vec<usize>) = if honoured.len() < marks.len() {
         let matched = match_on_torus(&source_square, source.vertex_count(), &map, marks, &t)?;
@@ -219,6 +161,113 @@ pub(crate) fn map(
         honoured,
         teichmueller_bound: bound,
     })
+}
+
+/// The periods of both meshes' squares (module `modulus`): independent, so both at
+/// once, on two cores.
+fn both_periods(
+    source: &Mesh,
+    target: &Mesh,
+    source_square: &Square,
+    target_square: &Square,
+) -> Result<(TorusPeriods, TorusPeriods), RegisterError> {
+    let (source_periods, target_periods) = parallel::join(
+        || {
+            periods(
+                source,
+                &source_square.cut,
+                &source_square.param,
+                Side::Source,
+            )
+        },
+        || {
+            periods(
+                target,
+                &target_square.cut,
+                &target_square.param,
+                Side::Target,
+            )
+        },
+    );
+    Ok((source_periods?, target_periods?))
+}
+
+/// The map of the squares without landmarks (module docs): of the classes of least
+/// Teichmueller bound, the one and the translation that best match the meshes in
+/// space; the choice is noted.
+fn map_by_space(
+    source: &Mesh,
+    target: &Mesh,
+    domain: &Mesh,
+    s_param: &[Complex64],
+    tau: Complex64,
+    target_periods: &TorusPeriods,
+    notes: &mut Vec<String>,
+) -> Result<SquareMap, RegisterError> {
+    let (candidates, identity) = least_distortion_classes(tau, target_periods);
+    let map = best_by_space(source, target, domain, s_param, &candidates)?;
+    notes.push(format!(
+        "torus: no landmark; {} (the homotopy class of least Teichmueller bound{}), translation ({:.3}, {:.3}) of the square chosen by a rough spatial match",
+        map.linear.describe(),
+        if candidates.contains(&LatticeMap::IDENTITY) {
+            String::new()
+        } else {
+            format!("; pairing a with a and b with b would have {identity:.4}")
+        },
+        map.shift.re,
+        map.shift.im
+    ));
+    Ok(map)
+}
+
+/// The map of the squares from the landmarks (module docs), `s_param` the source's
+/// square and `t` the landmarks' targets in the target's: the quarter turn and
+/// translation with the smallest periodic distances, and the landmarks it honours
+/// exactly; the choice is noted.
+fn map_by_landmarks(
+    marks: &[Resolved],
+    s_param: &[Complex64],
+    t: &[Complex64],
+    notes: &mut Vec<String>,
+) -> Result<(SquareMap, Vec<usize>), RegisterError> {
+    let s: Vec<Complex64> = marks.iter().map(|m| s_param[m.source.idx()]).collect();
+    let turns: &[u8] = if marks.len() == 1 {
+        &[0]
+    } else {
+        &[0, 1, 2, 3]
+    };
+    let mut best: Option<(f64, SquareMap)> = None;
+    for &quarter_turns in turns {
+        let mut map = SquareMap {
+            linear: LatticeMap::quarter_turns(quarter_turns),
+            shift: Complex64::new(0.0, 0.0),
+        };
+        map.shift = t[0] - map.turn(s[0]);
+        let residual: f64 = s
+            .iter()
+            .zip(t)
+            .skip(1)
+            .map(|(&a, &b)| periodic_distance(map.apply(a), b))
+            .sum();
+        if best.is_none_or(|(r, _)| residual < r - 1e-12) {
+            best = Some((residual, map));
+        }
+    }
+    let Some((_, map)) = best else {
+        return Err(RegisterError::NoSquare { side: Side::Source });
+    };
+    let honoured: Vec<usize> = (0..marks.len())
+        .filter(|&k| periodic_distance(map.apply(s[k]), t[k]) <= HONOURED)
+        .collect();
+    notes.push(format!(
+        "torus: {} and translation ({:.4}, {:.4}) of the square from the landmarks ({} of {} honoured exactly)",
+        map.linear.describe(),
+        map.shift.re,
+        map.shift.im,
+        honoured.len(),
+        marks.len(),
+    ));
+    Ok((map, honoured))
 }
 
 /// The source's square bent so that every landmark lands on its target `targets[k]`
