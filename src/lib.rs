@@ -58,6 +58,7 @@
 //! parses arguments, calls this library and prints); see the README for its commands.
 #![warn(missing_docs)]
 
+pub mod batch_job;
 pub mod catalog;
 pub mod correspondence;
 pub mod landmarks;

@@ -61,6 +61,23 @@ fn no_corpus_input_panics_in_any_target() {
 }
 
 #[test]
+fn a_jobs_line_cannot_end_the_flags_or_set_the_output_through_an_option_name() {
+    for (name, expected) in [
+        (
+            "empty-option-name-ends-the-flags.jsonl",
+            "line 1: \"\" is not a job option",
+        ),
+        (
+            "output-set-through-an-option-name.jsonl",
+            "line 1: \"output=c.obj\" is not a job option",
+        ),
+    ] {
+        let error = run_corpus_file("jobs", name).unwrap_err();
+        assert!(error.contains(expected), "{name}: {error}");
+    }
+}
+
+#[test]
 fn a_long_flat_sum_is_not_deep() {
     // 1,000 terms: a chain is one level, however long.
     let sum = vec!["0.0001*z"; 1000].join("+");

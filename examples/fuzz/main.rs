@@ -5,8 +5,9 @@
 //! cargo run --release --example fuzz -- all SECONDS [SEED]   # SECONDS per target
 //! ```
 //!
-//! Targets are listed in `targets.rs` (`obj`, `gltf`, `build`, `expr`, `field`,
-//! `landmarks`, `correspondence`, `cut`). Seeds are built in and read from
+//! Targets are listed in `targets.rs` (`TARGETS`: the mesh readers, the builder, the
+//! expression and field parsers, landmarks, correspondences, cuts, circle domains,
+//! remeshing and the batch jobs file). Seeds are built in and read from
 //! `tests/corpus/TARGET/`; each run takes a seed, applies a few random byte-level and
 //! token-level mutations (bit flips, inserted/deleted/duplicated ranges, numbers at the
 //! edges of f64, indices `0` and `-9`, deep nesting, splices of another seed) and runs
@@ -150,6 +151,10 @@ fn builtin_seeds(target: &str) -> Vec<Vec<u8>> {
         "stl" => vec!["solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n".into()],
         "circle-domain" => vec!["\u{3}\u{28}\u{3c}\u{1e}\u{4d}\u{4b}\u{14}".into()],
         "remesh" => vec!["\u{0}\u{10}\u{1e}\u{40}\u{7}".into(), "\u{3}\u{40}\u{1e}\u{7f}\u{7}".into()],
+        "jobs" => vec![
+            "\u{feff}# jobs\n{\"command\": \"param\", \"input\": \"a.obj\", \"output\": \"b.obj\", \"options\": {\"solver\": \"lscm\", \"pin\": [\"v0\", \"v9\"], \"repair\": true, \"json\": false, \"tolerance\": 1e-6}}\n\n{\"command\": \"register\", \"input\": [\"s.obj\", \"t.obj\"], \"output\": \"o.obj\"}\n".into(),
+            "{\"command\": \"qc\", \"input\": \"a\", \"output\": \"b\", \"options\": {\"mu\": \"-0.5\", \"max-iters\": 40}}\n".into(),
+        ],
         "off" => vec!["OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n4 0 2 3 1\n".into(), "STCOFF 3 1 0\n0 0 0 1 0 0 1 0 0\n1 0 0 0 1 0 1 1 0\n0 1 0 0 0 1 1 0 1\n3 0 1 2\n".into()],
         _ => Vec::new(),
     };

@@ -7,16 +7,16 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use beltrami::correspondence;
 use beltrami::fem::{BeltramiField, Expr};
 use beltrami::landmarks::Landmarks;
 use beltrami::mesh::io::{self, RawMesh};
 use beltrami::mesh::primitives::{self, Cells};
 use beltrami::mesh::{BuildOptions, Mesh, Point3, PolygonSoup, Repair, cut_graph, cut_to_disk};
+use beltrami::{batch_job, correspondence};
 use num_complex::Complex64;
 
 /// The targets, by the name the driver and the corpus folders use.
-pub const TARGETS: [&str; 13] = [
+pub const TARGETS: [&str; 14] = [
     "obj",
     "gltf",
     "ply",
@@ -30,6 +30,7 @@ pub const TARGETS: [&str; 13] = [
     "cut",
     "circle-domain",
     "remesh",
+    "jobs",
 ];
 
 /// Runs target `name` on `data`.
@@ -48,6 +49,7 @@ pub fn run(name: &str, data: &[u8]) -> Result<(), String> {
         "cut" => cut(data),
         "circle-domain" => circle_domain(data),
         "remesh" => remesh(data),
+        "jobs" => jobs(data),
         _ => Err(format!("unknown target `{name}`")),
     }
 }
@@ -224,6 +226,40 @@ fn landmarks(data: &[u8]) -> Result<(), String> {
     let marks = Landmarks::parse(Path::new("fuzz.landmarks"), text(data)?, mesh, mesh)
         .map_err(|e| e.to_string())?;
     let _ = marks.constraints(mesh);
+    Ok(())
+}
+
+/// The jobs file of `beltrami batch`. An accepted file must give command lines in which
+/// nothing but an option's own name reads as a flag: the command first, inputs that do
+/// not start with `-`, `-o OUTPUT`, then `--name [value]` groups whose values do not
+/// start with `--` and whose names are not empty, hold no `=` or space, and are not
+/// help, version or the output.
+fn jobs(data: &[u8]) -> Result<(), String> {
+    let jobs = batch_job::parse_jobs(text(data)?).map_err(|e| e.to_string())?;
+    for job in &jobs {
+        let args = &job.args;
+        assert_eq!(args[0], job.command, "line {}: {args:?}", job.line);
+        let o = args.iter().position(|a| a == "-o").expect("no -o");
+        assert!(args[1..o].iter().all(|a| !a.starts_with('-')), "{args:?}");
+        assert_eq!(Path::new(&args[o + 1]), job.output, "{args:?}");
+        assert!(!args[o + 1].starts_with('-'), "{args:?}");
+        for (k, a) in args.iter().enumerate().skip(o + 2) {
+            let is_flag = a.starts_with("--");
+            let follows_flag = args[k - 1].starts_with("--") && k - 1 > o + 1;
+            assert!(is_flag || follows_flag, "a bare value {a:?} in {args:?}");
+            if is_flag && !follows_flag {
+                assert!(a.len() > 2 && !a[2..].starts_with('-'), "{args:?}");
+                assert!(
+                    !a.contains('=') && !a.contains(char::is_whitespace),
+                    "{args:?}"
+                );
+                assert!(
+                    !matches!(a.as_str(), "--help" | "--version" | "--output" | "--o"),
+                    "{args:?}"
+                );
+            }
+        }
+    }
     Ok(())
 }
 

@@ -1,18 +1,8 @@
 //! `beltrami batch JOBS.jsonl`: many param, qc, register and remesh jobs, run in
 //! parallel, one JSON report line per job.
 //!
-//! A job is one JSON object per line (blank lines and lines starting with `#` are
-//! skipped):
-//!
-//! ```text
-//! {"command": "param", "input": "a.obj", "output": "a_uv.obj", "options": {"solver": "lscm"}}
-//! {"command": "register", "input": ["face_a.obj", "face_b.obj"], "output": "a_on_b.obj"}
-//! {"command": "remesh", "input": "bunny.obj", "output": "bunny_2k.obj", "options": {"vertices": 2000}}
-//! ```
-//!
-//! `input` is the command's positional argument or list of them, `output` its `-o`, and
-//! each `options` entry a flag: `"name": value` is `--name value`, `true` is `--name`
-//! alone, `false` omits it, and an array repeats the flag (`"pin": ["v0", "v9"]`). Paths
+//! A job is one JSON object per line (`command`, `input`, `output`, `options`), read by
+//! [`beltrami::batch_job`], which says how each becomes a command line. Paths
 //! are taken as written, relative to the current directory. Every job runs as its own
 //! `beltrami` process (in its own process group, so that a Ctrl-C of the batch does not
 //! cut a job short), with `--json`: its JSON report becomes the `report` of the job's
@@ -29,6 +19,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context as _, bail};
+use beltrami::batch_job::{Job, parse_jobs};
 use clap::Args;
 use serde_json::{Value, json};
 
@@ -48,118 +39,6 @@ pub struct BatchArgs {
     /// Also write the report lines to this file (JSON Lines, in the jobs' order).
     #[arg(long, value_name = "R.jsonl")]
     pub report: Option<PathBuf>,
-}
-
-/// The commands a job may run.
-const COMMANDS: &[&str] = &["param", "qc", "register", "remesh"];
-
-/// One job of the file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Job {
-    /// 1-based line of the jobs file.
-    pub line: usize,
-    /// `param`, `qc`, `register` or `remesh`.
-    pub command: String,
-    /// The output path (`-o`).
-    pub output: PathBuf,
-    /// The arguments after the command name.
-    pub args: Vec<String>,
-}
-
-/// Parses one line of the jobs file (module docs), naming the line in errors.
-pub fn parse_job(line: usize, text: &str) -> anyhow::Result<Job> {
-    let value: Value =
-        serde_json::from_str(text).with_context(|| format!("line {line}: not a JSON object"))?;
-    let object = value
-        .as_object()
-        .with_context(|| format!("line {line}: not a JSON object"))?;
-    let command = object
-        .get("command")
-        .and_then(Value::as_str)
-        .with_context(|| {
-            format!(
-                "line {line}: no \"command\" (one of {})",
-                COMMANDS.join(", ")
-            )
-        })?;
-    if !COMMANDS.contains(&command) {
-        bail!(
-            "line {line}: the command \"{command}\" is not one of {}",
-            COMMANDS.join(", ")
-        );
-    }
-    let output = object
-        .get("output")
-        .and_then(Value::as_str)
-        .with_context(|| format!("line {line}: no \"output\" path"))?;
-    let dashed = |what: &str, text: &str| -> anyhow::Result<()> {
-        if text.starts_with('-') {
-            bail!(
-                "line {line}: {what} \"{text}\" starts with `-`, which the command would read as a flag"
-            );
-        }
-        Ok(())
-    };
-    dashed("the output", output)?;
-    let inputs: Vec<String> = match object.get("input") {
-        Some(Value::String(s)) => vec![s.clone()],
-        Some(Value::Array(items)) => items
-            .iter()
-            .map(|v| {
-                v.as_str()
-                    .map(str::to_string)
-                    .with_context(|| format!("line {line}: \"input\" holds a non-string {v}"))
-            })
-            .collect::<anyhow::Result<_>>()?,
-        _ => bail!("line {line}: no \"input\" (a path or a list of paths)"),
-    };
-    for input in &inputs {
-        dashed("the input", input)?;
-    }
-    for key in object.keys() {
-        if !["command", "input", "output", "options"].contains(&key.as_str()) {
-            bail!("line {line}: unknown key \"{key}\" (command, input, output, options)");
-        }
-    }
-    let mut args = vec![command.to_string()];
-    args.extend(inputs);
-    args.extend(["-o".to_string(), output.to_string()]);
-    if let Some(options) = object.get("options") {
-        let options = options
-            .as_object()
-            .with_context(|| format!("line {line}: \"options\" is not an object"))?;
-        for (name, value) in options {
-            if matches!(name.as_str(), "help" | "version" | "output" | "o") || name.starts_with('-')
-            {
-                bail!(
-                    "line {line}: \"{name}\" is not a job option (the output is the job's \"output\"; help and version are not jobs)"
-                );
-            }
-            let flag = format!("--{name}");
-            let items = match value {
-                Value::Array(items) => items.clone(),
-                other => vec![other.clone()],
-            };
-            for item in items {
-                match item {
-                    Value::Bool(true) => args.push(flag.clone()),
-                    Value::Bool(false) => {}
-                    Value::String(s) if s.starts_with("--") => bail!(
-                        "line {line}: option \"{name}\" has the value \"{s}\", which the command would read as a flag"
-                    ),
-                    Value::String(s) => args.extend([flag.clone(), s]),
-                    Value::Number(n) => args.extend([flag.clone(), n.to_string()]),
-                    other => bail!("line {line}: option \"{name}\" has the value {other}"),
-                }
-            }
-        }
-    }
-    Ok(Job {
-        line,
-        command: command.to_string(),
-        output: PathBuf::from(output),
-        args,
-    })
 }
 
 /// Fails, before any job runs, when two jobs write the same file, or a job writes the
@@ -288,16 +167,8 @@ fn error_message(stderr: &str) -> Option<String> {
 pub fn run(args: &BatchArgs, quiet: bool) -> anyhow::Result<()> {
     let text = std::fs::read_to_string(&args.file)
         .with_context(|| format!("cannot read the jobs file {}", args.file.display()))?;
-    // Editors on Windows start UTF-8 files with a byte-order mark.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
     // A malformed line is a mistake in the file, found before any job runs.
-    let jobs: Vec<Job> = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
-        .map(|(i, l)| parse_job(i + 1, l))
-        .collect::<anyhow::Result<_>>()
-        .with_context(|| format!("in {}", args.file.display()))?;
+    let jobs = parse_jobs(&text).with_context(|| format!("in {}", args.file.display()))?;
     if let Some(path) = &args.report {
         super::outputs::check(&[("--report", Some(path.as_path()))])?;
     }
@@ -370,41 +241,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_job_line_becomes_the_command_line() {
-        let job = parse_job(
-            3,
-            r#"{"command": "param", "input": "a.obj", "output": "b.obj", "options": {"solver": "tutte", "pin": ["v0", "v4"], "json": false, "repair": true, "tolerance": 1e-6}}"#,
-        )
-        .unwrap();
-        assert_eq!(job.line, 3);
-        assert_eq!(job.output, PathBuf::from("b.obj"));
-        assert_eq!(
-            job.args,
-            [
-                "param",
-                "a.obj",
-                "-o",
-                "b.obj",
-                "--pin",
-                "v0",
-                "--pin",
-                "v4",
-                "--repair",
-                "--solver",
-                "tutte",
-                "--tolerance",
-                "1e-6"
-            ]
-        );
-        let two = parse_job(
-            1,
-            r#"{"command": "register", "input": ["s.obj", "t.obj"], "output": "o.obj"}"#,
-        )
-        .unwrap();
-        assert_eq!(two.args, ["register", "s.obj", "t.obj", "-o", "o.obj"]);
-    }
-
-    #[test]
     fn the_error_message_is_the_commands_error() {
         let clap = "error: the following required arguments were not provided:\n  --solver <SOLVER>\n\nUsage: beltrami param --solver <SOLVER> <MESH>\n\nFor more information, try '--help'.\n";
         assert_eq!(
@@ -416,29 +252,5 @@ mod tests {
             "cannot read a.obj: no such file"
         );
         assert_eq!(error_message("thread main panicked\n"), None);
-    }
-
-    #[test]
-    fn bad_lines_are_named() {
-        for (text, expected) in [
-            ("[1, 2]", "line 7: not a JSON object"),
-            (
-                "{\"command\": \"render\", \"input\": \"a\", \"output\": \"b\"}",
-                "\"render\" is not one of",
-            ),
-            ("{\"command\": \"qc\", \"input\": \"a\"}", "no \"output\""),
-            ("{\"command\": \"qc\", \"output\": \"b\"}", "no \"input\""),
-            (
-                "{\"command\": \"qc\", \"input\": \"a\", \"output\": \"b\", \"extra\": 1}",
-                "unknown key \"extra\"",
-            ),
-            (
-                "{\"command\": \"qc\", \"input\": \"a\", \"output\": \"b\", \"options\": {\"mu\": null}}",
-                "option \"mu\"",
-            ),
-        ] {
-            let error = format!("{:#}", parse_job(7, text).unwrap_err());
-            assert!(error.contains(expected), "{text}: {error}");
-        }
     }
 }
