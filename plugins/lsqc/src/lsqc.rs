@@ -11,7 +11,7 @@ use beltrami_fem::boundary::{self, BoundaryError};
 use beltrami_fem::element::check_planar;
 use beltrami_fem::operators::{beltrami_operator, weighted_residual};
 use beltrami_fem::{
-    BeltramiField, Distortion, DofConstraints, DofMap, Elements, FemError, Frame,
+    BeltramiField, BoundaryMap, Distortion, DofConstraints, DofMap, Elements, FemError, Frame,
     LeastSquaresSolver, MuError,
 };
 use beltrami_mesh::VertexId;
@@ -185,7 +185,27 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
     let mesh = problem.source;
     topology::require_disk(NAME, mesh, NOT_A_DISK)?;
     let planar = check_planar(mesh);
-    let field = match &problem.goal {
+    let field = field_of(problem, &planar)?;
+    check_constraints(problem)?;
+    let pins = pins(problem, planar.is_ok())?;
+    let boundary_map = boundary_map_of(problem)?;
+    let (fixed, default_pins) = fixed_vertices(problem, boundary_map, &pins)?;
+    Ok(Setup {
+        field,
+        fixed,
+        default_pins,
+    })
+}
+
+/// The Beltrami field of the goal (zero for the conformal map), refused when it is in
+/// the global frame on a source that is not in the plane (`planar`) or when the goal
+/// is not one lsqc follows.
+fn field_of(
+    problem: &Problem<'_>,
+    planar: &Result<(), FemError>,
+) -> Result<BeltramiField, SolverError> {
+    let mesh = problem.source;
+    match &problem.goal {
         Goal::Prescribed(field) => {
             // Names the first face with |mu| >= 1 or a non-finite value.
             field.check(mesh.face_count())?;
@@ -196,27 +216,28 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
                     "the Beltrami field is in the global frame, which needs a mesh in the plane z = 0, but vertex {vertex} has z = {z:e}; give the field in the face frame"
                 )));
             }
-            field.clone()
+            Ok(field.clone())
         }
-        Goal::Conformal { p } if *p == 2.0 => BeltramiField::zero(Frame::Face, mesh.face_count()),
-        Goal::Conformal { p } => {
-            return Err(unsupported(format!(
-                "lsqc minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu; use beltrami-flow for p > 2"
-            )));
+        Goal::Conformal { p } if *p == 2.0 => {
+            Ok(BeltramiField::zero(Frame::Face, mesh.face_count()))
         }
-        Goal::Extremal => {
-            return Err(unsupported(
-                "lsqc follows a prescribed Beltrami coefficient; for extremal (Teichmueller) maps use teichmuller"
-                    .to_string(),
-            ));
-        }
-        Goal::Features(_) => {
-            return Err(unsupported(
-                "lsqc follows a prescribed Beltrami coefficient; features are matched by register"
-                    .to_string(),
-            ));
-        }
-    };
+        Goal::Conformal { p } => Err(unsupported(format!(
+            "lsqc minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu; use beltrami-flow for p > 2"
+        ))),
+        Goal::Extremal => Err(unsupported(
+            "lsqc follows a prescribed Beltrami coefficient; for extremal (Teichmueller) maps use teichmuller"
+                .to_string(),
+        )),
+        Goal::Features(_) => Err(unsupported(
+            "lsqc follows a prescribed Beltrami coefficient; features are matched by register"
+                .to_string(),
+        )),
+    }
+}
+
+/// Refuses the constraints lsqc does not take: curves, and the normal and area
+/// constraints of maps into space.
+fn check_constraints(problem: &Problem<'_>) -> Result<(), SolverError> {
     if problem.constraints.curves().next().is_some() {
         return Err(unsupported(
             "lsqc does not make vertices follow curves yet; use beltrami-flow".to_string(),
@@ -231,11 +252,17 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
             "the normal and area constraints keep a map into space near the surface; they have no meaning in the plane: use --target space".to_string(),
         ));
     }
-    let pins = pins(problem, planar.is_ok())?;
-    let boundary_map = match &problem.target {
-        Target::Plane(PlanarBoundary::Free) => None,
+    Ok(())
+}
+
+/// The boundary held by the target: the source's own (keep), a given one, or none
+/// (free); other targets are refused.
+fn boundary_map_of(problem: &Problem<'_>) -> Result<Option<BoundaryMap>, SolverError> {
+    let mesh = problem.source;
+    match &problem.target {
+        Target::Plane(PlanarBoundary::Free) => Ok(None),
         Target::Plane(PlanarBoundary::Keep) => {
-            Some(boundary::keep(mesh).map_err(|e| match e {
+            Ok(Some(boundary::keep(mesh).map_err(|e| match e {
                 BoundaryError::NotPlanar { vertex, z } => unsupported(format!(
                     "keeping the boundary needs a source in the plane z = 0, but vertex {vertex} has z = {z:e}; give the boundary (a map) or leave it free"
                 )),
@@ -243,32 +270,42 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
                     solver: NAME,
                     error,
                 },
-            })?)
+            })?))
         }
-        Target::Plane(PlanarBoundary::Given(values)) => Some(
+        Target::Plane(PlanarBoundary::Given(values)) => Ok(Some(
             boundary::given(mesh, values)
                 .map_err(|error| SolverError::Boundary { solver: NAME, error })?,
-        ),
-        Target::Plane(_) => {
-            return Err(unsupported(
-                "lsqc keeps the source's boundary, takes a given boundary map or leaves the boundary free; map the boundary first (tutte, harmonic) and pass it as a given boundary"
-                    .to_string(),
-            ));
-        }
-        _ => {
-            return Err(unsupported(
-                "lsqc maps into the plane; for the disk, annulus, sphere or a target mesh use beltrami-flow"
-                    .to_string(),
-            ));
-        }
-    };
+        )),
+        Target::Plane(_) => Err(unsupported(
+            "lsqc keeps the source's boundary, takes a given boundary map or leaves the boundary free; map the boundary first (tutte, harmonic) and pass it as a given boundary"
+                .to_string(),
+        )),
+        _ => Err(unsupported(
+            "lsqc maps into the plane; for the disk, annulus, sphere or a target mesh use beltrami-flow"
+                .to_string(),
+        )),
+    }
+}
+
+/// The vertices held with their positions, and the two boundary vertices pinned by
+/// default ([`Setup::fixed`], [`Setup::default_pins`]).
+type Held = (Vec<(VertexId, Complex64)>, Option<(VertexId, VertexId)>);
+
+/// The vertices held and where, and the two boundary vertices pinned by default: the
+/// boundary map with the pins, or with a free boundary the pins (two without positions
+/// go to 0 and 1; none: two boundary vertices far apart).
+fn fixed_vertices(
+    problem: &Problem<'_>,
+    boundary_map: Option<BoundaryMap>,
+    pins: &[(VertexId, Option<Complex64>)],
+) -> Result<Held, SolverError> {
     let zero = Complex64::new(0.0, 0.0);
     let one = Complex64::new(1.0, 0.0);
-    let (fixed, default_pins) = match boundary_map {
+    match boundary_map {
         Some(map) => {
             let mut fixed: Vec<(VertexId, Complex64)> =
                 map.vertices.into_iter().zip(map.positions).collect();
-            for (v, z) in &pins {
+            for (v, z) in pins {
                 let z = z.ok_or_else(|| {
                     unsupported(format!(
                         "the pin on vertex {v} has no position and the source is not planar; give it a position"
@@ -276,19 +313,17 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
                 })?;
                 fixed.push((*v, z));
             }
-            (fixed, None)
+            Ok((fixed, None))
         }
-        None => match pins.as_slice() {
+        None => match pins {
             [] => {
-                let (a, b) = boundary::far_boundary_pair(mesh);
-                (vec![(a, zero), (b, one)], Some((a, b)))
+                let (a, b) = boundary::far_boundary_pair(problem.source);
+                Ok((vec![(a, zero), (b, one)], Some((a, b))))
             }
-            [(v, _)] => {
-                return Err(unsupported(format!(
-                    "with a free boundary lsqc needs two pinned vertices (or none, to pin two boundary vertices far apart), but only vertex {v} was pinned"
-                )));
-            }
-            [(a, None), (b, None)] => (vec![(*a, zero), (*b, one)], None),
+            [(v, _)] => Err(unsupported(format!(
+                "with a free boundary lsqc needs two pinned vertices (or none, to pin two boundary vertices far apart), but only vertex {v} was pinned"
+            ))),
+            [(a, None), (b, None)] => Ok((vec![(*a, zero), (*b, one)], None)),
             pins => {
                 let fixed = pins
                     .iter()
@@ -306,15 +341,10 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
                         fixed[0].1
                     )));
                 }
-                (fixed, None)
+                Ok((fixed, None))
             }
         },
-    };
-    Ok(Setup {
-        field,
-        fixed,
-        default_pins,
-    })
+    }
 }
 
 /// The pins with their planar positions: given ones, the vertex's own position for a

@@ -10,10 +10,11 @@ use beltrami_fem::element::check_planar;
 use beltrami_fem::{BeltramiField, Distortion, Elements, FemError, Frame, MuError};
 use beltrami_mesh::Mesh;
 use beltrami_sparse::SolveOptions;
+use num_complex::Complex64;
 
 use crate::NAME;
 use crate::initial::{CircleMap, Loops, initial_map};
-use crate::system::StepSystem;
+use crate::system::{Step, StepSystem};
 
 /// QCMC (crate docs): the map of a genus-0 mesh with `k >= 2` boundary loops onto a
 /// circle domain, the centres and radii found with the map.
@@ -118,77 +119,32 @@ impl Solver for Qcmc {
         })?;
 
         let mu = &field.mu;
-        let mut energy = StepSystem::energy(&elements, mu, &state.map);
+        let energy = StepSystem::energy(&elements, mu, &state.map);
         metrics.energy_history.push(energy);
-        // Which way each image triangle must turn: along the face's own orientation
-        // (face frames), or along the source's own turn in the plane (global frame).
-        let triangles: Vec<([usize; 3], f64)> = mesh
-            .faces()
-            .map(|f| {
-                let (v, _) = mesh.face_vertex_array(f);
-                let sign = match field.frame {
-                    Frame::Global => mesh.face_vector_area(f).z.signum(),
-                    Frame::Face => 1.0,
-                };
-                ([v[0].idx(), v[1].idx(), v[2].idx()], sign)
-            })
-            .collect();
+        let triangles = oriented_triangles(mesh, field.frame);
         if triangles.iter().map(|(_, s)| s).sum::<f64>() < 0.0 {
             // A planar mesh listed clockwise with a field in the global frame: the start
             // follows the faces' orientation, the energy the plane's; mirror the start.
             state.mirror();
         }
         metrics.initial_distortion = Some(measure(mesh, &elements, &state.map)?.stats);
-        let mut flips = flipped(&triangles, &state.map);
-        let mut near = near_folds(&elements, &state.map)?;
-        let iterate = std::time::Instant::now();
-        let mut factorizations = 0;
-        let stop = loop {
-            if metrics.iterations >= max_iters {
-                break Stop::IterationLimit;
-            }
-            if context.is_cancelled() {
-                break Stop::Cancelled;
-            }
-            let (step, _) = system.step(&elements, mu, &state)?;
-            factorizations += 1;
-            let mut t = 1.0;
-            let mut accepted = None;
-            for _ in 0..=HALVINGS {
-                let trial = step.apply(&state, t, system.loop_of());
-                if admissible(&trial)
-                    && flipped(&triangles, &trial.map) <= flips
-                    && near_folds(&elements, &trial.map)? <= near
-                {
-                    let e = StepSystem::energy(&elements, mu, &trial.map);
-                    if e < energy {
-                        accepted = Some((trial, e));
-                        break;
-                    }
-                }
-                t *= 0.5;
-            }
-            let Some((trial, e)) = accepted else {
-                break Stop::Stalled;
-            };
-            let moved = largest_move(&state, &trial);
-            flips = flipped(&triangles, &trial.map);
-            near = near_folds(&elements, &trial.map)?;
-            state = trial;
-            energy = e;
-            metrics.iterations += 1;
-            metrics.energy_history.push(energy);
-            metrics.step_sizes.push(t);
-            context.report(&Progress {
-                stage: "iteration",
-                done: metrics.iterations,
-                total: Some(max_iters),
-                energy: Some(energy),
-            });
-            if moved <= tolerance {
-                break Stop::Converged { tolerance };
-            }
+        let mut current = Current {
+            flips: flipped(&triangles, &state.map),
+            near: near_folds(&elements, &state.map)?,
+            state,
+            energy,
         };
+        let iterate = std::time::Instant::now();
+        let descent = Descent {
+            elements: &elements,
+            mu,
+            triangles: &triangles,
+            tolerance,
+            max_iters,
+        };
+        let (stop, factorizations) =
+            descent.run(&mut system, &mut current, &mut metrics, context)?;
+        let state = current.state;
         report
             .timings
             .push(("iterations".to_string(), iterate.elapsed().as_secs_f64()));
@@ -230,6 +186,123 @@ impl Solver for Qcmc {
             },
             report,
         })
+    }
+}
+
+/// Every face's vertex indices and the sign its image must turn by: along the face's
+/// own orientation (face frames), or along the source's own turn in the plane (global
+/// frame).
+fn oriented_triangles(mesh: &Mesh, frame: Frame) -> Vec<([usize; 3], f64)> {
+    mesh.faces()
+        .map(|f| {
+            let (v, _) = mesh.face_vertex_array(f);
+            let sign = match frame {
+                Frame::Global => mesh.face_vector_area(f).z.signum(),
+                Frame::Face => 1.0,
+            };
+            ([v[0].idx(), v[1].idx(), v[2].idx()], sign)
+        })
+        .collect()
+}
+
+/// Where the descent stands: the map, its energy, and its flips and near-folds, which
+/// a step may not add to.
+struct Current {
+    /// The map and its circles.
+    state: CircleMap,
+    /// Its least-squares Beltrami energy.
+    energy: f64,
+    /// Its flipped triangles ([`flipped`]).
+    flips: usize,
+    /// Its near-folds ([`near_folds`]).
+    near: usize,
+}
+
+/// The iteration of Algorithm 2 (crate docs): what every step reads.
+struct Descent<'a> {
+    /// The mesh's elements in the field's frame.
+    elements: &'a Elements,
+    /// The Beltrami coefficient the energy follows.
+    mu: &'a [Complex64],
+    /// Every face's vertex indices and the sign its image must turn by.
+    triangles: &'a [([usize; 3], f64)],
+    /// Stop when the largest move is at most this.
+    tolerance: f64,
+    /// Stop after this many iterations.
+    max_iters: usize,
+}
+
+impl Descent<'_> {
+    /// Steps from `current` until the iteration limit, a cancel, a step that finds no
+    /// lower energy, or a move within the tolerance, each step recorded in `metrics`
+    /// and reported to `context`: why it stopped and the factorizations made.
+    fn run(
+        &self,
+        system: &mut StepSystem,
+        current: &mut Current,
+        metrics: &mut Metrics,
+        context: &mut Context<'_>,
+    ) -> Result<(Stop, usize), SolverError> {
+        let mut factorizations = 0;
+        let stop = loop {
+            if metrics.iterations >= self.max_iters {
+                break Stop::IterationLimit;
+            }
+            if context.is_cancelled() {
+                break Stop::Cancelled;
+            }
+            let (step, _) = system.step(self.elements, self.mu, &current.state)?;
+            factorizations += 1;
+            let Some((trial, e, t)) = self.line_search(&step, system.loop_of(), current)? else {
+                break Stop::Stalled;
+            };
+            let moved = largest_move(&current.state, &trial);
+            current.flips = flipped(self.triangles, &trial.map);
+            current.near = near_folds(self.elements, &trial.map)?;
+            current.state = trial;
+            current.energy = e;
+            metrics.iterations += 1;
+            metrics.energy_history.push(current.energy);
+            metrics.step_sizes.push(t);
+            context.report(&Progress {
+                stage: "iteration",
+                done: metrics.iterations,
+                total: Some(self.max_iters),
+                energy: Some(current.energy),
+            });
+            if moved <= self.tolerance {
+                break Stop::Converged {
+                    tolerance: self.tolerance,
+                };
+            }
+        };
+        Ok((stop, factorizations))
+    }
+
+    /// The first of the step lengths 1, 1/2, .. (`HALVINGS` halvings) whose map still
+    /// bounds a circle domain, adds no flip nor near-fold and lowers the energy: that
+    /// map, its energy and the step length; `None` when none does.
+    fn line_search(
+        &self,
+        step: &Step,
+        loop_of: &[Option<usize>],
+        current: &Current,
+    ) -> Result<Option<(CircleMap, f64, f64)>, SolverError> {
+        let mut t = 1.0;
+        for _ in 0..=HALVINGS {
+            let trial = step.apply(&current.state, t, loop_of);
+            if admissible(&trial)
+                && flipped(self.triangles, &trial.map) <= current.flips
+                && near_folds(self.elements, &trial.map)? <= current.near
+            {
+                let e = StepSystem::energy(self.elements, self.mu, &trial.map);
+                if e < current.energy {
+                    return Ok(Some((trial, e, t)));
+                }
+            }
+            t *= 0.5;
+        }
+        Ok(None)
     }
 }
 
