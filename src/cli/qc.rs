@@ -14,8 +14,8 @@ use std::path::PathBuf;
 use anyhow::{Context as _, bail};
 use beltrami::map_file;
 use beltrami_core::{
-    Constraint, Goal, GoalKind, Map, OptionValue, PlanarBoundary, Position, Problem, Solver,
-    Target, TargetKind,
+    Constraint, Goal, GoalKind, Map, OptionValue, Options, PlanarBoundary, Position, Problem,
+    Solution, Solver, Target, TargetKind,
 };
 use beltrami_fem::{BeltramiField, Expr};
 use beltrami_mesh::Mesh;
@@ -320,7 +320,54 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     mapping::check_output_holds_map(&args.output, &target)?;
     let mut problem = Problem::new(mesh, target);
     problem.goal = goal;
-    let init = match args.init.as_deref() {
+    let init = initial_of(args, mesh, &mut problem)?;
+    add_constraints(args, mesh, &mut problem)?;
+    problem.options = options_of(args, solver, init);
+
+    let (solution, seconds, sections) = mapping::solve_formatting_output(
+        solver,
+        &problem,
+        args.common.progress(quiet),
+        &args.output,
+    )?;
+    if let (Some(Map::Spatial(_)), false) = (
+        solution.map(),
+        matches!(args.target, TargetArg::Sphere | TargetArg::Space),
+    ) {
+        bail!("{} gave points in space for a planar target", solver.name());
+    }
+    map_file::write(
+        &args.output,
+        mesh,
+        &solution,
+        None,
+        sections.as_ref(),
+        &loaded.mesh.obj_groups,
+    )?;
+    if let Some(path) = &args.qd {
+        write_quadratic_differential(path, mesh, &solution)?;
+    }
+    mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
+
+    let (report, extra) = report_and_summary(args, mesh, &problem.goal, &solution, seconds);
+    mapping::finish(
+        report,
+        args.common.report.as_deref(),
+        args.common.json,
+        quiet,
+        (&args.mesh, &args.output, &solution, seconds),
+        &extra,
+    )
+}
+
+/// The start of an iterative solver from `--init`: the name of a start the solver
+/// computes (`harmonic`, `tutte`), or a map read from a file into `problem.initial`.
+fn initial_of<'a>(
+    args: &'a QcArgs,
+    mesh: &Mesh,
+    problem: &mut Problem<'_>,
+) -> anyhow::Result<Option<&'a str>> {
+    Ok(match args.init.as_deref() {
         None => None,
         Some(name @ ("harmonic" | "tutte")) => Some(name),
         Some(path) => {
@@ -328,7 +375,13 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             problem.initial = Some(Map::Planar(planar_map_file("--init", path, mesh)?));
             None
         }
-    };
+    })
+}
+
+/// The constraints of the command line: `--pin`, `--normal-constraint`,
+/// `--area-constraint`, `--landmarks` and, into space, the boundary of
+/// `--boundary-map` held.
+fn add_constraints(args: &QcArgs, mesh: &Mesh, problem: &mut Problem<'_>) -> anyhow::Result<()> {
     // Into space a pin holds its vertex where it is (with the area constraint, one pin
     // fixes a closed surface: docs/qc-space.md).
     let space = args.target == TargetArg::Space;
@@ -362,7 +415,13 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             .with_context(|| format!("--boundary-map {}", path.display()))?;
         problem.constraints.hold_boundary(mesh, &held);
     }
-    problem.options = mapping::solver_options(
+    Ok(())
+}
+
+/// The solver's options from the command's flags (`init` the start `--init` names)
+/// and `--option`.
+fn options_of(args: &QcArgs, solver: &dyn Solver, init: Option<&str>) -> Options {
+    mapping::solver_options(
         solver,
         &[
             (
@@ -380,42 +439,28 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
             ("init", init.map(|s| OptionValue::Choice(s.into())), None),
         ],
         &args.common,
-    );
+    )
+}
 
-    let (solution, seconds, sections) = mapping::solve_formatting_output(
-        solver,
-        &problem,
-        args.common.progress(quiet),
-        &args.output,
-    )?;
+/// The JSON report of a run and the summary's lines after the common ones: the target
+/// and goal, the circles of a circle domain, `k`, the error against a prescribed `mu`
+/// and the iterations.
+fn report_and_summary(
+    args: &QcArgs,
+    mesh: &Mesh,
+    goal: &Goal,
+    solution: &Solution,
+    seconds: f64,
+) -> (serde_json::Map<String, serde_json::Value>, Vec<String>) {
     let error = solution.metrics.mu_error;
-    if let (Some(Map::Spatial(_)), false) = (
-        solution.map(),
-        matches!(args.target, TargetArg::Sphere | TargetArg::Space),
-    ) {
-        bail!("{} gave points in space for a planar target", solver.name());
-    }
-    map_file::write(
-        &args.output,
-        mesh,
-        &solution,
-        None,
-        sections.as_ref(),
-        &loaded.mesh.obj_groups,
-    )?;
-    if let Some(path) = &args.qd {
-        write_quadratic_differential(path, mesh, &solution)?;
-    }
-    mapping::write_png(args.common.png.as_deref(), mesh, &solution, None)?;
-
-    let mut report = mapping::report_json(&args.mesh, &args.output, &solution, seconds);
+    let mut report = mapping::report_json(&args.mesh, &args.output, solution, seconds);
     report.insert(
         "target".into(),
         json!(format!("{:?}", args.target).to_lowercase()),
     );
     report.insert(
         "goal".into(),
-        json!(match &problem.goal {
+        json!(match goal {
             Goal::Conformal { p } => format!("conformal L^{p}"),
             Goal::Prescribed(_) => "prescribed mu".into(),
             Goal::Extremal => "extremal".into(),
@@ -423,7 +468,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
         }),
     );
     report.extend(beltrami::report::mu_error_keys(error.as_ref()));
-    let mut extra = circles(mesh, &solution, &mut report);
+    let mut extra = circles(mesh, solution, &mut report);
     extra.extend(
         solution
             .metrics
@@ -454,14 +499,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
                 .unwrap_or(0.0)
         ));
     }
-    mapping::finish(
-        report,
-        args.common.report.as_deref(),
-        args.common.json,
-        quiet,
-        (&args.mesh, &args.output, &solution, seconds),
-        &extra,
-    )
+    (report, extra)
 }
 
 /// The circles of a circle-domain map (`extras.circles`): the report's `circles`

@@ -7,8 +7,9 @@ use std::path::PathBuf;
 use anyhow::bail;
 use beltrami::landmarks::Landmarks;
 use beltrami::{correspondence, map_file, report, vertex_field};
-use beltrami_core::{Features, Goal, Map, OptionValue, Problem, Target};
+use beltrami_core::{Features, Goal, Map, OptionValue, Options, Problem, Solution, Solver, Target};
 use beltrami_fem::BeltramiField;
+use beltrami_mesh::Mesh;
 use beltrami_register::{InverseConsistency, inverse_consistency};
 use clap::Args;
 use serde_json::json;
@@ -94,7 +95,56 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     let target = &target_loaded.mesh.mesh;
 
     let mut problem = Problem::new(source, Target::Mesh(target));
-    problem.goal = match (&args.mu, args.p, args.features.as_deref()) {
+    problem.goal = goal_of(args, source, target)?;
+    let marks = match &args.landmarks {
+        Some(path) => Landmarks::read(path, source, target)?,
+        None => Landmarks::default(),
+    };
+    problem
+        .constraints
+        .extend(marks.constraints(target).iter().cloned());
+    problem.options = options_of(args, solver);
+
+    let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
+    // The way back runs before anything is written: a failure there writes nothing.
+    let round_trip = if args.inverse_consistency {
+        let Some(Map::OnMesh(points)) = solution.map() else {
+            bail!("the register solver did not give points on the target mesh");
+        };
+        Some(round_trip(args, &problem, &marks, points, quiet)?)
+    } else {
+        None
+    };
+    map_file::write(
+        &args.output,
+        source,
+        &solution,
+        Some(target),
+        None,
+        &source_loaded.mesh.obj_groups,
+    )?;
+    if let Some(path) = &args.correspondence {
+        let Some(Map::OnMesh(points)) = solution.map() else {
+            bail!("the register solver did not give points on the target mesh");
+        };
+        correspondence::write(path, source, target, points)?;
+    }
+    mapping::write_png(args.common.png.as_deref(), source, &solution, Some(target))?;
+
+    let (report, extra) = report_and_summary(args, source, &solution, seconds, round_trip);
+    mapping::finish(
+        report,
+        args.common.report.as_deref(),
+        args.common.json,
+        quiet,
+        (&args.source, &args.output, &solution, seconds),
+        &extra,
+    )
+}
+
+/// The goal of `--mu`, `--p` and `--features`, refused when they are combined.
+fn goal_of(args: &RegisterArgs, source: &Mesh, target: &Mesh) -> anyhow::Result<Goal> {
+    Ok(match (&args.mu, args.p, args.features.as_deref()) {
         (Some(_), Some(_), _) => {
             bail!("--p is the exponent of the conformal goal; a prescribed --mu has no exponent")
         }
@@ -114,15 +164,12 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
         (None, p, None) => Goal::Conformal {
             p: p.unwrap_or(2.0),
         },
-    };
-    let marks = match &args.landmarks {
-        Some(path) => Landmarks::read(path, source, target)?,
-        None => Landmarks::default(),
-    };
-    problem
-        .constraints
-        .extend(marks.constraints(target).iter().cloned());
-    problem.options = mapping::solver_options(
+    })
+}
+
+/// The register solver's options from the command's flags and `--option`.
+fn options_of(args: &RegisterArgs, solver: &dyn Solver) -> Options {
+    mapping::solver_options(
         solver,
         &[
             (
@@ -154,37 +201,22 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
             ),
         ],
         &args.common,
-    );
+    )
+}
 
-    let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
-    // The way back runs before anything is written: a failure there writes nothing.
-    let round_trip = if args.inverse_consistency {
-        let Some(Map::OnMesh(points)) = solution.map() else {
-            bail!("the register solver did not give points on the target mesh");
-        };
-        Some(round_trip(args, &problem, &marks, points, quiet)?)
-    } else {
-        None
-    };
-    map_file::write(
-        &args.output,
-        source,
-        &solution,
-        Some(target),
-        None,
-        &source_loaded.mesh.obj_groups,
-    )?;
-    if let Some(path) = &args.correspondence {
-        let Some(Map::OnMesh(points)) = solution.map() else {
-            bail!("the register solver did not give points on the target mesh");
-        };
-        correspondence::write(path, source, target, points)?;
-    }
-    mapping::write_png(args.common.png.as_deref(), source, &solution, Some(target))?;
-
-    let mut report = mapping::report_json(&args.source, &args.output, &solution, seconds);
+/// The JSON report of a registration and the summary's lines after the common ones:
+/// the iterations, the landmarks, the route and the inverse consistency of
+/// `round_trip` (`--inverse-consistency`).
+fn report_and_summary(
+    args: &RegisterArgs,
+    source: &Mesh,
+    solution: &Solution,
+    seconds: f64,
+    round_trip: Option<InverseConsistency>,
+) -> (serde_json::Map<String, serde_json::Value>, Vec<String>) {
+    let mut report = mapping::report_json(&args.source, &args.output, solution, seconds);
     report.insert("target".into(), json!(args.target.display().to_string()));
-    let per_step = report::seconds_per_step(&solution).unwrap_or(0.0);
+    let per_step = report::seconds_per_step(solution).unwrap_or(0.0);
     let mut extra = vec![format!(
         "iterations      {} ({per_step:.3} s per step)",
         solution.metrics.iterations
@@ -219,14 +251,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
             trip.max / size
         ));
     }
-    mapping::finish(
-        report,
-        args.common.report.as_deref(),
-        args.common.json,
-        quiet,
-        (&args.source, &args.output, &solution, seconds),
-        &extra,
-    )
+    (report, extra)
 }
 
 /// The registration of TARGET onto SOURCE with `problem`'s options, landmarks reversed

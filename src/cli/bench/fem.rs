@@ -17,7 +17,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use beltrami_fem::operators::{ElementMatrices, complex_derivatives, real_block_form};
+use beltrami_fem::operators::{
+    ComplexDerivatives, ElementMatrices, complex_derivatives, real_block_form,
+};
 use beltrami_fem::{
     DofConstraints, DofMap, Elements, Frame, LeastSquaresSolver, assembly::Pattern,
 };
@@ -172,25 +174,7 @@ pub fn run(args: &FemArgs) -> anyhow::Result<()> {
     println!("|---|---|---|---|---|---|---|");
     let meshes = cases(&args.cases)?;
     for (name, mesh) in &meshes {
-        let t = Instant::now();
-        let elements = Elements::new(mesh, Frame::Face)?;
-        let e = secs(t);
-        let t = Instant::now();
-        let d = complex_derivatives(mesh, &elements)?;
-        let dz = secs(t);
-        std::hint::black_box(d);
-        let t = Instant::now();
-        let matrices = ElementMatrices::new(mesh.vertex_count(), &elements)?;
-        let p = secs(t);
-        let t = Instant::now();
-        let k = matrices.stiffness(&elements)?;
-        let v = secs(t);
-        std::hint::black_box(k);
-        println!(
-            "| {name} | {} | {} | {e:.3} | {dz:.3} | {p:.3} | {v:.3} |",
-            mesh.face_count(),
-            mesh.vertex_count()
-        );
+        print_assembly_row(name, mesh)?;
     }
     println!();
     println!("Solves (symbolic / numeric / solve, seconds):");
@@ -200,6 +184,71 @@ pub fn run(args: &FemArgs) -> anyhow::Result<()> {
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     for (name, mesh) in &meshes {
+        let systems = Systems::new(mesh)?;
+        for &threads in &args.threads {
+            systems.print_solve_rows(name, threads)?;
+        }
+        faer::set_global_parallelism(Par::Seq);
+    }
+    Ok(())
+}
+
+/// Times the assembly of one mesh (elements, `D_zbar`, the stiffness pattern and its
+/// values) and prints its row of the assembly table.
+fn print_assembly_row(name: &str, mesh: &Mesh) -> anyhow::Result<()> {
+    let t = Instant::now();
+    let elements = Elements::new(mesh, Frame::Face)?;
+    let e = secs(t);
+    let t = Instant::now();
+    let d = complex_derivatives(mesh, &elements)?;
+    let dz = secs(t);
+    std::hint::black_box(d);
+    let t = Instant::now();
+    let matrices = ElementMatrices::new(mesh.vertex_count(), &elements)?;
+    let p = secs(t);
+    let t = Instant::now();
+    let k = matrices.stiffness(&elements)?;
+    let v = secs(t);
+    std::hint::black_box(k);
+    println!(
+        "| {name} | {} | {} | {e:.3} | {dz:.3} | {p:.3} | {v:.3} |",
+        mesh.face_count(),
+        mesh.vertex_count()
+    );
+    Ok(())
+}
+
+/// The systems of one mesh whose solves are timed: LSCM with two pinned vertices (the
+/// `D_zbar` operator and the reduced normal matrix, complex and real), and the
+/// Dirichlet Laplacian.
+struct Systems {
+    /// The mesh's vertex count.
+    n: usize,
+    /// The two pinned vertices of LSCM.
+    pins: DofConstraints,
+    /// The unknowns of complex LSCM (vertices but the pinned ones).
+    free: usize,
+    /// `D_z`, `D_zbar` and the quadrature weights.
+    d: ComplexDerivatives,
+    /// The reduced LSCM normal matrix, complex.
+    normal_c: SparseColMat<usize, Complex64>,
+    /// The same in the real 2N form.
+    normal_r: SparseColMat<usize, f64>,
+    /// `D_zbar` in the real 2N form.
+    real_dzbar: SparseColMat<usize, f64>,
+    /// The quadrature weights, each twice (real and imaginary rows).
+    real_weights: Vec<f64>,
+    /// The Dirichlet Laplacian ([`dirichlet_laplacian`]).
+    laplacian: SparseColMat<usize, f64>,
+    /// Its right-hand side.
+    rhs: Mat<f64>,
+    /// Its unknowns (the interior vertices).
+    ni: usize,
+}
+
+impl Systems {
+    /// The systems of `mesh`, the LSCM pins at two boundary vertices far apart.
+    fn new(mesh: &Mesh) -> anyhow::Result<Self> {
         let elements = Elements::new(mesh, Frame::Face)?;
         let d = complex_derivatives(mesh, &elements)?;
         let (a, b) = far_boundary_pair(mesh)?;
@@ -219,81 +268,110 @@ pub fn run(args: &FemArgs) -> anyhow::Result<()> {
         let normal_r = real_block_form(&normal_c)?;
         let real_dzbar = real_block_form(&d.dzbar)?;
         let real_weights: Vec<f64> = d.weights.iter().flat_map(|&w| [w, w]).collect();
-
-        // Dirichlet Laplacian: interior block of the stiffness matrix, boundary = x.
-        let k = ElementMatrices::new(n, &elements)?.stiffness(&elements)?;
-        let mut interior = vec![usize::MAX; n];
-        let mut ni = 0;
-        for v in mesh.vertices() {
-            if !mesh.is_boundary_vertex(v) {
-                interior[v.idx()] = ni;
-                ni += 1;
-            }
-        }
-        let mut positions = Vec::new();
-        let mut values = Vec::new();
-        let mut rhs = Mat::<f64>::zeros(ni, 1);
-        for c in 0..n {
-            for (&r, &val) in k.row_idx_of_col_raw(c).iter().zip(k.val_of_col(c)) {
-                match (interior[r], interior[c]) {
-                    (ir, usize::MAX) if ir != usize::MAX => {
-                        rhs[(ir, 0)] -= val * mesh.positions()[c].x;
-                    }
-                    (ir, ic) if ir != usize::MAX => {
-                        positions.push((ir, ic));
-                        values.push(val);
-                    }
-                    _ => {}
-                }
-            }
-        }
-        let laplacian = Pattern::new(ni, ni, &positions)?.assemble(&values)?;
-
-        for &threads in &args.threads {
-            let options = SolveOptions {
-                threads,
-                ..SolveOptions::default()
-            };
-            faer::set_global_parallelism(options.par());
-
-            let dofs = DofMap::<Complex64>::complex(n, &pins)?;
-            let t = Instant::now();
-            let mut solver = LeastSquaresSolver::new(d.dzbar.symbolic(), &dofs, options)?;
-            let sym = secs(t);
-            let zero = vec![Complex64::new(0.0, 0.0); d.dzbar.nrows()];
-            let t = Instant::now();
-            std::hint::black_box(solver.solve(d.dzbar.as_ref(), Some(&d.weights), &zero)?);
-            let num = secs(t);
-            drop(solver);
-            let (fs, fnum, fsol) = faer_phases(&normal_c)?;
-            println!(
-                "| {name} | LSCM complex N | {free} | {threads} | {sym:.3} | {num:.3} | {fs:.3} | {fnum:.3} | {fsol:.3} |"
-            );
-
-            let dofs = DofMap::<f64>::real(n, &pins)?;
-            let t = Instant::now();
-            let mut solver = LeastSquaresSolver::new(real_dzbar.symbolic(), &dofs, options)?;
-            let sym = secs(t);
-            let zero = vec![0.0; real_dzbar.nrows()];
-            let t = Instant::now();
-            std::hint::black_box(solver.solve(real_dzbar.as_ref(), Some(&real_weights), &zero)?);
-            let num = secs(t);
-            drop(solver);
-            let (fs, fnum, fsol) = faer_phases(&normal_r)?;
-            println!(
-                "| {name} | LSCM real 2N | {} | {threads} | {sym:.3} | {num:.3} | {fs:.3} | {fnum:.3} | {fsol:.3} |",
-                2 * free
-            );
-
-            let t = Instant::now();
-            std::hint::black_box(solve_spd(laplacian.as_ref(), rhs.as_ref(), options)?);
-            let ours = secs(t);
-            let (fs, fnum, fsol) = faer_phases(&laplacian)?;
-            println!(
-                "| {name} | Laplacian (Dirichlet) | {ni} | {threads} | {ours:.3} (whole) | - | {fs:.3} | {fnum:.3} | {fsol:.3} |"
-            );
-        }
-        faer::set_global_parallelism(Par::Seq);
+        let (laplacian, rhs, ni) = dirichlet_laplacian(mesh, &elements)?;
+        Ok(Self {
+            n,
+            pins,
+            free,
+            d,
+            normal_c,
+            normal_r,
+            real_dzbar,
+            real_weights,
+            laplacian,
+            rhs,
+            ni,
+        })
     }
-    Ok(())
+
+    /// Times the solves on `threads` threads, ours against faer's phases, and prints
+    /// their rows: LSCM complex N, LSCM real 2N, the Dirichlet Laplacian.
+    fn print_solve_rows(&self, name: &str, threads: usize) -> anyhow::Result<()> {
+        let Self { n, free, ni, .. } = *self;
+        let (d, real_dzbar) = (&self.d, &self.real_dzbar);
+        let options = SolveOptions {
+            threads,
+            ..SolveOptions::default()
+        };
+        faer::set_global_parallelism(options.par());
+
+        let dofs = DofMap::<Complex64>::complex(n, &self.pins)?;
+        let t = Instant::now();
+        let mut solver = LeastSquaresSolver::new(d.dzbar.symbolic(), &dofs, options)?;
+        let sym = secs(t);
+        let zero = vec![Complex64::new(0.0, 0.0); d.dzbar.nrows()];
+        let t = Instant::now();
+        std::hint::black_box(solver.solve(d.dzbar.as_ref(), Some(&d.weights), &zero)?);
+        let num = secs(t);
+        drop(solver);
+        let (fs, fnum, fsol) = faer_phases(&self.normal_c)?;
+        println!(
+            "| {name} | LSCM complex N | {free} | {threads} | {sym:.3} | {num:.3} | {fs:.3} | {fnum:.3} | {fsol:.3} |"
+        );
+
+        let dofs = DofMap::<f64>::real(n, &self.pins)?;
+        let t = Instant::now();
+        let mut solver = LeastSquaresSolver::new(real_dzbar.symbolic(), &dofs, options)?;
+        let sym = secs(t);
+        let zero = vec![0.0; real_dzbar.nrows()];
+        let t = Instant::now();
+        std::hint::black_box(solver.solve(real_dzbar.as_ref(), Some(&self.real_weights), &zero)?);
+        let num = secs(t);
+        drop(solver);
+        let (fs, fnum, fsol) = faer_phases(&self.normal_r)?;
+        println!(
+            "| {name} | LSCM real 2N | {} | {threads} | {sym:.3} | {num:.3} | {fs:.3} | {fnum:.3} | {fsol:.3} |",
+            2 * free
+        );
+
+        let t = Instant::now();
+        std::hint::black_box(solve_spd(
+            self.laplacian.as_ref(),
+            self.rhs.as_ref(),
+            options,
+        )?);
+        let ours = secs(t);
+        let (fs, fnum, fsol) = faer_phases(&self.laplacian)?;
+        println!(
+            "| {name} | Laplacian (Dirichlet) | {ni} | {threads} | {ours:.3} (whole) | - | {fs:.3} | {fnum:.3} | {fsol:.3} |"
+        );
+        Ok(())
+    }
+}
+
+/// The Dirichlet Laplacian: the interior block of the stiffness matrix, the boundary
+/// held at `x`; with its right-hand side and its size (the interior vertices).
+fn dirichlet_laplacian(
+    mesh: &Mesh,
+    elements: &Elements,
+) -> anyhow::Result<(SparseColMat<usize, f64>, Mat<f64>, usize)> {
+    let n = mesh.vertex_count();
+    let k = ElementMatrices::new(n, elements)?.stiffness(elements)?;
+    let mut interior = vec![usize::MAX; n];
+    let mut ni = 0;
+    for v in mesh.vertices() {
+        if !mesh.is_boundary_vertex(v) {
+            interior[v.idx()] = ni;
+            ni += 1;
+        }
+    }
+    let mut positions = Vec::new();
+    let mut values = Vec::new();
+    let mut rhs = Mat::<f64>::zeros(ni, 1);
+    for c in 0..n {
+        for (&r, &val) in k.row_idx_of_col_raw(c).iter().zip(k.val_of_col(c)) {
+            match (interior[r], interior[c]) {
+                (ir, usize::MAX) if ir != usize::MAX => {
+                    rhs[(ir, 0)] -= val * mesh.positions()[c].x;
+                }
+                (ir, ic) if ir != usize::MAX => {
+                    positions.push((ir, ic));
+                    values.push(val);
+                }
+                _ => {}
+            }
+        }
+    }
+    let laplacian = Pattern::new(ni, ni, &positions)?.assemble(&values)?;
+    Ok((laplacian, rhs, ni))
 }
