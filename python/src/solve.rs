@@ -34,7 +34,7 @@ use beltrami::landmarks::Landmarks;
 use beltrami::map_file::{self, Image};
 use beltrami_core::{
     Constraint, Context, Features, Goal, Landmark, Map, Pin, PlanarBoundary, Position, Problem,
-    Progress, Solution, Target, components,
+    Progress, Solution, SurfacePoint, Target, components,
 };
 use beltrami_fem::{BeltramiField, Expr, Frame};
 use beltrami_mesh::Mesh;
@@ -409,6 +409,7 @@ fn report(mesh: &Mesh, solution: &Solution, seconds: f64) -> String {
 /// quadratic differential per face row of an extremal map).
 #[pyfunction]
 #[pyo3(signature = (solver, v, f, spec, boundary_map=None, initial=None, mu=None, target_v=None, target_f=None, progress=None))]
+// The arguments are the Python function's keyword arguments, the user API.
 #[allow(clippy::too_many_arguments)]
 pub fn solve<'py>(
     py: Python<'py>,
@@ -453,16 +454,7 @@ pub fn solve<'py>(
     constraints(&spec, &mut problem, target_mesh.as_ref(), &inputs)?;
     options(&spec, &mut problem, solver);
 
-    let pieces = match text(&spec, "components") {
-        None => Pieces::Whole,
-        Some("each") => Pieces::Each,
-        Some("largest") => Pieces::Largest,
-        Some(other) => {
-            return Err(option_error(format!(
-                "components={other:?}: expected 'each' (every connected component mapped on its own, side by side) or 'largest' (the largest alone, NaN rows elsewhere)"
-            )));
-        }
-    };
+    let pieces = pieces_of(&spec)?;
     let parts = match pieces {
         Pieces::Largest if mesh.component_count() > 1 => {
             Some(components::parts(&mesh).map_err(|e| errors::from_error(Kind::Mesh, &e))?)
@@ -474,17 +466,8 @@ pub fn solve<'py>(
         .and_then(|p| components::largest(p).map(|k| &p[k]));
     let (solution, seconds) = match largest {
         Some(part) => {
-            let on_part = part
-                .problem(&problem, solver.name())
-                .map_err(|e| errors::from_solver(&e))?;
-            let (mut solution, seconds) = run(py, solver, &on_part, false, progress)?;
-            solution.report.notes.push(format!(
-                "the largest of {} components mapped ({} of {} faces); the other vertices' rows are NaN",
-                parts.as_ref().map_or(0, Vec::len),
-                part.mesh.face_count(),
-                mesh.face_count()
-            ));
-            (solution, seconds)
+            let count = parts.as_ref().map_or(0, Vec::len);
+            solve_largest(py, solver, &problem, part, count, progress)?
         }
         None => run(py, solver, &problem, pieces == Pieces::Each, progress)?,
     };
@@ -498,56 +481,9 @@ pub fn solve<'py>(
     };
     let image = map_file::image(solved, map, target_mesh.as_ref())
         .map_err(|e| errors::from_error(Kind::Solver, &e))?;
-    // Values of the solved mesh's vertices on the whole mesh's (NaN off the part).
-    let whole = |values: Vec<Vec<f64>>, columns: usize| -> Vec<Vec<f64>> {
-        match largest {
-            None => values,
-            Some(part) => {
-                let mut out = vec![vec![f64::NAN; columns]; mesh.vertex_count()];
-                for (k, row) in values.into_iter().enumerate() {
-                    out[part.vertices[k].idx()] = row;
-                }
-                out
-            }
-        }
-    };
-    match image {
-        Image::Uv(uv) => {
-            out.set_item("kind", "uv")?;
-            let rows = whole(uv.iter().map(|t| vec![t.x, t.y]).collect(), 2);
-            out.set_item(
-                "image",
-                arrays::vertex_rows(&mesh, &rows, 2, Clone::clone).into_pyarray(py),
-            )?;
-        }
-        Image::Positions(p) => {
-            out.set_item("kind", "xyz")?;
-            let rows = whole(p.iter().map(|p| vec![p.x, p.y, p.z]).collect(), 3);
-            out.set_item(
-                "image",
-                arrays::vertex_rows(&mesh, &rows, 3, Clone::clone).into_pyarray(py),
-            )?;
-        }
-    }
+    set_image(py, &out, &mesh, largest, image)?;
     if let (Map::OnMesh(points), Some(target)) = (map, target_mesh.as_ref()) {
-        let face: Vec<f64> = points
-            .iter()
-            .map(|p| target.face_to_input(p.face) as f64)
-            .collect();
-        let degree = points
-            .iter()
-            .map(|p| target.face_degree(p.face))
-            .max()
-            .unwrap_or(3);
-        let rows = arrays::vertex_rows(&mesh, &face, 1, |&f| vec![f]);
-        let face: Array1<i64> = rows
-            .column(0)
-            .mapv(|x| if x.is_nan() { -1 } else { x as i64 });
-        let bary: Array2<f64> = arrays::vertex_rows(&mesh, points, degree, |p| {
-            p.coords[..target.face_degree(p.face)].to_vec()
-        });
-        out.set_item("face", face.into_pyarray(py))?;
-        out.set_item("bary", bary.into_pyarray(py))?;
+        set_target_faces(py, &out, &mesh, target, points)?;
     }
     if let Some(qd) = &solution.extras.quadratic_differential {
         let nan = Complex64::new(f64::NAN, f64::NAN);
@@ -558,6 +494,131 @@ pub fn solve<'py>(
     }
     out.set_item("report", report(solved, &solution, seconds))?;
     Ok(out)
+}
+
+/// `components=` of the call's description: the whole mesh, each component, or the
+/// largest alone.
+fn pieces_of(spec: &JsonMap<String, Value>) -> PyResult<Pieces> {
+    match text(spec, "components") {
+        None => Ok(Pieces::Whole),
+        Some("each") => Ok(Pieces::Each),
+        Some("largest") => Ok(Pieces::Largest),
+        Some(other) => Err(option_error(format!(
+            "components={other:?}: expected 'each' (every connected component mapped on its own, side by side) or 'largest' (the largest alone, NaN rows elsewhere)"
+        ))),
+    }
+}
+
+/// Solves `problem` on its largest component `part` alone (of `count` components),
+/// noting it in the report.
+fn solve_largest(
+    py: Python<'_>,
+    solver: &dyn beltrami_core::Solver,
+    problem: &Problem<'_>,
+    part: &components::Part,
+    count: usize,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Solution, f64)> {
+    let on_part = part
+        .problem(problem, solver.name())
+        .map_err(|e| errors::from_solver(&e))?;
+    let (mut solution, seconds) = run(py, solver, &on_part, false, progress)?;
+    solution.report.notes.push(format!(
+        "the largest of {count} components mapped ({} of {} faces); the other vertices' rows are NaN",
+        part.mesh.face_count(),
+        problem.source.face_count()
+    ));
+    Ok((solution, seconds))
+}
+
+/// Rows of the solved mesh's vertices (`columns` values each) as rows of the whole
+/// `mesh`'s: unchanged, or with only the `largest` component solved, NaN off it.
+fn on_whole_mesh(
+    values: Vec<Vec<f64>>,
+    columns: usize,
+    mesh: &Mesh,
+    largest: Option<&components::Part>,
+) -> Vec<Vec<f64>> {
+    match largest {
+        None => values,
+        Some(part) => {
+            let mut out = vec![vec![f64::NAN; columns]; mesh.vertex_count()];
+            for (k, row) in values.into_iter().enumerate() {
+                out[part.vertices[k].idx()] = row;
+            }
+            out
+        }
+    }
+}
+
+/// Sets `kind` (`uv` or `xyz`) and `image` (rows in the input's vertex order) of the
+/// result dict `out` from the map's `image`.
+fn set_image(
+    py: Python<'_>,
+    out: &Bound<'_, PyDict>,
+    mesh: &Mesh,
+    largest: Option<&components::Part>,
+    image: Image,
+) -> PyResult<()> {
+    match image {
+        Image::Uv(uv) => {
+            out.set_item("kind", "uv")?;
+            let rows = on_whole_mesh(
+                uv.iter().map(|t| vec![t.x, t.y]).collect(),
+                2,
+                mesh,
+                largest,
+            );
+            out.set_item(
+                "image",
+                arrays::vertex_rows(mesh, &rows, 2, Clone::clone).into_pyarray(py),
+            )?;
+        }
+        Image::Positions(p) => {
+            out.set_item("kind", "xyz")?;
+            let rows = on_whole_mesh(
+                p.iter().map(|p| vec![p.x, p.y, p.z]).collect(),
+                3,
+                mesh,
+                largest,
+            );
+            out.set_item(
+                "image",
+                arrays::vertex_rows(mesh, &rows, 3, Clone::clone).into_pyarray(py),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// Sets `face` (the target face row per vertex, -1 for none) and `bary` (barycentric
+/// coordinates) of the result dict `out` for a map onto the target mesh `target`.
+fn set_target_faces(
+    py: Python<'_>,
+    out: &Bound<'_, PyDict>,
+    mesh: &Mesh,
+    target: &Mesh,
+    points: &[SurfacePoint],
+) -> PyResult<()> {
+    let face: Vec<f64> = points
+        .iter()
+        .map(|p| target.face_to_input(p.face) as f64)
+        .collect();
+    let degree = points
+        .iter()
+        .map(|p| target.face_degree(p.face))
+        .max()
+        .unwrap_or(3);
+    let rows = arrays::vertex_rows(mesh, &face, 1, |&f| vec![f]);
+    let face: Array1<i64> = rows
+        .column(0)
+        .mapv(|x| if x.is_nan() { -1 } else { x as i64 });
+    let bary: Array2<f64> = arrays::vertex_rows(mesh, points, degree, |p| {
+        p.coords[..target.face_degree(p.face)].to_vec()
+    });
+    out.set_item("face", face.into_pyarray(py))?;
+    out.set_item("bary", bary.into_pyarray(py))?;
+    Ok(())
 }
 
 /// `components=`: the whole mesh as one problem, every component on its own, or the

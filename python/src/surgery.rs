@@ -25,6 +25,7 @@ fn mesh_arrays(mesh: &Mesh) -> PyResult<(Array2<f64>, Array2<i64>)> {
 /// the positions, the triangles and the JSON report of `--report`.
 #[pyfunction]
 #[pyo3(signature = (v, f, edge_length=None, vertices=None, param="auto", min_angle=30.0, size_field="uniform", max_vertices=5_000_000, feature_tolerance=beltrami_remesh::FEATURE_TOLERANCE, components=None))]
+// The arguments are the Python function's keyword arguments, the user API.
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub fn remesh<'py>(
     py: Python<'py>,
@@ -125,6 +126,7 @@ pub fn remesh<'py>(
 /// report of `--report`.
 #[pyfunction]
 #[pyo3(signature = (v, f, reference="optimized", constraint="normal", max_iters=10, tolerance=1e-4, feature_angle=60.0, project=true, allow_flips=false))]
+// The arguments are the Python function's keyword arguments, the user API.
 #[allow(clippy::too_many_arguments)]
 pub fn remesh_in_place<'py>(
     py: Python<'py>,
