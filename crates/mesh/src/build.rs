@@ -185,6 +185,26 @@ fn polygon_area(p: &[Point3<f64>], face: &[u32]) -> f64 {
     0.5 * twice.norm()
 }
 
+/// The first corner of a quad at which its bilinear patch folds, or `None`.
+///
+/// The patch `x(u, v)` of corners `p0..p3` has the normal `x_u x x_v`, bilinear in
+/// `(u, v)`, so its component along the quad's vector area `N = (p2 - p0) x (p3 - p1)` is
+/// positive on the whole patch exactly when it is positive at the four corners, where it
+/// is `((p_{k+1} - p_k) x (p_{k-1} - p_k)) . N`. A planar quad folds exactly when it is
+/// concave (a dart) or self-crossing (a bow tie); a non-planar one when it is so seen
+/// along `N` (however sharply it is bent across a diagonal otherwise: a square bent by
+/// 120 degrees does not fold). Such a patch turns over inside the face: its area,
+/// Jacobian and Beltrami coefficient have no consistent sign, and every measure of it
+/// disagrees with another.
+fn folded_quad_corner(p: &[Point3<f64>], face: &[u32]) -> Option<usize> {
+    let at = |k: usize| p[face[k % 4] as usize];
+    let normal = (at(2) - at(0)).cross(&(at(3) - at(1)));
+    (0..4).find(|&k| {
+        let corner = (at(k + 1) - at(k)).cross(&(at(k + 3) - at(k)));
+        corner.dot(&normal) <= 0.0
+    })
+}
+
 /// Undirected edges of the work faces.
 struct EdgeGroups {
     /// Edge of each corner (corner `c` is the side from vertex `c` to the next vertex).
@@ -651,6 +671,14 @@ fn collect_faces(
                 face: fi,
                 area,
                 threshold,
+            });
+        }
+        if mapped.len() == 4
+            && let Some(k) = folded_quad_corner(&soup.positions, mapped)
+        {
+            return Err(MeshError::FoldedQuad {
+                face: fi,
+                vertex: face[k] as usize,
             });
         }
         faces.indices.extend_from_slice(mapped);

@@ -127,6 +127,18 @@ pub enum MeshError {
         threshold: f64,
     },
 
+    /// A quad whose bilinear patch folds (concave or self-crossing, seen along its mean
+    /// normal): measures of it cannot agree.
+    #[error(
+        "face {face} is a quad that folds at its vertex {vertex} (concave or self-crossing, seen along its mean normal): split it into two triangles along the diagonal through vertex {vertex}"
+    )]
+    FoldedQuad {
+        /// Input face index.
+        face: usize,
+        /// The input vertex at the first corner where the patch turns over.
+        vertex: usize,
+    },
+
     /// A face with the same vertex set as an earlier face.
     #[error("face {face} duplicates face {first} (same vertices)")]
     DuplicateFace {

@@ -139,8 +139,9 @@ pub fn icosphere(subdivisions: usize) -> PolygonSoup {
 }
 
 /// [`grid`] with every vertex off the square's boundary moved by independent uniform
-/// offsets of up to `amount` cells in x and in y (`amount < 0.5` keeps every face
-/// counter-clockwise). The offsets come from a SplitMix64 stream seeded with `seed`, so
+/// offsets of up to `amount` cells in x and in y (`amount < 0.5` keeps every triangle
+/// counter-clockwise, `amount < 0.25` every quad convex: at 0.25 a corner can reach the
+/// line through its two neighbours, and a quad that folds is not a valid mesh). The offsets come from a SplitMix64 stream seeded with `seed`, so
 /// the same arguments give the same mesh on every machine: irregular meshes for tests and
 /// benchmarks.
 pub fn jittered_grid(nx: usize, ny: usize, cells: Cells, amount: f64, seed: u64) -> PolygonSoup {

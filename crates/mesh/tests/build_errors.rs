@@ -224,6 +224,72 @@ fn repeated_vertex() {
 }
 
 #[test]
+fn a_quad_that_folds_is_refused_naming_the_face_and_vertex() {
+    // A dart: vertex 3 at (0.7, 0.7) lies inside the triangle of the other three, so the
+    // quad is concave at it.
+    let dart = vec![
+        p(0.0, 0.0, 0.0),
+        p(1.0, 0.0, 0.0),
+        p(0.0, 1.0, 0.0),
+        p(0.7, 0.7, 0.0),
+        p(1.0, 1.0, 0.0),
+    ];
+    let s = soup(dart, &[&[1, 4, 2, 3], &[0, 1, 3]]);
+    let e = build_err(&s);
+    assert_eq!(e, MeshError::FoldedQuad { face: 0, vertex: 3 });
+    assert!(
+        e.to_string()
+            .contains("face 0 is a quad that folds at its vertex 3"),
+        "{e}"
+    );
+
+    // A bow tie whose vector area is not zero: (0,0), (2,0), (0,1), (1,1) crosses itself.
+    let bow = vec![
+        p(0.0, 0.0, 0.0),
+        p(2.0, 0.0, 0.0),
+        p(0.0, 1.0, 0.0),
+        p(1.0, 1.0, 0.0),
+    ];
+    assert!(matches!(
+        build_err(&soup(bow, &[&[0, 1, 2, 3]])),
+        MeshError::FoldedQuad { face: 0, .. }
+    ));
+
+    // A dart with its reflex vertex lifted off the plane: concave seen along its mean
+    // normal, so its patch still turns over.
+    let lifted = vec![
+        p(0.0, 0.0, 0.0),
+        p(1.0, 0.0, 0.0),
+        p(0.0, 1.0, 0.0),
+        p(0.7, 0.7, 0.2),
+        p(1.0, 1.0, 0.0),
+    ];
+    assert_eq!(
+        build_err(&soup(lifted, &[&[1, 4, 2, 3], &[0, 1, 3]])),
+        MeshError::FoldedQuad { face: 0, vertex: 3 }
+    );
+
+    // A unit square bent about its diagonal 0-2 by 120 degrees is a valid non-planar
+    // quad (its patch stays an immersion), as is a convex planar one.
+    let (a, b) = (0.5, 0.5);
+    let (c, s) = (120f64.to_radians().cos(), 120f64.to_radians().sin());
+    let bent = vec![
+        p(0.0, 0.0, 0.0),
+        p(a + b * c, a - b * c, b * s),
+        p(1.0, 1.0, 0.0),
+        p(0.0, 1.0, 0.0),
+    ];
+    build(&soup(bent, &[&[0, 1, 2, 3]])).expect("a quad bent by 120 degrees");
+    let kite = vec![
+        p(0.0, 0.0, 0.0),
+        p(1.0, 0.2, 0.0),
+        p(1.2, 1.2, 0.0),
+        p(0.2, 1.0, 0.0),
+    ];
+    build(&soup(kite, &[&[0, 1, 2, 3]])).expect("a convex quad");
+}
+
+#[test]
 fn degenerate_face() {
     // Three collinear points in face 2; the bounding box is [0,2] x [0,1], so the
     // threshold is 1e-12 * 5.

@@ -690,13 +690,18 @@ fn nonplanar_quad_frame_projects() {
 
 /// A simple (non-self-intersecting) planar quad with a reflex corner at p2, area 1.2.
 /// The builder accepts it.
+/// A concave quad: the builder refuses one (`MeshError::FoldedQuad`), but a map's image
+/// of a convex one may be one, and is measured by the same functions.
 fn dart() -> Mesh {
-    single_quad([
+    let square = single_quad([
         Point3::new(0.0, 0.0, 0.0),
         Point3::new(2.0, 0.0, 0.0),
-        Point3::new(0.6, 0.6, 0.0),
+        Point3::new(2.0, 2.0, 0.0),
         Point3::new(0.0, 2.0, 0.0),
-    ])
+    ]);
+    let mut positions = square.positions().to_vec();
+    positions[2] = Point3::new(0.6, 0.6, 0.0);
+    square.with_positions(positions).expect("finite positions")
 }
 
 #[test]

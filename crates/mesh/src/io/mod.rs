@@ -483,6 +483,7 @@ fn offending_face(e: &MeshError) -> Option<usize> {
         | MeshError::VertexIndexOutOfRange { face, .. }
         | MeshError::RepeatedVertex { face, .. }
         | MeshError::DegenerateFace { face, .. }
+        | MeshError::FoldedQuad { face, .. }
         | MeshError::DuplicateFace { face, .. }
         | MeshError::NonOrientable { face, .. } => Some(*face),
         MeshError::NonManifoldEdge { faces, .. } => faces.last().copied(),
