@@ -94,5 +94,6 @@ pub fn registry() -> beltrami_core::Registry {
     beltrami_qcmc::register(&mut registry);
     beltrami_extremal::register(&mut registry);
     beltrami_qc_iteration::register(&mut registry);
+    beltrami_affine::register(&mut registry);
     registry
 }

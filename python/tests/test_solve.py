@@ -43,3 +43,13 @@ def test_an_unknown_name_and_a_refused_target_are_typed_errors(disk):
         beltrami.solve("nosuch", V, F)
     with pytest.raises(beltrami.UnsupportedError, match="tutte"):
         beltrami.solve("tutte", V, F, target="sphere")
+
+
+def test_a_new_solver_is_reached_without_edits_of_the_python_package(disk):
+    # `affine` is one folder under plugins/ and one registry line (docs/adding-a-solver.md).
+    V, F = disk
+    V = V * [1, 1, 0]
+    assert "affine" in [s["name"] for s in beltrami.solvers()]
+    UV, report = beltrami.solve("affine", V, F, mu_expr="0.3+0.4i", info=True)
+    assert report["solver"] == "affine"
+    assert np.allclose(np.abs(beltrami.beltrami_coefficient(V, F, UV)), 0.5, atol=1e-12)
