@@ -128,9 +128,18 @@ fn the_cut_reproducer_is_refused_by_the_builder_and_its_scaled_copy_cuts() {
     assert!(e.contains("overflows"), "{e}");
     let e = run_corpus_file("build", "coordinates-1e300-tolerance-0-repair-all.bin").unwrap_err();
     assert!(e.contains("overflows"), "{e}");
-    // In range, the same mesh is a disk (a quad and a triangle sharing an edge): it cuts.
-    run_corpus_file("cut", "scaled-into-range-tolerance-0-repair-all.obj")
-        .expect("the mesh scaled into range cuts");
+    // Scaled into range, its quad folds (its far corner crosses the opposite side): the
+    // builder names it. With that corner at (1, 1, 0) the quad is convex, and the same
+    // disk (a quad and a triangle sharing an edge), under the same build options, cuts.
+    let e = run_corpus_file("cut", "scaled-into-range-tolerance-0-repair-all.obj").unwrap_err();
+    assert!(
+        e.contains("face 0 is a quad that folds at its vertex 3"),
+        "{e}"
+    );
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/corpus/cut/scaled-into-range-tolerance-0-repair-all.obj");
+    let convex = std::fs::read_to_string(path).unwrap().replace("1e75", "1");
+    targets::run("cut", convex.as_bytes()).expect("the mesh with a convex quad cuts");
     // A torus cuts under every build option.
     let torus = targets::torus_obj();
     for byte in 0..32u8 {
