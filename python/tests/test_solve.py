@@ -50,6 +50,6 @@ def test_a_new_solver_is_reached_without_edits_of_the_python_package(disk):
     V, F = disk
     V = V * [1, 1, 0]
     assert "affine" in [s["name"] for s in beltrami.solvers()]
-    UV, report = beltrami.solve("affine", V, F, mu_expr="0.3+0.4i", info=True)
+    UV, report = beltrami.solve("affine", V, F, mu_expr="0.3+0.4i", boundary="free", info=True)
     assert report["solver"] == "affine"
     assert np.allclose(np.abs(beltrami.beltrami_coefficient(V, F, UV)), 0.5, atol=1e-12)
