@@ -16,8 +16,9 @@ use nalgebra::Point3;
 
 #[test]
 fn reproduces_a_planar_mesh_with_its_own_boundary() {
-    for (cells, seed) in [(Cells::Triangles, 11), (Cells::Quads, 12)] {
-        let mesh = jittered(16, cells, 0.35, seed);
+    // Quads jittered by 0.25 cells or more may fold (a concave quad is not a mesh).
+    for (cells, amount, seed) in [(Cells::Triangles, 0.35, 11), (Cells::Quads, 0.24, 12)] {
+        let mesh = jittered(16, cells, amount, seed);
         let problem = Problem::new(&mesh, Target::Plane(PlanarBoundary::Keep));
         let solution = Harmonic.solve(&problem, &mut Context::new()).unwrap();
         let err = identity_error(&mesh, planar(solution.map().expect("a map")));

@@ -28,8 +28,9 @@ fn own_position(mesh: &Mesh, v: beltrami_mesh::VertexId) -> Complex64 {
 
 #[test]
 fn reproduces_a_planar_mesh_pinned_at_its_own_positions() {
-    for (cells, seed) in [(Cells::Triangles, 21), (Cells::Quads, 22)] {
-        let mesh = jittered(16, cells, 0.35, seed);
+    // Quads jittered by 0.25 cells or more may fold (a concave quad is not a mesh).
+    for (cells, amount, seed) in [(Cells::Triangles, 0.35, 21), (Cells::Quads, 0.24, 22)] {
+        let mesh = jittered(16, cells, amount, seed);
         let b = boundary_vertices(&mesh);
         let mut problem = free(&mesh);
         problem.constraints = [b[0], b[b.len() / 3]]
