@@ -1547,7 +1547,8 @@ def solvers() -> list:
     ranges), as ``beltrami solvers --json``.
 
     >>> import beltrami
-    >>> sorted(s["name"] for s in beltrami.solvers())[:4]
-    ['beltrami-flow', 'extremal', 'harmonic', 'lscm']
+    >>> lscm = next(s for s in beltrami.solvers() if s["name"] == "lscm")
+    >>> lscm["accepts"]["targets"]
+    ['plane-free']
     """
     return json.loads(_native.solvers())
