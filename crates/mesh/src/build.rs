@@ -193,15 +193,16 @@ fn polygon_area(p: &[Point3<f64>], face: &[u32]) -> f64 {
 /// is `((p_{k+1} - p_k) x (p_{k-1} - p_k)) . N`. A planar quad folds exactly when it is
 /// concave (a dart) or self-crossing (a bow tie); a non-planar one when it is so seen
 /// along `N` (however sharply it is bent across a diagonal otherwise: a square bent by
-/// 120 degrees does not fold). Such a patch turns over inside the face: its area,
-/// Jacobian and Beltrami coefficient have no consistent sign, and every measure of it
-/// disagrees with another.
+/// 120 degrees does not fold). A straight corner (a vertex on the line of its two
+/// neighbours) makes the normal vanish there only, and is kept. A patch that folds turns
+/// over inside the face: its area, Jacobian and Beltrami coefficient have no consistent
+/// sign, and every measure of it disagrees with another.
 fn folded_quad_corner(p: &[Point3<f64>], face: &[u32]) -> Option<usize> {
     let at = |k: usize| p[face[k % 4] as usize];
     let normal = (at(2) - at(0)).cross(&(at(3) - at(1)));
     (0..4).find(|&k| {
         let corner = (at(k + 1) - at(k)).cross(&(at(k + 3) - at(k)));
-        corner.dot(&normal) <= 0.0
+        corner.dot(&normal) < 0.0
     })
 }
 

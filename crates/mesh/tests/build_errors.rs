@@ -287,6 +287,15 @@ fn a_quad_that_folds_is_refused_naming_the_face_and_vertex() {
         p(0.2, 1.0, 0.0),
     ];
     build(&soup(kite, &[&[0, 1, 2, 3]])).expect("a convex quad");
+    // A straight corner (vertex 1 on the side from 0 to 2): the patch's normal vanishes
+    // at that corner only, and the quad is valid.
+    let straight = vec![
+        p(0.0, 0.0, 0.0),
+        p(1.0, 0.0, 0.0),
+        p(2.0, 0.0, 0.0),
+        p(1.0, 1.0, 0.0),
+    ];
+    build(&soup(straight, &[&[0, 1, 2, 3]])).expect("a quad with a straight corner");
 }
 
 #[test]
