@@ -284,13 +284,7 @@ fn match_interior_landmarks(
         &[],
         Side::Source,
     )?;
-    if matched.flipped > 0 {
-        return Err(RegisterError::LandmarkFolds {
-            domain: "disk",
-            flipped: matched.flipped,
-            steps: matched.steps,
-        });
-    }
+    let matched = matched.without_folds("disk")?;
     notes.push(format!(
         "disk: {} interior landmarks matched in the disk ({} smoothing steps)",
         interior.len(),

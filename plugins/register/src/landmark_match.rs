@@ -64,6 +64,21 @@ pub(crate) struct Matched {
     pub mean_mu: f64,
 }
 
+impl Matched {
+    /// The matching, or [`RegisterError::LandmarkFolds`] (naming `domain`) when its steps
+    /// ran out with faces still flipped.
+    pub(crate) fn without_folds(self, domain: &'static str) -> Result<Self, RegisterError> {
+        if self.flipped > 0 {
+            return Err(RegisterError::LandmarkFolds {
+                domain,
+                flipped: self.flipped,
+                steps: self.steps,
+            });
+        }
+        Ok(self)
+    }
+}
+
 /// The landmark-matching map of `mesh` bent from `initial` (one value per vertex) so
 /// that the vertices of `fixed` are at their values (module docs), each pair of `glued`
 /// moving as one (a fixed vertex fixes its glued partners at their offsets). Faces whose

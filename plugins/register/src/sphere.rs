@@ -358,13 +358,7 @@ fn match_on_sphere(
     } else {
         let matched =
             match_landmarks(&punctured, Frame::Face, &initial, &fixed, &[], Side::Source)?;
-        if matched.flipped > 0 {
-            return Err(RegisterError::LandmarkFolds {
-                domain: "sphere",
-                flipped: matched.flipped,
-                steps: matched.steps,
-            });
-        }
+        let matched = matched.without_folds("sphere")?;
         notes.push(format!(
             "sphere: every landmark matched on the sphere in the chart from source face {} (mean |mu| of the matching {:.4}, {} smoothing steps)",
             source.face_to_input(pole),

@@ -322,13 +322,7 @@ fn match_on_torus(
         &glued,
         Side::Source,
     )?;
-    if matched.flipped > 0 {
-        return Err(RegisterError::LandmarkFolds {
-            domain: "torus",
-            flipped: matched.flipped,
-            steps: matched.steps,
-        });
-    }
+    let matched = matched.without_folds("torus")?;
     Ok(matched)
 }
 
