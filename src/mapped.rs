@@ -417,4 +417,50 @@ mod tests {
             assert!(n.z > 0.0 && n.x.abs() < 1e-12 && n.y.abs() < 1e-12, "{n}");
         }
     }
+
+    /// The icosphere of `level` with `r = 1 + 0.1 cos(8x) cos(8y) cos(8z)`: bumps of
+    /// wavelength 0.79, about 20 edges of level 5, even in each coordinate.
+    fn bumpy_sphere(level: usize) -> Mesh {
+        let mut soup = beltrami_mesh::primitives::icosphere(level);
+        for p in &mut soup.positions {
+            let r = 1.0 + 0.1 * (8.0 * p.x).cos() * (8.0 * p.y).cos() * (8.0 * p.z).cos();
+            *p = Point3::from(p.coords * r);
+        }
+        Mesh::from_soup(&soup).unwrap()
+    }
+
+    /// The flip rule judged on coarse sources: the exact maps of a bumpy sphere of
+    /// levels 2 to 4 (faces up to 16 times the target's edge) onto level 5 keep every
+    /// face, and the mirror image `x -> -x` (onto the same surface, the bumps are even)
+    /// turns every face over.
+    #[test]
+    fn exact_maps_of_coarse_sources_keep_every_face_and_a_mirror_turns_all() {
+        use beltrami_fem::beltrami::ReferenceNormal;
+        use beltrami_fem::distortion::measure_surface;
+        let target = bumpy_sphere(5);
+        for level in 2..5 {
+            let source = bumpy_sphere(level);
+            for mirrored in [false, true] {
+                let image: Vec<Point3<f64>> = source
+                    .positions()
+                    .iter()
+                    .map(|p| {
+                        if mirrored {
+                            Point3::new(-p.x, p.y, p.z)
+                        } else {
+                            *p
+                        }
+                    })
+                    .collect();
+                let found = target_normals(&target, &source, &image).unwrap();
+                assert!(found.farthest < 1e-12, "level {level}: {}", found.farthest);
+                let measured =
+                    measure_surface(&source, &image, ReferenceNormal::PerFace(&found.normals))
+                        .unwrap();
+                let flipped = measured.flipped.iter().filter(|&&f| f).count();
+                let expected = if mirrored { source.face_count() } else { 0 };
+                assert_eq!(flipped, expected, "level {level}, mirrored {mirrored}");
+            }
+        }
+    }
 }
