@@ -6,9 +6,9 @@
 //! - the [`Problem`]: source mesh, [`Target`], [`Goal`], typed [`Constraints`] (pins,
 //!   landmarks, slides, curves, loop matches, normal and area constraints, reference
 //!   angles), an initial [`Map`] and the [`Options`] a user set;
-//! - the [`Solver`] trait: a name, what it accepts as data ([`Accepts`]), its typed
-//!   options ([`OptionSpec`]: type, default, range, help), and one validation shared by
-//!   [`Solver::check`] and [`Solver::solve`], before any work;
+//! - the [`Solver`] trait: one [`SolverInfo`] record (a name, what it accepts as data
+//!   ([`Accepts`]), its typed options ([`OptionSpec`]: type, default, range, help)), and
+//!   one validation shared by [`Solver::check`] and [`Solver::solve`], before any work;
 //! - the [`Solution`]: an [`Output`] (a [`Map`] of the source's vertices or a
 //!   [`Remeshed`] mesh located on the source), typed [`Metrics`] (`|mu|` statistics,
 //!   flips, `|mu - target|`, `k`, iterations and histories, why it stopped), typed
@@ -20,7 +20,7 @@
 //!
 //! ```
 //! use beltrami_core::{Accepts, Context, Element, GoalKind, Map, OptionKind, OptionSpec};
-//! use beltrami_core::{Problem, Report, Settings, Solution, Solver, SolverError};
+//! use beltrami_core::{Problem, Report, Settings, Solution, Solver, SolverError, SolverInfo};
 //! use beltrami_core::{Target, TargetKind, Topology};
 //! use beltrami_mesh::{Mesh, primitives::{grid, Cells}};
 //! use num_complex::Complex64;
@@ -34,19 +34,21 @@
 //!     help: "the factor",
 //! }];
 //!
+//! const INFO: SolverInfo = SolverInfo {
+//!     name: "scale",
+//!     description: "scales a planar mesh",
+//!     accepts: Accepts {
+//!         elements: &[Element::Triangle, Element::Quad],
+//!         topologies: &[Topology::Disk],
+//!         targets: &[TargetKind::PlaneKeep],
+//!         goals: &[GoalKind::Conformal],
+//!         constraints: &[],
+//!     },
+//!     options: OPTIONS,
+//! };
+//!
 //! impl Solver for Scale {
-//!     fn name(&self) -> &'static str { "scale" }
-//!     fn description(&self) -> &'static str { "scales a planar mesh" }
-//!     fn accepts(&self) -> Accepts {
-//!         Accepts {
-//!             elements: &[Element::Triangle, Element::Quad],
-//!             topologies: &[Topology::Disk],
-//!             targets: &[TargetKind::PlaneKeep],
-//!             goals: &[GoalKind::Conformal],
-//!             constraints: &[],
-//!         }
-//!     }
-//!     fn options(&self) -> &'static [OptionSpec] { OPTIONS }
+//!     fn info(&self) -> &'static SolverInfo { &INFO }
 //!     fn check_problem(&self, _: &Problem<'_>, _: &Settings) -> Result<(), SolverError> {
 //!         Ok(())
 //!     }
@@ -100,4 +102,4 @@ pub use solution::{
     AnnulusRadius, Circle, Extras, FeatureMismatch, LandmarkResidual, Metrics, Output,
     QuadraticDifferential, Remeshed, ShapeDistance, Solution, Stop,
 };
-pub use solver::{Context, Progress, Solver};
+pub use solver::{Context, Progress, Solver, SolverInfo};

@@ -1,30 +1,57 @@
-//! The [`Solver`] trait and the solve [`Context`] (progress and cancellation).
+//! The [`Solver`] trait, its [`SolverInfo`] record and the solve [`Context`] (progress
+//! and cancellation).
 
 use crate::{Accepts, OptionSpec, Problem, Report, Settings, Solution, SolverError, Target};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// What a solver is, as one constant record: its name, one line on what it computes,
+/// what it accepts and its options. The registry, the command line's help and
+/// reference, `beltrami solvers --json`, Python and batch jobs read it (through
+/// [`Solver::info`] or the provided [`Solver::name`], [`Solver::description`],
+/// [`Solver::accepts`] and [`Solver::options`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverInfo {
+    /// The stable name users select it by (`--solver NAME`).
+    pub name: &'static str,
+    /// One line on what it computes.
+    pub description: &'static str,
+    /// What it accepts: element types, topologies, targets, goals, constraint kinds.
+    pub accepts: Accepts,
+    /// Its options with types, defaults and ranges (`&[]` for none).
+    pub options: &'static [OptionSpec],
+}
+
 /// A mapping algorithm behind a stable name.
 ///
-/// An implementation states what it accepts ([`Solver::accepts`], as data) and its
-/// options ([`Solver::options`]), checks what is particular to it
+/// An implementation states what it is as data ([`Solver::info`]: its name, what it
+/// accepts and its options), checks what is particular to it
 /// ([`Solver::check_problem`]) and computes ([`Solver::run`]). Callers use the provided
 /// [`Solver::check`] and [`Solver::solve`], which run one validation: the options
 /// ([`Settings::resolve`]), the constraints ([`crate::Constraints::validate`]), the
 /// solver's own check, then the accepted kinds ([`Accepts::check`]), all before any work.
 pub trait Solver: Send + Sync {
-    /// The stable name users select it by (`--solver NAME`).
-    fn name(&self) -> &'static str;
+    /// Its record: name, description, what it accepts and its options.
+    fn info(&self) -> &'static SolverInfo;
 
-    /// One line on what it computes.
-    fn description(&self) -> &'static str;
+    /// The stable name users select it by (`--solver NAME`): [`SolverInfo::name`].
+    fn name(&self) -> &'static str {
+        self.info().name
+    }
 
-    /// What it accepts: element types, topologies, targets, goals, constraint kinds.
-    fn accepts(&self) -> Accepts;
+    /// One line on what it computes: [`SolverInfo::description`].
+    fn description(&self) -> &'static str {
+        self.info().description
+    }
 
-    /// Its options with types, defaults and ranges (none by default).
+    /// What it accepts: [`SolverInfo::accepts`].
+    fn accepts(&self) -> Accepts {
+        self.info().accepts
+    }
+
+    /// Its options with types, defaults and ranges: [`SolverInfo::options`].
     fn options(&self) -> &'static [OptionSpec] {
-        &[]
+        self.info().options
     }
 
     /// The checks particular to this solver, after the options and constraints were

@@ -9,7 +9,7 @@ use beltrami_core::{
     Accepts, Constraint, ConstraintError, ConstraintKind, Constraints, Context, Curve, Direction,
     Element, Goal, GoalKind, Landmark, LoopMatch, Map, OptionError, OptionKind, OptionSpec,
     OptionValue, Options, Pin, PlanarBoundary, Position, Problem, Report, Settings, Slide,
-    Solution, Solver, SolverError, Target, TargetKind, Topology,
+    Solution, Solver, SolverError, SolverInfo, Target, TargetKind, Topology,
 };
 use beltrami_fem::{BeltramiField, FieldError, Frame};
 use beltrami_mesh::primitives::{Cells, grid, icosphere};
@@ -417,18 +417,18 @@ const COUNTING_ACCEPTS: Accepts = Accepts {
     constraints: &[ConstraintKind::Hold],
 };
 
+/// What [`Counting`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const COUNTING_INFO: SolverInfo = SolverInfo {
+    name: "counting",
+    description: "counts its runs",
+    accepts: COUNTING_ACCEPTS,
+    options: SPECS,
+};
+
 impl Solver for Counting {
-    fn name(&self) -> &'static str {
-        "counting"
-    }
-    fn description(&self) -> &'static str {
-        "counts its runs"
-    }
-    fn accepts(&self) -> Accepts {
-        COUNTING_ACCEPTS
-    }
-    fn options(&self) -> &'static [OptionSpec] {
-        SPECS
+    fn info(&self) -> &'static SolverInfo {
+        &COUNTING_INFO
     }
     fn check_problem(&self, problem: &Problem<'_>, _: &Settings) -> Result<(), SolverError> {
         if matches!(problem.target, Target::Disk) {

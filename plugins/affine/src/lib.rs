@@ -11,8 +11,8 @@
 
 use beltrami_core::Goal;
 use beltrami_core::{
-    Accepts, Context, Element, GoalKind, Map, OptionSpec, Problem, Report, Settings, Solution,
-    Solver, SolverError, TargetKind, Topology,
+    Accepts, Context, Element, GoalKind, Map, Problem, Report, Settings, Solution, Solver,
+    SolverError, SolverInfo, TargetKind, Topology,
 };
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::distortion::{Distortion, MuError};
@@ -68,21 +68,18 @@ impl Affine {
     }
 }
 
+/// What [`Affine`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "the affine map z + k conj(z) of a planar disk, exact for a constant prescribed mu = k",
+    accepts: ACCEPTS,
+    options: &[],
+};
+
 impl Solver for Affine {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "the affine map z + k conj(z) of a planar disk, exact for a constant prescribed mu = k"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        &[]
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     /// The source in the plane `z = 0` and the prescribed field constant.

@@ -5,8 +5,8 @@
 
 use beltrami_atlas::unit_disk::map_to_unit_disk;
 use beltrami_core::{
-    Accepts, Context, Map, OptionSpec, Output, PlanarBoundary, Problem, Report, Settings, Solution,
-    Solver, SolverError, Target, solve_renumbered,
+    Context, Map, Output, PlanarBoundary, Problem, Report, Settings, Solution, Solver, SolverError,
+    SolverInfo, Target, solve_renumbered,
 };
 use beltrami_fem::element::is_planar;
 use beltrami_flow_engine::system::VertexOrder;
@@ -24,21 +24,18 @@ use beltrami_mesh::Point3;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BeltramiFlow;
 
+/// What [`BeltramiFlow`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "discrete Beltrami flow: a bijective map onto a fixed target with a prescribed mu or the smallest L^p norm of mu",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for BeltramiFlow {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "discrete Beltrami flow: a bijective map onto a fixed target with a prescribed mu or the smallest L^p norm of mu"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(

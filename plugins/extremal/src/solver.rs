@@ -4,7 +4,7 @@
 use beltrami_core::{
     Accepts, ConstraintKind, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind,
     OptionSpec, Output, Problem, Progress, QuadraticDifferential, Report, Settings, Solution,
-    Solver, SolverError, Stop, THREADS, Target, TargetKind, Topology,
+    Solver, SolverError, SolverInfo, Stop, THREADS, Target, TargetKind, Topology,
 };
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::beltrami::planar_map;
@@ -105,21 +105,18 @@ fn invalid(message: impl Into<String>) -> SolverError {
     }
 }
 
+/// What [`Extremal`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "extremal (Teichmueller) map with a prescribed boundary: constant |mu| = k, holomorphic quadratic differential (Weber-Myles-Zorin 2012)",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for Extremal {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "extremal (Teichmueller) map with a prescribed boundary: constant |mu| = k, holomorphic quadratic differential (Weber-Myles-Zorin 2012)"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(&self, problem: &Problem<'_>, _: &Settings) -> Result<(), SolverError> {

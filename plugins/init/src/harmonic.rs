@@ -20,7 +20,7 @@
 //! the flipped faces and the negative weights in its notes.
 
 use beltrami_core::{
-    Accepts, Context, OptionSpec, Problem, Settings, Solution, Solver, SolverError, THREADS,
+    Context, OptionSpec, Problem, Settings, Solution, Solver, SolverError, SolverInfo, THREADS,
 };
 
 use crate::tutte::{ACCEPTS, FixedBoundary};
@@ -46,21 +46,18 @@ const OPTIONS: &[OptionSpec] = &[
     THREADS,
 ];
 
+/// What [`Harmonic`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: "harmonic",
+    description: "harmonic map: disk onto a fixed boundary minimizing the Dirichlet energy (cotangent weights); may flip faces on obtuse meshes",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for Harmonic {
-    fn name(&self) -> &'static str {
-        "harmonic"
-    }
-
-    fn description(&self) -> &'static str {
-        "harmonic map: disk onto a fixed boundary minimizing the Dirichlet energy (cotangent weights); may flip faces on obtuse meshes"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(

@@ -24,8 +24,8 @@
 
 use beltrami_core::{
     Accepts, ConstraintKind, Context, Element, Extras, GoalKind, Map, Metrics, OptionSpec, Output,
-    PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver, SolverError, THREADS,
-    Target, TargetKind, Topology, topology,
+    PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver, SolverError, SolverInfo,
+    THREADS, Target, TargetKind, Topology, topology,
 };
 use beltrami_fem::boundary::far_boundary_pair;
 use beltrami_fem::conformal_energy::{ConformalSystem, conformal_energy, conformal_system};
@@ -65,21 +65,18 @@ const ACCEPTS: Accepts = Accepts {
     constraints: &[ConstraintKind::Hold, ConstraintKind::Pin],
 };
 
+/// What [`Lscm`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "least-squares conformal map (LSCM): disk into the plane with a free boundary and two pinned vertices",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for Lscm {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "least-squares conformal map (LSCM): disk into the plane with a free boundary and two pinned vertices"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(

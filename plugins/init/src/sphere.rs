@@ -120,8 +120,8 @@ use std::f64::consts::{PI, TAU};
 
 use beltrami_core::{
     Accepts, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind, OptionSpec,
-    Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, THREADS, Target,
-    TargetKind, Topology, solve_renumbered, topology,
+    Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, SolverInfo,
+    THREADS, Target, TargetKind, Topology, solve_renumbered, topology,
 };
 use beltrami_fem::ReferenceNormal;
 use beltrami_fem::distortion::measure_surface;
@@ -220,21 +220,18 @@ const CORRECTION_TOLERANCE: f64 = 1e-9;
 /// A normalization step halves its candidate this many times at most.
 const MAX_HALVINGS: u32 = 20;
 
+/// What [`Sphere`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "closed genus-0 mesh onto the unit sphere, nearly conformally: cotangent-harmonic map of the punctured mesh, harmonic corrections alternating between the two stereographic charts, Moebius centering, flipped faces untangled (start=tutte: the Tutte embedding of the old initialization)",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for Sphere {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "closed genus-0 mesh onto the unit sphere, nearly conformally: cotangent-harmonic map of the punctured mesh, harmonic corrections alternating between the two stereographic charts, Moebius centering, flipped faces untangled (start=tutte: the Tutte embedding of the old initialization)"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(&self, problem: &Problem<'_>, settings: &Settings) -> Result<(), SolverError> {

@@ -20,8 +20,8 @@
 
 use beltrami_core::{
     Accepts, ConstraintKind, Context, Element, Extras, GoalKind, Map, Metrics, OptionSpec, Output,
-    PlanarBoundary, Problem, Report, Settings, Solution, Solver, SolverError, THREADS, Target,
-    TargetKind, Topology, topology,
+    PlanarBoundary, Problem, Report, Settings, Solution, Solver, SolverError, SolverInfo, THREADS,
+    Target, TargetKind, Topology, topology,
 };
 use beltrami_fem::boundary::{self, BoundaryError, BoundaryMap};
 use beltrami_fem::{EdgeWeights, WeightError, WeightedMeanSystem};
@@ -46,21 +46,18 @@ use crate::{
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Tutte;
 
+/// What [`Tutte`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: "tutte",
+    description: "Tutte embedding: disk onto a convex boundary, interior vertices at weighted means (uniform or mean-value weights); bijective for a convex boundary",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for Tutte {
-    fn name(&self) -> &'static str {
-        "tutte"
-    }
-
-    fn description(&self) -> &'static str {
-        "Tutte embedding: disk onto a convex boundary, interior vertices at weighted means (uniform or mean-value weights); bijective for a convex boundary"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(

@@ -4,7 +4,7 @@
 use beltrami_core::{
     Accepts, Constraint, ConstraintKind, Context, Element, Extras, Goal, GoalKind, Map, Metrics,
     OptionSpec, Output, PlanarBoundary, Position, Problem, Report, Settings, Solution, Solver,
-    SolverError, THREADS, Target, TargetKind, Topology, topology,
+    SolverError, SolverInfo, THREADS, Target, TargetKind, Topology, topology,
 };
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::boundary::{self, BoundaryError};
@@ -59,21 +59,18 @@ const ACCEPTS: Accepts = Accepts {
 /// What to do with a mesh that is not a disk.
 const NOT_A_DISK: &str = "run `beltrami cut` first or use beltrami-flow";
 
+/// What [`Lsqc`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "least-squares quasiconformal map for a prescribed Beltrami coefficient (one linear solve)",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for Lsqc {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "least-squares quasiconformal map for a prescribed Beltrami coefficient (one linear solve)"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(

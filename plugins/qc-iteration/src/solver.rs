@@ -3,7 +3,7 @@
 use beltrami_core::{
     Accepts, Constraint, ConstraintKind, Context, Element, Extras, Goal, GoalKind, Metrics,
     OptionKind, OptionSpec, Output, Problem, Progress, Report, Settings, Solution, Solver,
-    SolverError, Stop, THREADS, Target, TargetKind, Topology,
+    SolverError, SolverInfo, Stop, THREADS, Target, TargetKind, Topology,
 };
 use beltrami_fem::element::check_planar;
 use beltrami_fem::operators::beltrami_operator;
@@ -74,21 +74,18 @@ const ACCEPTS: Accepts = Accepts {
     ],
 };
 
+/// What [`QcIteration`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "QC iteration towards the Teichmueller map of a boundary condition, in the plane or into R^3 (Lui et al. 2014; Gruber-Aulisa 2022)",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for QcIteration {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "QC iteration towards the Teichmueller map of a boundary condition, in the plane or into R^3 (Lui et al. 2014; Gruber-Aulisa 2022)"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(&self, problem: &Problem<'_>, _: &Settings) -> Result<(), SolverError> {

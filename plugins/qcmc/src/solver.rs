@@ -2,8 +2,8 @@
 
 use beltrami_core::{
     Accepts, Circle, Context, Element, Extras, Goal, GoalKind, Map, Metrics, OptionKind,
-    OptionSpec, Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError, Stop,
-    THREADS, TargetKind, Topology,
+    OptionSpec, Output, Problem, Progress, Report, Settings, Solution, Solver, SolverError,
+    SolverInfo, Stop, THREADS, TargetKind, Topology,
 };
 use beltrami_fem::beltrami::planar_map;
 use beltrami_fem::element::check_planar;
@@ -70,21 +70,18 @@ const ACCEPTS: Accepts = Accepts {
 /// Halvings of the step tried before the iteration counts as stalled.
 const HALVINGS: usize = 12;
 
+/// What [`Qcmc`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "quasiconformal map of a multiply-connected mesh onto a circle domain whose centres and radii are unknowns (Ho-Lui 2016)",
+    accepts: ACCEPTS,
+    options: OPTIONS,
+};
+
 impl Solver for Qcmc {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "quasiconformal map of a multiply-connected mesh onto a circle domain whose centres and radii are unknowns (Ho-Lui 2016)"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(&self, problem: &Problem<'_>, settings: &Settings) -> Result<(), SolverError> {

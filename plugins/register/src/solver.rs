@@ -1,11 +1,10 @@
 //! [`Register`]: the solver behind `beltrami register` (crate docs).
 
-use std::sync::LazyLock;
-
 use beltrami_core::{
     Accepts, Constraint, ConstraintKind, Constraints, Context, Element, Features, Goal, GoalKind,
     LandmarkResidual, Map, OptionKind, OptionSpec, OptionValue, Position, Problem, Report,
-    Settings, ShapeDistance, Solution, Solver, SolverError, Target, TargetKind, solve_renumbered,
+    Settings, ShapeDistance, Solution, Solver, SolverError, SolverInfo, Target, TargetKind,
+    solve_renumbered,
 };
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
@@ -58,26 +57,44 @@ const ACCEPTS: Accepts = Accepts {
     constraints: &[ConstraintKind::Landmark, ConstraintKind::OpenCurve],
 };
 
-/// The flow's options, `allow-flips`, `match-shape` and `allow-missed-landmarks`.
-static OPTIONS: LazyLock<Vec<OptionSpec>> = LazyLock::new(|| {
-    let mut options = beltrami_flow_engine::OPTIONS.to_vec();
-    options.push(OptionSpec {
+/// The options register adds to the flow's.
+const OWN_OPTIONS: [OptionSpec; 3] = [
+    OptionSpec {
         name: "allow-flips",
         kind: OptionKind::Bool { default: false },
         help: "keep a map that still has flipped faces after the flow (they are named in the notes) instead of failing",
-    });
-    options.push(OptionSpec {
+    },
+    OptionSpec {
         name: "match-shape",
         kind: OptionKind::Bool { default: false },
         help: "after the conformal registration, pull each image towards where the source, aligned by a similarity, lies on the target (a bijective non-rigid ICP; disks and closed genus-0 surfaces)",
-    });
-    options.push(OptionSpec {
+    },
+    OptionSpec {
         name: "allow-missed-landmarks",
         kind: OptionKind::Bool { default: false },
         help: "keep a map whose landmarks are not all exact (their distances are in the report) instead of failing",
-    });
+    },
+];
+
+/// How many options register takes: the flow's and its own.
+const OPTION_COUNT: usize = beltrami_flow_engine::OPTIONS.len() + OWN_OPTIONS.len();
+
+/// The flow's options, `allow-flips`, `match-shape` and `allow-missed-landmarks`.
+const OPTIONS: [OptionSpec; OPTION_COUNT] = {
+    let flow = beltrami_flow_engine::OPTIONS;
+    let mut options = [OWN_OPTIONS[0]; OPTION_COUNT];
+    let mut i = 0;
+    while i < flow.len() {
+        options[i] = flow[i];
+        i += 1;
+    }
+    let mut j = 0;
+    while j < OWN_OPTIONS.len() {
+        options[flow.len() + j] = OWN_OPTIONS[j];
+        j += 1;
+    }
     options
-});
+};
 
 /// A landmark is exact when its image is within this of its target, relative to the
 /// target's bounding-box diagonal (rounding of barycentric coordinates is ~1e-16).
@@ -257,21 +274,18 @@ fn landmarks(problem: &Problem<'_>) -> Result<Vec<Landmark>, SolverError> {
         .collect()
 }
 
+/// What [`Register`] is: its name, one line on what it computes, what it accepts and
+/// its options.
+const INFO: SolverInfo = SolverInfo {
+    name: NAME,
+    description: "surface registration: a bijective map onto another mesh of the same topology, as conformal as the constraints allow (or with a prescribed mu)",
+    accepts: ACCEPTS,
+    options: &OPTIONS,
+};
+
 impl Solver for Register {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn description(&self) -> &'static str {
-        "surface registration: a bijective map onto another mesh of the same topology, as conformal as the constraints allow (or with a prescribed mu)"
-    }
-
-    fn accepts(&self) -> Accepts {
-        ACCEPTS
-    }
-
-    fn options(&self) -> &'static [OptionSpec] {
-        &OPTIONS
+    fn info(&self) -> &'static SolverInfo {
+        &INFO
     }
 
     fn check_problem(&self, problem: &Problem<'_>, settings: &Settings) -> Result<(), SolverError> {
