@@ -232,7 +232,7 @@ impl Accepts {
     /// outside the lists, naming the first one found (a face by its input index, a
     /// constraint by its index).
     pub fn check(&self, solver: &'static str, problem: &Problem<'_>) -> Result<(), SolverError> {
-        let unsupported = |message: String| Err(SolverError::Unsupported { solver, message });
+        let unsupported = |message: String| Err(SolverError::unsupported(solver, message));
         let names = |list: &[&str]| list.join(", ");
         let mesh = problem.source;
         for f in mesh.faces() {

@@ -95,11 +95,13 @@ impl Part {
         problem: &Problem<'a>,
         solver: &'static str,
     ) -> Result<Problem<'a>, SolverError> {
-        let refuse = |what: &str| SolverError::Unsupported {
-            solver,
-            message: format!(
-                "{what} cannot be split between the mesh's components: solve each component's file on its own"
-            ),
+        let refuse = |what: &str| {
+            SolverError::unsupported(
+                solver,
+                format!(
+                    "{what} cannot be split between the mesh's components: solve each component's file on its own"
+                ),
+            )
         };
         if problem.initial.is_some() {
             return Err(refuse("an initial map"));
@@ -164,10 +166,10 @@ pub fn solve_each(
         problem.target,
         Target::Plane(_) | Target::Disk | Target::Annulus { .. }
     ) {
-        return Err(SolverError::Unsupported {
-            solver: name,
-            message: "each component on its own joins maps into the plane side by side; maps onto the sphere, a circle domain, a mesh or a surface have no such joining: solve the largest component, or each component's file".into(),
-        });
+        return Err(SolverError::unsupported(
+            name,
+            "each component on its own joins maps into the plane side by side; maps onto the sphere, a circle domain, a mesh or a surface have no such joining: solve the largest component, or each component's file",
+        ));
     }
     let parts = parts(mesh)?;
     // Every part's problem checked before any is solved.
@@ -184,9 +186,8 @@ pub fn solve_each(
     let mut images: Vec<Vec<Complex64>> = Vec::with_capacity(parts.len());
     for (problem, settings) in &problems {
         let solution = solver.run(problem, settings, context)?;
-        let image = solution.planar().ok_or_else(|| SolverError::InvalidInput {
-            solver: name,
-            message: "a component's solution is not a planar map".into(),
+        let image = solution.planar().ok_or_else(|| {
+            SolverError::invalid(name, "a component's solution is not a planar map")
         })?;
         images.push(image.to_vec());
         report.timings.extend(solution.report.timings);

@@ -99,6 +99,38 @@ pub enum SolverError {
     Solve(#[from] SolveError),
 }
 
+impl SolverError {
+    /// [`SolverError::Unsupported`]: `solver` cannot take this problem; `message` says
+    /// why, in plain words, with the way out.
+    pub fn unsupported(solver: &'static str, message: impl Into<String>) -> Self {
+        SolverError::Unsupported {
+            solver,
+            message: message.into(),
+        }
+    }
+
+    /// [`SolverError::InvalidInput`]: an input of `solver`'s problem is invalid;
+    /// `message` says what is wrong, naming the element.
+    pub fn invalid(solver: &'static str, message: impl Into<String>) -> Self {
+        SolverError::InvalidInput {
+            solver,
+            message: message.into(),
+        }
+    }
+
+    /// [`SolverError::Plugin`]: `error` of a plugin's own crate or of a crate core does
+    /// not know, met by `solver`, kept typed as the source.
+    pub fn plugin(
+        solver: &'static str,
+        error: impl std::error::Error + Send + Sync + 'static,
+    ) -> Self {
+        SolverError::Plugin {
+            solver,
+            error: Box::new(error),
+        }
+    }
+}
+
 impl From<beltrami_fem::quaternionic_lsqc::SpaceError> for SolverError {
     fn from(e: beltrami_fem::quaternionic_lsqc::SpaceError) -> Self {
         use beltrami_fem::quaternionic_lsqc::SpaceError;

@@ -26,13 +26,13 @@ pub fn require_disk(solver: &'static str, mesh: &Mesh, advice: &str) -> Result<(
     if mesh.is_disk() {
         return Ok(());
     }
-    Err(SolverError::Unsupported {
+    Err(SolverError::unsupported(
         solver,
-        message: format!(
+        format!(
             "{solver} maps disk-topology meshes; this mesh has {}: {advice}",
             describe(mesh)
         ),
-    })
+    ))
 }
 
 /// `Ok` for a single closed genus-0 surface; otherwise [`SolverError::Unsupported`].
@@ -41,11 +41,11 @@ pub fn require_sphere(solver: &'static str, mesh: &Mesh, advice: &str) -> Result
     if c.len() == 1 && c[0].genus == 0 && c[0].boundary_loops == 0 {
         return Ok(());
     }
-    Err(SolverError::Unsupported {
+    Err(SolverError::unsupported(
         solver,
-        message: format!(
+        format!(
             "{solver} maps closed genus-0 meshes; this mesh has {}: {advice}",
             describe(mesh)
         ),
-    })
+    ))
 }

@@ -138,10 +138,10 @@ impl std::fmt::Debug for MeshTarget<'_> {
 }
 
 fn spatial_error(error: beltrami_spatial::SpatialError) -> SolverError {
-    SolverError::InvalidInput {
-        solver: crate::NAME,
-        message: format!("locating a point on the target mesh: {error}"),
-    }
+    SolverError::invalid(
+        crate::NAME,
+        format!("locating a point on the target mesh: {error}"),
+    )
 }
 
 impl<'a> MeshTarget<'a> {

@@ -20,7 +20,7 @@ use crate::setup::{Domain, curve_roles, diagonal, domain, goals, mesh_roles, pin
 use crate::system::{FlowSystem, VertexOrder};
 use crate::target::{INNER, OUTER, Role, TargetGeometry};
 use crate::untangle::{UntangleRounds, Untangled, untangle, untangle_patches};
-use crate::validate::{invalid, validate};
+use crate::validate::validate;
 
 /// The flow's options.
 pub const OPTIONS: &[OptionSpec] = &[
@@ -135,11 +135,14 @@ pub fn solve(
         Ok(Elements::new(mesh, goal.frame)?)
     })?;
     if initial.len() != mesh.vertex_count() {
-        return Err(invalid(format!(
-            "the initial map has {} images for {} vertices",
-            initial.len(),
-            mesh.vertex_count()
-        )));
+        return Err(SolverError::invalid(
+            crate::NAME,
+            format!(
+                "the initial map has {} images for {} vertices",
+                initial.len(),
+                mesh.vertex_count()
+            ),
+        ));
     }
     let threads = settings.int("threads");
     let step_threads = match settings.int("step-threads") {
@@ -374,7 +377,7 @@ impl Runner<'_, '_> {
         let index = context.stage("target index", report, || {
             SurfaceIndex::new(target)
                 .map(|index| index.with_threads(self.step_threads))
-                .map_err(|e| invalid(format!("the target mesh: {e}")))
+                .map_err(|e| SolverError::invalid(crate::NAME, format!("the target mesh: {e}")))
         })?;
         let (curves, roles) = mesh_roles(self.problem, target, &initial, pins)?;
         let geometry = MeshTarget::new(&index, curves);
@@ -729,7 +732,8 @@ fn undetermined(e: SolverError) -> SolverError {
         SolverError::Solve(
             beltrami_sparse::SolveError::Singular { .. }
             | beltrami_sparse::SolveError::NotPositiveDefinite { .. },
-        ) => invalid(
+        ) => SolverError::invalid(
+            crate::NAME,
             "the flow is not determined: pin more vertices (disk: one interior and one boundary vertex; annulus: one boundary vertex; sphere: three vertices)",
         ),
         e => e,

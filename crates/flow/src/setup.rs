@@ -6,7 +6,6 @@ use beltrami_mesh::{Mesh, Point3, VertexId};
 
 use crate::mesh_target::TargetCurve;
 use crate::target::{Annulus, PlaneRegion, Role, Side, UnitDisk, UnitSphere};
-use crate::validate::{invalid, unsupported};
 
 /// Boundary vertices whose boundary turns by less than this (radians) slide along a
 /// straight side of a planar region; the others are corners and stay.
@@ -27,11 +26,17 @@ pub fn given_initial(problem: &Problem<'_>) -> Result<Option<Vec<Point3<f64>>>, 
             .map(|(v, p)| {
                 p.validate(target)
                     .map(|()| p.position(target))
-                    .map_err(|e| invalid(format!("the initial map at vertex {v}: {e}")))
+                    .map_err(|e| {
+                        SolverError::invalid(
+                            crate::NAME,
+                            format!("the initial map at vertex {v}: {e}"),
+                        )
+                    })
             })
             .collect::<Result<_, _>>()?,
         (Map::OnMesh(_), _) => {
-            return Err(unsupported(
+            return Err(SolverError::unsupported(
+                crate::NAME,
                 "an initial map on a mesh needs that mesh as the target",
             ));
         }
@@ -75,7 +80,12 @@ pub(crate) fn domain(problem: &Problem<'_>, image: &[Point3<f64>]) -> Result<Dom
             )
         }
         Target::Sphere => Domain::Sphere(UnitSphere),
-        _ => return Err(unsupported("no flow for this target")),
+        _ => {
+            return Err(SolverError::unsupported(
+                crate::NAME,
+                "no flow for this target",
+            ));
+        }
     })
 }
 
@@ -265,7 +275,8 @@ pub(crate) fn mesh_roles(
             d(a).total_cmp(&d(b))
         });
         let Some(c) = nearest else {
-            return Err(unsupported(
+            return Err(SolverError::unsupported(
+                crate::NAME,
                 "the source has a boundary and the target mesh none",
             ));
         };

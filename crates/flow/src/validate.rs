@@ -26,29 +26,18 @@ pub(crate) struct CheckedGoal {
     pub(crate) p: f64,
 }
 
-pub(crate) fn unsupported(message: impl Into<String>) -> SolverError {
-    SolverError::Unsupported {
-        solver: NAME,
-        message: message.into(),
-    }
-}
-
-pub(crate) fn invalid(message: impl Into<String>) -> SolverError {
-    SolverError::InvalidInput {
-        solver: NAME,
-        message: message.into(),
-    }
-}
-
 /// Everything that can be checked before any work.
 pub(crate) fn validate(problem: &Problem<'_>) -> Result<CheckedGoal, SolverError> {
     let mesh = problem.source;
     if let Some(f) = mesh.faces().find(|&f| mesh.face_degree(f) != 3) {
-        return Err(unsupported(format!(
-            "the flow works on triangle meshes; face {} (input index) has {} vertices: split quads into triangles first",
-            mesh.face_to_input(f),
-            mesh.face_degree(f)
-        )));
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
+                "the flow works on triangle meshes; face {} (input index) has {} vertices: split quads into triangles first",
+                mesh.face_to_input(f),
+                mesh.face_degree(f)
+            ),
+        ));
     }
     let planar = is_planar(mesh);
     check_target(problem, planar)?;
@@ -64,7 +53,8 @@ fn check_target(problem: &Problem<'_>, planar: bool) -> Result<(), SolverError> 
     match &problem.target {
         Target::Plane(PlanarBoundary::Keep) => {
             if !planar {
-                return Err(unsupported(
+                return Err(SolverError::unsupported(
+                    NAME,
                     "the target `plane` keeps the input's own planar region; this mesh is not in the plane z = 0: use the disk target",
                 ));
             }
@@ -85,7 +75,8 @@ fn check_target(problem: &Problem<'_>, planar: bool) -> Result<(), SolverError> 
             )?;
         }
         Target::Plane(PlanarBoundary::Free | PlanarBoundary::Given(_)) => {
-            return Err(unsupported(
+            return Err(SolverError::unsupported(
+                NAME,
                 "the flow needs a target region; for a free or given boundary use lsqc",
             ));
         }
@@ -99,7 +90,8 @@ fn check_target(problem: &Problem<'_>, planar: bool) -> Result<(), SolverError> 
         }
         Target::Mesh(target) => check_target_mesh(problem, target)?,
         Target::CircleDomain | Target::Surface => {
-            return Err(unsupported(
+            return Err(SolverError::unsupported(
+                NAME,
                 "targets here: plane, disk, annulus, sphere, a target mesh (circle domains come with another solver)",
             ));
         }
@@ -113,17 +105,21 @@ fn check_target(problem: &Problem<'_>, planar: bool) -> Result<(), SolverError> 
 fn check_annulus(problem: &Problem<'_>, inner_radius: Option<f64>) -> Result<(), SolverError> {
     let mesh = problem.source;
     if mesh.boundary_loop_count() != 2 || mesh.component_count() != 1 || mesh.genus() != Some(0) {
-        return Err(unsupported(format!(
-            "the annulus target needs a connected genus-0 mesh with two boundary loops; this mesh has {}",
-            topology::describe(mesh)
-        )));
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
+                "the annulus target needs a connected genus-0 mesh with two boundary loops; this mesh has {}",
+                topology::describe(mesh)
+            ),
+        ));
     }
     if let Some(r) = inner_radius
         && !(r > 0.0 && r < 1.0)
     {
-        return Err(invalid(format!(
-            "the inner radius must be in (0, 1), got {r}"
-        )));
+        return Err(SolverError::invalid(
+            NAME,
+            format!("the inner radius must be in (0, 1), got {r}"),
+        ));
     }
     if problem.initial.is_none() {
         annulus_of(mesh)?;
@@ -139,39 +135,50 @@ fn check_target_mesh(problem: &Problem<'_>, target: &Mesh) -> Result<(), SolverE
         || target.genus() != mesh.genus()
         || target.component_count() != mesh.component_count()
     {
-        return Err(unsupported(format!(
-            "the source and the target mesh differ in topology: source has {}, target has {}",
-            topology::describe(mesh),
-            topology::describe(target)
-        )));
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
+                "the source and the target mesh differ in topology: source has {}, target has {}",
+                topology::describe(mesh),
+                topology::describe(target)
+            ),
+        ));
     }
     if problem.initial.is_none() {
-        return Err(unsupported(
+        return Err(SolverError::unsupported(
+            NAME,
             "a target mesh needs an initial map onto it: use the register solver, which builds one",
         ));
     }
     if let Some(f) = target.faces().find(|&f| target.face_degree(f) != 3) {
-        return Err(unsupported(format!(
-            "the target mesh must be made of triangles; its face {} (input index) is not",
-            target.face_to_input(f)
-        )));
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
+                "the target mesh must be made of triangles; its face {} (input index) is not",
+                target.face_to_input(f)
+            ),
+        ));
     }
     // Lengths and vertex ids were checked with every constraint
     // (`Constraints::validate`).
     for (k, curve) in problem.constraints.curves().enumerate() {
         if curve.closed {
-            return Err(unsupported(format!(
-                "curve {k} is closed; the flow slides open feature curves with fixed ends"
-            )));
+            return Err(SolverError::unsupported(
+                NAME,
+                format!("curve {k} is closed; the flow slides open feature curves with fixed ends"),
+            ));
         }
         // The chain slides along its segments, which must lie on the target.
         for pair in curve.target.windows(2) {
             if !target.vertex_neighbors(pair[0]).any(|w| w == pair[1]) {
-                return Err(invalid(format!(
-                    "curve {k}: target vertices {} and {} (input indices) are not joined by an edge",
-                    target.vertex_map().to_input(pair[0]),
-                    target.vertex_map().to_input(pair[1])
-                )));
+                return Err(SolverError::invalid(
+                    NAME,
+                    format!(
+                        "curve {k}: target vertices {} and {} (input indices) are not joined by an edge",
+                        target.vertex_map().to_input(pair[0]),
+                        target.vertex_map().to_input(pair[1])
+                    ),
+                ));
             }
         }
     }
@@ -191,13 +198,15 @@ fn check_constraints(problem: &Problem<'_>) -> Result<(), SolverError> {
             _ => false,
         };
         if refused {
-            return Err(unsupported(
+            return Err(SolverError::unsupported(
+                NAME,
                 "pins hold their vertex where the initial map puts it; pins at given positions (landmarks) are for target meshes",
             ));
         }
     }
     if problem.constraints.curves().next().is_some() && !on_mesh {
-        return Err(unsupported(
+        return Err(SolverError::unsupported(
+            NAME,
             "curve constraints come with target meshes (register)",
         ));
     }
@@ -214,10 +223,13 @@ fn check_initial(problem: &Problem<'_>) -> Result<(), SolverError> {
             Map::OnMesh(p) => p.len(),
         };
         if n != mesh.vertex_count() {
-            return Err(invalid(format!(
-                "the initial map has {n} images for {} vertices",
-                mesh.vertex_count()
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "the initial map has {n} images for {} vertices",
+                    mesh.vertex_count()
+                ),
+            ));
         }
     }
     Ok(())
@@ -231,9 +243,12 @@ fn check_goal(problem: &Problem<'_>, planar: bool) -> Result<CheckedGoal, Solver
     match &problem.goal {
         Goal::Conformal { p } => {
             if !(*p >= 2.0 && *p <= MAX_P) {
-                return Err(invalid(format!(
-                    "the L^p goal needs 2 <= p <= {MAX_P} (|mu|^p of a larger p underflows to zero), got {p}"
-                )));
+                return Err(SolverError::invalid(
+                    NAME,
+                    format!(
+                        "the L^p goal needs 2 <= p <= {MAX_P} (|mu|^p of a larger p underflows to zero), got {p}"
+                    ),
+                ));
             }
             Ok(CheckedGoal {
                 frame: if planar { Frame::Global } else { Frame::Face },
@@ -244,7 +259,8 @@ fn check_goal(problem: &Problem<'_>, planar: bool) -> Result<CheckedGoal, Solver
         Goal::Prescribed(field) => {
             field.check(mesh.face_count())?;
             if field.frame == Frame::Global && !planar {
-                return Err(invalid(
+                return Err(SolverError::invalid(
+                    NAME,
                     "a field in the global frame needs a mesh in the plane z = 0; give it in the face frame",
                 ));
             }
@@ -254,10 +270,12 @@ fn check_goal(problem: &Problem<'_>, planar: bool) -> Result<CheckedGoal, Solver
                 p: 2.0,
             })
         }
-        Goal::Extremal => Err(unsupported(
+        Goal::Extremal => Err(SolverError::unsupported(
+            NAME,
             "extremal (Teichmueller) maps come with their own solver",
         )),
-        Goal::Features(_) => Err(unsupported(
+        Goal::Features(_) => Err(SolverError::unsupported(
+            NAME,
             "features are matched by register, in the parameter domain",
         )),
     }
@@ -287,7 +305,8 @@ pub fn annulus_of(mesh: &Mesh) -> Result<(f64, usize), SolverError> {
     };
     let r = radii[inner].1;
     if !(is_planar(mesh) && on(radii[outer], 1.0) && on(radii[inner], r) && r > 0.0 && r < 1.0) {
-        return Err(unsupported(
+        return Err(SolverError::unsupported(
+            NAME,
             "the annulus target starts from a mesh already in an annulus r <= |z| <= 1 centred at 0 (both boundary loops on their circles), or from a given initial map",
         ));
     }

@@ -42,10 +42,10 @@ impl Affine {
     /// naming the first face that differs.
     fn constant_mu(problem: &Problem<'_>) -> Result<Complex64, SolverError> {
         let Goal::Prescribed(field) = &problem.goal else {
-            return Err(SolverError::Unsupported {
-                solver: NAME,
-                message: "affine takes a prescribed mu (--mu or --mu-expr)".into(),
-            });
+            return Err(SolverError::unsupported(
+                NAME,
+                "affine takes a prescribed mu (--mu or --mu-expr)",
+            ));
         };
         let global = field.to_frame(problem.source, Frame::Global)?;
         let mesh = problem.source;
@@ -55,14 +55,14 @@ impl Affine {
             .zip(&global.mu)
             .find(|(_, mu)| (*mu - first).norm() > CONSTANT);
         if let (Some((face, mu)), Some(face0)) = (differing, mesh.faces().next()) {
-            return Err(SolverError::Unsupported {
-                solver: NAME,
-                message: format!(
+            return Err(SolverError::unsupported(
+                NAME,
+                format!(
                     "affine takes a constant mu, and face {} has {mu} where face {} has {first} (in the plane's frame): use lsqc or beltrami-flow for a varying one",
                     mesh.face_to_input(face),
                     mesh.face_to_input(face0),
                 ),
-            });
+            ));
         }
         Ok(first)
     }

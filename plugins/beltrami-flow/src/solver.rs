@@ -81,13 +81,6 @@ fn flow(
     beltrami_flow_engine::solve(problem, settings, initial, Some(&order), report, context)
 }
 
-fn invalid(message: &str) -> SolverError {
-    SolverError::InvalidInput {
-        solver: NAME,
-        message: message.to_string(),
-    }
-}
-
 /// The map the flow starts from, as points of R^3 (z = 0 for planar targets): the given
 /// one, or one built here. `threads` is passed to the initialization's factorizations,
 /// `context` (the caller's [`Context::inner`]) to its solve.
@@ -102,7 +95,7 @@ fn initial_map(
     }
     let planar_points = |output: Output| match output {
         Output::Map(Map::Planar(z)) => Ok(z.iter().map(|z| Point3::new(z.re, z.im, 0.0)).collect()),
-        _ => Err(invalid("the initial map is not planar")),
+        _ => Err(SolverError::invalid(NAME, "the initial map is not planar")),
     };
     let identity = || {
         mesh.positions()
@@ -131,10 +124,8 @@ fn initial_map(
             // The boundary-first conformal map (exactly on the circle): on the human
             // face the flow's error starts at 2.4e-5 from it (2.2e-5 at the end), at
             // 4.5e-2 from Tutte's map, whose max |mu| is 0.93.
-            let boundary_first = map_to_unit_disk(mesh).map_err(|error| SolverError::Plugin {
-                solver: NAME,
-                error: Box::new(error),
-            })?;
+            let boundary_first =
+                map_to_unit_disk(mesh).map_err(|error| SolverError::plugin(NAME, error))?;
             if let Ok(points) = boundary_first {
                 return Ok(points
                     .iter()
@@ -169,15 +160,16 @@ fn initial_map(
             }
             match Sphere.solve(&init, context)?.output {
                 Output::Map(Map::Spatial(p)) => Ok(p),
-                _ => Err(invalid(
+                _ => Err(SolverError::invalid(
+                    NAME,
                     "the sphere initialization did not give points of R^3",
                 )),
             }
         }
-        _ => Err(SolverError::Unsupported {
-            solver: NAME,
-            message: "no initial map for this target".to_string(),
-        }),
+        _ => Err(SolverError::unsupported(
+            NAME,
+            "no initial map for this target",
+        )),
     }
 }
 

@@ -80,9 +80,8 @@ pub fn flatten(mesh: &Mesh, context: &mut Context<'_>) -> Result<Flattening, Sol
     let layout = disk.as_ref().unwrap_or(mesh);
     let problem = Problem::new(layout, Target::Plane(PlanarBoundary::Free));
     let solution = Lscm.solve(&problem, context)?;
-    let uv = solution.planar().ok_or_else(|| SolverError::Unsupported {
-        solver: NAME,
-        message: "the conformal flattening gave no planar map".to_string(),
+    let uv = solution.planar().ok_or_else(|| {
+        SolverError::unsupported(NAME, "the conformal flattening gave no planar map")
     })?;
     let uv = &uv[..mesh.vertex_count()];
     let elements = Elements::new(mesh, Frame::Face)?;
@@ -92,12 +91,12 @@ pub fn flatten(mesh: &Mesh, context: &mut Context<'_>) -> Result<Flattening, Sol
         .filter(|d| d.fz.norm_sqr() - d.fzbar.norm_sqr() <= 0.0)
         .count();
     if flipped > 0 {
-        return Err(SolverError::Unsupported {
-            solver: NAME,
-            message: format!(
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
                 "the conformal flattening of the surface (LSCM) flips {flipped} faces; flatten it with a bijective map first (e.g. `beltrami param --solver tutte`) and map the flat copy"
             ),
-        });
+        ));
     }
     let mus: Vec<f64> = derivatives
         .iter()

@@ -28,6 +28,8 @@ use beltrami_mesh::{Mesh, VertexId};
 use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
+use crate::solver::NAME;
+
 /// How far from the unit circle a landmark's destination may be.
 const ON_CIRCLE: f64 = 1e-9;
 
@@ -44,17 +46,17 @@ pub(crate) struct Quadrilateral {
 /// The quadrilateral of a disk-target problem: exactly four landmarks, on boundary
 /// vertices, with destinations on the unit circle in the same cyclic order as the
 /// vertices along the boundary. Errors name the offending landmark.
-pub(crate) fn quadrilateral(
-    problem: &Problem<'_>,
-    invalid: impl Fn(String) -> SolverError,
-) -> Result<Quadrilateral, SolverError> {
+pub(crate) fn quadrilateral(problem: &Problem<'_>) -> Result<Quadrilateral, SolverError> {
     let mesh = problem.source;
     let loops = mesh.boundary_loop_list();
     let [boundary] = loops.as_slice() else {
-        return Err(invalid(format!(
-            "--target disk slides one boundary loop on the unit circle; this mesh has {}",
-            loops.len()
-        )));
+        return Err(SolverError::invalid(
+            NAME,
+            format!(
+                "--target disk slides one boundary loop on the unit circle; this mesh has {}",
+                loops.len()
+            ),
+        ));
     };
     // Boundary loops run with the surface on their right (docs/conventions.md): reversed,
     // the loop of a positively oriented disk turns counter-clockwise.
@@ -65,41 +67,53 @@ pub(crate) fn quadrilateral(
             continue;
         };
         let Position::Planar(w) = l.position else {
-            return Err(invalid(format!(
-                "the landmark of vertex {} is a point of R^3; the disk target takes points x + i y of the unit circle",
-                l.vertex
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "the landmark of vertex {} is a point of R^3; the disk target takes points x + i y of the unit circle",
+                    l.vertex
+                ),
+            ));
         };
         if (w.norm() - 1.0).abs() > ON_CIRCLE {
-            return Err(invalid(format!(
-                "the landmark of vertex {} goes to ({}, {}), which is not on the unit circle (|w| = {})",
-                l.vertex,
-                w.re,
-                w.im,
-                w.norm()
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "the landmark of vertex {} goes to ({}, {}), which is not on the unit circle (|w| = {})",
+                    l.vertex,
+                    w.re,
+                    w.im,
+                    w.norm()
+                ),
+            ));
         }
         let Some(at) = ccw.iter().position(|&v| v == l.vertex) else {
-            return Err(invalid(format!(
-                "the landmark vertex {} is not on the boundary: the four-point problem moves boundary points",
-                l.vertex
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "the landmark vertex {} is not on the boundary: the four-point problem moves boundary points",
+                    l.vertex
+                ),
+            ));
         };
         marks.push((at, w / w.norm()));
     }
     if marks.len() != 4 {
-        return Err(invalid(format!(
-            "the disk target with a sliding boundary is the four-point problem: give exactly four boundary landmarks (`p INDEX x y`), not {}",
-            marks.len()
-        )));
+        return Err(SolverError::invalid(
+            NAME,
+            format!(
+                "the disk target with a sliding boundary is the four-point problem: give exactly four boundary landmarks (`p INDEX x y`), not {}",
+                marks.len()
+            ),
+        ));
     }
     marks.sort_by_key(|&(at, _)| at);
     // Destinations must turn once around the circle, counter-clockwise, in loop order.
     let turn: f64 = (0..4).map(|j| arc(marks[j].1, marks[(j + 1) % 4].1)).sum();
     if (turn - std::f64::consts::TAU).abs() > 1e-6 {
-        return Err(invalid(
-            "the landmarks' destinations are not in the order of their vertices along the boundary (counter-clockwise): no homeomorphism of the disk moves them there"
-                .to_string(),
+        return Err(SolverError::invalid(
+            NAME,
+            "the landmarks' destinations are not in the order of their vertices along the boundary (counter-clockwise): no homeomorphism of the disk moves them there",
         ));
     }
     let start = marks[0].0;
@@ -200,7 +214,7 @@ impl Quadrilateral {
             }
         }
         let weights = EdgeWeights::cotangent(mesh).map_err(|error| SolverError::Weights {
-            solver: crate::solver::NAME,
+            solver: NAME,
             error,
         })?;
         let u = WeightedMeanSystem::new(

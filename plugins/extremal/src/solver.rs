@@ -91,20 +91,6 @@ const ACCEPTS: Accepts = Accepts {
     constraints: &[ConstraintKind::Landmark],
 };
 
-fn unsupported(message: impl Into<String>) -> SolverError {
-    SolverError::Unsupported {
-        solver: NAME,
-        message: message.into(),
-    }
-}
-
-fn invalid(message: impl Into<String>) -> SolverError {
-    SolverError::InvalidInput {
-        solver: NAME,
-        message: message.into(),
-    }
-}
-
 /// What [`Extremal`] is: its name, one line on what it computes, what it accepts and
 /// its options.
 const INFO: SolverInfo = SolverInfo {
@@ -236,58 +222,74 @@ impl Boundary {
 fn setup(problem: &Problem<'_>) -> Result<Boundary, SolverError> {
     let mesh = problem.source;
     if problem.goal != Goal::Extremal {
-        return Err(unsupported(
+        return Err(SolverError::unsupported(
+            NAME,
             "extremal computes the extremal map of a boundary condition; for a prescribed mu use lsqc or beltrami-flow",
         ));
     }
     if check_planar(mesh).is_err() && mesh.genus() != Some(0) {
-        return Err(unsupported(format!(
-            "extremal maps planar meshes (z = 0) and curved surfaces of genus 0 (laid out conformally first), but this curved mesh has {}",
-            beltrami_core::topology::describe(mesh)
-        )));
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
+                "extremal maps planar meshes (z = 0) and curved surfaces of genus 0 (laid out conformally first), but this curved mesh has {}",
+                beltrami_core::topology::describe(mesh)
+            ),
+        ));
     }
     let landmarks = problem.constraints.landmarks().count();
     let boundary = match problem.planar_boundary_values() {
         Some(_) if landmarks > 0 => {
-            return Err(unsupported(
+            return Err(SolverError::unsupported(
+                NAME,
                 "landmarks move boundary points of the sliding disk (`--target disk`); with a prescribed boundary every boundary vertex is already placed",
             ));
         }
         Some(values) => {
-            let values = values.map_err(invalid)?;
+            let values = values.map_err(|message| SolverError::invalid(NAME, message))?;
             for (k, curve) in loop_curves(mesh, &values).iter().enumerate() {
                 if crosses_itself(curve) {
-                    return Err(invalid(format!(
-                        "the boundary map takes boundary loop {k} onto a curve that crosses itself: the boundary of a one-to-one map is a simple curve"
-                    )));
+                    return Err(SolverError::invalid(
+                        NAME,
+                        format!(
+                            "the boundary map takes boundary loop {k} onto a curve that crosses itself: the boundary of a one-to-one map is a simple curve"
+                        ),
+                    ));
                 }
             }
             Boundary::Fixed(values)
         }
         None if matches!(problem.target, Target::Disk) => {
-            Boundary::Sliding(quadrilateral(problem, invalid)?)
+            Boundary::Sliding(quadrilateral(problem)?)
         }
         None => {
-            return Err(unsupported(
+            return Err(SolverError::unsupported(
+                NAME,
                 "extremal needs the boundary values: keep the source's boundary or give a boundary map (`--boundary given --boundary-map MAP`), or slide on the unit disk with four landmarks (`--target disk --landmarks FILE`)",
             ));
         }
     };
     if let Some(Map::Planar(z)) = &problem.initial {
         if z.len() != mesh.vertex_count() {
-            return Err(invalid(format!(
-                "the initial map has {} values, but the mesh has {} vertices",
-                z.len(),
-                mesh.vertex_count()
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "the initial map has {} values, but the mesh has {} vertices",
+                    z.len(),
+                    mesh.vertex_count()
+                ),
+            ));
         }
         if let Some(v) = z.iter().position(|z| !z.is_finite()) {
-            return Err(invalid(format!(
-                "the initial map is not finite at vertex {v}"
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!("the initial map is not finite at vertex {v}"),
+            ));
         }
     } else if problem.initial.is_some() {
-        return Err(unsupported("extremal starts from a planar map"));
+        return Err(SolverError::unsupported(
+            NAME,
+            "extremal starts from a planar map",
+        ));
     }
     Ok(boundary)
 }
@@ -320,9 +322,12 @@ fn same_turn(domain: &Mesh, values: &[(VertexId, Complex64)]) -> Result<(), Solv
     for (k, (curve, layout)) in given.iter().zip(loop_curves(domain, &own)).enumerate() {
         let (a, b) = (signed_area(curve), signed_area(&layout));
         if a * b < 0.0 {
-            return Err(invalid(format!(
-                "the boundary map turns boundary loop {k} the other way than the surface does (signed area {a:.3e} against {b:.3e} in the loop's order): the map would reverse the orientation; mirror the map or reverse the surface's faces"
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "the boundary map turns boundary loop {k} the other way than the surface does (signed area {a:.3e} against {b:.3e} in the loop's order): the map would reverse the orientation; mirror the map or reverse the surface's faces"
+                ),
+            ));
         }
     }
     Ok(())

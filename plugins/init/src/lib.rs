@@ -93,7 +93,7 @@ const NOT_A_DISK: &str = "run `beltrami cut` first or use beltrami-flow";
 /// Rejects goals other than least-squares conformality and curve constraints, which
 /// none of these linear solvers can honour.
 fn check_goal_and_curves(solver: &'static str, problem: &Problem<'_>) -> Result<(), SolverError> {
-    let unsupported = |message: String| Err(SolverError::Unsupported { solver, message });
+    let unsupported = |message: String| Err(SolverError::unsupported(solver, message));
     match &problem.goal {
         Goal::Conformal { p } if *p == 2.0 => {}
         Goal::Conformal { p } => {

@@ -269,39 +269,34 @@ fn by_elements(
 /// The capability check, returning the pinned vertices and their images.
 fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError> {
     let mesh = problem.source;
-    let unsupported = |message: String| SolverError::Unsupported {
-        solver: NAME,
-        message,
-    };
-    let invalid = |message: String| SolverError::InvalidInput {
-        solver: NAME,
-        message,
-    };
     topology::require_disk(NAME, mesh, NOT_A_DISK)?;
     check_goal_and_curves(NAME, problem)?;
     match &problem.target {
         Target::Plane(PlanarBoundary::Free) => {}
         Target::Plane(_) | Target::Disk => {
-            return Err(unsupported(
-                "lscm leaves the boundary free; for a fixed boundary use harmonic or tutte"
-                    .to_string(),
+            return Err(SolverError::unsupported(
+                NAME,
+                "lscm leaves the boundary free; for a fixed boundary use harmonic or tutte",
             ));
         }
         _ => {
-            return Err(unsupported(
-                "lscm maps into the plane with a free boundary; for other targets use beltrami-flow, lsqc or qcmc"
-                    .to_string(),
+            return Err(SolverError::unsupported(
+                NAME,
+                "lscm maps into the plane with a free boundary; for other targets use beltrami-flow, lsqc or qcmc",
             ));
         }
     }
     let given: Vec<_> = problem.constraints.pins().collect();
     for pin in &given {
         if pin.vertex.idx() >= mesh.vertex_count() {
-            return Err(invalid(format!(
-                "a pin is on vertex {}, but the mesh has {} vertices",
-                pin.vertex,
-                mesh.vertex_count()
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "a pin is on vertex {}, but the mesh has {} vertices",
+                    pin.vertex,
+                    mesh.vertex_count()
+                ),
+            ));
         }
     }
     let positions: Vec<Option<Complex64>> = given
@@ -309,14 +304,20 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
         .map(|pin| match pin.position {
             None => Ok(None),
             Some(Position::Planar(z)) if z.is_finite() => Ok(Some(z)),
-            Some(Position::Planar(_)) => Err(invalid(format!(
-                "the position of the pin on vertex {} is not finite",
-                pin.vertex
-            ))),
-            Some(Position::Spatial(_)) => Err(unsupported(format!(
-                "lscm maps into the plane, but the pin on vertex {} has a position in space",
-                pin.vertex
-            ))),
+            Some(Position::Planar(_)) => Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "the position of the pin on vertex {} is not finite",
+                    pin.vertex
+                ),
+            )),
+            Some(Position::Spatial(_)) => Err(SolverError::unsupported(
+                NAME,
+                format!(
+                    "lscm maps into the plane, but the pin on vertex {} has a position in space",
+                    pin.vertex
+                ),
+            )),
         })
         .collect::<Result<_, _>>()?;
     let zero = Complex64::new(0.0, 0.0);
@@ -327,18 +328,21 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
             vec![(a, zero), (b, one)]
         }
         1 => {
-            return Err(unsupported(format!(
-                "lscm needs two pinned vertices (or none, to pin two boundary vertices far apart), but only vertex {} was pinned",
-                given[0].vertex
-            )));
+            return Err(SolverError::unsupported(
+                NAME,
+                format!(
+                    "lscm needs two pinned vertices (or none, to pin two boundary vertices far apart), but only vertex {} was pinned",
+                    given[0].vertex
+                ),
+            ));
         }
         2 => match (positions[0], positions[1]) {
             (None, None) => vec![(given[0].vertex, zero), (given[1].vertex, one)],
             (Some(p), Some(q)) => vec![(given[0].vertex, p), (given[1].vertex, q)],
             _ => {
-                return Err(unsupported(
-                    "give positions to both pins or to neither (then they go to (0, 0) and (1, 0))"
-                        .to_string(),
+                return Err(SolverError::unsupported(
+                    NAME,
+                    "give positions to both pins or to neither (then they go to (0, 0) and (1, 0))",
                 ));
             }
         },
@@ -347,20 +351,26 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
             .zip(&positions)
             .map(|(pin, z)| {
                 z.map(|z| (pin.vertex, z)).ok_or_else(|| {
-                    unsupported(format!(
-                        "with {n} pins every pin needs a position, but the pin on vertex {} has none",
-                        pin.vertex
-                    ))
+                    SolverError::unsupported(
+                        NAME,
+                        format!(
+                            "with {n} pins every pin needs a position, but the pin on vertex {} has none",
+                            pin.vertex
+                        ),
+                    )
                 })
             })
             .collect::<Result<_, _>>()?,
     };
     // Pins that all coincide let the whole mesh collapse onto one point (zero energy).
     if pinned.iter().all(|&(_, z)| z == pinned[0].1) {
-        return Err(invalid(format!(
-            "all pins are at the same position {}: the map would collapse to a point",
-            pinned[0].1
-        )));
+        return Err(SolverError::invalid(
+            NAME,
+            format!(
+                "all pins are at the same position {}: the map would collapse to a point",
+                pinned[0].1
+            ),
+        ));
     }
     Ok(pinned)
 }

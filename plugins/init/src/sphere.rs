@@ -465,12 +465,7 @@ fn tutte_start(
 
 /// The capability check, returning the weights to use.
 fn weights(problem: &Problem<'_>, settings: &Settings) -> Result<Weights, SolverError> {
-    let unsupported = |message: String| {
-        Err(SolverError::Unsupported {
-            solver: NAME,
-            message,
-        })
-    };
+    let unsupported = |message: String| Err(SolverError::unsupported(NAME, message));
     topology::require_sphere(NAME, problem.source, NOT_A_SPHERE)?;
     match &problem.target {
         Target::Sphere => {}
@@ -560,24 +555,24 @@ fn puncture(mesh: &Mesh, removed: FaceId) -> Result<Mesh, SolverError> {
         .vertices()
         .find(|&v| map.from_input(v.idx()) != Some(v))
     {
-        return Err(SolverError::InvalidInput {
-            solver: NAME,
-            message: format!(
+        return Err(SolverError::invalid(
+            NAME,
+            format!(
                 "removing face {} (input index) left vertex {} (input index) without faces",
                 mesh.face_to_input(removed),
                 mesh.vertex_map().to_input(v)
             ),
-        });
+        ));
     }
     if !punctured.is_disk() {
-        return Err(SolverError::InvalidInput {
-            solver: NAME,
-            message: format!(
+        return Err(SolverError::invalid(
+            NAME,
+            format!(
                 "removing face {} (input index) left {} instead of a disk",
                 mesh.face_to_input(removed),
                 topology::describe(&punctured)
             ),
-        });
+        ));
     }
     Ok(punctured)
 }

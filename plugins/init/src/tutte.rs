@@ -122,13 +122,6 @@ fn weight_name(w: Weights) -> &'static str {
 }
 
 impl FixedBoundary {
-    fn unsupported(&self, message: String) -> SolverError {
-        SolverError::Unsupported {
-            solver: self.solver,
-            message,
-        }
-    }
-
     /// The capability check of the solver.
     pub(crate) fn check(&self, problem: &Problem<'_>) -> Result<(), SolverError> {
         self.prepare(problem).map(|_| ())
@@ -153,32 +146,47 @@ impl FixedBoundary {
             }
             Target::Plane(PlanarBoundary::Keep) => match boundary::keep(mesh) {
                 Err(BoundaryError::NotPlanar { vertex, z }) => {
-                    return Err(self.unsupported(format!(
-                        "keeping the boundary needs a source in the plane z = 0, but vertex {vertex} has z = {z:e}; map it onto a circle, square or polygon instead"
-                    )));
+                    return Err(SolverError::unsupported(
+                        self.solver,
+                        format!(
+                            "keeping the boundary needs a source in the plane z = 0, but vertex {vertex} has z = {z:e}; map it onto a circle, square or polygon instead"
+                        ),
+                    ));
                 }
                 other => other,
             },
             Target::Plane(PlanarBoundary::Given(values)) => boundary::given(mesh, values),
             Target::Plane(PlanarBoundary::Free) => {
-                return Err(self.unsupported(format!(
-                    "{solver} needs a fixed boundary (circle, square, polygon); for a free boundary use lscm"
-                )));
+                return Err(SolverError::unsupported(
+                    self.solver,
+                    format!(
+                        "{solver} needs a fixed boundary (circle, square, polygon); for a free boundary use lscm"
+                    ),
+                ));
             }
             Target::Annulus { .. } | Target::CircleDomain => {
-                return Err(self.unsupported(format!(
-                    "{solver} maps onto a disk or a convex polygon; annuli and circle domains need a multiply-connected mesh and qcmc"
-                )));
+                return Err(SolverError::unsupported(
+                    self.solver,
+                    format!(
+                        "{solver} maps onto a disk or a convex polygon; annuli and circle domains need a multiply-connected mesh and qcmc"
+                    ),
+                ));
             }
             Target::Sphere => {
-                return Err(self.unsupported(format!(
-                    "{solver} maps into the plane; for the sphere use beltrami-flow"
-                )));
+                return Err(SolverError::unsupported(
+                    self.solver,
+                    format!(
+                        "{solver} maps into the plane; for the sphere use beltrami-flow"
+                    ),
+                ));
             }
             Target::Mesh(_) | Target::Surface => {
-                return Err(self.unsupported(format!(
-                    "{solver} maps into the plane; for maps onto a surface use beltrami-flow or lsqc"
-                )));
+                return Err(SolverError::unsupported(
+                    self.solver,
+                    format!(
+                        "{solver} maps into the plane; for maps onto a surface use beltrami-flow or lsqc"
+                    ),
+                ));
             }
         }
         .map_err(invalid)
@@ -193,16 +201,22 @@ impl FixedBoundary {
             return Ok(None);
         };
         if pins.len() > 1 {
-            return Err(self.unsupported(format!(
-                "{solver} fixes the whole boundary and takes at most one pin (the vertex that starts the boundary), {} were given; for several pins use lscm",
-                pins.len()
-            )));
+            return Err(SolverError::unsupported(
+                self.solver,
+                format!(
+                    "{solver} fixes the whole boundary and takes at most one pin (the vertex that starts the boundary), {} were given; for several pins use lscm",
+                    pins.len()
+                ),
+            ));
         }
         if pin.position.is_some() {
-            return Err(self.unsupported(format!(
-                "{solver} places the boundary itself; the pin on vertex {} may choose where it starts but cannot have a position",
-                pin.vertex
-            )));
+            return Err(SolverError::unsupported(
+                self.solver,
+                format!(
+                    "{solver} places the boundary itself; the pin on vertex {} may choose where it starts but cannot have a position",
+                    pin.vertex
+                ),
+            ));
         }
         let start_is_free = matches!(
             problem.target,
@@ -214,9 +228,10 @@ impl FixedBoundary {
                 )
         );
         if !start_is_free {
-            return Err(self.unsupported(format!(
-                "the target fixes where the boundary starts, so {solver} takes no pin"
-            )));
+            return Err(SolverError::unsupported(
+                self.solver,
+                format!("the target fixes where the boundary starts, so {solver} takes no pin"),
+            ));
         }
         Ok(Some(pin.vertex))
     }

@@ -163,20 +163,6 @@ struct Setup {
     default_pins: Option<(VertexId, VertexId)>,
 }
 
-pub(crate) fn unsupported(message: String) -> SolverError {
-    SolverError::Unsupported {
-        solver: NAME,
-        message,
-    }
-}
-
-pub(crate) fn invalid(message: String) -> SolverError {
-    SolverError::InvalidInput {
-        solver: NAME,
-        message,
-    }
-}
-
 /// The capability check: topology, goal, curves, boundary and pins.
 fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
     let mesh = problem.source;
@@ -209,25 +195,31 @@ fn field_of(
             if field.frame == Frame::Global
                 && let Err(FemError::NotPlanar { vertex, z }) = planar
             {
-                return Err(unsupported(format!(
-                    "the Beltrami field is in the global frame, which needs a mesh in the plane z = 0, but vertex {vertex} has z = {z:e}; give the field in the face frame"
-                )));
+                return Err(SolverError::unsupported(
+                    NAME,
+                    format!(
+                        "the Beltrami field is in the global frame, which needs a mesh in the plane z = 0, but vertex {vertex} has z = {z:e}; give the field in the face frame"
+                    ),
+                ));
             }
             Ok(field.clone())
         }
         Goal::Conformal { p } if *p == 2.0 => {
             Ok(BeltramiField::zero(Frame::Face, mesh.face_count()))
         }
-        Goal::Conformal { p } => Err(unsupported(format!(
-            "lsqc minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu; use beltrami-flow for p > 2"
-        ))),
-        Goal::Extremal => Err(unsupported(
-            "lsqc follows a prescribed Beltrami coefficient; for extremal (Teichmueller) maps use teichmuller"
-                .to_string(),
+        Goal::Conformal { p } => Err(SolverError::unsupported(
+            NAME,
+            format!(
+                "lsqc minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu; use beltrami-flow for p > 2"
+            ),
         )),
-        Goal::Features(_) => Err(unsupported(
-            "lsqc follows a prescribed Beltrami coefficient; features are matched by register"
-                .to_string(),
+        Goal::Extremal => Err(SolverError::unsupported(
+            NAME,
+            "lsqc follows a prescribed Beltrami coefficient; for extremal (Teichmueller) maps use teichmuller",
+        )),
+        Goal::Features(_) => Err(SolverError::unsupported(
+            NAME,
+            "lsqc follows a prescribed Beltrami coefficient; features are matched by register",
         )),
     }
 }
@@ -236,8 +228,9 @@ fn field_of(
 /// constraints of maps into space.
 fn check_constraints(problem: &Problem<'_>) -> Result<(), SolverError> {
     if problem.constraints.curves().next().is_some() {
-        return Err(unsupported(
-            "lsqc does not make vertices follow curves yet; use beltrami-flow".to_string(),
+        return Err(SolverError::unsupported(
+            NAME,
+            "lsqc does not make vertices follow curves yet; use beltrami-flow",
         ));
     }
     if problem
@@ -245,8 +238,9 @@ fn check_constraints(problem: &Problem<'_>) -> Result<(), SolverError> {
         .iter()
         .any(|c| matches!(c, Constraint::Normal { .. } | Constraint::Area))
     {
-        return Err(unsupported(
-            "the normal and area constraints keep a map into space near the surface; they have no meaning in the plane: use --target space".to_string(),
+        return Err(SolverError::unsupported(
+            NAME,
+            "the normal and area constraints keep a map into space near the surface; they have no meaning in the plane: use --target space",
         ));
     }
     Ok(())
@@ -260,9 +254,12 @@ fn boundary_map_of(problem: &Problem<'_>) -> Result<Option<BoundaryMap>, SolverE
         Target::Plane(PlanarBoundary::Free) => Ok(None),
         Target::Plane(PlanarBoundary::Keep) => {
             Ok(Some(boundary::keep(mesh).map_err(|e| match e {
-                BoundaryError::NotPlanar { vertex, z } => unsupported(format!(
-                    "keeping the boundary needs a source in the plane z = 0, but vertex {vertex} has z = {z:e}; give the boundary (a map) or leave it free"
-                )),
+                BoundaryError::NotPlanar { vertex, z } => SolverError::unsupported(
+                    NAME,
+                    format!(
+                        "keeping the boundary needs a source in the plane z = 0, but vertex {vertex} has z = {z:e}; give the boundary (a map) or leave it free"
+                    ),
+                ),
                 error => SolverError::Boundary {
                     solver: NAME,
                     error,
@@ -273,13 +270,13 @@ fn boundary_map_of(problem: &Problem<'_>) -> Result<Option<BoundaryMap>, SolverE
             boundary::given(mesh, values)
                 .map_err(|error| SolverError::Boundary { solver: NAME, error })?,
         )),
-        Target::Plane(_) => Err(unsupported(
-            "lsqc keeps the source's boundary, takes a given boundary map or leaves the boundary free; map the boundary first (tutte, harmonic) and pass it as a given boundary"
-                .to_string(),
+        Target::Plane(_) => Err(SolverError::unsupported(
+            NAME,
+            "lsqc keeps the source's boundary, takes a given boundary map or leaves the boundary free; map the boundary first (tutte, harmonic) and pass it as a given boundary",
         )),
-        _ => Err(unsupported(
-            "lsqc maps into the plane; for the disk, annulus, sphere or a target mesh use beltrami-flow"
-                .to_string(),
+        _ => Err(SolverError::unsupported(
+            NAME,
+            "lsqc maps into the plane; for the disk, annulus, sphere or a target mesh use beltrami-flow",
         )),
     }
 }
@@ -304,9 +301,12 @@ fn fixed_vertices(
                 map.vertices.into_iter().zip(map.positions).collect();
             for (v, z) in pins {
                 let z = z.ok_or_else(|| {
-                    unsupported(format!(
-                        "the pin on vertex {v} has no position and the source is not planar; give it a position"
-                    ))
+                    SolverError::unsupported(
+                        NAME,
+                        format!(
+                            "the pin on vertex {v} has no position and the source is not planar; give it a position"
+                        ),
+                    )
                 })?;
                 fixed.push((*v, z));
             }
@@ -317,26 +317,35 @@ fn fixed_vertices(
                 let (a, b) = boundary::far_boundary_pair(problem.source);
                 Ok((vec![(a, zero), (b, one)], Some((a, b))))
             }
-            [(v, _)] => Err(unsupported(format!(
-                "with a free boundary lsqc needs two pinned vertices (or none, to pin two boundary vertices far apart), but only vertex {v} was pinned"
-            ))),
+            [(v, _)] => Err(SolverError::unsupported(
+                NAME,
+                format!(
+                    "with a free boundary lsqc needs two pinned vertices (or none, to pin two boundary vertices far apart), but only vertex {v} was pinned"
+                ),
+            )),
             [(a, None), (b, None)] => Ok((vec![(*a, zero), (*b, one)], None)),
             pins => {
                 let fixed = pins
                     .iter()
                     .map(|&(v, z)| {
                         z.map(|z| (v, z)).ok_or_else(|| {
-                            unsupported(format!(
-                                "the pin on vertex {v} has no position; give every pin a position, or none of two pins (then they go to (0, 0) and (1, 0))"
-                            ))
+                            SolverError::unsupported(
+                                NAME,
+                                format!(
+                                    "the pin on vertex {v} has no position; give every pin a position, or none of two pins (then they go to (0, 0) and (1, 0))"
+                                ),
+                            )
                         })
                     })
                     .collect::<Result<Vec<_>, _>>()?;
                 if fixed.iter().all(|&(_, z)| z == fixed[0].1) {
-                    return Err(invalid(format!(
-                        "all pins are at the same position {}: the map would collapse to a point",
-                        fixed[0].1
-                    )));
+                    return Err(SolverError::invalid(
+                        NAME,
+                        format!(
+                            "all pins are at the same position {}: the map would collapse to a point",
+                            fixed[0].1
+                        ),
+                    ));
                 }
                 Ok((fixed, None))
             }
@@ -357,19 +366,28 @@ fn pins(
         .map(|pin| {
             let v = pin.vertex;
             if v.idx() >= mesh.vertex_count() {
-                return Err(invalid(format!(
-                    "a pin is on vertex {v}, but the mesh has {} vertices",
-                    mesh.vertex_count()
-                )));
+                return Err(SolverError::invalid(
+                    NAME,
+                    format!(
+                        "a pin is on vertex {v}, but the mesh has {} vertices",
+                        mesh.vertex_count()
+                    ),
+                ));
             }
             match pin.position {
                 Some(Position::Planar(z)) if z.is_finite() => Ok((v, Some(z))),
-                Some(Position::Planar(_)) => Err(invalid(format!(
-                    "the position of the pin on vertex {v} is not finite"
-                ))),
-                Some(Position::Spatial(_)) => Err(unsupported(format!(
-                    "lsqc maps into the plane, but the pin on vertex {v} has a position in space"
-                ))),
+                Some(Position::Planar(_)) => Err(SolverError::invalid(
+                    NAME,
+                    format!(
+                        "the position of the pin on vertex {v} is not finite"
+                    ),
+                )),
+                Some(Position::Spatial(_)) => Err(SolverError::unsupported(
+                    NAME,
+                    format!(
+                        "lsqc maps into the plane, but the pin on vertex {v} has a position in space"
+                    ),
+                )),
                 None if planar => {
                     let p = mesh.position(v);
                     Ok((v, Some(Complex64::new(p.x, p.y))))

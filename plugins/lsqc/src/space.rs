@@ -26,7 +26,7 @@ use beltrami_fem::{BeltramiField, Elements, Frame, MuError, ReferenceNormal};
 use beltrami_mesh::{Point3, VertexId};
 use beltrami_sparse::SolveOptions;
 
-use crate::lsqc::{NAME, invalid, unsupported};
+use crate::lsqc::NAME;
 
 /// What the check finds: the field in the face frames and the held vertices.
 pub(crate) struct SpaceSetup {
@@ -41,37 +41,42 @@ pub(crate) fn setup(problem: &Problem<'_>) -> Result<SpaceSetup, SolverError> {
         Goal::Prescribed(field) => {
             field.check(mesh.face_count())?;
             if field.frame != Frame::Face {
-                return Err(unsupported(
-                    "a map into space takes its Beltrami field in the face frames (`# mu frame=face`), where mu1 + i mu2 is the quaternionic mu1 + mu2 N".to_string(),
+                return Err(SolverError::unsupported(
+                    NAME,
+                    "a map into space takes its Beltrami field in the face frames (`# mu frame=face`), where mu1 + i mu2 is the quaternionic mu1 + mu2 N",
                 ));
             }
             field.clone()
         }
         Goal::Conformal { p } if *p == 2.0 => BeltramiField::zero(Frame::Face, mesh.face_count()),
         Goal::Conformal { p } => {
-            return Err(unsupported(format!(
-                "lsqc minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu"
-            )));
+            return Err(SolverError::unsupported(
+                NAME,
+                format!("lsqc minimizes a least-squares (p = 2) energy, not the L^{p} norm of mu"),
+            ));
         }
         Goal::Extremal => {
-            return Err(unsupported(
-                "lsqc follows a prescribed Beltrami coefficient; for extremal maps use extremal"
-                    .to_string(),
+            return Err(SolverError::unsupported(
+                NAME,
+                "lsqc follows a prescribed Beltrami coefficient; for extremal maps use extremal",
             ));
         }
         Goal::Features(_) => {
-            return Err(unsupported(
-                "lsqc follows a prescribed Beltrami coefficient; features are matched by register"
-                    .to_string(),
+            return Err(SolverError::unsupported(
+                NAME,
+                "lsqc follows a prescribed Beltrami coefficient; features are matched by register",
             ));
         }
     };
     if problem.constraints.curves().next().is_some() {
-        return Err(unsupported(
-            "lsqc does not make vertices follow curves yet".to_string(),
+        return Err(SolverError::unsupported(
+            NAME,
+            "lsqc does not make vertices follow curves yet",
         ));
     }
-    let held = problem.spatial_pins().map_err(invalid)?;
+    let held = problem
+        .spatial_pins()
+        .map_err(|message| SolverError::invalid(NAME, message))?;
     let has = |kind: fn(&Constraint) -> bool| problem.constraints.iter().any(kind);
     if let Some(message) = undetermined(
         held.len(),
@@ -79,7 +84,7 @@ pub(crate) fn setup(problem: &Problem<'_>) -> Result<SpaceSetup, SolverError> {
         has(|c| matches!(c, Constraint::Area)),
         mesh.boundary_loop_list().is_empty(),
     ) {
-        return Err(unsupported(message));
+        return Err(SolverError::unsupported(NAME, message));
     }
     Ok(SpaceSetup { field, held })
 }

@@ -280,17 +280,15 @@ struct SpaceSetup {
 fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
     let mesh = problem.source;
     if problem.goal != Goal::Extremal {
-        return Err(unsupported(
+        return Err(SolverError::unsupported(
+            NAME,
             "the QC iteration looks for the Teichmueller map of a boundary condition (no --mu, --mu-expr or --conformal); for a prescribed mu use lsqc",
         ));
     }
     if matches!(problem.target, Target::Surface) {
         let held = problem
             .spatial_pins()
-            .map_err(|message| SolverError::InvalidInput {
-                solver: NAME,
-                message,
-            })?;
+            .map_err(|message| SolverError::invalid(NAME, message))?;
         let mut space = SpaceSetup {
             held,
             normal: None,
@@ -311,7 +309,7 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
             space.area,
             mesh.boundary_loop_list().is_empty(),
         ) {
-            return Err(unsupported(message));
+            return Err(SolverError::unsupported(NAME, message));
         }
         return Ok(Setup::Space(space));
     }
@@ -321,38 +319,36 @@ fn setup(problem: &Problem<'_>) -> Result<Setup, SolverError> {
             Constraint::Normal { .. } | Constraint::Area | Constraint::ReferenceAngles(_)
         )
     }) {
-        return Err(unsupported(format!(
-            "the {} constraint shapes a map into space; use --target space",
-            c.kind().name()
-        )));
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
+                "the {} constraint shapes a map into space; use --target space",
+                c.kind().name()
+            ),
+        ));
     }
     if mesh.quad_count() > 0 {
-        return Err(unsupported(
+        return Err(SolverError::unsupported(
+            NAME,
             "the QC iteration in the plane maps triangle meshes; map a quad mesh with --target space",
         ));
     }
     if let Err(FemError::NotPlanar { vertex, z }) = check_planar(mesh) {
-        return Err(unsupported(format!(
-            "the QC iteration in the plane maps planar meshes (z = 0), but vertex {vertex} has z = {z:e}; map the surface into space (--target space) or use extremal, which flattens curved disks"
-        )));
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
+                "the QC iteration in the plane maps planar meshes (z = 0), but vertex {vertex} has z = {z:e}; map the surface into space (--target space) or use extremal, which flattens curved disks"
+            ),
+        ));
     }
     match problem.planar_boundary_values() {
         Some(values) => values
             .map(Setup::Planar)
-            .map_err(|message| SolverError::InvalidInput {
-                solver: NAME,
-                message,
-            }),
-        None => Err(unsupported(
+            .map_err(|message| SolverError::invalid(NAME, message)),
+        None => Err(SolverError::unsupported(
+            NAME,
             "the QC iteration needs the boundary values: keep the source's boundary or give a boundary map (`--boundary given --boundary-map MAP`)",
         )),
-    }
-}
-
-fn unsupported(message: impl Into<String>) -> SolverError {
-    SolverError::Unsupported {
-        solver: NAME,
-        message: message.into(),
     }
 }
 

@@ -26,8 +26,8 @@ use beltrami_mesh::{Mesh, Point3, PolygonSoup, VertexId};
 use beltrami_sparse::SolveOptions;
 use num_complex::Complex64;
 
+use crate::NAME;
 use crate::moebius::{DiskAutomorphism, PlaneCircle};
-use crate::{NAME, invalid};
 
 /// The boundary loops, the outer one first.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,14 +48,14 @@ impl Loops {
         let outer = match outer {
             Some(o) if o < list.len() => o,
             Some(o) => {
-                return Err(SolverError::Unsupported {
-                    solver: NAME,
-                    message: format!(
+                return Err(SolverError::unsupported(
+                    NAME,
+                    format!(
                         "option `outer`: the mesh has {} boundary loops (0 to {}), there is no loop {o}",
                         list.len(),
                         list.len().saturating_sub(1)
                     ),
-                });
+                ));
             }
             None => (0..list.len())
                 .max_by(|&a, &b| list[a].length.total_cmp(&list[b].length))
@@ -150,8 +150,9 @@ pub fn initial_map(
         || (0..filled.vertex_count())
             .any(|i| filled.vertex_map().to_input(VertexId::from_usize(i)) != i)
     {
-        return Err(invalid(
-            "closing the holes renumbered the vertices (the mesh has unreferenced vertices); remove them first".to_string(),
+        return Err(SolverError::invalid(
+            NAME,
+            "closing the holes renumbered the vertices (the mesh has unreferenced vertices); remove them first",
         ));
     }
     let start = loops.vertices[0][0];
@@ -171,11 +172,14 @@ pub fn initial_map(
             .map(|(a, b)| distance_to_segment(center, map[a.idx()], map[b.idx()]))
             .fold(f64::INFINITY, f64::min);
         if !(radius > 0.0 && radius.is_finite()) {
-            return Err(invalid(format!(
-                "the initial map closes boundary loop {} (starting at vertex {}) to a point",
-                loops.index[j],
-                mesh.vertex_map().to_input(vertices[0])
-            )));
+            return Err(SolverError::invalid(
+                NAME,
+                format!(
+                    "the initial map closes boundary loop {} (starting at vertex {}) to a point",
+                    loops.index[j],
+                    mesh.vertex_map().to_input(vertices[0])
+                ),
+            ));
         }
         let circle = PlaneCircle { center, radius };
         for v in vertices {
@@ -190,10 +194,13 @@ pub fn initial_map(
         }
         for (j, circle) in circles.iter_mut().enumerate().skip(1) {
             *circle = phi.circle(circle).ok_or_else(|| {
-                invalid(format!(
-                    "the initial circle of boundary loop {} degenerated",
-                    loops.index[j]
-                ))
+                SolverError::invalid(
+                    NAME,
+                    format!(
+                        "the initial circle of boundary loop {} degenerated",
+                        loops.index[j]
+                    ),
+                )
             })?;
         }
         circles[1].center = Complex64::new(0.0, 0.0);

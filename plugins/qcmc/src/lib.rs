@@ -44,11 +44,3 @@ pub const NAME: &str = "qcmc";
 pub fn register(registry: &mut beltrami_core::Registry) {
     registry.register(Box::new(Qcmc));
 }
-
-/// An [`beltrami_core::SolverError::InvalidInput`] of this solver.
-pub(crate) fn invalid(message: String) -> beltrami_core::SolverError {
-    beltrami_core::SolverError::InvalidInput {
-        solver: NAME,
-        message,
-    }
-}

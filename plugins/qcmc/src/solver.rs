@@ -316,50 +316,48 @@ fn setup(
             if field.frame == Frame::Global
                 && let Err(FemError::NotPlanar { vertex, z }) = check_planar(mesh)
             {
-                return Err(SolverError::Unsupported {
-                    solver: NAME,
-                    message: format!(
+                return Err(SolverError::unsupported(
+                    NAME,
+                    format!(
                         "the Beltrami field is in the global frame, which needs a mesh in the plane z = 0, but vertex {vertex} has z = {z:e}; give the field in the face frame"
                     ),
-                });
+                ));
             }
             field.clone()
         }
         Goal::Conformal { p } if *p == 2.0 => BeltramiField::zero(Frame::Face, mesh.face_count()),
         Goal::Conformal { p } => {
-            return Err(SolverError::Unsupported {
-                solver: NAME,
-                message: format!(
+            return Err(SolverError::unsupported(
+                NAME,
+                format!(
                     "qcmc minimizes the least-squares (p = 2) Beltrami energy, not the L^{p} norm of mu"
                 ),
-            });
+            ));
         }
         Goal::Extremal => {
-            return Err(SolverError::Unsupported {
-                solver: NAME,
-                message:
-                    "qcmc follows a prescribed Beltrami coefficient or mu = 0, not an extremal map"
-                        .to_string(),
-            });
+            return Err(SolverError::unsupported(
+                NAME,
+                "qcmc follows a prescribed Beltrami coefficient or mu = 0, not an extremal map",
+            ));
         }
         Goal::Features(_) => {
-            return Err(SolverError::Unsupported {
-                solver: NAME,
-                message: "qcmc follows a prescribed Beltrami coefficient or mu = 0; features are matched by register".to_string(),
-            });
+            return Err(SolverError::unsupported(
+                NAME,
+                "qcmc follows a prescribed Beltrami coefficient or mu = 0; features are matched by register",
+            ));
         }
     };
     if !matches!(
         Topology::of(mesh),
         Topology::Annulus | Topology::MultiplyConnected
     ) {
-        return Err(SolverError::Unsupported {
-            solver: NAME,
-            message: format!(
+        return Err(SolverError::unsupported(
+            NAME,
+            format!(
                 "qcmc maps connected genus-0 meshes with two or more boundary loops; this mesh has {}: use tutte, lscm or beltrami-flow for a disk, sphere for a closed genus-0 mesh",
                 beltrami_core::topology::describe(mesh)
             ),
-        });
+        ));
     }
     let outer = settings.int("outer").checked_sub(1);
     let loops = Loops::new(mesh, outer)?;

@@ -100,18 +100,16 @@ const OPTIONS: [OptionSpec; OPTION_COUNT] = {
 /// target's bounding-box diagonal (rounding of barycentric coordinates is ~1e-16).
 pub const LANDMARK_TOLERANCE: f64 = 1e-9;
 
-/// A registration error as a solver error.
-fn plugin(error: RegisterError) -> SolverError {
+/// A registration error as a solver error: [`SolverError::plugin`] of register, except
+/// a cancelled inner solve, which stays [`SolverError::Cancelled`].
+fn registration_error(error: RegisterError) -> SolverError {
     match error {
         // A Ctrl-C during an inner solve is the caller's cancellation, not a failure.
         RegisterError::Sphere {
             error: SolverError::Cancelled,
             ..
         } => SolverError::Cancelled,
-        error => SolverError::Plugin {
-            solver: NAME,
-            error: Box::new(error),
-        },
+        error => SolverError::plugin(NAME, error),
     }
 }
 
@@ -249,13 +247,6 @@ fn judge_landmarks(
 /// Corners whose target normals differ by more than this lie across a fold.
 const FOLD_DEGREES: f64 = 90.0;
 
-fn unsupported(message: impl Into<String>) -> SolverError {
-    SolverError::Unsupported {
-        solver: NAME,
-        message: message.into(),
-    }
-}
-
 /// The problem's landmarks, as the initial map takes them.
 fn landmarks(problem: &Problem<'_>) -> Result<Vec<Landmark>, SolverError> {
     problem
@@ -266,10 +257,13 @@ fn landmarks(problem: &Problem<'_>) -> Result<Vec<Landmark>, SolverError> {
                 source: mark.vertex,
                 target: LandmarkTarget::Point(p),
             }),
-            Position::Planar(_) => Err(unsupported(format!(
-                "the landmark on source vertex {} needs a point on the target mesh, not in the plane",
-                mark.vertex
-            ))),
+            Position::Planar(_) => Err(SolverError::unsupported(
+                NAME,
+                format!(
+                    "the landmark on source vertex {} needs a point on the target mesh, not in the plane",
+                    mark.vertex
+                ),
+            )),
         })
         .collect()
 }
@@ -290,17 +284,23 @@ impl Solver for Register {
 
     fn check_problem(&self, problem: &Problem<'_>, settings: &Settings) -> Result<(), SolverError> {
         let Target::Mesh(target) = &problem.target else {
-            return Err(unsupported("register maps onto a target mesh"));
+            return Err(SolverError::unsupported(
+                NAME,
+                "register maps onto a target mesh",
+            ));
         };
-        let topology =
-            check_topology(problem.source, target).map_err(|e| unsupported(e.to_string()))?;
+        let topology = check_topology(problem.source, target)
+            .map_err(|e| SolverError::unsupported(NAME, e.to_string()))?;
         for (side, mesh) in [("source", problem.source), ("target", *target)] {
             if let Some(f) = mesh.faces().find(|&f| mesh.face_degree(f) != 3) {
-                return Err(unsupported(format!(
-                    "the flow works on triangle meshes; {side} face {} (input index) has {} vertices: split quads into triangles first",
-                    mesh.face_to_input(f),
-                    mesh.face_degree(f)
-                )));
+                return Err(SolverError::unsupported(
+                    NAME,
+                    format!(
+                        "the flow works on triangle meshes; {side} face {} (input index) has {} vertices: split quads into triangles first",
+                        mesh.face_to_input(f),
+                        mesh.face_degree(f)
+                    ),
+                ));
             }
         }
         landmarks(problem)?;
@@ -310,12 +310,14 @@ impl Solver for Register {
         };
         let shape = settings.flag("match-shape");
         if (features.is_some() || shape) && problem.constraints.curves().next().is_some() {
-            return Err(unsupported(
+            return Err(SolverError::unsupported(
+                NAME,
                 "feature curves and matched fields (features, match-shape) together are not matched yet: give landmarks along the curves instead",
             ));
         }
-        crate::check_features(topology, features, shape, problem.source, target).map_err(plugin)?;
-        crate::consistency::check(problem, target).map_err(plugin)?;
+        crate::check_features(topology, features, shape, problem.source, target)
+            .map_err(registration_error)?;
+        crate::consistency::check(problem, target).map_err(registration_error)?;
         Ok(())
     }
 
@@ -342,7 +344,10 @@ fn after_features(
     context: &mut Context<'_>,
 ) -> Result<Solution, SolverError> {
     let Target::Mesh(target) = flow.target else {
-        return Err(unsupported("register maps onto a target mesh"));
+        return Err(SolverError::unsupported(
+            NAME,
+            "register maps onto a target mesh",
+        ));
     };
     let Some(Map::OnMesh(points)) = solution.map() else {
         return Ok(solution);
@@ -356,11 +361,11 @@ fn after_features(
         .into_iter()
         .collect();
     let shape = if shape {
-        let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
+        let index = SurfaceIndex::new(target).map_err(|e| registration_error(e.into()))?;
         let fitted = Shape::new(flow.source, target, &index, points)
-            .map_err(plugin)?
+            .map_err(registration_error)?
             .ok_or_else(|| {
-                plugin(RegisterError::Features {
+                registration_error(RegisterError::Features {
                     reason: "the registration's images lie on a line: no similarity places the source for match-shape".to_string(),
                 })
             })?;
@@ -373,7 +378,7 @@ fn after_features(
     let mut notes = Vec::new();
     let (matched, mismatch) = context.stage("feature match", &mut report, || {
         match_features_after(flow.source, target, initial, points, &channels, &mut notes)
-            .map_err(plugin)
+            .map_err(registration_error)
     })?;
     report.notes.extend(notes);
     let distance = shape.as_ref().map(|s| ShapeDistance {
@@ -411,7 +416,10 @@ pub(crate) fn register(
     context: &mut Context<'_>,
 ) -> Result<Solution, SolverError> {
     let Target::Mesh(target) = problem.target else {
-        return Err(unsupported("register maps onto a target mesh"));
+        return Err(SolverError::unsupported(
+            NAME,
+            "register maps onto a target mesh",
+        ));
     };
     let source = problem.source;
     let marks = landmarks(problem)?;
@@ -424,7 +432,7 @@ pub(crate) fn register(
     let matched = features.is_some() || shape;
     let cancel = context.cancel_flag();
     let initial = context.stage("initial map", &mut report, || {
-        initial_map_for(source, target, &marks, matched, &cancel).map_err(plugin)
+        initial_map_for(source, target, &marks, matched, &cancel).map_err(registration_error)
     })?;
     report.notes.extend(initial.notes.iter().cloned());
     let mut flow = problem.clone();
@@ -479,9 +487,9 @@ pub(crate) fn register(
         settings.flag("allow-missed-landmarks"),
         &mut solution.report,
     )
-    .map_err(plugin)?;
+    .map_err(registration_error)?;
     if solution.metrics.flipped().unwrap_or(0) > 0 {
-        let index = SurfaceIndex::new(target).map_err(|e| plugin(e.into()))?;
+        let index = SurfaceIndex::new(target).map_err(|e| registration_error(e.into()))?;
         judge_flips(
             source,
             &index,
@@ -490,7 +498,7 @@ pub(crate) fn register(
             settings.flag("allow-flips"),
             &mut solution.report,
         )
-        .map_err(plugin)?;
+        .map_err(registration_error)?;
     }
     Ok(solution)
 }
@@ -516,7 +524,7 @@ mod tests {
         let target = Mesh::from_soup(&folded(octahedral_sphere(3))).unwrap();
         let cancel = Arc::new(AtomicBool::new(true));
         let error = crate::initial_map_for(&source, &target, &[], false, &cancel).unwrap_err();
-        assert!(matches!(plugin(error), SolverError::Cancelled));
+        assert!(matches!(registration_error(error), SolverError::Cancelled));
         assert!(crate::initial_map_for(&source, &target, &[], false, &Arc::default()).is_ok());
     }
 

@@ -524,10 +524,10 @@ fn sphere(
         Some(Map::Spatial(points)) => Ok(points.iter().map(|p| p.coords.normalize()).collect()),
         _ => Err(RegisterError::Sphere {
             side,
-            error: SolverError::InvalidInput {
-                solver: "sphere",
-                message: "the sphere initialization returned no positions in space".to_string(),
-            },
+            error: SolverError::invalid(
+                "sphere",
+                "the sphere initialization returned no positions in space",
+            ),
         }),
     }
 }
