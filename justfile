@@ -18,9 +18,10 @@ python:
     pip install "./python[test]"
     python -m pytest -q python/tests
 
-# Build the Python wheel (abi3: one wheel for CPython 3.9 and later) into dist/.
+# Build the distributable Python wheel into dist/: abi3 (CPython 3.9 and later),
+# manylinux2014 (x86_64 Linux with glibc 2.17 or newer).
 wheel:
-    pip wheel --no-deps -w dist ./python
+    bash python/build_wheel.sh dist
 
 # What CI runs: fmt, clippy, tests.
 ci:
