@@ -259,10 +259,10 @@ impl FlowSystem {
         let (dofs, offset) = declare_unknowns(target, image, &roles)?;
         let n = dofs.reduced_len();
         if n == 0 {
-            return Err(SolverError::InvalidInput {
-                solver: crate::NAME,
-                message: "every vertex is fixed: there is nothing to flow".into(),
-            });
+            return Err(SolverError::invalid(
+                crate::NAME,
+                "every vertex is fixed: there is nothing to flow",
+            ));
         }
         let FaceLayout {
             local_ptr,
@@ -279,14 +279,14 @@ impl FlowSystem {
         let diagonal = slots.split_off(faces_end);
         let matrix = pattern.assemble(&vec![0.0; positions.len()])?;
         if order.0.order.len() != roles.len() {
-            return Err(SolverError::InvalidInput {
-                solver: crate::NAME,
-                message: format!(
+            return Err(SolverError::invalid(
+                crate::NAME,
+                format!(
                     "the vertex order has {} vertices for {}",
                     order.0.order.len(),
                     roles.len()
                 ),
-            });
+            ));
         }
         let order = order_of_unknowns(&order.0, &dofs)?;
         let solver = SpdSolver::with_split_order(pattern.symbolic().as_ref(), &order, options)?;
@@ -524,10 +524,10 @@ impl FlowSystem {
         let mut terms = self.dofs.node_terms(VertexId::from_usize(v))?;
         match (terms.next(), terms.next()) {
             (Some((_, first)), Some((_, second))) => Ok([first.dof, second.dof]),
-            _ => Err(SolverError::InvalidInput {
-                solver: crate::NAME,
-                message: format!("free vertex {v} does not have two flow unknowns"),
-            }),
+            _ => Err(SolverError::invalid(
+                crate::NAME,
+                format!("free vertex {v} does not have two flow unknowns"),
+            )),
         }
     }
 
@@ -917,9 +917,11 @@ impl FaceLayout {
                             local.len() - start - 1
                         }
                     };
-                    let term = u32::try_from(term).map_err(|_| SolverError::InvalidInput {
-                        solver: crate::NAME,
-                        message: format!("{term} flow terms exceed the u32 index range"),
+                    let term = u32::try_from(term).map_err(|_| {
+                        SolverError::invalid(
+                            crate::NAME,
+                            format!("{term} flow terms exceed the u32 index range"),
+                        )
                     })?;
                     // At most three vertices with two terms each: the casts are exact.
                     face_terms.push(FaceTerm {
