@@ -15,10 +15,9 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 out="$(realpath -m "${1:-$root/dist}")"
 target="${CARGO_TARGET_DIR:-$root/target}"
 tools="$target/wheel-tools"
-if [ ! -x "$tools/bin/maturin" ]; then
-    python3 -m venv "$tools"
-    "$tools/bin/pip" install --quiet --disable-pip-version-check "maturin>=1.9,<2" "ziglang==0.17.1"
-fi
+[ -x "$tools/bin/pip" ] || python3 -m venv "$tools"
+# Run every time so that a changed pin takes effect; a satisfied one costs a second.
+"$tools/bin/pip" install --quiet --disable-pip-version-check "maturin>=1.9,<2" "ziglang==0.17.1"
 mkdir -p "$out"
 cd "$root/python"
 PATH="$tools/bin:$PATH" maturin build --release --zig --compatibility manylinux2014 --strip \

@@ -62,9 +62,9 @@ const MU_SMOOTHING: usize = 8;
 const FORCE_SMOOTHING: usize = 16;
 
 /// A step that lowers the mismatch by less than this fraction of the first value ends
-/// the matching. Measured on fsaverage5 pial onto white with the sulcal depth: `1e-4`
-/// took 284 steps for 0.70 mm mean distance to the truth, `3e-4` (with `MAX_LENGTH`)
-/// 190 steps for 0.65 mm (docs/benchmarks.md).
+/// the matching: on fsaverage5 pial onto white with the sulcal depth, steps below it
+/// each gain about `1e-5` of the mismatch and no measurable distance to the truth
+/// (docs/benchmarks.md).
 const STALL: f64 = 3e-4;
 
 /// Rebuilds of a step that folds a few faces, at most.
