@@ -29,7 +29,7 @@
 //! # let target = source.clone();
 //! use beltrami::landmarks::Landmarks;
 //! let marks = Landmarks::read("marks.txt".as_ref(), &source, &target)?;
-//! let constraints = marks.constraints(&target); // Landmark and open Curve constraints
+//! let constraints = marks.constraints(); // Landmark and open Curve constraints
 //! # Ok(()) }
 //! ```
 
@@ -144,24 +144,14 @@ pub enum LandmarksError {
     },
 }
 
-/// Where a landmark's source vertex goes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum LandmarkGoal {
-    /// A target vertex (`v` line).
-    Vertex(VertexId),
-    /// The target point nearest to a point of R^3 (`p` line).
-    Point(Point3<f64>),
-}
-
-/// One `v` or `p` line.
+/// One `v` or `p` line: its landmark, the target vertex ([`Position::TargetVertex`]) of
+/// a `v` line or the point ([`Position::Spatial`]) of a `p` line.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LandmarkLine {
     /// The 1-based line number in the file.
     pub line: usize,
-    /// The source vertex.
-    pub source: VertexId,
-    /// Where it goes.
-    pub goal: LandmarkGoal,
+    /// The landmark.
+    pub landmark: Landmark,
 }
 
 /// One `c` line: a source chain onto a target chain, both of at least two vertices.
@@ -223,7 +213,7 @@ fn coordinate(text: &str) -> Result<f64, LineError> {
 /// One line of the file, parsed.
 enum Parsed {
     /// A `v` or `p` line.
-    Point(VertexId, LandmarkGoal),
+    Point(Landmark),
     /// A `c` line: the source and target chains.
     Curve(Vec<VertexId>, Vec<VertexId>),
 }
@@ -232,14 +222,18 @@ enum Parsed {
 fn parse_line(content: &str, source: &Mesh, target: &Mesh) -> Result<Parsed, LineError> {
     let fields: Vec<&str> = content.split_whitespace().collect();
     Ok(match fields.as_slice() {
-        ["v", s, t] => Parsed::Point(
-            vertex(s, source, Side::Source)?,
-            LandmarkGoal::Vertex(vertex(t, target, Side::Target)?),
-        ),
-        ["p", s, x, y, z] => Parsed::Point(
-            vertex(s, source, Side::Source)?,
-            LandmarkGoal::Point(Point3::new(coordinate(x)?, coordinate(y)?, coordinate(z)?)),
-        ),
+        ["v", s, t] => Parsed::Point(Landmark {
+            vertex: vertex(s, source, Side::Source)?,
+            position: Position::TargetVertex(vertex(t, target, Side::Target)?),
+        }),
+        ["p", s, x, y, z] => Parsed::Point(Landmark {
+            vertex: vertex(s, source, Side::Source)?,
+            position: Position::Spatial(Point3::new(
+                coordinate(x)?,
+                coordinate(y)?,
+                coordinate(z)?,
+            )),
+        }),
         ["c", s, t] => Parsed::Curve(
             chain(s, source, Side::Source)?,
             chain(t, target, Side::Target)?,
@@ -327,8 +321,8 @@ impl Landmarks {
                 line,
                 error,
             };
-            let (vertex, goal) = match parse_line(content, source, target).map_err(at)? {
-                Parsed::Point(vertex, goal) => (vertex, goal),
+            let landmark = match parse_line(content, source, target).map_err(at)? {
+                Parsed::Point(landmark) => landmark,
                 Parsed::Curve(source, target) => {
                     out.curves.push(CurveLine {
                         line,
@@ -338,6 +332,7 @@ impl Landmarks {
                     continue;
                 }
             };
+            let vertex = landmark.vertex;
             if let Some(&first_line) = first_line.get(&vertex) {
                 return Err(at(LineError::TwoLandmarks {
                     index: source.vertex_map().to_input(vertex),
@@ -345,11 +340,7 @@ impl Landmarks {
                 }));
             }
             first_line.insert(vertex, line);
-            out.points.push(LandmarkLine {
-                line,
-                source: vertex,
-                goal,
-            });
+            out.points.push(LandmarkLine { line, landmark });
         }
         Ok(out)
     }
@@ -361,13 +352,15 @@ impl Landmarks {
         let points = self
             .points
             .iter()
-            .map(|l| match l.goal {
-                LandmarkGoal::Vertex(w) => Ok(LandmarkLine {
+            .map(|l| match l.landmark.position {
+                Position::TargetVertex(w) => Ok(LandmarkLine {
                     line: l.line,
-                    source: w,
-                    goal: LandmarkGoal::Vertex(l.source),
+                    landmark: Landmark {
+                        vertex: w,
+                        position: Position::TargetVertex(l.landmark.vertex),
+                    },
                 }),
-                LandmarkGoal::Point(_) => Err(l.line),
+                _ => Err(l.line),
             })
             .collect::<Result<_, _>>()?;
         let curves = self
@@ -382,20 +375,12 @@ impl Landmarks {
         Ok(Self { points, curves })
     }
 
-    /// The constraints of the file for a map onto `target` (the mesh it was parsed
-    /// against), in file order: a [`Constraint::Landmark`] per `v` line (at the target
-    /// vertex's position) and `p` line (at its point; the solver moves the vertex to the
-    /// nearest target point), then a [`Constraint::Curve`] (open) per `c` line.
-    pub fn constraints(&self, target: &Mesh) -> Constraints {
-        let landmarks = self.points.iter().map(|l| {
-            Constraint::Landmark(Landmark {
-                vertex: l.source,
-                position: Position::Spatial(match l.goal {
-                    LandmarkGoal::Vertex(w) => target.position(w),
-                    LandmarkGoal::Point(p) => p,
-                }),
-            })
-        });
+    /// The constraints of the file, in file order: a [`Constraint::Landmark`] per `v`
+    /// line (onto the target vertex itself) and `p` line (at its point; the solver
+    /// moves the vertex to the nearest target point), then a [`Constraint::Curve`]
+    /// (open) per `c` line.
+    pub fn constraints(&self) -> Constraints {
+        let landmarks = self.points.iter().map(|l| Constraint::Landmark(l.landmark));
         let curves = self
             .curves
             .iter()
@@ -435,13 +420,17 @@ mod tests {
             vec![
                 LandmarkLine {
                     line: 2,
-                    source: VertexId(0),
-                    goal: LandmarkGoal::Vertex(VertexId(5)),
+                    landmark: Landmark {
+                        vertex: VertexId(0),
+                        position: Position::TargetVertex(VertexId(5)),
+                    },
                 },
                 LandmarkLine {
                     line: 3,
-                    source: VertexId(3),
-                    goal: LandmarkGoal::Point(Point3::new(0.5, 0.5, 0.0)),
+                    landmark: Landmark {
+                        vertex: VertexId(3),
+                        position: Position::Spatial(Point3::new(0.5, 0.5, 0.0)),
+                    },
                 },
             ]
         );
@@ -549,7 +538,7 @@ mod tests {
     }
 
     #[test]
-    fn constraints_put_vertex_landmarks_at_the_target_vertex_and_curves_open() {
+    fn constraints_keep_vertex_landmarks_as_target_vertices_and_curves_open() {
         let source = mesh();
         // The target: the same grid moved, so that positions differ from the source's.
         let mut soup = grid(3, 3, Cells::Triangles);
@@ -559,7 +548,7 @@ mod tests {
         let target = Mesh::from_soup(&soup).unwrap();
         let text = "c 1,2 4,5\nv 0 5\np 3 0.25 0.5 2\n";
         let marks = Landmarks::parse(Path::new("m.txt"), text, &source, &target).unwrap();
-        let constraints = marks.constraints(&target);
+        let constraints = marks.constraints();
         assert_eq!(constraints.len(), 3);
         constraints.validate(&source, Some(&target)).unwrap();
         let landmarks: Vec<&Landmark> = constraints.landmarks().collect();
@@ -567,7 +556,7 @@ mod tests {
             *landmarks[0],
             Landmark {
                 vertex: VertexId(0),
-                position: Position::Spatial(target.position(VertexId(5))),
+                position: Position::TargetVertex(VertexId(5)),
             }
         );
         assert_eq!(
@@ -599,8 +588,13 @@ mod tests {
         let mesh = Mesh::from_soup(&soup).unwrap();
         let path = Path::new("m.txt");
         let marks = Landmarks::parse(path, "v 1 2\n", &mesh, &mesh).unwrap();
-        assert_eq!(marks.points[0].source, VertexId(0));
-        assert_eq!(marks.points[0].goal, LandmarkGoal::Vertex(VertexId(1)));
+        assert_eq!(
+            marks.points[0].landmark,
+            Landmark {
+                vertex: VertexId(0),
+                position: Position::TargetVertex(VertexId(1)),
+            }
+        );
         let err = Landmarks::parse(path, "v 0 2\n", &mesh, &mesh).unwrap_err();
         assert!(
             err.to_string().contains("source vertex 0 is not a vertex"),

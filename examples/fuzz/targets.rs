@@ -225,7 +225,7 @@ fn landmarks(data: &[u8]) -> Result<(), String> {
     let mesh = disk();
     let marks = Landmarks::parse(Path::new("fuzz.landmarks"), text(data)?, mesh, mesh)
         .map_err(|e| e.to_string())?;
-    let _ = marks.constraints(mesh);
+    let _ = marks.constraints();
     Ok(())
 }
 

@@ -300,7 +300,7 @@ fn constraints(
             .map_err(|e| errors::from_error(Kind::Constraint, &e))?;
         problem
             .constraints
-            .extend(marks.constraints(target).iter().cloned());
+            .extend(marks.constraints().iter().cloned());
     }
     Ok(())
 }

@@ -102,7 +102,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     };
     problem
         .constraints
-        .extend(marks.constraints(target).iter().cloned());
+        .extend(marks.constraints().iter().cloned());
     problem.options = options_of(args, solver);
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
@@ -287,7 +287,7 @@ fn round_trip(
     })?;
     reverse
         .constraints
-        .extend(reversed.constraints(source).iter().cloned());
+        .extend(reversed.constraints().iter().cloned());
     reverse.options = problem.options.clone();
     let registry = beltrami::registry();
     let solver = registry.get("register")?;

@@ -6,7 +6,7 @@
 //! | constraint | what it asks | typical solvers |
 //! |---|---|---|
 //! | [`Pin`] | a vertex stays at a point (or where the initial map puts it) | lscm, lsqc, flow |
-//! | [`Landmark`] | a vertex is moved to a point of the target, then held | register |
+//! | [`Landmark`] | a vertex is moved to a point or a vertex of the target, then held | register |
 //! | [`Slide`] | a vertex moves only along a line through its position | lsqc, qc-iteration |
 //! | [`Curve`] | a source chain (open or closed) lies on a target chain | register, flow |
 //! | [`LoopMatch`] | a boundary loop of the source maps onto one of the target | register, qcmc |
@@ -461,7 +461,8 @@ impl Constraints {
     }
 
     /// Checks what holds for every solver: referenced vertices and boundary loops exist
-    /// (in `source`, and in `target` for the target side of curves and loop matches),
+    /// (in `source`, and in `target` for the target side of curves, loop matches and
+    /// target-vertex positions, which need a target mesh),
     /// points and directions are finite, slide directions are not zero, no vertex has two
     /// point constraints (pin, landmark, slide), open chains have at least 2 vertices and
     /// closed ones 3, a normal weight is positive, reference angles are one per face
@@ -543,13 +544,13 @@ impl Checked {
             Constraint::Pin(pin) => {
                 self.exists(source, "source", pin.vertex)?;
                 if let Some(p) = pin.position {
-                    self.finite(pin.vertex, "point", p.is_finite())?;
+                    self.position(pin.vertex, p, target)?;
                 }
                 Some(pin.vertex)
             }
             Constraint::Landmark(mark) => {
                 self.exists(source, "source", mark.vertex)?;
-                self.finite(mark.vertex, "point", mark.position.is_finite())?;
+                self.position(mark.vertex, mark.position, target)?;
                 Some(mark.vertex)
             }
             Constraint::Slide(slide) => {
@@ -579,6 +580,25 @@ impl Checked {
                 None
             }
         })
+    }
+
+    /// Where `vertex` must go: a finite point, or a vertex of the target mesh.
+    fn position(
+        self,
+        vertex: VertexId,
+        position: Position,
+        target: Option<&Mesh>,
+    ) -> Result<(), ConstraintError> {
+        match position {
+            Position::TargetVertex(w) => match target {
+                Some(target) => self.exists(target, "target", w),
+                None => Err(ConstraintError::NoTargetMesh {
+                    index: self.index,
+                    kind: self.kind,
+                }),
+            },
+            p => self.finite(vertex, "point", p.is_finite()),
+        }
     }
 
     /// A slide: its vertex exists and its direction is finite and not zero.
@@ -728,19 +748,25 @@ impl Extend<Constraint> for Constraints {
 }
 
 impl Position {
-    /// True if every coordinate is finite.
+    /// True if every coordinate is finite (a target vertex has none).
     pub fn is_finite(&self) -> bool {
         match self {
             Position::Planar(z) => z.is_finite(),
             Position::Spatial(p) => p.iter().all(|x| x.is_finite()),
+            Position::TargetVertex(_) => true,
         }
     }
 
-    /// The point in R^3 (`(x, y, 0)` for a planar position).
-    pub fn to_point(&self) -> Point3<f64> {
+    /// The point in R^3: `(x, y, 0)` for a planar position, the vertex's position on
+    /// `target` for a target vertex (`None` without a target mesh or for a vertex it
+    /// does not have).
+    pub fn point(&self, target: Option<&Mesh>) -> Option<Point3<f64>> {
         match *self {
-            Position::Planar(z) => Point3::new(z.re, z.im, 0.0),
-            Position::Spatial(p) => p,
+            Position::Planar(z) => Some(Point3::new(z.re, z.im, 0.0)),
+            Position::Spatial(p) => Some(p),
+            Position::TargetVertex(w) => target
+                .filter(|t| w.idx() < t.vertex_count())
+                .map(|t| t.position(w)),
         }
     }
 }

@@ -43,27 +43,36 @@ pub enum OptionKind {
         /// The admissible names.
         choices: &'static [&'static str],
     },
+    /// A name from a list only known when the solver runs (another registered solver's
+    /// name): any text passes [`Settings::resolve`], and the solver's own check refuses
+    /// a name it does not know.
+    Name {
+        /// The default.
+        default: &'static str,
+    },
 }
 
 impl OptionKind {
-    /// The type's name in listings: `float`, `int`, `bool` or `choice`.
+    /// The type's name in listings: `float`, `int`, `bool`, `choice` or `name`.
     pub fn type_name(&self) -> &'static str {
         match self {
             OptionKind::Float { .. } => "float",
             OptionKind::Int { .. } => "int",
             OptionKind::Bool { .. } => "bool",
             OptionKind::Choice { .. } => "choice",
+            OptionKind::Name { .. } => "name",
         }
     }
 
     /// What a value must be, in words for messages: "a number", "a whole number from 1
-    /// to 100", "true or false", "one of a, b".
+    /// to 100", "true or false", "one of a, b", "a name".
     pub fn expected(&self) -> String {
         match self {
             OptionKind::Float { .. } => "a number".to_string(),
             OptionKind::Int { min, max, .. } => format!("a whole number from {min} to {max}"),
             OptionKind::Bool { .. } => "true or false".to_string(),
             OptionKind::Choice { choices, .. } => format!("one of {}", choices.join(", ")),
+            OptionKind::Name { .. } => "a name".to_string(),
         }
     }
 
@@ -73,7 +82,9 @@ impl OptionKind {
             OptionKind::Float { default, .. } => OptionValue::Float(default),
             OptionKind::Int { default, .. } => OptionValue::Int(default),
             OptionKind::Bool { default } => OptionValue::Bool(default),
-            OptionKind::Choice { default, .. } => OptionValue::Choice(default.to_string()),
+            OptionKind::Choice { default, .. } | OptionKind::Name { default } => {
+                OptionValue::Choice(default.to_string())
+            }
         }
     }
 }
@@ -98,7 +109,7 @@ pub enum OptionValue {
     Int(usize),
     /// A flag.
     Bool(bool),
-    /// A name.
+    /// A name (of a choice or a name option).
     Choice(String),
 }
 
@@ -305,10 +316,11 @@ impl Settings {
         }
     }
 
-    /// The value of a declared choice option.
+    /// The value of a declared choice or name option.
     ///
     /// # Panics
-    /// If `name` is not a declared choice option of the solver (a bug in the solver).
+    /// If `name` is not a declared choice or name option of the solver (a bug in the
+    /// solver).
     pub fn choice(&self, name: &str) -> &str {
         match self.value(name) {
             OptionValue::Choice(s) => s,
@@ -383,6 +395,10 @@ fn check(
             }
         }
         (OptionKind::Choice { .. }, _) => Err(wrong_type()),
+        (OptionKind::Name { .. }, OptionValue::Choice(text)) => {
+            Ok(OptionValue::Choice(text.trim().to_string()))
+        }
+        (OptionKind::Name { .. }, _) => Err(wrong_type()),
     }
 }
 

@@ -103,6 +103,9 @@ pub enum Position {
     Planar(Complex64),
     /// A point of R^3 (on the sphere or a target surface).
     Spatial(Point3<f64>),
+    /// A vertex of the target mesh (a registration landmark `v SRC TGT`): that vertex
+    /// itself, kept as a vertex through the solve, not its position located again.
+    TargetVertex(VertexId),
 }
 
 /// A mapping problem.
@@ -201,6 +204,9 @@ impl<'a> Problem<'a> {
                     }
                     Some(Position::Spatial(_)) => Err(format!(
                         "the position of the pin on vertex {v} is not finite"
+                    )),
+                    Some(Position::TargetVertex(w)) => Err(format!(
+                        "the pin on vertex {v} holds it at target vertex {w}, but a map into space has no target mesh"
                     )),
                     Some(Position::Planar(_)) => Err(format!(
                         "a map into space holds vertices at points of R^3, but the pin on vertex {v} has a position in the plane"

@@ -27,8 +27,8 @@ use beltrami_mesh::{
 };
 
 use crate::{
-    Constraint, Constraints, Curve, Goal, Landmark, Map, Output, Pin, Problem, Slide, Solution,
-    SolverError, Target,
+    Constraint, Constraints, Curve, Goal, Landmark, Map, Output, Pin, Position, Problem, Slide,
+    Solution, SolverError, Target,
 };
 
 /// The median index spread from which a mesh is renumbered: 4096 vertices of a flow's
@@ -153,16 +153,22 @@ impl Renumbered {
             _ => source_numbering,
         };
         let chain_vertex = |v| chain_numbering.map_or(v, |n: &Renumbering| n.new_vertex(v));
+        let position = |p| match p {
+            Position::TargetVertex(w) => Position::TargetVertex(
+                target_numbering.map_or(w, |n: &Renumbering| n.new_vertex(w)),
+            ),
+            other => other,
+        };
         let mut constraints = Constraints::new();
         for constraint in problem.constraints.iter() {
             constraints.push(match constraint {
                 Constraint::Pin(pin) => Constraint::Pin(Pin {
                     vertex: vertex(pin.vertex),
-                    ..*pin
+                    position: pin.position.map(position),
                 }),
                 Constraint::Landmark(mark) => Constraint::Landmark(Landmark {
                     vertex: vertex(mark.vertex),
-                    ..*mark
+                    position: position(mark.position),
                 }),
                 Constraint::Slide(slide) => Constraint::Slide(Slide {
                     vertex: vertex(slide.vertex),
@@ -268,8 +274,6 @@ mod tests {
     use beltrami_mesh::{Point3, VertexId};
     use num_complex::Complex64;
 
-    use crate::Position;
-
     fn scattered_mesh(soup: &beltrami_mesh::PolygonSoup) -> Mesh {
         Mesh::from_soup(&scattered(soup)).unwrap()
     }
@@ -288,6 +292,10 @@ mod tests {
             vertex: VertexId(5),
             position: Position::Spatial(Point3::new(0.0, 0.0, 1.0)),
         }));
+        problem.constraints.push(Constraint::Landmark(Landmark {
+            vertex: VertexId(9),
+            position: Position::TargetVertex(VertexId(33)),
+        }));
         let mu: Vec<Complex64> = (0..source.face_count())
             .map(|f| Complex64::new(f as f64 * 1e-3, 0.0))
             .collect();
@@ -305,11 +313,19 @@ mod tests {
         for (&old, &new) in chain(&[2, 30, 41]).iter().zip(&curve.target) {
             assert_eq!(local_target.position(new), target.position(old));
         }
-        let mark = local.constraints.landmarks().next().unwrap();
+        let marks: Vec<_> = local.constraints.landmarks().collect();
         assert_eq!(
-            local.source.position(mark.vertex),
+            local.source.position(marks[0].vertex),
             source.position(VertexId(5))
         );
+        assert_eq!(
+            local.source.position(marks[1].vertex),
+            source.position(VertexId(9))
+        );
+        let Position::TargetVertex(onto) = marks[1].position else {
+            panic!("a target vertex stays a target vertex");
+        };
+        assert_eq!(local_target.position(onto), target.position(VertexId(33)));
         let Goal::Prescribed(field) = &local.goal else {
             panic!("a prescribed goal");
         };

@@ -253,6 +253,39 @@ fn curve_target_vertices_are_checked_on_the_target_mesh() {
     curve.validate(&source, None).unwrap();
 }
 
+#[test]
+fn target_vertex_landmarks_need_a_target_mesh_that_has_the_vertex() {
+    let source = square();
+    let target = Mesh::from_soup(&icosphere(0)).unwrap();
+    let onto = |w: usize| -> Constraints {
+        vec![Constraint::Landmark(Landmark {
+            vertex: VertexId(4),
+            position: Position::TargetVertex(VertexId(w as u32)),
+        })]
+        .into_iter()
+        .collect()
+    };
+    let last = target.vertex_count() - 1;
+    onto(last).validate(&source, Some(&target)).unwrap();
+    assert!(matches!(
+        onto(last).validate(&source, None),
+        Err(ConstraintError::NoTargetMesh { index: 0, .. })
+    ));
+    let e = onto(last + 1).validate(&source, Some(&target)).unwrap_err();
+    assert!(
+        matches!(e, ConstraintError::MissingVertex { side: "target", vertex, .. } if vertex.idx() == last + 1),
+        "{e}"
+    );
+    // The point of a target vertex is that vertex's position on the target, and none
+    // without a target.
+    let mark = Position::TargetVertex(VertexId(last as u32));
+    assert_eq!(
+        mark.point(Some(&target)),
+        Some(target.position(VertexId(last as u32)))
+    );
+    assert_eq!(mark.point(None), None);
+}
+
 const SPECS: &[OptionSpec] = &[
     OptionSpec {
         name: "tolerance",

@@ -249,9 +249,13 @@ pub(crate) fn diagonal(image: &[Point3<f64>]) -> f64 {
 /// Per source vertex, the point a landmark pulls it to (the vertex is moved there by
 /// the flow, then held).
 pub(crate) fn goals(problem: &Problem<'_>) -> Vec<Option<Point3<f64>>> {
+    let target = match problem.target {
+        Target::Mesh(target) => Some(target),
+        _ => None,
+    };
     let mut goals = vec![None; problem.source.vertex_count()];
     for mark in problem.constraints.landmarks() {
-        goals[mark.vertex.idx()] = Some(mark.position.to_point());
+        goals[mark.vertex.idx()] = mark.position.point(target);
     }
     goals
 }

@@ -185,15 +185,19 @@ fn check_target_mesh(problem: &Problem<'_>, target: &Mesh) -> Result<(), SolverE
     Ok(())
 }
 
-/// The constraints: pins without positions, landmarks (at points in space) and curves
-/// only on a target mesh.
+/// The constraints: pins without positions, landmarks (at points in space or target
+/// vertices) and curves only on a target mesh.
 fn check_constraints(problem: &Problem<'_>) -> Result<(), SolverError> {
     let on_mesh = matches!(problem.target, Target::Mesh(_));
     for constraint in problem.constraints.iter() {
         let refused = match constraint {
             Constraint::Pin(pin) => pin.position.is_some(),
             Constraint::Landmark(mark) => {
-                !on_mesh || !matches!(mark.position, Position::Spatial(_))
+                !on_mesh
+                    || !matches!(
+                        mark.position,
+                        Position::Spatial(_) | Position::TargetVertex(_)
+                    )
             }
             _ => false,
         };

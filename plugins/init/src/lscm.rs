@@ -311,7 +311,7 @@ fn pins(problem: &Problem<'_>) -> Result<Vec<(VertexId, Complex64)>, SolverError
                     pin.vertex
                 ),
             )),
-            Some(Position::Spatial(_)) => Err(SolverError::unsupported(
+            Some(Position::Spatial(_) | Position::TargetVertex(_)) => Err(SolverError::unsupported(
                 NAME,
                 format!(
                     "lscm maps into the plane, but the pin on vertex {} has a position in space",

@@ -382,7 +382,7 @@ fn pins(
                         "the position of the pin on vertex {v} is not finite"
                     ),
                 )),
-                Some(Position::Spatial(_)) => Err(SolverError::unsupported(
+                Some(Position::Spatial(_) | Position::TargetVertex(_)) => Err(SolverError::unsupported(
                     NAME,
                     format!(
                         "lsqc maps into the plane, but the pin on vertex {v} has a position in space"

@@ -4,7 +4,7 @@
 //! finiteness, a vertex constrained twice). A registration also needs them to agree:
 //!
 //! - two landmarks onto one target point would make the map non-injective;
-//! - a landmark point far from the target (more than [`FAR_OFF`] of the target's
+//! - a landmark point far from the target (more than [`crate::landmarks::FAR_OFF`] of the target's
 //!   bounding-box diagonal from its closest point) is almost surely a point of another
 //!   mesh or in other units, and silently snapping it would hide that;
 //! - feature curves (a source chain onto a target chain, Wong-Zhao 2014 section 5.3)
@@ -16,72 +16,24 @@
 //!   paired loops must come in the same cyclic order
 //!   ([`crate::routing::check_boundary_landmarks`]).
 
-use beltrami_core::Problem;
+use beltrami_core::{Landmark, Problem};
 use beltrami_mesh::{Mesh, VertexId};
 use beltrami_spatial::SurfaceIndex;
 
 use crate::error::RegisterError;
-use crate::landmarks::SAME_POINT;
-
-/// The largest distance of a landmark point from the target, relative to the target's
-/// bounding-box diagonal.
-pub(crate) const FAR_OFF: f64 = 0.05;
 
 /// Checks that the problem's landmarks and curves can be honoured together by a
 /// bijection onto `target` (module docs).
 pub(crate) fn check(problem: &Problem<'_>, target: &Mesh) -> Result<(), RegisterError> {
-    let diagonal = target.bounding_box().diagonal().max(f64::MIN_POSITIVE);
-    let marks: Vec<_> = problem.constraints.landmarks().collect();
+    let marks: Vec<Landmark> = problem.constraints.landmarks().copied().collect();
     if !marks.is_empty() {
         let index = SurfaceIndex::new(target)?;
-        let mut located = Vec::with_capacity(marks.len());
-        let mut points = Vec::with_capacity(marks.len());
-        for (i, mark) in marks.iter().enumerate() {
-            let p = mark.position.to_point();
-            let found = index.locate(&p)?;
-            if found.distance > FAR_OFF * diagonal {
-                return Err(RegisterError::Landmark {
-                    index: i,
-                    vertex: mark.vertex,
-                    reason: format!(
-                        "its point ({}, {}, {}) is {:.4e} from the target, more than {:.0}% of the target's size ({:.4e}): is it a point of the target mesh, in its units?",
-                        p.x,
-                        p.y,
-                        p.z,
-                        found.distance,
-                        100.0 * FAR_OFF,
-                        diagonal
-                    ),
-                });
-            }
-            let q = found.position;
-            located.push(q);
-            points.push(found.point);
-        }
-        if let Some((j, i)) = crate::landmarks::coincident(&located, SAME_POINT * diagonal) {
-            return Err(crate::landmarks::same_point(
-                i,
-                marks[i].vertex,
-                j,
-                marks[j].vertex,
-            ));
-        }
+        let resolved = crate::landmarks::resolve(problem.source, target, &index, &marks)?;
         if matches!(
             crate::Shape::of(problem.source).topology(),
             Some(crate::Topology::MultiplyConnected | crate::Topology::HigherGenus)
         ) && problem.source.boundary_loop_count() > 0
         {
-            let resolved: Vec<crate::landmarks::Resolved> = marks
-                .iter()
-                .zip(points)
-                .enumerate()
-                .map(|(i, (mark, target))| crate::landmarks::Resolved {
-                    index: i,
-                    source: mark.vertex,
-                    target,
-                    vertex: None,
-                })
-                .collect();
             crate::routing::check_boundary_landmarks(problem.source, target, &resolved)?;
         }
     }

@@ -3,30 +3,13 @@
 //! a torus. Without landmarks the same freedoms are fixed by a rough spatial match of
 //! the two meshes ([`SpatialMatch`]).
 
+use beltrami_core::{Landmark, Position};
 use beltrami_mesh::{Mesh, Point3, SurfacePoint, Vector3, VertexId};
 use beltrami_spatial::SurfaceIndex;
 use nalgebra::{Matrix3, Matrix3x4, Rotation3, Unit};
 use num_complex::Complex64;
 
 use crate::error::RegisterError;
-
-/// Where a landmark's source vertex must go on the target.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum LandmarkTarget {
-    /// Onto this target vertex.
-    Vertex(VertexId),
-    /// Onto the closest point of the target to this point.
-    Point(Point3<f64>),
-}
-
-/// A correspondence given by the user: source vertex `source` goes to `target`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Landmark {
-    /// The source vertex.
-    pub source: VertexId,
-    /// Where it goes.
-    pub target: LandmarkTarget,
-}
 
 /// A checked landmark with its target as a surface point of the target mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,15 +20,18 @@ pub(crate) struct Resolved {
     pub source: VertexId,
     /// The target point.
     pub target: SurfacePoint,
-    /// The target vertex, for [`LandmarkTarget::Vertex`].
+    /// The target vertex: a [`Position::TargetVertex`], or a point at a vertex.
     pub vertex: Option<VertexId>,
 }
 
-/// Checks every landmark and locates point targets on the target mesh.
+/// Checks every landmark and locates point targets on the target mesh; a target vertex
+/// ([`Position::TargetVertex`]) stays that vertex.
 ///
 /// # Errors
 /// [`RegisterError::Landmark`] for a source or target vertex out of range, a source
-/// vertex given twice, or a target point with a NaN or infinite coordinate.
+/// vertex given twice, a target point with a NaN or infinite coordinate or farther than
+/// [`FAR_OFF`] from the target, a destination in the plane, or two landmarks onto one
+/// point.
 pub(crate) fn resolve(
     source: &Mesh,
     target: &Mesh,
@@ -57,10 +43,10 @@ pub(crate) fn resolve(
     for (index, landmark) in landmarks.iter().enumerate() {
         let fail = |reason: String| RegisterError::Landmark {
             index,
-            vertex: landmark.source,
+            vertex: landmark.vertex,
             reason,
         };
-        let s = landmark.source;
+        let s = landmark.vertex;
         if s.idx() >= source.vertex_count() {
             return Err(fail(format!(
                 "the source has only {} vertices",
@@ -74,8 +60,8 @@ pub(crate) fn resolve(
             )));
         }
         seen[s.idx()] = index;
-        let (point, vertex) = match landmark.target {
-            LandmarkTarget::Vertex(v) => {
+        let (point, vertex) = match landmark.position {
+            Position::TargetVertex(v) => {
                 if v.idx() >= target.vertex_count() {
                     return Err(fail(format!(
                         "target vertex {v} does not exist: the target has {} vertices",
@@ -84,18 +70,34 @@ pub(crate) fn resolve(
                 }
                 (SurfacePoint::at_vertex(target, v), Some(v))
             }
-            LandmarkTarget::Point(p) => {
+            Position::Spatial(p) => {
                 if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
                     return Err(fail(format!("the target point {p:?} is not finite")));
                 }
-                let point = target_index.locate(&p)?.point;
-                // A point at a vertex (a `v SRC TGT` landmark arrives as the vertex's
-                // position) is that vertex, whichever of its faces the location chose:
-                // a boundary vertex stays on the boundary.
+                let found = target_index.locate(&p)?;
+                let diagonal = target.bounding_box().diagonal();
+                if found.distance > FAR_OFF * diagonal {
+                    return Err(fail(format!(
+                        "its point ({}, {}, {}) is {:.4e} from the target, more than {:.0}% of the target's size ({diagonal:.4e}): is it a point of the target mesh, in its units?",
+                        p.x,
+                        p.y,
+                        p.z,
+                        found.distance,
+                        100.0 * FAR_OFF,
+                    )));
+                }
+                let point = found.point;
+                // A point at a vertex is that vertex, whichever of its faces the
+                // location chose: a boundary vertex stays on the boundary.
                 match at_corner(target, &point) {
                     Some(v) => (SurfacePoint::at_vertex(target, v), Some(v)),
                     None => (point, None),
                 }
+            }
+            Position::Planar(_) => {
+                return Err(fail(
+                    "its destination is a point of the plane; a map onto a target mesh needs a point of R^3 or a target vertex".into(),
+                ));
             }
         };
         out.push(Resolved {
@@ -121,13 +123,18 @@ fn one_target_each(
     match coincident(&at, SAME_POINT * target.bounding_box().diagonal()) {
         Some((first, second)) => Err(same_point(
             second,
-            landmarks[second].source,
+            landmarks[second].vertex,
             first,
-            landmarks[first].source,
+            landmarks[first].vertex,
         )),
         None => Ok(()),
     }
 }
+
+/// The largest distance of a landmark point from the target, relative to the target's
+/// bounding-box diagonal: a point farther off is almost surely of another mesh or in
+/// other units, and silently snapping it would hide that.
+pub(crate) const FAR_OFF: f64 = 0.05;
 
 /// Two landmark targets closer than this (relative to the target's diagonal) are one
 /// point.
@@ -468,8 +475,8 @@ mod tests {
         let index = SurfaceIndex::new(&target).unwrap();
         for v in target.vertices() {
             let marks = [Landmark {
-                source: VertexId(0),
-                target: LandmarkTarget::Point(target.position(v)),
+                vertex: VertexId(0),
+                position: Position::Spatial(target.position(v)),
             }];
             let resolved = resolve(&source, &target, &index, &marks).unwrap();
             assert_eq!(resolved[0].vertex, Some(v));
@@ -478,8 +485,8 @@ mod tests {
         // A point inside a face stays a point.
         let f = target.faces().next().unwrap();
         let inside = [Landmark {
-            source: VertexId(0),
-            target: LandmarkTarget::Point(target.face_centroid(f)),
+            vertex: VertexId(0),
+            position: Position::Spatial(target.face_centroid(f)),
         }];
         assert_eq!(
             resolve(&source, &target, &index, &inside).unwrap()[0].vertex,

@@ -60,7 +60,7 @@ mod square_map;
 mod topology;
 mod torus;
 
-use beltrami_core::Features;
+use beltrami_core::{Features, Landmark};
 use beltrami_fem::DistortionStats;
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
@@ -72,7 +72,6 @@ use std::sync::atomic::AtomicBool;
 
 pub use error::{RegisterError, Side};
 pub use inverse_consistency::{InverseConsistency, inverse_consistency};
-pub use landmarks::{Landmark, LandmarkTarget};
 pub use modulus::{TorusPeriods, teichmueller_bound};
 pub use solver::Register;
 pub use topology::{Shape, Topology, check_topology};

@@ -2,8 +2,8 @@
 
 use beltrami_core::{
     Accepts, Constraint, ConstraintKind, Constraints, Context, Element, Features, Goal, GoalKind,
-    LandmarkResidual, Map, OptionKind, OptionSpec, OptionValue, Position, Problem, Report,
-    Settings, ShapeDistance, Solution, Solver, SolverError, SolverInfo, Target, TargetKind,
+    Landmark, LandmarkResidual, Map, OptionKind, OptionSpec, OptionValue, Position, Problem,
+    Report, Settings, ShapeDistance, Solution, Solver, SolverError, SolverInfo, Target, TargetKind,
     solve_renumbered,
 };
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
@@ -12,10 +12,7 @@ use beltrami_spatial::SurfaceIndex;
 use crate::compose::flipped_faces;
 use crate::feature_match::Channel;
 use crate::shape::Shape;
-use crate::{
-    InitialMap, Landmark, LandmarkTarget, RegisterError, check_topology, initial_map_for,
-    match_features_after,
-};
+use crate::{InitialMap, RegisterError, check_topology, initial_map_for, match_features_after};
 
 /// Surface registration: the initial bijection of `initial_map` (through a common
 /// parameter domain chosen by the topology, aligned by the landmarks), then the discrete
@@ -247,25 +244,9 @@ fn judge_landmarks(
 /// Corners whose target normals differ by more than this lie across a fold.
 const FOLD_DEGREES: f64 = 90.0;
 
-/// The problem's landmarks, as the initial map takes them.
-fn landmarks(problem: &Problem<'_>) -> Result<Vec<Landmark>, SolverError> {
-    problem
-        .constraints
-        .landmarks()
-        .map(|mark| match mark.position {
-            Position::Spatial(p) => Ok(Landmark {
-                source: mark.vertex,
-                target: LandmarkTarget::Point(p),
-            }),
-            Position::Planar(_) => Err(SolverError::unsupported(
-                NAME,
-                format!(
-                    "the landmark on source vertex {} needs a point on the target mesh, not in the plane",
-                    mark.vertex
-                ),
-            )),
-        })
-        .collect()
+/// The problem's landmarks, in their order.
+fn landmarks(problem: &Problem<'_>) -> Vec<Landmark> {
+    problem.constraints.landmarks().copied().collect()
 }
 
 /// What [`Register`] is: its name, one line on what it computes, what it accepts and
@@ -303,7 +284,6 @@ impl Solver for Register {
                 ));
             }
         }
-        landmarks(problem)?;
         let features = match &problem.goal {
             Goal::Features(features) => Some(features),
             _ => None,
@@ -422,7 +402,7 @@ pub(crate) fn register(
         ));
     };
     let source = problem.source;
-    let marks = landmarks(problem)?;
+    let marks = landmarks(problem);
     let mut report = Report::new(NAME);
     let features = match &problem.goal {
         Goal::Features(features) => Some(features),

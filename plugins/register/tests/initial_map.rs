@@ -6,11 +6,10 @@ use std::f64::consts::TAU;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use beltrami_core::{Landmark, Position};
 use beltrami_mesh::primitives::{self, Cells, ModifiedTorus};
 use beltrami_mesh::{BuildOptions, Mesh, Point3, PolygonSoup, VertexId, io};
-use beltrami_register::{
-    InitialMap, Landmark, LandmarkTarget, RegisterError, Topology, check_topology, initial_map,
-};
+use beltrami_register::{InitialMap, RegisterError, Topology, check_topology, initial_map};
 use beltrami_spatial::SurfaceIndex;
 
 fn mesh(soup: &PolygonSoup) -> Mesh {
@@ -112,8 +111,8 @@ fn disk_boundary_landmark_lands_exactly() {
         .nth(20)
         .unwrap();
     let landmarks = [Landmark {
-        source: s,
-        target: LandmarkTarget::Vertex(t),
+        vertex: s,
+        position: Position::TargetVertex(t),
     }];
     let map = initial_map(&source, &target, &landmarks).unwrap();
     check_on_target(&source, &target, &map);
@@ -125,8 +124,8 @@ fn disk_boundary_landmark_lands_exactly() {
         .find(|&v| !source.is_boundary_vertex(v))
         .unwrap();
     let bad = [Landmark {
-        source: inner,
-        target: LandmarkTarget::Vertex(t),
+        vertex: inner,
+        position: Position::TargetVertex(t),
     }];
     assert!(matches!(
         initial_map(&source, &target, &bad),
@@ -140,12 +139,12 @@ fn disk_boundary_landmark_lands_exactly() {
     let bad = [
         landmarks[0],
         Landmark {
-            source: source
+            vertex: source
                 .vertices()
                 .filter(|&v| source.is_boundary_vertex(v))
                 .nth(9)
                 .unwrap(),
-            target: LandmarkTarget::Vertex(inside),
+            position: Position::TargetVertex(inside),
         },
     ];
     assert!(matches!(
@@ -172,8 +171,8 @@ fn every_disk_landmark_lands_exactly_and_boundary_order_is_kept() {
     let plain = initial_map(&source, &target, &[]).unwrap();
     let mut landmarks: Vec<Landmark> = (0..3)
         .map(|k| Landmark {
-            source: along_boundary(&source, k, 3),
-            target: LandmarkTarget::Point(target.position(along_boundary(&target, 3 * k + 1, 9))),
+            vertex: along_boundary(&source, k, 3),
+            position: Position::Spatial(target.position(along_boundary(&target, 3 * k + 1, 9))),
         })
         .collect();
     let interior: Vec<VertexId> = source
@@ -186,8 +185,8 @@ fn every_disk_landmark_lands_exactly_and_boundary_order_is_kept() {
         let angle = k as f64 * std::f64::consts::FRAC_PI_2;
         let p = plain.positions[v.idx()];
         landmarks.push(Landmark {
-            source: v,
-            target: LandmarkTarget::Point(Point3::new(
+            vertex: v,
+            position: Position::Spatial(Point3::new(
                 p.x + 0.1 * angle.cos(),
                 p.y + 0.1 * angle.sin(),
                 p.z,
@@ -200,19 +199,19 @@ fn every_disk_landmark_lands_exactly_and_boundary_order_is_kept() {
     let index = SurfaceIndex::new(&target).unwrap();
     let scale = target.bounding_box().diagonal();
     for (k, mark) in landmarks.iter().enumerate() {
-        let LandmarkTarget::Point(p) = mark.target else {
+        let Position::Spatial(p) = mark.position else {
             unreachable!()
         };
         let goal = index.locate(&p).unwrap().position;
-        let d = (map.positions[mark.source.idx()] - goal).norm();
+        let d = (map.positions[mark.vertex.idx()] - goal).norm();
         assert!(d <= 1e-12 * scale, "landmark {k}: {d:e}");
     }
     // The boundary landmarks in the other turn of the target's loop: refused, naming
     // the one that breaks the order.
     let reversed: Vec<Landmark> = (0..3)
         .map(|k| Landmark {
-            source: along_boundary(&source, k, 3),
-            target: LandmarkTarget::Vertex(along_boundary(&target, (3 - k) % 3, 3)),
+            vertex: along_boundary(&source, k, 3),
+            position: Position::TargetVertex(along_boundary(&target, (3 - k) % 3, 3)),
         })
         .collect();
     match initial_map(&source, &target, &reversed) {
@@ -228,8 +227,8 @@ fn disk_onto_itself_is_the_identity() {
     let m = jittered_disk(4, 0.01, 5);
     let b = m.vertices().find(|&v| m.is_boundary_vertex(v)).unwrap();
     let landmarks = [Landmark {
-        source: b,
-        target: LandmarkTarget::Vertex(b),
+        vertex: b,
+        position: Position::TargetVertex(b),
     }];
     let map = initial_map(&m, &m, &landmarks).unwrap();
     for v in m.vertices() {
@@ -280,17 +279,17 @@ fn sphere_landmarks_land_exactly() {
         let landmarks: Vec<Landmark> = [(0u32, 5u32), (17, 40), (100, 90)][..count]
             .iter()
             .map(|&(s, t)| Landmark {
-                source: VertexId(s),
-                target: LandmarkTarget::Vertex(VertexId(t)),
+                vertex: VertexId(s),
+                position: Position::TargetVertex(VertexId(t)),
             })
             .collect();
         let map = initial_map(&source, &target, &landmarks).unwrap();
         check_on_target(&source, &target, &map);
         for l in &landmarks {
-            let LandmarkTarget::Vertex(t) = l.target else {
+            let Position::TargetVertex(t) = l.position else {
                 unreachable!()
             };
-            assert_eq!(map.positions[l.source.idx()], target.position(t));
+            assert_eq!(map.positions[l.vertex.idx()], target.position(t));
         }
         assert_eq!(map.flipped(), 0, "{count} landmarks: {:?}", map.notes);
     }
@@ -300,8 +299,8 @@ fn sphere_landmarks_land_exactly() {
         &source,
         &target,
         &[Landmark {
-            source: VertexId(7),
-            target: LandmarkTarget::Point(p),
+            vertex: VertexId(7),
+            position: Position::Spatial(p),
         }],
     )
     .unwrap();
@@ -362,11 +361,11 @@ fn spot_onto_bunny() {
 /// Every landmark (all onto target vertices) lands on its vertex to rounding.
 fn assert_vertex_landmarks_exact(map: &InitialMap, target: &Mesh, marks: &[Landmark]) {
     for mark in marks {
-        let LandmarkTarget::Vertex(v) = mark.target else {
-            panic!("landmark {} is not onto a vertex", mark.source);
+        let Position::TargetVertex(v) = mark.position else {
+            panic!("landmark {} is not onto a vertex", mark.vertex);
         };
-        let miss = (map.positions[mark.source.idx()] - target.position(v)).norm();
-        assert!(miss < 1e-12, "landmark {}: {miss:.3e}", mark.source);
+        let miss = (map.positions[mark.vertex.idx()] - target.position(v)).norm();
+        assert!(miss < 1e-12, "landmark {}: {miss:.3e}", mark.vertex);
     }
 }
 
@@ -399,8 +398,8 @@ fn torus_onto_modified_tori_has_no_flips_and_names_its_loops() {
 fn torus_landmarks_and_identity() {
     let m = torus(40, 16);
     let landmarks = [Landmark {
-        source: VertexId(0),
-        target: LandmarkTarget::Vertex(VertexId(0)),
+        vertex: VertexId(0),
+        position: Position::TargetVertex(VertexId(0)),
     }];
     let map = initial_map(&m, &m, &landmarks).unwrap();
     assert_eq!(map.flipped(), 0);
@@ -413,12 +412,12 @@ fn torus_landmarks_and_identity() {
     let target = mesh(&primitives::modified_torus(ModifiedTorus::Phi1, 60, 24));
     let landmarks = [
         Landmark {
-            source: VertexId(3),
-            target: LandmarkTarget::Vertex(VertexId(100)),
+            vertex: VertexId(3),
+            position: Position::TargetVertex(VertexId(100)),
         },
         Landmark {
-            source: VertexId(300),
-            target: LandmarkTarget::Vertex(VertexId(900)),
+            vertex: VertexId(300),
+            position: Position::TargetVertex(VertexId(900)),
         },
     ];
     let map = initial_map(&m, &target, &landmarks).unwrap();
@@ -442,8 +441,8 @@ fn every_torus_landmark_lands_exactly_under_a_twist() {
             let ti = (1.5 * i as f64 + twist).round().rem_euclid(60.0) as usize;
             let tj = (1.5 * j as f64).round() as usize % 24;
             Landmark {
-                source: VertexId::from_usize(i * nv + j),
-                target: LandmarkTarget::Vertex(VertexId::from_usize(ti * 24 + tj)),
+                vertex: VertexId::from_usize(i * nv + j),
+                position: Position::TargetVertex(VertexId::from_usize(ti * 24 + tj)),
             }
         })
         .collect();
@@ -531,12 +530,12 @@ fn bad_landmarks_name_their_index() {
     let sphere = mesh(&primitives::icosphere(2));
     let out_of_range = [
         Landmark {
-            source: VertexId(0),
-            target: LandmarkTarget::Vertex(VertexId(1)),
+            vertex: VertexId(0),
+            position: Position::TargetVertex(VertexId(1)),
         },
         Landmark {
-            source: VertexId(100_000),
-            target: LandmarkTarget::Vertex(VertexId(1)),
+            vertex: VertexId(100_000),
+            position: Position::TargetVertex(VertexId(1)),
         },
     ];
     let err = initial_map(&sphere, &sphere, &out_of_range).unwrap_err();
@@ -545,8 +544,8 @@ fn bad_landmarks_name_their_index() {
         "{err}"
     );
     let nan = [Landmark {
-        source: VertexId(0),
-        target: LandmarkTarget::Point(Point3::new(f64::NAN, 0.0, 0.0)),
+        vertex: VertexId(0),
+        position: Position::Spatial(Point3::new(f64::NAN, 0.0, 0.0)),
     }];
     assert!(matches!(
         initial_map(&sphere, &sphere, &nan),
@@ -560,16 +559,16 @@ fn bad_landmarks_name_their_index() {
     // Two source vertices onto one target, once as a vertex and once as its position.
     let one_point = [
         Landmark {
-            source: VertexId(3),
-            target: LandmarkTarget::Vertex(VertexId(7)),
+            vertex: VertexId(3),
+            position: Position::TargetVertex(VertexId(7)),
         },
         Landmark {
-            source: VertexId(5),
-            target: LandmarkTarget::Vertex(VertexId(9)),
+            vertex: VertexId(5),
+            position: Position::TargetVertex(VertexId(9)),
         },
         Landmark {
-            source: VertexId(4),
-            target: LandmarkTarget::Point(sphere.position(VertexId(7))),
+            vertex: VertexId(4),
+            position: Position::Spatial(sphere.position(VertexId(7))),
         },
     ];
     let err = initial_map(&sphere, &sphere, &one_point).unwrap_err();
@@ -597,8 +596,8 @@ fn genus_two_onto_a_turned_copy_through_matched_cuts() {
     let marks: Vec<Landmark> = [0u32, 200, 400, 600]
         .iter()
         .map(|&v| Landmark {
-            source: VertexId(v),
-            target: LandmarkTarget::Vertex(VertexId(v)),
+            vertex: VertexId(v),
+            position: Position::TargetVertex(VertexId(v)),
         })
         .collect();
     let map = initial_map(&eight, &target, &marks).unwrap();
