@@ -53,6 +53,9 @@
 //! - [`report`]: a solution as a JSON object (the `--report` of the mapping commands).
 //! - [`mapped`]: maps given as mesh files, read back (connectivity check, texture
 //!   seams, a target surface's normals at the image).
+//! - [`problem_spec`]: a problem in a front end's words (solver, target and boundary by
+//!   name, goal, constraints, options), turned into a core `Problem` in one place for
+//!   the command line, batch jobs and the Python package.
 //!
 //! The `beltrami` binary built from this package is the command-line front end (it
 //! parses arguments, calls this library and prints); see the README for its commands.
@@ -64,6 +67,7 @@ pub mod correspondence;
 pub mod landmarks;
 pub mod map_file;
 pub mod mapped;
+pub mod problem_spec;
 pub mod report;
 pub mod vertex_field;
 

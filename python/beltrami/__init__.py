@@ -133,7 +133,9 @@ def _options(options: Optional[Dict[str, Any]], **flags: Any) -> Dict[str, str]:
 
 def _goal(
     mu: Optional[ArrayLike], mu_expr: Optional[str], mu_frame: Optional[str], p: Optional[float]
-) -> Dict[str, Any]:
+) -> Optional[Dict[str, Any]]:
+    """The goal of the description; None (no goal given) leaves it to the solver: the
+    extremal map for a solver that computes extremal maps, else the most conformal."""
     if mu is not None and mu_expr is not None:
         raise OptionError("give mu or mu_expr, not both")
     if (mu is not None or mu_expr is not None) and p is not None:
@@ -144,7 +146,9 @@ def _goal(
         return {"kind": "mu", "frame": mu_frame or "global"}
     if mu_expr is not None:
         return {"kind": "mu_expr", "expr": str(mu_expr)}
-    return {"kind": "conformal", "p": 2.0 if p is None else float(p)}
+    if p is None:
+        return None
+    return {"kind": "conformal", "p": float(p)}
 
 
 def _pins(pins: Iterable[int]) -> list:
@@ -559,7 +563,7 @@ def lsqc(
         raise OptionError(f"lsqc maps into the plane or space, not target={target!r}")
     spec = {
         "target": target,
-        "boundary": boundary or ("given" if target == "space" else "free"),
+        "boundary": boundary or _lsqc_boundary(target, boundary_map),
         "goal": _goal(mu, mu_expr, mu_frame, None),
         "pins": _pins(pins),
         "normal_constraint": normal_constraint,
@@ -569,6 +573,14 @@ def lsqc(
     }
     out = _solve("lsqc", V, F, spec, boundary_map=boundary_map, mu=mu)
     return _result(out, info)
+
+
+def _lsqc_boundary(target: str, boundary_map: Optional[ArrayLike]) -> Optional[str]:
+    """lsqc's boundary when none is named: free in the plane; into space, held at
+    ``boundary_map`` when it is given (else only the pins hold the surface)."""
+    if target == "plane":
+        return "free"
+    return "given" if boundary_map is not None else None
 
 
 @overload
@@ -657,7 +669,7 @@ def beltrami_flow(
         )
     spec = {
         "target": target,
-        "boundary": boundary or "keep",
+        "boundary": boundary or ("keep" if target == "plane" else None),
         "free_radius": bool(free_radius),
         "goal": _goal(mu, mu_expr, mu_frame, p),
         "pins": _pins(pins),
@@ -704,7 +716,7 @@ def _extremal_like(
     sliding = landmarks is not None
     spec = {
         "target": "disk" if sliding else "plane",
-        "boundary": "given",
+        "boundary": None if sliding else "given",
         "planar_landmarks": _planar_landmarks(landmarks) if sliding else [],
         "goal": {"kind": "extremal"},
         "options": _options(options, init=init, **flags),
@@ -1112,7 +1124,7 @@ def register(
         back_spec = dict(spec, landmarks=_reversed_landmarks(spec["landmarks"]))
     out = _solve("register", V, F, spec, mu=mu, target=(TV, TF), progress=progress)
     if inverse_consistency:
-        if goal.get("kind") == "features":
+        if goal is not None and goal.get("kind") == "features":
             back_spec["goal"] = dict(goal, source=goal["target"], target=goal["source"])
         back = _solve("register", TV, TF, back_spec, target=(V, F), progress=progress)
         start = np.asarray(V, dtype=float)

@@ -32,11 +32,14 @@ use std::time::Instant;
 
 use beltrami::landmarks::Landmarks;
 use beltrami::map_file::{self, Image};
-use beltrami_core::{
-    Constraint, Context, Features, Goal, Landmark, Map, Pin, PlanarBoundary, Position, Problem,
-    Progress, Solution, SurfacePoint, Target, components,
+use beltrami::problem_spec::{
+    BoundaryMap, BoundaryName, GoalSpec, ProblemSpec, SpecError, Spelling, TargetName,
 };
-use beltrami_fem::{BeltramiField, Expr, Frame};
+use beltrami_core::{
+    Constraint, Constraints, Context, Features, Landmark, Map, OptionValue, Pin, Position, Problem,
+    Progress, Solution, SurfacePoint, components,
+};
+use beltrami_fem::{BeltramiField, Frame};
 use beltrami_mesh::Mesh;
 use num_complex::Complex64;
 use numpy::ndarray::{Array1, Array2};
@@ -63,73 +66,77 @@ fn text<'a>(spec: &'a JsonMap<String, Value>, key: &str) -> Option<&'a str> {
     spec.get(key).and_then(Value::as_str)
 }
 
-/// The target of the description (`target_mesh` for `mesh`).
-fn target<'a>(
+/// The problem's words of the description (module docs), its arrays read: the one
+/// translation into a problem is [`ProblemSpec::problem`], shared with the command line.
+fn spec_of(
     spec: &JsonMap<String, Value>,
     mesh: &Mesh,
-    target_mesh: Option<&'a Mesh>,
+    target_mesh: Option<&Mesh>,
     inputs: &Inputs<'_>,
-) -> PyResult<Target<'a>> {
+) -> PyResult<ProblemSpec> {
     let name = text(spec, "target").unwrap_or("plane");
-    Ok(match name {
-        "plane" => Target::Plane(match text(spec, "boundary").unwrap_or("keep") {
-            "circle" => PlanarBoundary::Circle,
-            "square" => PlanarBoundary::Square { corners: None },
-            "free" => PlanarBoundary::Free,
-            "keep" => PlanarBoundary::Keep,
-            "given" => {
-                let Some(map) = &inputs.boundary_map else {
-                    return Err(option_error(
-                        "boundary='given' needs boundary_map, an (n, 2) array".into(),
-                    ));
-                };
-                PlanarBoundary::Given(arrays::planar(mesh, map.as_array(), "boundary_map")?)
-            }
-            other => {
-                return Err(option_error(format!(
-                    "boundary={other:?}: expected 'circle', 'square', 'free', 'keep' or 'given'"
-                )));
-            }
-        }),
-        "disk" => Target::Disk,
-        "annulus" => Target::Annulus {
-            inner_radius: if spec.get("free_radius").and_then(Value::as_bool) == Some(true) {
-                None
-            } else {
-                beltrami::flow_engine::annulus_inner_radius(mesh)
-            },
-        },
-        "sphere" => Target::Sphere,
-        "space" => Target::Surface,
-        "circle-domain" => Target::CircleDomain,
-        "mesh" => Target::Mesh(
-            target_mesh
-                .ok_or_else(|| option_error("the target mesh (TV, TF) is missing".into()))?,
-        ),
-        other => {
-            return Err(option_error(format!(
-                "target={other:?}: expected 'plane', 'disk', 'annulus', 'sphere' or 'space'"
-            )));
-        }
-    })
+    let target = TargetName::parse(name).ok_or_else(|| {
+        option_error(format!(
+            "target={name:?}: expected 'plane', 'disk', 'annulus', 'sphere', 'space', 'circle-domain' or 'mesh'"
+        ))
+    })?;
+    let mut out = ProblemSpec::new(target);
+    out.spelling = Spelling::Keywords;
+    out.boundary = text(spec, "boundary")
+        .map(|name| {
+            BoundaryName::parse(name).ok_or_else(|| {
+                option_error(format!(
+                    "boundary={name:?}: expected 'circle', 'square', 'free', 'keep' or 'given'"
+                ))
+            })
+        })
+        .transpose()?;
+    out.boundary_map =
+        match &inputs.boundary_map {
+            None => None,
+            Some(map) if target == TargetName::Space => Some(BoundaryMap::Spatial(
+                arrays::spatial(mesh, map.as_array(), "boundary_map")?,
+            )),
+            Some(map) => Some(BoundaryMap::Planar(arrays::planar(
+                mesh,
+                map.as_array(),
+                "boundary_map",
+            )?)),
+        };
+    out.free_radius = spec.get("free_radius").and_then(Value::as_bool) == Some(true);
+    out.goal = goal(spec, mesh, target_mesh, inputs)?;
+    out.initial = match &inputs.initial {
+        Some(initial) => Some(arrays::planar(mesh, initial.as_array(), "init")?),
+        None => None,
+    };
+    out.constraints = constraints(spec, mesh, target_mesh)?;
+    out.normal_constraint = spec.get("normal_constraint").and_then(Value::as_f64);
+    out.area_constraint = spec.get("area_constraint").and_then(Value::as_bool) == Some(true);
+    for (name, value) in entries(spec, "defaults") {
+        out.defaults.push((name, OptionValue::Choice(value)));
+    }
+    for (name, value) in entries(spec, "options") {
+        out.options.set_text(&name, &value);
+    }
+    Ok(out)
 }
 
-/// The goal of the description (the problem's default, the conformal map, without one).
+/// The goal of the description, or `None` for the solver's own (the extremal map of a
+/// solver that computes extremal maps, else the most conformal one).
 fn goal(
     spec: &JsonMap<String, Value>,
     mesh: &Mesh,
     target_mesh: Option<&Mesh>,
     inputs: &Inputs<'_>,
-) -> PyResult<Option<Goal>> {
+) -> PyResult<Option<GoalSpec>> {
     let Some(goal) = spec.get("goal").and_then(Value::as_object) else {
         return Ok(None);
     };
-    let field_error = |e: &(dyn std::error::Error + 'static)| errors::from_error(Kind::Field, e);
     Ok(Some(match goal.get("kind").and_then(Value::as_str) {
-        Some("conformal") => Goal::Conformal {
-            p: goal.get("p").and_then(Value::as_f64).unwrap_or(2.0),
+        Some("conformal") => GoalSpec::Conformal {
+            p: goal.get("p").and_then(Value::as_f64),
         },
-        Some("extremal") => Goal::Extremal,
+        Some("extremal") => GoalSpec::Extremal,
         Some("mu") => {
             let Some(mu) = &inputs.mu else {
                 return Err(option_error("mu is missing".into()));
@@ -139,42 +146,21 @@ fn goal(
                 _ => Frame::Global,
             };
             let values = arrays::faces_from_rows(mesh, mu.as_array(), "mu")?;
-            Goal::Prescribed(BeltramiField::new(frame, values))
+            GoalSpec::Mu(BeltramiField::new(frame, values))
         }
-        Some("mu_expr") => {
-            let source = goal.get("expr").and_then(Value::as_str).unwrap_or("");
-            let expr = Expr::parse(source).map_err(|e| {
-                errors::raise(
-                    Kind::Field,
-                    format!(
-                        "mu_expr {source:?}: {}",
-                        beltrami::report::error_message(&e)
-                    ),
-                )
-            })?;
-            let field = if text(spec, "target") == Some("sphere") {
-                beltrami::flow::stereographic::field(mesh, |z| expr.eval(z))
-                    .map_err(|e| field_error(&e))?
-            } else {
-                expr.field(mesh).map_err(|e| {
-                    errors::raise(
-                        Kind::Field,
-                        format!(
-                            "mu_expr evaluates mu at z = x + i y and needs a mesh in the plane z = 0 ({}); give a per-face mu instead",
-                            beltrami::report::error_message(&e)
-                        ),
-                    )
-                })?
-            };
-            Goal::Prescribed(field)
-        }
+        Some("mu_expr") => GoalSpec::MuExpr(
+            goal.get("expr")
+                .and_then(Value::as_str)
+                .unwrap_or("")
+                .to_string(),
+        ),
         Some("features") => {
             let Some(target_mesh) = target_mesh else {
                 return Err(option_error(
                     "features need the target mesh (TV, TF)".into(),
                 ));
             };
-            Goal::Features(Features {
+            GoalSpec::Features(Features {
                 source: vertex_field(goal.get("source"), mesh, "source")?,
                 target: vertex_field(goal.get("target"), target_mesh, "target")?,
             })
@@ -222,15 +208,13 @@ fn vertex_field(value: Option<&Value>, mesh: &Mesh, side: &str) -> PyResult<Vec<
     }
 }
 
-/// The constraints of the description: pins, the normal and area constraints, the held
-/// boundary of `space`, landmarks.
+/// The pins and landmarks of the description.
 fn constraints(
     spec: &JsonMap<String, Value>,
-    problem: &mut Problem<'_>,
+    mesh: &Mesh,
     target_mesh: Option<&Mesh>,
-    inputs: &Inputs<'_>,
-) -> PyResult<()> {
-    let mesh = problem.source;
+) -> PyResult<Constraints> {
+    let mut out = Constraints::new();
     let pins = spec.get("pins").and_then(Value::as_array);
     let positions = spec.get("pin_positions").and_then(Value::as_array);
     for (k, pin) in pins.into_iter().flatten().enumerate() {
@@ -250,26 +234,10 @@ fn constraints(
                 )),
             }
         });
-        problem.constraints.push(Constraint::Pin(Pin {
+        out.push(Constraint::Pin(Pin {
             vertex: arrays::vertex(mesh, index, "pins")?,
             position: position.transpose()?,
         }));
-    }
-    if let Some(weight) = spec.get("normal_constraint").and_then(Value::as_f64) {
-        problem.constraints.push(Constraint::Normal { weight });
-    }
-    if spec.get("area_constraint").and_then(Value::as_bool) == Some(true) {
-        problem.constraints.push(Constraint::Area);
-    }
-    if text(spec, "target") == Some("space") {
-        let Some(map) = &inputs.boundary_map else {
-            return Err(option_error(
-                "target='space' holds the boundary at the positions of boundary_map, an (n, 3) array"
-                    .into(),
-            ));
-        };
-        let held = arrays::spatial(mesh, map.as_array(), "boundary_map")?;
-        problem.constraints.hold_boundary(mesh, &held);
     }
     for mark in spec
         .get("planar_landmarks")
@@ -278,19 +246,16 @@ fn constraints(
         .flatten()
     {
         let fields = mark.as_array().map(Vec::as_slice).unwrap_or_default();
-        let [v, x, y] = fields else {
+        let (Some(v), Some(x), Some(y)) = (match fields {
+            [v, x, y] => (v.as_i64(), x.as_f64(), y.as_f64()),
+            _ => (None, None, None),
+        }) else {
             return Err(errors::raise(
                 Kind::Constraint,
                 format!("landmark {mark}: expected (vertex, (x, y))"),
             ));
         };
-        let (Some(v), Some(x), Some(y)) = (v.as_i64(), x.as_f64(), y.as_f64()) else {
-            return Err(errors::raise(
-                Kind::Constraint,
-                format!("landmark {mark}: expected (vertex, (x, y))"),
-            ));
-        };
-        problem.constraints.push(Constraint::Landmark(Landmark {
+        out.push(Constraint::Landmark(Landmark {
             vertex: arrays::vertex(mesh, v, "landmarks")?,
             position: Position::Planar(Complex64::new(x, y)),
         }));
@@ -298,42 +263,24 @@ fn constraints(
     if let (Some(source), Some(target)) = (text(spec, "landmarks"), target_mesh) {
         let marks = Landmarks::parse(Path::new("landmarks"), source, mesh, target)
             .map_err(|e| errors::from_error(Kind::Constraint, &e))?;
-        problem
-            .constraints
-            .extend(marks.constraints().iter().cloned());
+        out.extend(marks.constraints().iter().cloned());
     }
-    Ok(())
+    Ok(out)
 }
 
-/// Sets the description's `options` (always) and `defaults` (when `solver` declares
-/// them), as the command line's `solver_options` does.
-fn options(
-    spec: &JsonMap<String, Value>,
-    problem: &mut Problem<'_>,
-    solver: &dyn beltrami_core::Solver,
-) {
-    let declared = |name: &str| solver.options().iter().any(|s| s.name == name);
-    let entries = |key: &str| {
-        spec.get(key)
-            .and_then(Value::as_object)
-            .into_iter()
-            .flatten()
-            .map(|(k, v)| {
-                (
-                    k.clone(),
-                    v.as_str().map_or_else(|| v.to_string(), str::to_string),
-                )
-            })
-            .collect::<Vec<_>>()
-    };
-    for (name, value) in entries("defaults") {
-        if declared(&name) {
-            problem.options.set_text(&name, &value);
-        }
-    }
-    for (name, value) in entries("options") {
-        problem.options.set_text(&name, &value);
-    }
+/// The `{name: value}` entries of `key` (`options` or `defaults`), values as text.
+fn entries(spec: &JsonMap<String, Value>, key: &str) -> Vec<(String, String)> {
+    spec.get(key)
+        .and_then(Value::as_object)
+        .into_iter()
+        .flatten()
+        .map(|(k, v)| {
+            (
+                k.clone(),
+                v.as_str().map_or_else(|| v.to_string(), str::to_string),
+            )
+        })
+        .collect()
 }
 
 /// Checks and runs `solver` on `problem` with the GIL released; Python's signals are
@@ -440,19 +387,12 @@ pub fn solve<'py>(
         _ => None,
     };
 
-    let mut problem = Problem::new(&mesh, target(&spec, &mesh, target_mesh.as_ref(), &inputs)?);
-    if let Some(goal) = goal(&spec, &mesh, target_mesh.as_ref(), &inputs)? {
-        problem.goal = goal;
-    }
-    if let Some(initial) = &inputs.initial {
-        problem.initial = Some(Map::Planar(arrays::planar(
-            &mesh,
-            initial.as_array(),
-            "init",
-        )?));
-    }
-    constraints(&spec, &mut problem, target_mesh.as_ref(), &inputs)?;
-    options(&spec, &mut problem, solver);
+    let problem = spec_of(&spec, &mesh, target_mesh.as_ref(), &inputs)?
+        .problem(&mesh, target_mesh.as_ref(), solver)
+        .map_err(|e| match e {
+            SpecError::Field { .. } => errors::from_error(Kind::Field, &e),
+            SpecError::Words { .. } => errors::from_error(Kind::Option, &e),
+        })?;
 
     let pieces = pieces_of(&spec)?;
     let parts = match pieces {

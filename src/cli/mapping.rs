@@ -7,9 +7,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, bail};
 use beltrami::map_file::{self, Image};
 use beltrami::report;
-use beltrami_core::{
-    Context, OptionValue, Options, Pin, Problem, Progress, Solution, Solver, Target,
-};
+use beltrami_core::{Context, Pin, Problem, Progress, Solution, Solver, Target};
 use beltrami_fem::ReferenceNormal;
 use beltrami_mesh::Mesh;
 use beltrami_mesh::io::obj::MeshSections;
@@ -54,34 +52,6 @@ fn option_pair(text: &str) -> Result<(String, String), String> {
         }
         _ => Err(format!("expected NAME=VALUE, got `{text}`")),
     }
-}
-
-/// The solver options of a command: each of `command` (an option name, the value the
-/// user gave with a dedicated flag, and the command's default) is set when given, or
-/// set to the command's default when the solver declares that option; then every
-/// `--option NAME=VALUE`. Types and ranges are checked by the solver before any work.
-pub fn solver_options(
-    solver: &dyn Solver,
-    command: &[(&str, Option<OptionValue>, Option<OptionValue>)],
-    common: &CommonArgs,
-) -> Options {
-    let mut options = Options::new();
-    let declared = |name: &str| solver.options().iter().any(|s| s.name == name);
-    for (name, given, default) in command {
-        match (given, default) {
-            (Some(value), _) => {
-                options.set(name, value.clone());
-            }
-            (None, Some(value)) if declared(name) => {
-                options.set(name, value.clone());
-            }
-            _ => {}
-        }
-    }
-    for (name, value) in &common.options {
-        options.set_text(name, value);
-    }
-    options
 }
 
 /// How a solve reports progress.

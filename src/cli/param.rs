@@ -3,10 +3,8 @@
 use std::path::PathBuf;
 
 use beltrami::map_file;
-use beltrami_core::{
-    Constraint, GoalKind, OptionValue, PlanarBoundary, Problem, Solver, Target, TargetKind,
-    components,
-};
+use beltrami::problem_spec::{BoundaryDefault, BoundaryName, ProblemSpec, TargetName};
+use beltrami_core::{Constraint, GoalKind, OptionValue, components};
 use clap::{Args, ValueEnum};
 
 use super::load::{ComponentsArg, load_mesh};
@@ -80,63 +78,51 @@ pub struct ParamArgs {
     pub common: mapping::CommonArgs,
 }
 
-/// The target: the unit sphere for a solver that maps only onto it, when no
-/// `--boundary` is given; otherwise the plane with the boundary of `--boundary`, by
-/// default the first of circle, square and free the solver takes, in the order of its
-/// accepted targets (a solver that cannot take the boundary refuses it in its check).
-fn target_of(args: &ParamArgs, solver: &dyn Solver) -> Target<'static> {
-    let accepts = solver.accepts();
-    if args.boundary.is_none() && accepts.targets == [TargetKind::Sphere] {
-        return Target::Sphere;
-    }
-    if args.boundary.is_none() && accepts.targets == [TargetKind::CircleDomain] {
-        return Target::CircleDomain;
-    }
-    let first = accepts.targets.iter().find_map(|kind| match kind {
-        TargetKind::PlaneCircle => Some(BoundaryArg::Circle),
-        TargetKind::PlaneSquare => Some(BoundaryArg::Square),
-        TargetKind::PlaneFree => Some(BoundaryArg::Free),
-        _ => None,
+/// The problem's words from the flags: the plane with the boundary of `--boundary`, by
+/// default the first of circle, square and free the solver takes (the unit sphere or a
+/// circle domain for a solver that maps only onto one), `--weights`, `--outer` and
+/// `--option`.
+fn spec_of(args: &ParamArgs) -> ProblemSpec {
+    let mut spec = ProblemSpec::new(TargetName::Plane);
+    spec.solver = Some(args.solver.clone());
+    spec.boundary = args.boundary.map(|b| match b {
+        BoundaryArg::Circle => BoundaryName::Circle,
+        BoundaryArg::Square => BoundaryName::Square,
+        BoundaryArg::Free => BoundaryName::Free,
     });
-    Target::Plane(
-        match args.boundary.or(first).unwrap_or(BoundaryArg::Circle) {
-            BoundaryArg::Circle => PlanarBoundary::Circle,
-            BoundaryArg::Square => PlanarBoundary::Square { corners: None },
-            BoundaryArg::Free => PlanarBoundary::Free,
-        },
-    )
+    spec.boundary_default = BoundaryDefault::Shaped;
+    let weights = args.weights.map(|w| match w {
+        WeightsArg::Uniform => "uniform",
+        WeightsArg::MeanValue => "mean-value",
+        WeightsArg::Cotan => "cotan",
+    });
+    if let Some(weights) = weights {
+        spec.options
+            .set("weights", OptionValue::Choice(weights.to_string()));
+    }
+    if let Some(outer) = args.outer {
+        spec.options.set("outer", OptionValue::Int(outer + 1));
+    }
+    for (name, value) in &args.common.options {
+        spec.options.set_text(name, value);
+    }
+    spec
 }
 
 pub fn run(args: &ParamArgs, quiet: bool) -> anyhow::Result<()> {
     mapping::check_outputs(&args.output, &args.common, &[])?;
+    let mut spec = spec_of(args);
     let registry = beltrami::registry();
-    let solver = registry.get(&args.solver)?;
-    mapping::check_output_holds_map(&args.output, &target_of(args, solver))?;
+    let solver = registry.get(spec.solver_name())?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
-
-    let mut problem = Problem::new(mesh, target_of(args, solver));
-    let weights = args.weights.map(|w| {
-        OptionValue::Choice(
-            match w {
-                WeightsArg::Uniform => "uniform",
-                WeightsArg::MeanValue => "mean-value",
-                WeightsArg::Cotan => "cotan",
-            }
-            .to_string(),
-        )
-    });
-    let outer = args.outer.map(|l| OptionValue::Int(l + 1));
-    problem.options = mapping::solver_options(
-        solver,
-        &[("weights", weights, None), ("outer", outer, None)],
-        &args.common,
-    );
-    problem.constraints.extend(
+    spec.constraints.extend(
         mapping::resolve_pins(&args.pins, mesh)?
             .into_iter()
             .map(Constraint::Pin),
     );
+    let problem = spec.problem(mesh, None, solver)?;
+    mapping::check_output_holds_map(&args.output, &problem.target)?;
 
     let progress = args.common.progress(quiet);
     let parts;

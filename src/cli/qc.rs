@@ -13,11 +13,11 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use beltrami::map_file;
-use beltrami_core::{
-    Constraint, Goal, GoalKind, Map, OptionValue, Options, PlanarBoundary, Position, Problem,
-    Solution, Solver, Target, TargetKind,
+use beltrami::problem_spec::{
+    BoundaryDefault, BoundaryMap, BoundaryName, GoalSpec, ProblemSpec, TargetName,
 };
-use beltrami_fem::{BeltramiField, Expr};
+use beltrami_core::{Constraint, Goal, GoalKind, Map, OptionValue, Solution, Solver, Target};
+use beltrami_fem::BeltramiField;
 use beltrami_mesh::Mesh;
 use clap::{ArgGroup, Args, ValueEnum};
 use num_complex::Complex64;
@@ -151,45 +151,30 @@ pub struct QcArgs {
     pub common: mapping::CommonArgs,
 }
 
-/// The goal of `--mu`, `--mu-expr` or `--conformal`; without one, the extremal map for
-/// a solver that computes extremal maps.
-fn goal_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<Goal> {
+/// The goal of `--mu`, `--mu-expr` or `--conformal`; without one, the solver's
+/// extremal map (a solver that computes none needs a goal flag).
+fn goal_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<Option<GoalSpec>> {
     if args.mu.is_none() && args.mu_expr.is_none() && !args.conformal {
         if solver.accepts().goals.contains(&GoalKind::Extremal) {
-            return Ok(Goal::Extremal);
+            return Ok(None);
         }
         bail!("give the goal with --mu FILE, --mu-expr EXPR or --conformal");
     }
     if args.conformal {
-        return Ok(Goal::Conformal {
-            p: args.p.unwrap_or(2.0),
-        });
+        return Ok(Some(GoalSpec::Conformal { p: args.p }));
     }
     if args.p.is_some() {
         bail!("--p is the exponent of --conformal; a prescribed mu has no exponent");
     }
-    let field = if let Some(path) = &args.mu {
-        BeltramiField::read(path, mesh.face_count())?
-    } else {
-        let Some(text) = &args.mu_expr else {
-            bail!("give the goal with --mu FILE, --mu-expr EXPR or --conformal");
-        };
-        let expr = Expr::parse(text).with_context(|| format!("--mu-expr `{text}`"))?;
-        if args.target == TargetArg::Sphere {
-            beltrami_flow::stereographic::field(mesh, |z| expr.eval(z))
-                .with_context(|| format!("--mu-expr `{text}` on the sphere"))?
-        } else {
-            expr.field(mesh).with_context(|| {
-                "--mu-expr evaluates mu at z = x + i y and needs a mesh in the plane z = 0; give a per-face field with --mu"
-            })?
-        }
-    };
-    Ok(Goal::Prescribed(field))
+    Ok(Some(match (&args.mu, &args.mu_expr) {
+        (Some(path), _) => GoalSpec::Mu(BeltramiField::read(path, mesh.face_count())?),
+        (None, Some(text)) => GoalSpec::MuExpr(text.clone()),
+        (None, None) => bail!("give the goal with --mu FILE, --mu-expr EXPR or --conformal"),
+    }))
 }
 
-/// The planar map of `--boundary-map` ([`beltrami::mapped::read_planar`]).
 /// The planar map of the file `path` given to `flag` (`--boundary-map` or `--init`),
-/// named in errors.
+/// named in errors ([`beltrami::mapped::read_planar`]).
 fn planar_map_file(
     flag: &str,
     path: &std::path::Path,
@@ -199,130 +184,55 @@ fn planar_map_file(
         .with_context(|| format!("{flag} {}", path.display()))
 }
 
-/// The target of `--target` (and `--boundary`, `--free-radius`). `--target plane` is
-/// the plane with the boundary condition of `--boundary` for every solver (a solver that
-/// cannot take it refuses it in its check); without `--boundary`, a free boundary when
-/// the solver takes one, else the input's own.
-fn target_of(args: &QcArgs, mesh: &Mesh, solver: &dyn Solver) -> anyhow::Result<Target<'static>> {
-    if args.target == TargetArg::Plane && solver.accepts().targets == [TargetKind::CircleDomain] {
-        return Ok(Target::CircleDomain);
-    }
-    Ok(match args.target {
-        TargetArg::Plane => {
-            let free = solver.accepts().targets.contains(&TargetKind::PlaneFree);
-            let default = if free {
-                QcBoundaryArg::Free
-            } else {
-                QcBoundaryArg::Keep
-            };
-            Target::Plane(match args.boundary.unwrap_or(default) {
-                QcBoundaryArg::Keep => PlanarBoundary::Keep,
-                QcBoundaryArg::Free => PlanarBoundary::Free,
-                QcBoundaryArg::Given => {
-                    let Some(path) = &args.boundary_map else {
-                        bail!("--boundary given needs --boundary-map FILE");
-                    };
-                    PlanarBoundary::Given(planar_map_file("--boundary-map", path, mesh)?)
-                }
-            })
-        }
-        TargetArg::Disk => Target::Disk,
-        TargetArg::Annulus => Target::Annulus {
-            inner_radius: if args.free_radius {
-                None
-            } else {
-                beltrami_flow_engine::annulus_inner_radius(mesh)
-            },
-        },
-        TargetArg::Sphere => Target::Sphere,
-        TargetArg::Space => Target::Surface,
-    })
+/// The problem's words from the flags, before any mesh is read: the target, boundary,
+/// radius, normal and area constraints and the solver's name.
+fn spec_of(args: &QcArgs) -> ProblemSpec {
+    let mut spec = ProblemSpec::new(match args.target {
+        TargetArg::Plane => TargetName::Plane,
+        TargetArg::Disk => TargetName::Disk,
+        TargetArg::Annulus => TargetName::Annulus,
+        TargetArg::Sphere => TargetName::Sphere,
+        TargetArg::Space => TargetName::Space,
+    });
+    spec.solver = args.solver.clone();
+    spec.boundary = args.boundary.map(|b| match b {
+        QcBoundaryArg::Keep => BoundaryName::Keep,
+        QcBoundaryArg::Free => BoundaryName::Free,
+        QcBoundaryArg::Given => BoundaryName::Given,
+    });
+    spec.boundary_default = BoundaryDefault::FreeOrKeep;
+    spec.free_radius = args.free_radius;
+    spec.normal_constraint = args.normal_constraint;
+    spec.area_constraint = args.area_constraint;
+    spec
 }
 
-/// The solver of `--solver`, or the one that maps onto `--target`: lsqc onto the plane
-/// (one linear solve), beltrami-flow onto the disk, an annulus or the sphere (lsqc maps
-/// into the plane only).
-fn solver_name(args: &QcArgs) -> &str {
-    match (&args.solver, args.target) {
-        (Some(name), _) => name,
-        (None, TargetArg::Plane) => "lsqc",
-        (None, TargetArg::Disk | TargetArg::Annulus | TargetArg::Sphere) => "beltrami-flow",
-        (None, TargetArg::Space) => "lsqc",
-    }
-}
-
-/// Refuses, before any work, flags that the other flags make meaningless (they would be
-/// ignored silently): `--boundary` and `--boundary-map` off the plane target,
-/// `--boundary-map` without `--boundary given`, `--qd` off the extremal solver,
-/// `--free-radius` off the annulus target.
-fn check_flag_use(args: &QcArgs) -> anyhow::Result<()> {
-    let target = format!("{:?}", args.target).to_lowercase();
-    if args.boundary.is_some() && !matches!(args.target, TargetArg::Plane | TargetArg::Space) {
-        bail!(
-            "--boundary is the boundary condition of --target plane and space; --target {target} has its own"
-        );
-    }
-    if let Some(w) = args.normal_constraint {
-        if args.target != TargetArg::Space {
-            bail!(
-                "--normal-constraint keeps a map into space near the surface: it needs --target space"
-            );
-        }
-        if !(w.is_finite() && w > 0.0) {
-            bail!("--normal-constraint {w}: the weight must be a positive number");
-        }
-    }
-    if args.area_constraint && args.target != TargetArg::Space {
-        bail!("--area-constraint keeps the area of a map into space: it needs --target space");
-    }
-    if args.target == TargetArg::Space
-        && args.boundary != Some(QcBoundaryArg::Given)
-        && args.pins.is_empty()
-    {
-        bail!(
-            "--target space holds vertices where they go: the boundary at the positions of a map (add --boundary given --boundary-map MAP), or vertices where they are (--pin)"
-        );
-    }
-    if args.boundary_map.is_some() && args.boundary != Some(QcBoundaryArg::Given) {
-        bail!(
-            "--boundary-map gives the boundary of --boundary given; add that or drop --boundary-map"
-        );
-    }
-    if args.qd.is_some() && solver_name(args) != "extremal" {
-        bail!(
-            "--qd writes the quadratic differential of --solver extremal; {} computes none",
-            solver_name(args)
-        );
-    }
-    if args.landmarks.is_some() && args.target != TargetArg::Disk {
-        bail!(
-            "--landmarks moves boundary points of --target disk (the four-point problem); --target {target} holds its boundary otherwise"
-        );
-    }
-    if args.free_radius && args.target != TargetArg::Annulus {
-        bail!(
-            "--free-radius lets the inner radius of --target annulus move; --target {target} has none"
-        );
+/// Refuses, before any work, `--qd` off the extremal solver; the flags that the others
+/// make meaningless are refused by [`ProblemSpec::check_words`] once their files are
+/// read.
+fn check_qd(args: &QcArgs, spec: &ProblemSpec) -> anyhow::Result<()> {
+    let name = spec.solver_name();
+    if args.qd.is_some() && name != "extremal" {
+        bail!("--qd writes the quadratic differential of --solver extremal; {name} computes none");
     }
     Ok(())
 }
 
 pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     mapping::check_outputs(&args.output, &args.common, &[("--qd", args.qd.as_deref())])?;
-    check_flag_use(args)?;
+    let mut spec = spec_of(args);
+    check_qd(args, &spec)?;
     let registry = beltrami::registry();
-    let solver = registry.get(solver_name(args))?;
+    let solver = registry.get(spec.solver_name())?;
     let loaded = load_mesh(&args.mesh, args.common.repair, quiet || args.common.json)?;
     let mesh = &loaded.mesh.mesh;
-    let goal = goal_of(args, mesh, solver)?;
-
-    let target = target_of(args, mesh, solver)?;
-    mapping::check_output_holds_map(&args.output, &target)?;
-    let mut problem = Problem::new(mesh, target);
-    problem.goal = goal;
-    let init = initial_of(args, mesh, &mut problem)?;
-    add_constraints(args, mesh, &mut problem)?;
-    problem.options = options_of(args, solver, init);
+    spec.goal = goal_of(args, mesh, solver)?;
+    spec.boundary_map = boundary_map_of(args, mesh)?;
+    spec.initial = initial_of(args, mesh)?;
+    add_constraints(args, mesh, &mut spec)?;
+    set_options(args, &mut spec);
+    let problem = spec.problem(mesh, None, solver)?;
+    mapping::check_output_holds_map(&args.output, &problem.target)?;
 
     let (solution, seconds, sections) = mapping::solve_formatting_output(
         solver,
@@ -332,7 +242,7 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     )?;
     if let (Some(Map::Spatial(_)), false) = (
         solution.map(),
-        matches!(args.target, TargetArg::Sphere | TargetArg::Space),
+        matches!(problem.target, Target::Sphere | Target::Surface),
     ) {
         bail!("{} gave points in space for a planar target", solver.name());
     }
@@ -360,86 +270,78 @@ pub fn run(args: &QcArgs, quiet: bool) -> anyhow::Result<()> {
     )
 }
 
-/// The start of an iterative solver from `--init`: the name of a start the solver
-/// computes (`harmonic`, `tutte`), or a map read from a file into `problem.initial`.
-fn initial_of<'a>(
-    args: &'a QcArgs,
-    mesh: &Mesh,
-    problem: &mut Problem<'_>,
-) -> anyhow::Result<Option<&'a str>> {
-    Ok(match args.init.as_deref() {
-        None => None,
-        Some(name @ ("harmonic" | "tutte")) => Some(name),
-        Some(path) => {
-            let path = std::path::Path::new(path);
-            problem.initial = Some(Map::Planar(planar_map_file("--init", path, mesh)?));
-            None
-        }
-    })
+/// The map of `--boundary-map`: planar for the plane's `given` boundary, points of R^3
+/// into space.
+fn boundary_map_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<Option<BoundaryMap>> {
+    let Some(path) = &args.boundary_map else {
+        return Ok(None);
+    };
+    Ok(Some(if args.target == TargetArg::Space {
+        BoundaryMap::Spatial(
+            beltrami::mapped::read_spatial(path, mesh, false)
+                .with_context(|| format!("--boundary-map {}", path.display()))?,
+        )
+    } else {
+        BoundaryMap::Planar(planar_map_file("--boundary-map", path, mesh)?)
+    }))
 }
 
-/// The constraints of the command line: `--pin`, `--normal-constraint`,
-/// `--area-constraint`, `--landmarks` and, into space, the boundary of
-/// `--boundary-map` held.
-fn add_constraints(args: &QcArgs, mesh: &Mesh, problem: &mut Problem<'_>) -> anyhow::Result<()> {
-    // Into space a pin holds its vertex where it is (with the area constraint, one pin
-    // fixes a closed surface: docs/qc-space.md).
-    let space = args.target == TargetArg::Space;
-    problem
-        .constraints
-        .extend(
-            mapping::resolve_pins(&args.pins, mesh)?
-                .into_iter()
-                .map(|mut pin| {
-                    if space {
-                        pin.position = Some(Position::Spatial(mesh.position(pin.vertex)));
-                    }
-                    Constraint::Pin(pin)
-                }),
-        );
-    if let Some(weight) = args.normal_constraint {
-        problem.constraints.push(Constraint::Normal { weight });
+/// The start map of `--init` read from a file (a name, `harmonic` or `tutte`, is the
+/// solver's `init` option instead).
+fn initial_of(args: &QcArgs, mesh: &Mesh) -> anyhow::Result<Option<Vec<Complex64>>> {
+    match args.init.as_deref() {
+        None | Some("harmonic" | "tutte") => Ok(None),
+        Some(path) => Ok(Some(planar_map_file(
+            "--init",
+            std::path::Path::new(path),
+            mesh,
+        )?)),
     }
-    if args.area_constraint {
-        problem.constraints.push(Constraint::Area);
-    }
+}
+
+/// The constraints of `--pin` and `--landmarks`.
+fn add_constraints(args: &QcArgs, mesh: &Mesh, spec: &mut ProblemSpec) -> anyhow::Result<()> {
+    spec.constraints.extend(
+        mapping::resolve_pins(&args.pins, mesh)?
+            .into_iter()
+            .map(Constraint::Pin),
+    );
     if let Some(path) = &args.landmarks {
-        problem.constraints.extend(
+        spec.constraints.extend(
             beltrami::landmarks::read_planar(path, mesh)?
                 .into_iter()
                 .map(Constraint::Landmark),
         );
     }
-    if let (TargetArg::Space, Some(path)) = (args.target, &args.boundary_map) {
-        let held = beltrami::mapped::read_spatial(path, mesh, false)
-            .with_context(|| format!("--boundary-map {}", path.display()))?;
-        problem.constraints.hold_boundary(mesh, &held);
-    }
     Ok(())
 }
 
-/// The solver's options from the command's flags (`init` the start `--init` names)
-/// and `--option`.
-fn options_of(args: &QcArgs, solver: &dyn Solver, init: Option<&str>) -> Options {
-    mapping::solver_options(
-        solver,
-        &[
-            (
-                "tolerance",
-                args.tolerance.map(OptionValue::Float),
-                Some(OptionValue::Float(1e-6)),
-            ),
-            (
-                "max-iters",
-                args.max_iters.map(OptionValue::Int),
-                Some(OptionValue::Int(200)),
-            ),
-            ("threads", args.threads.map(OptionValue::Int), None),
-            ("outer", args.outer.map(|l| OptionValue::Int(l + 1)), None),
-            ("init", init.map(|s| OptionValue::Choice(s.into())), None),
-        ],
-        &args.common,
-    )
+/// The solver's options from the command's flags (`--init` naming a start the solver
+/// computes) with the command's defaults, and `--option`.
+fn set_options(args: &QcArgs, spec: &mut ProblemSpec) {
+    let init = args
+        .init
+        .as_deref()
+        .filter(|name| matches!(*name, "harmonic" | "tutte"));
+    spec.defaults = vec![
+        ("tolerance".into(), OptionValue::Float(1e-6)),
+        ("max-iters".into(), OptionValue::Int(200)),
+    ];
+    let given = [
+        ("tolerance", args.tolerance.map(OptionValue::Float)),
+        ("max-iters", args.max_iters.map(OptionValue::Int)),
+        ("threads", args.threads.map(OptionValue::Int)),
+        ("outer", args.outer.map(|l| OptionValue::Int(l + 1))),
+        ("init", init.map(|s| OptionValue::Choice(s.into()))),
+    ];
+    for (name, value) in given {
+        if let Some(value) = value {
+            spec.options.set(name, value);
+        }
+    }
+    for (name, value) in &args.common.options {
+        spec.options.set_text(name, value);
+    }
 }
 
 /// The JSON report of a run and the summary's lines after the common ones: the target

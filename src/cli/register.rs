@@ -6,8 +6,9 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use beltrami::landmarks::Landmarks;
+use beltrami::problem_spec::{GoalSpec, ProblemSpec, TargetName};
 use beltrami::{correspondence, map_file, report, vertex_field};
-use beltrami_core::{Features, Goal, Map, OptionValue, Options, Problem, Solution, Solver, Target};
+use beltrami_core::{Features, Goal, Map, OptionValue, Problem, Solution, Target};
 use beltrami_fem::BeltramiField;
 use beltrami_mesh::Mesh;
 use beltrami_register::{InverseConsistency, inverse_consistency};
@@ -94,16 +95,14 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
     let source = &source_loaded.mesh.mesh;
     let target = &target_loaded.mesh.mesh;
 
-    let mut problem = Problem::new(source, Target::Mesh(target));
-    problem.goal = goal_of(args, source, target)?;
+    let mut spec = spec_of(args);
+    spec.goal = Some(goal_of(args, source, target)?);
     let marks = match &args.landmarks {
         Some(path) => Landmarks::read(path, source, target)?,
         None => Landmarks::default(),
     };
-    problem
-        .constraints
-        .extend(marks.constraints().iter().cloned());
-    problem.options = options_of(args, solver);
+    spec.constraints = marks.constraints();
+    let problem = spec.problem(source, Some(target), solver)?;
 
     let (solution, seconds) = mapping::solve(solver, &problem, args.common.progress(quiet))?;
     // The way back runs before anything is written: a failure there writes nothing.
@@ -143,7 +142,7 @@ pub fn run(args: &RegisterArgs, quiet: bool) -> anyhow::Result<()> {
 }
 
 /// The goal of `--mu`, `--p` and `--features`, refused when they are combined.
-fn goal_of(args: &RegisterArgs, source: &Mesh, target: &Mesh) -> anyhow::Result<Goal> {
+fn goal_of(args: &RegisterArgs, source: &Mesh, target: &Mesh) -> anyhow::Result<GoalSpec> {
     Ok(match (&args.mu, args.p, args.features.as_deref()) {
         (Some(_), Some(_), _) => {
             bail!("--p is the exponent of the conformal goal; a prescribed --mu has no exponent")
@@ -153,55 +152,51 @@ fn goal_of(args: &RegisterArgs, source: &Mesh, target: &Mesh) -> anyhow::Result<
                 "--features matches fields with the least-squares conformal map as its start; it takes neither --p nor --mu"
             )
         }
-        (None, None, Some([source_field, target_field])) => Goal::Features(Features {
+        (None, None, Some([source_field, target_field])) => GoalSpec::Features(Features {
             source: vertex_field::read(source_field, source)?,
             target: vertex_field::read(target_field, target)?,
         }),
         (None, None, Some(_)) => bail!("--features takes two fields: SOURCE_FIELD TARGET_FIELD"),
-        (Some(path), None, None) => {
-            Goal::Prescribed(BeltramiField::read(path, source.face_count())?)
-        }
-        (None, p, None) => Goal::Conformal {
-            p: p.unwrap_or(2.0),
-        },
+        (Some(path), None, None) => GoalSpec::Mu(BeltramiField::read(path, source.face_count())?),
+        (None, p, None) => GoalSpec::Conformal { p },
     })
 }
 
-/// The register solver's options from the command's flags and `--option`.
-fn options_of(args: &RegisterArgs, solver: &dyn Solver) -> Options {
-    mapping::solver_options(
-        solver,
-        &[
-            (
-                "tolerance",
-                args.tolerance.map(OptionValue::Float),
-                Some(OptionValue::Float(1e-5)),
-            ),
-            (
-                "max-iters",
-                args.max_iters.map(OptionValue::Int),
-                Some(OptionValue::Int(100)),
-            ),
-            ("threads", args.threads.map(OptionValue::Int), None),
-            (
-                "allow-flips",
-                args.allow_flips.then_some(OptionValue::Bool(true)),
-                None,
-            ),
-            (
-                "allow-missed-landmarks",
-                args.allow_missed_landmarks
-                    .then_some(OptionValue::Bool(true)),
-                None,
-            ),
-            (
-                "match-shape",
-                args.match_shape.then_some(OptionValue::Bool(true)),
-                None,
-            ),
-        ],
-        &args.common,
-    )
+/// The problem's words from the flags: onto the target mesh, the command's defaults
+/// (`tolerance` 1e-5, `max-iters` 100), the option flags and `--option`.
+fn spec_of(args: &RegisterArgs) -> ProblemSpec {
+    let mut spec = ProblemSpec::new(TargetName::Mesh);
+    spec.defaults = vec![
+        ("tolerance".into(), OptionValue::Float(1e-5)),
+        ("max-iters".into(), OptionValue::Int(100)),
+    ];
+    let given = [
+        ("tolerance", args.tolerance.map(OptionValue::Float)),
+        ("max-iters", args.max_iters.map(OptionValue::Int)),
+        ("threads", args.threads.map(OptionValue::Int)),
+        (
+            "allow-flips",
+            args.allow_flips.then_some(OptionValue::Bool(true)),
+        ),
+        (
+            "allow-missed-landmarks",
+            args.allow_missed_landmarks
+                .then_some(OptionValue::Bool(true)),
+        ),
+        (
+            "match-shape",
+            args.match_shape.then_some(OptionValue::Bool(true)),
+        ),
+    ];
+    for (name, value) in given {
+        if let Some(value) = value {
+            spec.options.set(name, value);
+        }
+    }
+    for (name, value) in &args.common.options {
+        spec.options.set_text(name, value);
+    }
+    spec
 }
 
 /// The JSON report of a registration and the summary's lines after the common ones:
@@ -285,9 +280,7 @@ fn round_trip(
             "--inverse-consistency: landmarks line {line} is a `p` line, which has no target vertex to start the registration back from; give `v SRC TGT` lines"
         )
     })?;
-    reverse
-        .constraints
-        .extend(reversed.constraints().iter().cloned());
+    reverse.constraints = reversed.constraints();
     reverse.options = problem.options.clone();
     let registry = beltrami::registry();
     let solver = registry.get("register")?;

@@ -109,6 +109,41 @@ impl Channel {
     }
 }
 
+/// The demons force of every vertex (module docs), summed over the channels:
+/// `u_i = sum_c r_ci g_ci / (sum_c |g_ci|^2 + alpha^2 sum_c r_ci^2)` with
+/// `r_ci = I_c(v_i) - J_c(f(v_i))` and `g_ci = grad J_c` at `f(v_i)` (`probe`), zero on
+/// held vertices and where the fields are flat and agree.
+fn demons_force(
+    source_fields: &[Vec<f64>],
+    probe: &Probe,
+    held: &[bool],
+    alpha: f64,
+) -> Vec<Complex64> {
+    let zero = Complex64::new(0.0, 0.0);
+    (0..held.len())
+        .map(|i| {
+            if held[i] {
+                return zero;
+            }
+            let mut pull = zero;
+            let (mut slope, mut residual) = (0.0, 0.0);
+            for (c, field) in source_fields.iter().enumerate() {
+                let r = field[i] - probe.values[c][i];
+                let g = probe.gradients[c][i];
+                pull += g * r;
+                slope += g.norm_sqr();
+                residual += r * r;
+            }
+            let denominator = slope + alpha * alpha * residual;
+            if denominator > 0.0 {
+                pull / denominator
+            } else {
+                zero
+            }
+        })
+        .collect()
+}
+
 /// A map that matches the fields and how far it got.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FeatureMatch {
@@ -177,28 +212,7 @@ pub(crate) fn match_features(
         let mut length = 1.0;
         let mut level_steps = 0;
         while level_steps < MAX_STEPS && length >= MIN_STEP {
-            let force: Vec<Complex64> = (0..map.len())
-                .map(|i| {
-                    if held[i] {
-                        return Complex64::new(0.0, 0.0);
-                    }
-                    let mut pull = Complex64::new(0.0, 0.0);
-                    let (mut slope, mut residual) = (0.0, 0.0);
-                    for (c, field) in source_fields.iter().enumerate() {
-                        let r = field[i] - probe.values[c][i];
-                        let g = probe.gradients[c][i];
-                        pull += g * r;
-                        slope += g.norm_sqr();
-                        residual += r * r;
-                    }
-                    let denominator = slope + alpha * alpha * residual;
-                    if denominator > 0.0 {
-                        pull / denominator
-                    } else {
-                        Complex64::new(0.0, 0.0)
-                    }
-                })
-                .collect();
+            let force = demons_force(&source_fields, &probe, &held, alpha);
             let force = smoothed(&neighbours, Some(&held), force, FORCE_SMOOTHING);
             let moved: Vec<Complex64> = map
                 .iter()
