@@ -35,6 +35,7 @@ pub fn solver_json(solver: &dyn Solver) -> Value {
                     o["default"] = json!(default);
                     o["choices"] = json!(choices);
                 }
+                OptionKind::Name { default } => o["default"] = json!(default),
             }
             o
         })
@@ -91,6 +92,7 @@ pub fn solver_text(solver: &dyn Solver) -> String {
             OptionKind::Choice { default, choices } => {
                 format!("= {default} {{{}}}", choices.join(", "))
             }
+            OptionKind::Name { default } => format!("= {default}"),
         };
         out.push_str(&format!(
             "{:<14} option {} ({}) {range}: {}\n",
@@ -103,11 +105,16 @@ pub fn solver_text(solver: &dyn Solver) -> String {
     out
 }
 
-/// The registered solvers that map into a parameter domain (any target but a mesh)
-/// and take `goal`, by name in the registry's order: `param` lists those of the
-/// conformal goal, `qc` those of a prescribed coefficient or an extremal map.
+/// The registered solvers that map into a parameter domain (a target other than a
+/// mesh or the source surface itself) and take `goal`, by name in the registry's order:
+/// `param` lists those of the conformal goal, `qc` those of a prescribed coefficient or
+/// an extremal map.
 pub fn domain_solvers(goal: impl Fn(&[GoalKind]) -> bool) -> Vec<&'static str> {
-    let onto_domain = |a: &Accepts| a.targets.iter().any(|t| *t != TargetKind::Mesh);
+    let onto_domain = |a: &Accepts| {
+        a.targets
+            .iter()
+            .any(|t| !matches!(t, TargetKind::Mesh | TargetKind::Surface))
+    };
     crate::registry()
         .iter()
         .filter(|solver| {

@@ -33,6 +33,8 @@
 //!   condition, in the plane and from surfaces into R^3 (qc-iteration).
 //! - [`remesh`]: remeshing through a parameterization (spade's constrained Delaunay
 //!   refinement of the parameter domain with a size field measured on the surface).
+//! - [`remesh_solver`]: the remeshing as the registered solver `remesh` (through any
+//!   registered parameterizer, or in place by reference angles).
 //! - [`atlas`]: texture atlases of any triangle mesh (cones, cuts, boundary first
 //!   flattening, charts split where they overlap, packing) and texture stretch.
 //! - [`render`]: pictures of maps (uv and 3D views, |mu| colors, checkerboards) and
@@ -84,6 +86,7 @@ pub use beltrami_qc_iteration as qc_iteration;
 pub use beltrami_qcmc as qcmc;
 pub use beltrami_register as register;
 pub use beltrami_remesh as remesh;
+pub use beltrami_remesh_solver as remesh_solver;
 pub use beltrami_render as render;
 pub use beltrami_sparse as sparse;
 pub use beltrami_spatial as spatial;
@@ -99,5 +102,6 @@ pub fn registry() -> beltrami_core::Registry {
     beltrami_extremal::register(&mut registry);
     beltrami_qc_iteration::register(&mut registry);
     beltrami_affine::register(&mut registry);
+    beltrami_remesh_solver::register(&mut registry, crate::registry);
     registry
 }

@@ -33,7 +33,7 @@
 //! text of an error and its causes, as the command-line program and the Python package
 //! print it.
 
-use beltrami_core::{Circle, Solution};
+use beltrami_core::{Circle, InPlaceSummary, ParamSummary, Report, Solution};
 use beltrami_fem::MuError;
 use beltrami_mesh::Mesh;
 use serde_json::{Map as JsonMap, Value, json};
@@ -187,28 +187,39 @@ pub fn atlas(
     }
 }
 
-/// The report of a remeshing of `input` (`beltrami remesh --report` without the file
-/// names): the method and parameterizer, sizes, angles, edge lengths, distances (also
-/// relative to the input's bounding-box diagonal), the seconds and the timings.
+/// The stage timings of `report` as a JSON object: stage name to seconds.
+fn timings_object(report: &Report) -> Value {
+    Value::Object(
+        report
+            .timings
+            .iter()
+            .map(|(name, s)| (name.clone(), json!(s)))
+            .collect(),
+    )
+}
+
+/// The report of a remeshing through a parameterization (`beltrami remesh --report`
+/// without the file names): the method and parameterizer of `summary`, sizes, angles,
+/// edge lengths and distances of the quality `q` of the new mesh against `input` (the
+/// surface remeshed, [`crate::remesh_solver::remeshed_input`]; distances also relative
+/// to its bounding-box diagonal), the seconds, the timings and notes of the solution's
+/// `report`, and per component (`components`, when they were remeshed one by one) its
+/// input faces, parameterizer, opening, edge length and new vertex and face counts.
 pub fn remesh(
     input: &Mesh,
-    result: &beltrami_remesh::Summary,
+    summary: &ParamSummary,
+    report: &Report,
     q: &beltrami_remesh::Quality,
     seconds: f64,
 ) -> JsonMap<String, Value> {
-    let timings: JsonMap<String, Value> = result
-        .timings
-        .iter()
-        .map(|(name, s)| (name.to_string(), json!(s)))
-        .collect();
     let value = json!({
         "method": "param",
-        "parameterizer": result.parameterizer,
-        "opening": result.opening,
+        "parameterizer": summary.parameterizer,
+        "opening": summary.opening,
         "topology": beltrami_core::topology::describe(input),
         "input_vertices": input.vertex_count(),
         "input_faces": input.face_count(),
-        "edge_length": result.edge_length,
+        "edge_length": summary.edge_length,
         "vertices": q.vertices,
         "faces": q.faces,
         "min_angle": q.min_angle,
@@ -218,58 +229,55 @@ pub fn remesh(
         "edge_mean": q.edge_mean,
         "edge_max": q.edge_max,
         "edge_spread": q.edge_spread,
-        "edge_mean_over_asked": q.edge_mean / result.edge_length,
+        "edge_mean_over_asked": q.edge_mean / summary.edge_length,
         "hausdorff": q.hausdorff,
         "mean_distance": q.mean_distance,
         "diagonal": q.diagonal,
         "hausdorff_over_diagonal": q.hausdorff / q.diagonal,
         "mean_distance_over_diagonal": q.mean_distance / q.diagonal,
-        "size_passes": result.size_passes,
+        "size_passes": summary.size_passes,
         "seconds": seconds,
-        "timings": timings,
-        "notes": result.notes,
+        "timings": timings_object(report),
+        "notes": report.notes,
     });
-    match value {
-        Value::Object(map) => map,
-        _ => JsonMap::new(),
-    }
-}
-
-/// The `components` entry of the report of a remeshing piece by piece
-/// (`beltrami_remesh::components::remesh_each`): per component, in order, its input
-/// faces, parameterizer, opening, edge length and new vertex and face counts.
-pub fn remesh_components(components: &[beltrami_remesh::components::ComponentRemeshing]) -> Value {
-    let list: Vec<Value> = components
-        .iter()
-        .map(|c| {
-            let r = &c.remeshing;
-            json!({
-                "input_faces": c.input_faces,
-                "parameterizer": r.parameterizer,
-                "opening": r.opening.name(),
-                "edge_length": r.edge_length,
-                "vertices": r.remeshed.mesh.vertex_count(),
-                "faces": r.remeshed.mesh.face_count(),
+    let Value::Object(mut map) = value else {
+        return JsonMap::new();
+    };
+    if !summary.components.is_empty() {
+        let components = summary
+            .components
+            .iter()
+            .map(|c| {
+                json!({
+                    "input_faces": c.input_faces,
+                    "parameterizer": c.parameterizer,
+                    "opening": c.opening,
+                    "edge_length": c.edge_length,
+                    "vertices": c.vertices,
+                    "faces": c.faces,
+                })
             })
-        })
-        .collect();
-    Value::Array(list)
+            .collect();
+        map.insert("components".into(), Value::Array(components));
+    }
+    map
 }
 
 /// The report of an in-place remeshing by reference angles (`beltrami remesh --method
-/// qc-angles`): the reference and constraint, the angles before and after, the
-/// distance to the input (also relative to its bounding-box diagonal), the QC
+/// qc-angles`): the reference and constraint of `summary`, the angles before and after,
+/// the distance to the input (also relative to its bounding-box diagonal), the QC
 /// iteration's `k`, `|mu|` statistics (from the reference shapes), iterations, stop and
-/// `|mu|` spread history, flips, seconds and timings.
+/// `|mu|` spread history (the metrics of `solution`), flips, seconds, and the timings and
+/// notes of the solution's report.
 pub fn remesh_in_place(
     input: &Mesh,
-    result: &beltrami_remesh::in_place::InPlace,
-    options: &beltrami_remesh::in_place::InPlaceOptions,
+    summary: &InPlaceSummary,
+    solution: &Solution,
     before: &beltrami_remesh::Quality,
     after: &beltrami_remesh::Quality,
     seconds: f64,
 ) -> JsonMap<String, Value> {
-    let metrics = &result.solution.metrics;
+    let metrics = &solution.metrics;
     let angles = |q: &beltrami_remesh::Quality| {
         json!({
             "min_angle": q.min_angle,
@@ -278,18 +286,11 @@ pub fn remesh_in_place(
             "edge_spread": q.edge_spread,
         })
     };
-    let timings: JsonMap<String, Value> = result
-        .solution
-        .report
-        .timings
-        .iter()
-        .map(|(name, s)| (name.to_string(), json!(s)))
-        .collect();
     let value = json!({
         "method": "qc-angles",
-        "reference": options.reference.name(),
-        "constraint": options.keep.name(),
-        "projected": options.project,
+        "reference": summary.reference,
+        "constraint": summary.constraint,
+        "projected": summary.projected,
         "topology": beltrami_core::topology::describe(input),
         "vertices": input.vertex_count(),
         "faces": input.face_count(),
@@ -308,14 +309,14 @@ pub fn remesh_in_place(
         "iterations": metrics.iterations,
         "stop": metrics.stop.as_ref().map(|s| s.name()),
         "mu_spread_history": metrics.energy_history,
-        "flipped": result.flipped,
-        "input_flipped": result.input_flipped,
-        "pulled_back": result.pulled,
-        "feature_angle": options.feature_angle,
-        "feature_vertices": result.features,
+        "flipped": summary.flipped,
+        "input_flipped": summary.input_flipped,
+        "pulled_back": summary.pulled,
+        "feature_angle": summary.feature_angle,
+        "feature_vertices": summary.features,
         "seconds": seconds,
-        "timings": timings,
-        "notes": result.solution.report.notes,
+        "timings": timings_object(&solution.report),
+        "notes": solution.report.notes,
     });
     match value {
         Value::Object(map) => map,

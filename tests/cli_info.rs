@@ -140,7 +140,12 @@ fn the_solver_help_lists_every_registered_solver_of_the_command() {
     for solver in solvers.as_array().unwrap() {
         let name = solver["name"].as_str().unwrap().to_owned();
         let goals = list(solver, "goals");
-        if list(solver, "targets") == ["mesh"] {
+        // A registration (onto a mesh) and a remeshing (on the source surface itself)
+        // map into no parameter domain.
+        if list(solver, "targets")
+            .iter()
+            .all(|t| t == "mesh" || t == "surface")
+        {
             continue;
         }
         if goals.iter().any(|g| g == "conformal") {

@@ -502,3 +502,138 @@ fn a_face_with_three_small_holes_is_remeshed_at_every_length() {
         remesh_and_check(&input, &holes, l, &[]);
     }
 }
+
+#[test]
+fn the_remesh_solver_is_listed_with_the_options_of_both_methods() {
+    let out = beltrami(&["solvers"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let listing = text(&out.stdout);
+    assert!(
+        listing.lines().any(|l| l.starts_with("remesh ")),
+        "{listing}"
+    );
+    let out = beltrami(&["solvers", "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let solvers: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let remesh = solvers
+        .as_array()
+        .and_then(|list| list.iter().find(|s| s["name"] == "remesh"))
+        .expect("remesh in `solvers --json`");
+    assert_eq!(remesh["accepts"]["targets"], serde_json::json!(["surface"]));
+    let options: Vec<&str> = remesh["options"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| o["name"].as_str().unwrap())
+        .collect();
+    for name in [
+        "method",
+        "edge-length",
+        "vertices",
+        "param",
+        "min-angle",
+        "size-field",
+        "max-vertices",
+        "feature-tolerance",
+        "components",
+        "reference",
+        "constraint",
+        "max-iters",
+        "tolerance",
+        "project",
+        "feature-angle",
+        "allow-flips",
+    ] {
+        assert!(options.contains(&name), "{name} not in {options:?}");
+    }
+    let method = &remesh["options"][0];
+    assert_eq!(method["name"], "method");
+    assert_eq!(method["choices"], serde_json::json!(["param", "qc-angles"]));
+    let param = remesh["options"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|o| o["name"] == "param")
+        .unwrap();
+    assert_eq!(
+        (&param["type"], &param["default"]),
+        (&"name".into(), &"auto".into())
+    );
+    // It maps into no parameter domain: `param` does not offer it.
+    let help = text(&beltrami(&["param", "--help"]).stdout);
+    assert!(!help.contains("remesh"), "{help}");
+}
+
+#[test]
+fn the_registered_solver_remeshes_a_generated_hemisphere() {
+    // `beltrami::registry()` as every front end builds it: its `remesh` takes its
+    // parameterizers from the same registry.
+    let mut soup = disk(4);
+    for p in &mut soup.positions {
+        p.z = (1.0 - p.x * p.x - p.y * p.y).max(0.0).sqrt();
+    }
+    let mesh = Mesh::from_soup(&soup).unwrap();
+    let registry = beltrami::registry();
+    let solver = registry.get("remesh").unwrap();
+    for l in [0.12, 0.06] {
+        let mut problem = beltrami_core::Problem::new(&mesh, beltrami_core::Target::Surface);
+        problem.options.set_text("edge-length", &l.to_string());
+        let solution = solver
+            .solve(&problem, &mut beltrami_core::Context::new())
+            .unwrap();
+        let beltrami_core::Output::Mesh(remeshed) = &solution.output else {
+            panic!("remesh gave no mesh");
+        };
+        let q = beltrami::remesh::quality::measure(&mesh, &remeshed.mesh).unwrap();
+        let ratio = q.edge_mean / l;
+        assert!((ratio - 1.0).abs() < 0.1, "at {l}: mean edge {ratio} L");
+        assert!(q.min_angle > 20.0, "at {l}: smallest angle {}", q.min_angle);
+        assert_eq!(describe(&remeshed.mesh), describe(&mesh));
+    }
+}
+
+#[test]
+fn a_batch_job_remeshes_through_the_solver() {
+    let dir = tempfile::tempdir().unwrap();
+    let output = dir.path().join("out.obj");
+    let refused = dir.path().join("refused.obj");
+    let jobs = dir.path().join("jobs.jsonl");
+    let lines = [
+        serde_json::json!({
+            "command": "remesh", "input": "meshes/disk_hemisphere.obj", "output": s(&output),
+            "options": {"edge-length": 0.1, "size-field": "curvature"},
+        }),
+        serde_json::json!({
+            "command": "remesh", "input": "meshes/disk_hemisphere.obj", "output": s(&refused),
+            "options": {"method": "qc-angles", "min-angle": 25},
+        }),
+    ];
+    let text_of = |v: &serde_json::Value| format!("{v}\n");
+    std::fs::write(&jobs, lines.iter().map(text_of).collect::<String>()).unwrap();
+    let report = dir.path().join("report.jsonl");
+    let out = beltrami(&["-q", "batch", s(&jobs), "--report", s(&report)]);
+    assert!(!out.status.success(), "the refused job fails the batch");
+    let lines: Vec<serde_json::Value> = std::fs::read_to_string(&report)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let by_output = |path: &Path| {
+        lines
+            .iter()
+            .find(|l| l["output"] == s(path))
+            .unwrap_or_else(|| panic!("no report line for {}", path.display()))
+    };
+    let ok = by_output(&output);
+    assert_eq!(ok["status"], "ok", "{ok}");
+    assert_eq!(ok["report"]["method"], "param", "{ok}");
+    assert!(output.exists());
+    let failed = by_output(&refused);
+    assert!(
+        failed
+            .to_string()
+            .contains("--min-angle is a flag of --method param"),
+        "{failed}"
+    );
+    assert!(!refused.exists());
+}

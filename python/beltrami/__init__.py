@@ -1090,6 +1090,7 @@ def register(
     Returns ``(P, face, bary)``: the image of every vertex ``(n, 3)``, the row of ``TF``
     it lies in and its barycentric coordinates there (``(n, 3)``, ``(n, 4)`` on quads).
     ``beltrami register`` (with ``--correspondence``)."""
+    goal: Optional[Dict[str, Any]]
     if features is not None:
         if mu is not None or p is not None:
             raise OptionError("features start from the least-squares conformal map: give neither mu nor p")

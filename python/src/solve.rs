@@ -416,7 +416,10 @@ pub fn solve<'py>(
     let Some(map) = solution.map() else {
         return Err(errors::raise(
             Kind::Solver,
-            format!("{} gave no map", solver.name()),
+            format!(
+                "{} makes a new mesh, not a map of this one: call beltrami.remesh or beltrami.remesh_in_place",
+                solver.name()
+            ),
         ));
     };
     let image = map_file::image(solved, map, target_mesh.as_ref())

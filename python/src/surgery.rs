@@ -1,11 +1,14 @@
-//! New meshes from a mesh: `remesh` and `cut_to_disk`.
+//! New meshes from a mesh: `remesh` and `remesh_in_place` (through the registered solver
+//! `remesh`) and `cut_to_disk`.
 
 use std::time::Instant;
 
-use beltrami_core::Context;
+use beltrami::remesh_solver::{self, RemeshOptionError};
+use beltrami_core::{
+    Context, OptionValue, Options, Output, Problem, RemeshSummary, Solution, SolverError, Target,
+};
 use beltrami_mesh::Mesh;
-use beltrami_remesh::components::{Coverage, remesh_covering};
-use beltrami_remesh::{RemeshError, RemeshOptions, Resolution, SizeField};
+use beltrami_remesh::RemeshError;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -20,9 +23,57 @@ fn mesh_arrays(mesh: &Mesh) -> PyResult<(Array2<f64>, Array2<i64>)> {
         .ok_or_else(|| errors::raise(Kind::Solver, "the new mesh mixes triangles and quads"))
 }
 
+/// Runs the registered solver `remesh` on `mesh` with `options`, with the GIL released;
+/// its error as the Python exception of its kind: a refused option (of the solver or of
+/// the remeshing library, a size that would make too many vertices) is `OptionError`, a
+/// mesh in pieces without `components` is `UnsupportedError` naming the argument.
+fn remesh_solution(py: Python<'_>, mesh: &Mesh, options: Options) -> PyResult<(Solution, f64)> {
+    let registry = beltrami::registry();
+    let solver = registry
+        .get(remesh_solver::NAME)
+        .map_err(|e| errors::from_solver(&e))?;
+    let mut problem = Problem::new(mesh, Target::Surface);
+    problem.options = options;
+    let start = Instant::now();
+    let solution = py.detach(|| solver.solve(&problem, &mut Context::new()));
+    let seconds = start.elapsed().as_secs_f64();
+    let error = match solution {
+        Ok(solution) => return Ok((solution, seconds)),
+        Err(error) => error,
+    };
+    let SolverError::Plugin { error: source, .. } = &error else {
+        return Err(errors::from_solver(&error));
+    };
+    let source: &(dyn std::error::Error + 'static) = source.as_ref();
+    if source.is::<RemeshOptionError>() {
+        return Err(errors::from_error(Kind::Option, source));
+    }
+    Err(match source.downcast_ref::<RemeshError>() {
+        Some(e @ RemeshError::Components { .. }) => errors::raise(
+            Kind::Unsupported,
+            format!(
+                "{e}: pass components='each' (every piece remeshed on its own) or components='largest' (the largest alone)"
+            ),
+        ),
+        Some(e @ (RemeshError::TooFine { .. } | RemeshError::InvalidOption { .. })) => {
+            errors::from_error(Kind::Option, e)
+        }
+        _ => errors::from_error(Kind::Solver, source),
+    })
+}
+
+/// The new mesh of a `remesh` solution and how it was made.
+fn remeshed(solution: &Solution) -> PyResult<(&Mesh, &RemeshSummary)> {
+    match (&solution.output, &solution.extras.remesh) {
+        (Output::Mesh(remeshed), Some(summary)) => Ok((&remeshed.mesh, summary)),
+        _ => Err(errors::raise(Kind::Solver, "remesh gave no new mesh")),
+    }
+}
+
 /// A new triangle mesh of the surface `V`, `F` with the asked edge length (or about
-/// `vertices` vertices), made through a parameterization (`beltrami remesh`): returns
-/// the positions, the triangles and the JSON report of `--report`.
+/// `vertices` vertices), made through a parameterization (`beltrami remesh`, the
+/// registered solver `remesh`): returns the positions, the triangles and the JSON report
+/// of `--report`.
 #[pyfunction]
 #[pyo3(signature = (v, f, edge_length=None, vertices=None, param="auto", min_angle=30.0, size_field="uniform", max_vertices=5_000_000, feature_tolerance=beltrami_remesh::FEATURE_TOLERANCE, components=None))]
 // The arguments are the Python function's keyword arguments, the user API.
@@ -40,9 +91,10 @@ pub fn remesh<'py>(
     feature_tolerance: f64,
     components: Option<&str>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>, String)> {
-    let resolution = match (edge_length, vertices) {
-        (Some(l), None) => Resolution::EdgeLength(l),
-        (None, Some(n)) => Resolution::Vertices(n),
+    let mut options = Options::new();
+    match (edge_length, vertices) {
+        (Some(l), None) => options.set("edge-length", OptionValue::Float(l)),
+        (None, Some(n)) => options.set("vertices", OptionValue::Int(n)),
         _ => {
             return Err(errors::raise(
                 Kind::Option,
@@ -50,36 +102,6 @@ pub fn remesh<'py>(
             ));
         }
     };
-    let size_field = match size_field {
-        "uniform" => SizeField::Uniform,
-        "curvature" => SizeField::Curvature,
-        other => {
-            return Err(errors::raise(
-                Kind::Option,
-                format!("size_field={other:?}: expected 'uniform' or 'curvature'"),
-            ));
-        }
-    };
-    let options = RemeshOptions {
-        resolution,
-        min_angle,
-        size_field,
-        max_vertices,
-        feature_tolerance,
-    };
-    let remesh_error = |e: &RemeshError| match e {
-        RemeshError::Components { .. } => errors::raise(
-            Kind::Unsupported,
-            format!(
-                "{e}: pass components='each' (every piece remeshed on its own) or components='largest' (the largest alone)"
-            ),
-        ),
-        RemeshError::TooFine { .. } => errors::from_error(Kind::Option, e),
-        other => errors::from_error(Kind::Solver, other),
-    };
-    options
-        .validate()
-        .map_err(|e| errors::from_error(Kind::Option, &e))?;
     if let Some(other) = components.filter(|c| !matches!(*c, "each" | "largest")) {
         return Err(errors::raise(
             Kind::Option,
@@ -88,32 +110,42 @@ pub fn remesh<'py>(
             ),
         ));
     }
-    let mesh = arrays::mesh(v.as_array(), f.as_array())?;
-    let registry = beltrami::registry();
-    let choose = |part: &Mesh| beltrami_remesh::param::chosen(&registry, part, param);
-    let start = Instant::now();
-    let coverage = match components {
-        Some("each") => Coverage::Each,
-        Some("largest") => Coverage::Largest,
-        _ => Coverage::Whole,
-    };
-    let result = py.detach(|| {
-        let covered = remesh_covering(&mesh, coverage, choose, &options, &mut Context::new())?;
-        let quality = beltrami_remesh::quality::measure(covered.input(&mesh), &covered.mesh)?;
-        Ok::<_, RemeshError>((covered, quality))
-    });
-    let (covered, quality) = result.map_err(|e| remesh_error(&e))?;
-    let seconds = start.elapsed().as_secs_f64();
-    let mut report =
-        beltrami::report::remesh(covered.input(&mesh), &covered.summary, &quality, seconds);
-    if !covered.components.is_empty() {
-        report.insert(
-            "components".into(),
-            beltrami::report::remesh_components(&covered.components),
-        );
+    if let Some(components) = components {
+        options.set_text("components", components);
     }
-    let out = covered.mesh;
-    let (v, f) = mesh_arrays(&out)?;
+    options
+        .set_text("param", param)
+        .set("min-angle", OptionValue::Float(min_angle))
+        .set_text("size-field", size_field)
+        .set("max-vertices", OptionValue::Int(max_vertices));
+    if feature_tolerance == f64::INFINITY {
+        options.set("keep-features", OptionValue::Bool(false));
+    } else {
+        options.set("feature-tolerance", OptionValue::Float(feature_tolerance));
+    }
+    let mesh = arrays::mesh(v.as_array(), f.as_array())?;
+    let (solution, seconds) = remesh_solution(py, &mesh, options)?;
+    let (out, summary) = remeshed(&solution)?;
+    let RemeshSummary::Param(summary) = summary else {
+        return Err(errors::raise(
+            Kind::Solver,
+            "remesh moved the vertices instead",
+        ));
+    };
+    let report = py.detach(|| {
+        let input = remesh_solver::remeshed_input(&mesh, summary)
+            .map_err(|e| errors::from_error(Kind::Mesh, &e))?;
+        let quality = beltrami_remesh::quality::measure(&input, out)
+            .map_err(|e| errors::from_error(Kind::Solver, &e))?;
+        Ok::<_, PyErr>(beltrami::report::remesh(
+            &input,
+            summary,
+            &solution.report,
+            &quality,
+            seconds,
+        ))
+    })?;
+    let (v, f) = mesh_arrays(out)?;
     Ok((
         v.into_pyarray(py),
         f.into_pyarray(py),
@@ -122,8 +154,8 @@ pub fn remesh<'py>(
 }
 
 /// The surface `V`, `F` remeshed in place by reference angles (`beltrami remesh --method
-/// qc-angles`, [`beltrami_remesh::in_place`]): returns the moved positions and the JSON
-/// report of `--report`.
+/// qc-angles`, the registered solver `remesh` with `method=qc-angles`): returns the
+/// moved positions and the JSON report of `--report`.
 #[pyfunction]
 #[pyo3(signature = (v, f, reference="optimized", constraint="normal", max_iters=10, tolerance=1e-4, feature_angle=60.0, project=true, allow_flips=false))]
 // The arguments are the Python function's keyword arguments, the user API.
@@ -140,68 +172,35 @@ pub fn remesh_in_place<'py>(
     project: bool,
     allow_flips: bool,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, String)> {
-    use beltrami_remesh::in_place::{InPlaceOptions, Keep, remesh_in_place};
-    use beltrami_remesh::reference_angles::Reference;
-    let reference = match reference {
-        "optimized" => Reference::Optimized,
-        "equiangular" => Reference::Equiangular,
-        other => {
-            return Err(errors::raise(
-                Kind::Option,
-                format!("reference={other:?}: expected 'optimized' or 'equiangular'"),
-            ));
-        }
-    };
-    let keep = match constraint {
-        "normal" => Keep::Normal,
-        "area" => Keep::Area,
-        other => {
-            return Err(errors::raise(
-                Kind::Option,
-                format!("constraint={other:?}: expected 'normal' or 'area'"),
-            ));
-        }
-    };
-    if !(tolerance.is_finite() && tolerance > 0.0) {
-        return Err(errors::raise(
-            Kind::Option,
-            format!("tolerance={tolerance}: give a positive number"),
-        ));
-    }
-    if !(feature_angle > 0.0 && feature_angle <= 180.0) {
-        return Err(errors::raise(
-            Kind::Option,
-            format!("feature_angle={feature_angle}: give an angle in (0, 180] degrees"),
-        ));
-    }
-    let options = InPlaceOptions {
-        reference,
-        keep,
-        max_iters,
-        tolerance,
-        project,
-        feature_angle,
-        allow_flips,
-    };
+    let mut options = Options::new();
+    options
+        .set_text("method", "qc-angles")
+        .set_text("reference", reference)
+        .set_text("constraint", constraint)
+        .set("max-iters", OptionValue::Int(max_iters))
+        .set("tolerance", OptionValue::Float(tolerance))
+        .set("feature-angle", OptionValue::Float(feature_angle))
+        .set("project", OptionValue::Bool(project))
+        .set("allow-flips", OptionValue::Bool(allow_flips));
     let mesh = arrays::mesh(v.as_array(), f.as_array())?;
-    let registry = beltrami::registry();
-    let solver = registry
-        .get("qc-iteration")
-        .map_err(|e| errors::from_error(Kind::Unsupported, &e))?;
-    let start = Instant::now();
-    let result = py.detach(|| {
-        let mut context = Context::new();
-        let result = remesh_in_place(&mesh, solver, &options, &mut context)?;
-        let before = beltrami_remesh::quality::shape(&mesh);
-        let after = beltrami_remesh::quality::measure(&mesh, &result.mesh)?;
-        Ok((result, before, after))
-    });
-    let (result, before, after) =
-        result.map_err(|e: beltrami_remesh::RemeshError| errors::from_error(Kind::Solver, &e))?;
-    let seconds = start.elapsed().as_secs_f64();
+    let (solution, seconds) = remesh_solution(py, &mesh, options)?;
+    let (out, summary) = remeshed(&solution)?;
+    let RemeshSummary::InPlace(summary) = summary else {
+        return Err(errors::raise(
+            Kind::Solver,
+            "remesh made a new mesh instead",
+        ));
+    };
+    let (before, after) = py
+        .detach(|| {
+            let before = beltrami_remesh::quality::shape(&mesh);
+            let after = beltrami_remesh::quality::measure(&mesh, out)?;
+            Ok((before, after))
+        })
+        .map_err(|e: RemeshError| errors::from_error(Kind::Solver, &e))?;
     let report =
-        beltrami::report::remesh_in_place(&mesh, &result, &options, &before, &after, seconds);
-    let (v, _) = mesh_arrays(&result.mesh)?;
+        beltrami::report::remesh_in_place(&mesh, summary, &solution, &before, &after, seconds);
+    let (v, _) = mesh_arrays(out)?;
     Ok((
         v.into_pyarray(py),
         serde_json::Value::Object(report).to_string(),

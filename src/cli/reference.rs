@@ -215,6 +215,7 @@ fn solver_section(solver: &dyn Solver) -> String {
             }
             OptionKind::Bool { default } => (default.to_string(), "true, false".to_string()),
             OptionKind::Choice { default, choices } => (default.to_string(), choices.join(", ")),
+            OptionKind::Name { default } => (default.to_string(), "a name".to_string()),
         };
         out.push_str(&format!(
             "| `{}` | {} | `{}` | {} | {} |\n",

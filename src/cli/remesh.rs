@@ -1,17 +1,20 @@
 //! `beltrami remesh`: a new triangle mesh of a surface with the asked edge length, made
-//! through a parameterization (see the `beltrami-remesh` crate and docs/remesh.md).
+//! through a parameterization, or its own vertices moved towards reference angles: the
+//! registered solver `remesh` (the `beltrami-remesh-solver` plugin over the
+//! `beltrami-remesh` crate; docs/remesh.md), its options set from the flags.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::{Context as _, bail};
-use beltrami_core::Context;
+use anyhow::{Context as _, anyhow, bail};
+use beltrami::remesh_solver::{self, OPTIONS, RemeshOptionError};
+use beltrami_core::{
+    Context, InPlaceSummary, OptionError, OptionValue, Options, Output, ParamSummary, Problem,
+    RemeshSummary, Report, Solution, SolverError, Target,
+};
 use beltrami_mesh::Mesh;
 use beltrami_mesh::io::{self, VertexAttributes};
-use beltrami_remesh::components::{Coverage, remesh_covering};
-use beltrami_remesh::in_place::{InPlaceOptions, Keep, remesh_in_place};
-use beltrami_remesh::reference_angles::Reference;
-use beltrami_remesh::{Quality, RemeshError, RemeshOptions, Resolution, SizeField, Summary};
+use beltrami_remesh::{Quality, RemeshError};
 use beltrami_render::{ColorBy, Scene, Style, View};
 use clap::{Args, ValueEnum};
 use serde_json::{Value, json};
@@ -151,22 +154,71 @@ pub struct RemeshArgs {
     pub components: Option<ComponentsArg>,
 }
 
+/// The name of a value of a `ValueEnum` flag, as the command line and the `remesh`
+/// solver's options spell it.
+fn value_name(value: impl ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .map(|v| v.get_name().to_string())
+        .unwrap_or_default()
+}
+
 impl RemeshArgs {
-    fn options(&self) -> RemeshOptions {
-        RemeshOptions {
-            resolution: match (self.edge_length, self.vertices) {
-                (Some(l), _) => Resolution::EdgeLength(l),
-                (None, Some(n)) => Resolution::Vertices(n),
-                (None, None) => Resolution::EdgeLength(f64::NAN),
-            },
-            min_angle: self.min_angle,
-            size_field: match self.size_field {
-                SizeFieldArg::Uniform => SizeField::Uniform,
-                SizeFieldArg::Curvature => SizeField::Curvature,
-            },
-            max_vertices: self.max_vertices,
-            feature_tolerance: self.feature_tolerance,
+    /// The options of the `remesh` solver these flags set: the method, the size and
+    /// `--components` when given, and every other flag whose value differs from the
+    /// solver's default (a flag left at its default is not given, so that the flags of
+    /// the other method are refused only when set); `--feature-tolerance inf` is
+    /// `keep-features=false`.
+    fn solver_options(&self) -> Options {
+        let mut options = Options::new();
+        options.set("method", OptionValue::Choice(value_name(self.method)));
+        if let Some(l) = self.edge_length {
+            options.set("edge-length", OptionValue::Float(l));
         }
+        if let Some(n) = self.vertices {
+            options.set("vertices", OptionValue::Int(n));
+        }
+        if let Some(components) = self.components {
+            options.set("components", OptionValue::Choice(value_name(components)));
+        }
+        let features = if self.feature_tolerance == f64::INFINITY {
+            ("keep-features", OptionValue::Bool(false))
+        } else {
+            (
+                "feature-tolerance",
+                OptionValue::Float(self.feature_tolerance),
+            )
+        };
+        let flags = [
+            ("param", OptionValue::Choice(self.param.clone())),
+            ("min-angle", OptionValue::Float(self.min_angle)),
+            (
+                "size-field",
+                OptionValue::Choice(value_name(self.size_field)),
+            ),
+            ("max-vertices", OptionValue::Int(self.max_vertices)),
+            features,
+            ("reference", OptionValue::Choice(value_name(self.reference))),
+            (
+                "constraint",
+                OptionValue::Choice(value_name(self.constraint)),
+            ),
+            ("max-iters", OptionValue::Int(self.max_iters)),
+            ("tolerance", OptionValue::Float(self.tolerance)),
+            ("feature-angle", OptionValue::Float(self.feature_angle)),
+            ("project", OptionValue::Bool(!self.no_project)),
+            ("allow-flips", OptionValue::Bool(self.allow_flips)),
+        ];
+        for (name, value) in flags {
+            let default = OPTIONS
+                .iter()
+                .find(|spec| spec.name == name)
+                .map(|spec| spec.kind.default_value());
+            if default.as_ref() != Some(&value) {
+                options.set(name, value);
+            }
+        }
+        options
     }
 }
 
@@ -177,52 +229,119 @@ pub fn run(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
         ("--png", args.png.as_deref()),
         ("--report", args.report.as_deref()),
     ])?;
-    check_method_flags(args)?;
-    match args.method {
-        MethodArg::Param if args.edge_length.is_none() && args.vertices.is_none() => {
-            bail!(
-                "--method param makes a new mesh: give its size with --edge-length L or --vertices N"
-            )
-        }
-        MethodArg::QcAngles if args.edge_length.is_some() || args.vertices.is_some() => {
-            bail!(
-                "--method qc-angles keeps the input's vertices and faces: drop --edge-length and --vertices"
-            )
-        }
-        MethodArg::QcAngles => return run_in_place(args, quiet),
-        MethodArg::Param => {}
-    }
-    let options = args.options();
-    options.validate()?;
+    let options = args.solver_options();
+    remesh_solver::check_options(&options).map_err(flag_error)?;
     let registry = beltrami::registry();
+    let solver = registry.get(remesh_solver::NAME)?;
     let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
-    let whole = &loaded.mesh.mesh;
+    let source = &loaded.mesh.mesh;
+    let mut problem = Problem::new(source, Target::Surface);
+    problem.options = options;
     let start = Instant::now();
-    let mut context = Context::new().with_cancel_flag(super::interrupt::cancel_flag());
-    let choose = |part: &Mesh| beltrami_remesh::param::chosen(&registry, part, &args.param);
-    let coverage = match args.components {
-        None => Coverage::Whole,
-        Some(ComponentsArg::Each) => Coverage::Each,
-        Some(ComponentsArg::Largest) => Coverage::Largest,
+    let mut bar = LateBar::new(args.method == MethodArg::QcAngles && !(quiet || args.json));
+    let solved = {
+        let mut context = Context::new()
+            .with_progress(|p: &beltrami_core::Progress| bar.update(p))
+            .with_cancel_flag(super::interrupt::cancel_flag());
+        solver.solve(&problem, &mut context)
     };
-    let covered = remesh_covering(whole, coverage, choose, &options, &mut context)
-        .map_err(with_hint)
+    bar.finish();
+    let solution = solved
+        .map_err(flag_error)
         .with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
-    let (out, mesh, summary) = (&covered.mesh, covered.input(whole), &covered.summary);
     let seconds = start.elapsed().as_secs_f64();
+    let (Output::Mesh(remeshed), Some(summary)) = (&solution.output, &solution.extras.remesh)
+    else {
+        bail!("{} gave no new mesh", solver.name());
+    };
+    let out = &remeshed.mesh;
     io::write(&args.output, out, &VertexAttributes::default())?;
-    let quality = beltrami_remesh::quality::measure(mesh, out)?;
     write_png(args.png.as_deref(), out)?;
-    let mut report = report_json(args, mesh, summary, &quality, seconds);
-    if let (false, Value::Object(map)) = (covered.components.is_empty(), &mut report) {
-        map.insert(
-            "components".into(),
-            beltrami::report::remesh_components(&covered.components),
-        );
+    match summary {
+        RemeshSummary::Param(summary) => {
+            let input = remesh_solver::remeshed_input(source, summary)?;
+            let quality = beltrami_remesh::quality::measure(&input, out)?;
+            let report = report_json(
+                args,
+                beltrami::report::remesh(&input, summary, &solution.report, &quality, seconds),
+            );
+            finish(args, &report, quiet, || {
+                print_summary(args, summary, &solution.report, &quality, seconds)
+            })
+        }
+        RemeshSummary::InPlace(summary) => {
+            let before = beltrami_remesh::quality::shape(source);
+            let after = beltrami_remesh::quality::measure(source, out)?;
+            let report = report_json(
+                args,
+                beltrami::report::remesh_in_place(
+                    source, summary, &solution, &before, &after, seconds,
+                ),
+            );
+            finish(args, &report, quiet, || {
+                let quality = [("before", &before), ("after", &after)];
+                print_in_place(args, source, summary, &solution, &quality, seconds)
+            })
+        }
     }
-    finish(args, &report, quiet, || {
-        print_summary(args, summary, &quality, seconds)
-    })
+}
+
+/// The command-line spelling of the `remesh` solver's option `option`.
+fn flag(option: &str) -> String {
+    match option {
+        "project" => "--no-project".to_string(),
+        "keep-features" => "--feature-tolerance".to_string(),
+        other => format!("--{other}"),
+    }
+}
+
+/// The `remesh` solver's refusal `error` in the words of the command line: its option
+/// errors name the flags, a remeshing error is shown as it is (with the `--components`
+/// flags named when the mesh has several components).
+fn flag_error(error: SolverError) -> anyhow::Error {
+    let error = match error {
+        SolverError::Option(OptionError::Range {
+            option,
+            min,
+            max,
+            got,
+            ..
+        }) => return anyhow!("{} {got}: give a value in [{min}, {max}]", flag(option)),
+        SolverError::Plugin { solver, error } => match error.downcast::<RemeshOptionError>() {
+            Ok(refusal) => return anyhow!(flag_message(&refusal)),
+            Err(error) => match error.downcast::<RemeshError>() {
+                Ok(error) => return with_hint(*error),
+                Err(error) => SolverError::Plugin { solver, error },
+            },
+        },
+        other => other,
+    };
+    anyhow::Error::new(error)
+}
+
+/// [`RemeshOptionError`] with the flags of the command line.
+fn flag_message(error: &RemeshOptionError) -> String {
+    match error {
+        RemeshOptionError::OtherMethod {
+            option: "edge-length" | "vertices",
+            method: "qc-angles",
+            ..
+        } => "--method qc-angles keeps the input's vertices and faces: drop --edge-length and --vertices".to_string(),
+        RemeshOptionError::OtherMethod { option, method, of } => format!(
+            "{} is a flag of --method {of}; --method {method} does not read it",
+            flag(option)
+        ),
+        RemeshOptionError::NoSize => {
+            "--method param makes a new mesh: give its size with --edge-length L or --vertices N"
+                .to_string()
+        }
+        RemeshOptionError::Value {
+            option,
+            got,
+            expected,
+        } => format!("{} {got}: give {expected}", flag(option)),
+        other => other.to_string(),
+    }
 }
 
 /// `error`, with the `--components` flags named when the mesh has several components.
@@ -235,151 +354,63 @@ fn with_hint(error: RemeshError) -> anyhow::Error {
     }
 }
 
-/// Refuses, before any work, the flags of the other method (they would be ignored
-/// silently): a flag counts as given when its value differs from its default.
-fn check_method_flags(args: &RemeshArgs) -> anyhow::Result<()> {
-    let given = |set: bool, flag: &'static str| set.then_some(flag);
-    let (flags, method, other) = match args.method {
-        MethodArg::QcAngles => (
-            [
-                given(args.param != "auto", "--param"),
-                given(args.components.is_some(), "--components"),
-                given(args.min_angle != 30.0, "--min-angle"),
-                given(args.size_field != SizeFieldArg::Uniform, "--size-field"),
-                given(args.max_vertices != 5_000_000, "--max-vertices"),
-                given(
-                    args.feature_tolerance != beltrami_remesh::FEATURE_TOLERANCE,
-                    "--feature-tolerance",
-                ),
-            ]
-            .into_iter()
-            .flatten()
-            .collect::<Vec<_>>(),
-            "qc-angles",
-            "param",
-        ),
-        MethodArg::Param => (
-            [
-                given(args.reference != ReferenceArg::Optimized, "--reference"),
-                given(args.constraint != KeepArg::Normal, "--constraint"),
-                given(args.max_iters != 10, "--max-iters"),
-                given(args.tolerance != 1e-4, "--tolerance"),
-                given(args.feature_angle != 60.0, "--feature-angle"),
-                given(args.no_project, "--no-project"),
-                given(args.allow_flips, "--allow-flips"),
-            ]
-            .into_iter()
-            .flatten()
-            .collect(),
-            "param",
-            "qc-angles",
-        ),
-    };
-    if let Some(flag) = flags.first() {
-        bail!("{flag} is a flag of --method {other}; --method {method} does not read it");
-    }
-    Ok(())
-}
-
-/// `--method qc-angles` ([`beltrami_remesh::in_place`]).
-fn run_in_place(args: &RemeshArgs, quiet: bool) -> anyhow::Result<()> {
-    if !(args.feature_angle > 0.0 && args.feature_angle <= 180.0) {
-        bail!(
-            "--feature-angle {}: give an angle in (0, 180] degrees",
-            args.feature_angle
+/// The summary of `--method qc-angles`: angles `before` and after, distance, `|mu|`,
+/// iterations, flips and held features.
+fn print_in_place(
+    args: &RemeshArgs,
+    mesh: &Mesh,
+    summary: &InPlaceSummary,
+    solution: &Solution,
+    quality: &[(&str, &Quality); 2],
+    seconds: f64,
+) {
+    println!(
+        "{} -> {} (qc-angles, {} reference, {} constraint, {seconds:.3} s)",
+        args.mesh.display(),
+        args.output.display(),
+        summary.reference,
+        summary.constraint
+    );
+    println!(
+        "  vertices        {}  faces {}",
+        mesh.vertex_count(),
+        mesh.face_count()
+    );
+    for (name, q) in quality {
+        println!(
+            "  angles {name:<8} min {:.2}  mean {:.2}  under 30: {:.3}%",
+            q.min_angle,
+            q.mean_angle,
+            100.0 * q.share_below_30
         );
     }
-    if !(args.tolerance.is_finite() && args.tolerance > 0.0) {
-        bail!("--tolerance {}: give a positive number", args.tolerance);
+    let after = quality[1].1;
+    println!(
+        "  distance        Hausdorff {:.4e} ({:.3}% of the diagonal)  mean {:.4e}",
+        after.hausdorff,
+        100.0 * after.hausdorff / after.diagonal,
+        after.mean_distance
+    );
+    let m = &solution.metrics;
+    if let (Some(k), Some(d)) = (m.k, &m.distortion) {
+        println!(
+            "  |mu|            k {k:.4}  mean {:.4}  std {:.4}  max {:.4}",
+            d.mu_mean, d.mu_std, d.mu_max
+        );
     }
-    let registry = beltrami::registry();
-    let solver = registry.get("qc-iteration")?;
-    let loaded = load_mesh(&args.mesh, args.repair, quiet || args.json)?;
-    let mesh = &loaded.mesh.mesh;
-    let options = InPlaceOptions {
-        reference: match args.reference {
-            ReferenceArg::Optimized => Reference::Optimized,
-            ReferenceArg::Equiangular => Reference::Equiangular,
-        },
-        keep: match args.constraint {
-            KeepArg::Normal => Keep::Normal,
-            KeepArg::Area => Keep::Area,
-        },
-        max_iters: args.max_iters,
-        tolerance: args.tolerance,
-        project: !args.no_project,
-        feature_angle: args.feature_angle,
-        allow_flips: args.allow_flips,
-    };
-    let start = Instant::now();
-    let mut bar = LateBar::new(!(quiet || args.json));
-    let result = {
-        let mut context = Context::new()
-            .with_progress(|p: &beltrami_core::Progress| bar.update(p))
-            .with_cancel_flag(super::interrupt::cancel_flag());
-        remesh_in_place(mesh, solver, &options, &mut context)
-    };
-    bar.finish();
-    let result = result.with_context(|| format!("cannot remesh {}", args.mesh.display()))?;
-    let seconds = start.elapsed().as_secs_f64();
-    io::write(&args.output, &result.mesh, &VertexAttributes::default())?;
-    let before = beltrami_remesh::quality::shape(mesh);
-    let after = beltrami_remesh::quality::measure(mesh, &result.mesh)?;
-    write_png(args.png.as_deref(), &result.mesh)?;
-    let mut report = serde_json::Map::new();
-    report.insert("mesh".into(), json!(args.mesh.display().to_string()));
-    report.insert("output".into(), json!(args.output.display().to_string()));
-    report.extend(beltrami::report::remesh_in_place(
-        mesh, &result, &options, &before, &after, seconds,
-    ));
-    finish(args, &Value::Object(report), quiet, || {
-        println!(
-            "{} -> {} (qc-angles, {} reference, {} constraint, {seconds:.3} s)",
-            args.mesh.display(),
-            args.output.display(),
-            options.reference.name(),
-            options.keep.name()
-        );
-        println!(
-            "  vertices        {}  faces {}",
-            mesh.vertex_count(),
-            mesh.face_count()
-        );
-        for (name, q) in [("before", &before), ("after", &after)] {
-            println!(
-                "  angles {name:<8} min {:.2}  mean {:.2}  under 30: {:.3}%",
-                q.min_angle,
-                q.mean_angle,
-                100.0 * q.share_below_30
-            );
-        }
-        println!(
-            "  distance        Hausdorff {:.4e} ({:.3}% of the diagonal)  mean {:.4e}",
-            after.hausdorff,
-            100.0 * after.hausdorff / after.diagonal,
-            after.mean_distance
-        );
-        let m = &result.solution.metrics;
-        if let (Some(k), Some(d)) = (m.k, &m.distortion) {
-            println!(
-                "  |mu|            k {k:.4}  mean {:.4}  std {:.4}  max {:.4}",
-                d.mu_mean, d.mu_std, d.mu_max
-            );
-        }
-        println!(
-            "  iterations      {} ({})",
-            m.iterations,
-            m.stop.as_ref().map_or("", |s| s.name())
-        );
-        println!(
-            "  flipped         {} (input {}; {} vertices pulled back)",
-            result.flipped, result.input_flipped, result.pulled
-        );
-        println!("  held features   {} vertices", result.features);
-        for note in &result.solution.report.notes {
-            println!("  note: {note}");
-        }
-    })
+    println!(
+        "  iterations      {} ({})",
+        m.iterations,
+        m.stop.as_ref().map_or("", |s| s.name())
+    );
+    println!(
+        "  flipped         {} (input {}; {} vertices pulled back)",
+        summary.flipped, summary.input_flipped, summary.pulled
+    );
+    println!("  held features   {} vertices", summary.features);
+    for note in &solution.report.notes {
+        println!("  note: {note}");
+    }
 }
 
 /// `--png`: the mesh in 3D with its edges.
@@ -423,28 +454,31 @@ fn finish(
     Ok(())
 }
 
-/// The JSON report: the input and output files and [`beltrami::report::remesh`].
-fn report_json(
-    args: &RemeshArgs,
-    input: &beltrami_mesh::Mesh,
-    result: &Summary,
-    q: &Quality,
-    seconds: f64,
-) -> Value {
+/// The JSON report: the input and output files, then `body`
+/// ([`beltrami::report::remesh`] or [`beltrami::report::remesh_in_place`]).
+fn report_json(args: &RemeshArgs, body: serde_json::Map<String, Value>) -> Value {
     let mut report = serde_json::Map::new();
     report.insert("mesh".into(), json!(args.mesh.display().to_string()));
     report.insert("output".into(), json!(args.output.display().to_string()));
-    report.extend(beltrami::report::remesh(input, result, q, seconds));
+    report.extend(body);
     Value::Object(report)
 }
 
-fn print_summary(args: &RemeshArgs, result: &Summary, q: &Quality, seconds: f64) {
+/// The summary of `--method param`: the parameterizer and opening, sizes, angles, edge
+/// lengths, distance, timings and notes.
+fn print_summary(
+    args: &RemeshArgs,
+    summary: &ParamSummary,
+    report: &Report,
+    q: &Quality,
+    seconds: f64,
+) {
     println!(
         "{} -> {} ({}, {}, {seconds:.3} s)",
         args.mesh.display(),
         args.output.display(),
-        result.parameterizer,
-        result.opening
+        summary.parameterizer,
+        summary.opening
     );
     println!("  vertices        {}", q.vertices);
     println!("  faces           {}", q.faces);
@@ -456,7 +490,7 @@ fn print_summary(args: &RemeshArgs, result: &Summary, q: &Quality, seconds: f64)
     );
     println!(
         "  edges           asked {:.4e}  mean {:.4e}  min {:.4e}  max {:.4e}  spread {:.3}",
-        result.edge_length, q.edge_mean, q.edge_min, q.edge_max, q.edge_spread
+        summary.edge_length, q.edge_mean, q.edge_min, q.edge_max, q.edge_spread
     );
     println!(
         "  distance        Hausdorff {:.4e} ({:.3}% of the diagonal)  mean {:.4e}",
@@ -464,10 +498,10 @@ fn print_summary(args: &RemeshArgs, result: &Summary, q: &Quality, seconds: f64)
         100.0 * q.hausdorff / q.diagonal,
         q.mean_distance
     );
-    for (stage, s) in &result.timings {
+    for (stage, s) in &report.timings {
         println!("  {stage:<15} {s:.3} s");
     }
-    for note in &result.notes {
+    for note in &report.notes {
         println!("  note: {note}");
     }
 }

@@ -12,8 +12,8 @@
 //! - the [`Solution`]: an [`Output`] (a [`Map`] of the source's vertices or a
 //!   [`Remeshed`] mesh located on the source), typed [`Metrics`] (`|mu|` statistics,
 //!   flips, `|mu - target|`, `k`, iterations and histories, why it stopped), typed
-//!   [`Extras`] (an annulus radius, circle-domain circles, a quadratic differential)
-//!   and a [`Report`] of timings and prose notes;
+//!   [`Extras`] (an annulus radius, circle-domain circles, a quadratic differential,
+//!   how a remeshing was made) and a [`Report`] of timings and prose notes;
 //! - the solve [`Context`] (progress callback, cancellation), the [`Registry`] of
 //!   solvers by name, and [`SolverError`], which keeps the errors of the crates below
 //!   typed (`#[from]`/`source`).
@@ -99,7 +99,8 @@ pub use registry::Registry;
 pub use renumbered::{Renumbered, SCATTERED_SPREAD, solve_renumbered};
 pub use report::Report;
 pub use solution::{
-    AnnulusRadius, Circle, Extras, FeatureMismatch, LandmarkResidual, Metrics, Output,
-    QuadraticDifferential, Remeshed, ShapeDistance, Solution, Stop,
+    AnnulusRadius, Circle, ComponentSummary, Extras, FeatureMismatch, InPlaceSummary,
+    LandmarkResidual, Metrics, Output, ParamSummary, QuadraticDifferential, RemeshSummary,
+    Remeshed, ShapeDistance, Solution, Stop,
 };
 pub use solver::{Context, Progress, Solver, SolverInfo};

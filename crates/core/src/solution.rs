@@ -185,6 +185,84 @@ pub struct Extras {
     pub features: Option<FeatureMismatch>,
     /// A registration's shape match (its option `match-shape`).
     pub shape: Option<ShapeDistance>,
+    /// How a remeshing's new mesh ([`Output::Mesh`]) was made.
+    pub remesh: Option<RemeshSummary>,
+}
+
+/// How the `remesh` solver made its new mesh, by method; its timings and notes are in
+/// the solution's [`Report`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum RemeshSummary {
+    /// A new mesh through a parameterization (method `param`).
+    Param(ParamSummary),
+    /// The source's own vertices and faces, the vertices moved along it towards
+    /// reference angles (method `qc-angles`); the metrics are the QC iteration's.
+    InPlace(InPlaceSummary),
+}
+
+/// A remeshing through a parameterization.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamSummary {
+    /// The parameterizer: a registered solver's name, `plane` for a planar surface (its
+    /// own parameterization), `per component` when the components used different ones.
+    pub parameterizer: &'static str,
+    /// How the surface was opened for it (`uncut`, `slit`, `cut-graph`, `filled`,
+    /// `two-charts`), `per component` when the components were opened differently.
+    pub opening: &'static str,
+    /// The asked edge length; for components remeshed to a shared vertex count, the mean
+    /// of their edge lengths weighted by area.
+    pub edge_length: f64,
+    /// Size passes of the refinement (the most of any component).
+    pub size_passes: usize,
+    /// Per connected component remeshed on its own, in the order of their first faces
+    /// (empty unless the components were remeshed one by one).
+    pub components: Vec<ComponentSummary>,
+    /// The one component remeshed alone (the largest of a source in pieces), by its
+    /// index in the order of [`crate::components::parts`]; `None` when the whole source
+    /// was remeshed. The new mesh then replaces that component only.
+    pub component: Option<usize>,
+}
+
+/// One connected component's remeshing within a [`ParamSummary`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComponentSummary {
+    /// The component's faces in the source.
+    pub input_faces: usize,
+    /// Its parameterizer.
+    pub parameterizer: &'static str,
+    /// How it was opened.
+    pub opening: &'static str,
+    /// Its asked edge length.
+    pub edge_length: f64,
+    /// The vertices of its new mesh.
+    pub vertices: usize,
+    /// The faces of its new mesh.
+    pub faces: usize,
+}
+
+/// A remeshing in place by reference angles: its settings as used, and what became of
+/// the faces that could turn against the surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InPlaceSummary {
+    /// The reference shapes: `optimized` or `equiangular`.
+    pub reference: &'static str,
+    /// How the image stayed near the surface: `normal` or `area`.
+    pub constraint: &'static str,
+    /// Whether the moved vertices were projected onto the source.
+    pub projected: bool,
+    /// Vertices of edges whose faces' normals differ by more than this (degrees) were
+    /// held.
+    pub feature_angle: f64,
+    /// Faces turned against the source surface (their normal and the source's at the
+    /// closest point to their centroid 90 degrees or more apart).
+    pub flipped: usize,
+    /// Faces of the source turned against its own surface by the same measure.
+    pub input_flipped: usize,
+    /// Vertices held on sharp features.
+    pub features: usize,
+    /// Vertices pulled back towards their source positions because a face of theirs had
+    /// turned.
+    pub pulled: usize,
 }
 
 /// The result of a solve.

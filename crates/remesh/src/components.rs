@@ -153,6 +153,8 @@ pub fn remesh_each<'r>(
 pub struct Largest {
     /// The component with the most faces (the first of equals), as a mesh of its own.
     pub part: Part,
+    /// Its index among the components, in the order of [`parts`].
+    pub index: usize,
     /// How many components the mesh has.
     pub of: usize,
     /// Its remeshing, on the component alone.
@@ -195,6 +197,7 @@ pub fn remesh_largest<'r>(
     let remeshing = remesh(&part.mesh, &solvers, options, context)?;
     Ok(Largest {
         part,
+        index: k,
         of,
         remeshing,
     })
@@ -214,10 +217,7 @@ fn join(pieces: &[Part], components: &[ComponentRemeshing]) -> Result<Remeshed, 
                 .faces()
                 .map(|f| new.mesh.face_vertices(f).map(|v| v.0 + offset).collect()),
         );
-        on_source.extend(new.on_source.iter().map(|p| SurfacePoint {
-            face: part.faces[p.face.idx()],
-            coords: p.coords,
-        }));
+        on_source.extend(on_whole(part, &new.on_source));
     }
     let mut soup = PolygonSoup::new(positions);
     for face in &faces {
@@ -228,6 +228,18 @@ fn join(pieces: &[Part], components: &[ComponentRemeshing]) -> Result<Remeshed, 
         error,
     })?;
     Ok(Remeshed { mesh, on_source })
+}
+
+/// `points` on the component `part`, as points on the whole mesh (the part's face is
+/// the whole mesh's face of the same corners, in the same order).
+fn on_whole<'a>(
+    part: &'a Part,
+    points: &'a [SurfacePoint],
+) -> impl Iterator<Item = SurfacePoint> + 'a {
+    points.iter().map(|p| SurfacePoint {
+        face: part.faces[p.face.idx()],
+        coords: p.coords,
+    })
 }
 
 /// Which connected components a remeshing covers (`beltrami remesh --components`).
@@ -248,6 +260,9 @@ pub enum Coverage {
 pub struct Covered {
     /// The new mesh.
     pub mesh: Mesh,
+    /// Per vertex of the new mesh (by id), its point on the whole input (also when one
+    /// component was remeshed alone).
+    pub on_source: Vec<SurfacePoint>,
     /// The remeshing's summary; with [`Coverage::Largest`] of a mesh in pieces its notes
     /// say what was remeshed ([`Largest::note`]).
     pub summary: Summary,
@@ -256,6 +271,8 @@ pub struct Covered {
     /// The component remeshed alone ([`Coverage::Largest`] of a mesh in pieces), the
     /// input the new mesh is to be measured against; `None` when that is the whole.
     pub part: Option<Part>,
+    /// That component's index in the order of [`parts`].
+    pub component: Option<usize>,
 }
 
 impl Covered {
@@ -281,20 +298,26 @@ pub fn remesh_covering<'r>(
             let summary = joined.summary();
             Ok(Covered {
                 mesh: joined.remeshed.mesh,
+                on_source: joined.remeshed.on_source,
                 summary,
                 components: joined.components,
                 part: None,
+                component: None,
             })
         }
         Coverage::Largest if mesh.component_count() > 1 => {
             let largest = remesh_largest(mesh, choose, options, context)?;
             let mut summary = largest.remeshing.summary();
             summary.notes.push(largest.note(mesh));
+            let on_source =
+                on_whole(&largest.part, &largest.remeshing.remeshed.on_source).collect();
             Ok(Covered {
                 mesh: largest.remeshing.remeshed.mesh,
+                on_source,
                 summary,
                 components: Vec::new(),
                 part: Some(largest.part),
+                component: Some(largest.index),
             })
         }
         Coverage::Whole | Coverage::Largest => {
@@ -303,9 +326,11 @@ pub fn remesh_covering<'r>(
             let summary = result.summary();
             Ok(Covered {
                 mesh: result.remeshed.mesh,
+                on_source: result.remeshed.on_source,
                 summary,
                 components: Vec::new(),
                 part: None,
+                component: None,
             })
         }
     }
