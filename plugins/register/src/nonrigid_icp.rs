@@ -31,7 +31,7 @@
 
 use beltrami_fem::FemError;
 use beltrami_fem::assembly::Pattern;
-use beltrami_mesh::{Mesh, Point3, Vector3};
+use beltrami_mesh::{FaceId, Mesh, Point3, Vector3};
 use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
 use beltrami_spatial::{Located, SurfaceIndex};
 use faer::Mat;
@@ -72,12 +72,19 @@ pub(crate) fn nonrigid_icp(
     let mut equations = NormalEquations::new(source, placed.iter().map(to_unit))?;
     let mut images: Vec<Vector3<f64>> = placed.iter().map(to_unit).collect();
     let n = images.len();
+    // Each round's closest points start their search from the last round's faces: the
+    // images move little between rounds (the answer does not depend on the start).
+    let mut hints: Option<Vec<FaceId>> = None;
     for stiffness in STIFFNESS {
         let alpha2 = (stiffness * stiffness) * n as f64;
         let mut weights = None;
         for _ in 0..ROUNDS {
             let positions: Vec<Point3<f64>> = images.iter().map(from_unit).collect();
-            let closest = index.locate_all(&positions)?;
+            let closest = match &hints {
+                Some(faces) => index.locate_all_near(&positions, faces)?,
+                None => index.locate_all(&positions)?,
+            };
+            hints = Some(closest.iter().map(|l| l.point.face).collect());
             let weights = match &weights {
                 Some(w) => w,
                 None => {

@@ -340,21 +340,23 @@ fn after_features(
         })
         .into_iter()
         .collect();
+    let mut report = solution.report.clone();
     let shape = if shape {
-        let index = SurfaceIndex::new(target).map_err(|e| registration_error(e.into()))?;
-        let fitted = Shape::new(flow.source, target, &index, points)
-            .map_err(registration_error)?
-            .ok_or_else(|| {
-                registration_error(RegisterError::Features {
-                    reason: "the registration's images lie on a line: no similarity places the source for match-shape".to_string(),
+        let fitted = context.stage("shape template", &mut report, || {
+            let index = SurfaceIndex::new(target).map_err(|e| registration_error(e.into()))?;
+            Shape::new(flow.source, target, &index, points)
+                .map_err(registration_error)?
+                .ok_or_else(|| {
+                    registration_error(RegisterError::Features {
+                        reason: "the registration's images lie on a line: no similarity places the source for match-shape".to_string(),
+                    })
                 })
-            })?;
+        })?;
         channels.extend(fitted.channels(target));
         Some(fitted)
     } else {
         None
     };
-    let mut report = solution.report.clone();
     let mut notes = Vec::new();
     let (matched, mismatch) = context.stage("feature match", &mut report, || {
         match_features_after(flow.source, target, initial, points, &channels, &mut notes)
