@@ -20,11 +20,16 @@
 //!
 //! The weights are judged at the first round of each stiffness and kept for its other
 //! rounds, which then only move the closest points `U`: one numeric factorization per
-//! stiffness instead of one per round. Measured against judging them every round (the
-//! paper's loop): `g0_spot` onto its deformation 0.0147 from the truth either way;
-//! fsaverage5 pial onto white 1.7213 against 1.7207 mm (0.5674 against 0.5681 mm with
-//! the sulcal depth), the whole registration 9.3 s instead of 14.6 s.
+//! stiffness instead of one per round (the same distances to the truth as judging them
+//! every round, the paper's loop, at two thirds of the time).
 //!
+//! The schedule ends supple (`0.002 sqrt(n)`): the template then follows the target
+//! closely where the stiff rounds brought it, which is what the shape match pulls the
+//! images towards. On fsaverage5 pial onto white the match lands 1.47 mm from the true
+//! correspondence with the schedule down to 0.002, 1.51 mm down to 0.0075 and 1.72 mm
+//! down to 0.03; `g0_spot` onto its deformation 0.0142, 0.0143 and 0.0148
+//! (docs/benchmarks.md).
+
 //! Positions are taken relative to the placed source's centroid and divided by its
 //! root-mean-square radius, so that `gamma = 1` weighs the translations like the linear
 //! parts.
@@ -40,7 +45,9 @@ use crate::error::{RegisterError, Side};
 use crate::shape::{centroid_and_spread, vertex_normals_at};
 
 /// The stiffness schedule, per `sqrt(n)` (module docs), stiff to supple.
-const STIFFNESS: [f64; 6] = [1.0, 0.5, 0.25, 0.12, 0.06, 0.03];
+const STIFFNESS: [f64; 10] = [
+    1.0, 0.5, 0.25, 0.12, 0.06, 0.03, 0.015, 0.0075, 0.004, 0.002,
+];
 
 /// Rounds per stiffness at most.
 const ROUNDS: usize = 10;
