@@ -216,7 +216,9 @@ def solve(
     ``'circle-domain'`` or ``'space'``), the plane's ``boundary`` (``'keep'``,
     ``'free'``, ``'circle'``, ``'square'`` or ``'given'`` with ``boundary_map``), the
     goal (``mu`` per face or ``mu_expr``, else the most conformal map with exponent
-    ``p``), ``pins``, an ``initial`` map, and the solver's ``options`` by name. The
+    ``p``; with none of the three, the extremal map for a solver that computes extremal
+    maps and the most conformal one otherwise), ``pins``, an ``initial`` map, and the
+    solver's ``options`` by name. The
     solver refuses, before any work, what it does not accept. Returns the map (``(n, 2)``
     or ``(n, 3)``), with the report when ``info=True``.
 

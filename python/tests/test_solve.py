@@ -53,3 +53,20 @@ def test_a_new_solver_is_reached_without_edits_of_the_python_package(disk):
     UV, report = beltrami.solve("affine", V, F, mu_expr="0.3+0.4i", boundary="free", info=True)
     assert report["solver"] == "affine"
     assert np.allclose(np.abs(beltrami.beltrami_coefficient(V, F, UV)), 0.5, atol=1e-12)
+
+
+def test_the_solver_chooses_the_goal_and_meaningless_words_are_refused(disk):
+    V, F = disk
+    flat = V * [1, 1, 0]
+    # No goal given: the extremal solver computes the extremal map of the boundary
+    # values, here those of the stretch x -> 2x, which is its own extremal map:
+    # f = 2x + iy = 1.5 z + 0.5 conj(z), mu = 1/3 on every face.
+    stretched = flat[:, :2] * [2.0, 1.0]
+    UV = beltrami.solve("extremal", flat, F, boundary="given", boundary_map=stretched)
+    mu = beltrami.beltrami_coefficient(flat, F, UV)
+    assert np.allclose(mu, 1.0 / 3.0, atol=1e-6)
+    # A boundary condition off the plane is refused, named in Python's words.
+    with pytest.raises(beltrami.OptionError, match=r"boundary is the boundary condition of target='plane'"):
+        beltrami.solve("beltrami-flow", V, F, target="disk", boundary="keep")
+    with pytest.raises(beltrami.OptionError, match=r"free_radius"):
+        beltrami.beltrami_flow(V, F, target="disk", free_radius=True)
