@@ -37,6 +37,8 @@
 //! two sides factored at once (module `two_domains`: one level of substructuring), when
 //! the separator is small against the whole.
 
+#[cfg(feature = "cg-compare")]
+pub mod cg_compare;
 pub mod check;
 mod cholesky;
 mod error;

@@ -203,18 +203,19 @@ impl<T: Scalar> SpdSolver<T> {
             return Err(SolveError::PatternMismatch { col });
         }
         check_finite_matrix("the matrix", matrix)?;
-        self.cholesky
-            .factorize(matrix, self.options.tolerance(n))
-            .map_err(|failure| match failure {
-                FactorFailure::NonPositivePivot { index } => {
-                    SolveError::NotPositiveDefinite { index }
-                }
-                FactorFailure::SmallPivot { index, ratio } => SolveError::Singular {
-                    index,
-                    node: None,
-                    ratio,
-                },
-            })?;
+        #[cfg(feature = "cg-compare")]
+        let start = std::time::Instant::now();
+        let factored = self.cholesky.factorize(matrix, self.options.tolerance(n));
+        #[cfg(feature = "cg-compare")]
+        crate::cg_compare::record_factorization(n, start.elapsed().as_secs_f64());
+        factored.map_err(|failure| match failure {
+            FactorFailure::NonPositivePivot { index } => SolveError::NotPositiveDefinite { index },
+            FactorFailure::SmallPivot { index, ratio } => SolveError::Singular {
+                index,
+                node: None,
+                ratio,
+            },
+        })?;
         self.factored = true;
         Ok(())
     }
@@ -241,69 +242,12 @@ impl<T: Scalar> SpdSolver<T> {
         if !self.factored {
             return Err(SolveError::NotFactored);
         }
-        let zero = T::from_f64(0.0);
-        let dot = |a: &[T], b: &[T]| -> T {
-            a.iter().zip(b).fold(zero, |acc, (&x, &y)| {
-                acc + faer::traits::ComplexField::conj_impl(&x) * y
-            })
-        };
-        let norm = |a: &[T]| faer::traits::ComplexField::real_part_impl(&dot(a, a)).sqrt();
-        let target = tolerance * norm(rhs);
-        let mut residual = rhs.to_vec();
-        let mut x = vec![zero; n];
-        let start = norm(&residual);
-        if start <= target {
-            rhs.copy_from_slice(&x);
-            return Ok(Preconditioned {
-                converged: true,
-                iterations: 0,
-            });
-        }
-        let mut z = residual.clone();
-        self.cholesky.solve_in_place(column_mut(&mut z))?;
-        let mut direction = z.clone();
-        let mut rz = dot(&residual, &z);
-        let mut product = vec![zero; n];
-        for iteration in 1..=max_iterations {
-            symmetric_lower_product(matrix, &direction, &mut product);
-            let alpha = rz / dot(&direction, &product);
-            for i in 0..n {
-                x[i] += alpha * direction[i];
-                residual[i] -= alpha * product[i];
-            }
-            let r = norm(&residual);
-            if r <= target {
-                check_finite_solution(&x)?;
-                rhs.copy_from_slice(&x);
-                return Ok(Preconditioned {
-                    converged: true,
-                    iterations: iteration,
-                });
-            }
-            // Mean reduction per iteration so far, and the iterations it predicts.
-            let rate = (r / start).powf(1.0 / iteration as f64);
-            if rate.is_nan()
-                || rate >= 1.0
-                || (target / start).ln() / rate.ln() > max_iterations as f64
-            {
-                return Ok(Preconditioned {
-                    converged: false,
-                    iterations: iteration,
-                });
-            }
-            z.copy_from_slice(&residual);
-            self.cholesky.solve_in_place(column_mut(&mut z))?;
-            let rz_next = dot(&residual, &z);
-            let beta = rz_next / rz;
-            rz = rz_next;
-            for i in 0..n {
-                direction[i] = z[i] + beta * direction[i];
-            }
-        }
-        Ok(Preconditioned {
-            converged: false,
-            iterations: max_iterations,
-        })
+        // `beltrami bench cg` measures this loop against faer's on the caller's systems.
+        #[cfg(feature = "cg-compare")]
+        let solve = crate::cg_compare::solve::<T>;
+        #[cfg(not(feature = "cg-compare"))]
+        let solve = conjugate_gradients::<T>;
+        solve(&mut self.cholesky, matrix, rhs, tolerance, max_iterations)
     }
 
     /// [`SpdSolver::solve_in_place`] for one right-hand side given as a slice: `x` is
@@ -351,6 +295,79 @@ impl<T: Scalar> SpdSolver<T> {
     }
 }
 
+/// The conjugate gradients of [`SpdSolver::solve_preconditioned`] (arguments checked
+/// there), preconditioned with the factorization `cholesky`.
+pub(crate) fn conjugate_gradients<T: Scalar>(
+    cholesky: &mut Cholesky<T>,
+    matrix: SparseColMatRef<'_, usize, T>,
+    rhs: &mut [T],
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<Preconditioned, SolveError> {
+    let n = rhs.len();
+    let zero = T::from_f64(0.0);
+    let dot = |a: &[T], b: &[T]| -> T {
+        a.iter().zip(b).fold(zero, |acc, (&x, &y)| {
+            acc + faer::traits::ComplexField::conj_impl(&x) * y
+        })
+    };
+    let norm = |a: &[T]| faer::traits::ComplexField::real_part_impl(&dot(a, a)).sqrt();
+    let target = tolerance * norm(rhs);
+    let mut residual = rhs.to_vec();
+    let mut x = vec![zero; n];
+    let start = norm(&residual);
+    if start <= target {
+        rhs.copy_from_slice(&x);
+        return Ok(Preconditioned {
+            converged: true,
+            iterations: 0,
+        });
+    }
+    let mut z = residual.clone();
+    cholesky.solve_in_place(column_mut(&mut z))?;
+    let mut direction = z.clone();
+    let mut rz = dot(&residual, &z);
+    let mut product = vec![zero; n];
+    for iteration in 1..=max_iterations {
+        symmetric_lower_product(matrix, &direction, &mut product);
+        let alpha = rz / dot(&direction, &product);
+        for i in 0..n {
+            x[i] += alpha * direction[i];
+            residual[i] -= alpha * product[i];
+        }
+        let r = norm(&residual);
+        if r <= target {
+            check_finite_solution(&x)?;
+            rhs.copy_from_slice(&x);
+            return Ok(Preconditioned {
+                converged: true,
+                iterations: iteration,
+            });
+        }
+        // Mean reduction per iteration so far, and the iterations it predicts.
+        let rate = (r / start).powf(1.0 / iteration as f64);
+        if rate.is_nan() || rate >= 1.0 || (target / start).ln() / rate.ln() > max_iterations as f64
+        {
+            return Ok(Preconditioned {
+                converged: false,
+                iterations: iteration,
+            });
+        }
+        z.copy_from_slice(&residual);
+        cholesky.solve_in_place(column_mut(&mut z))?;
+        let rz_next = dot(&residual, &z);
+        let beta = rz_next / rz;
+        rz = rz_next;
+        for i in 0..n {
+            direction[i] = z[i] + beta * direction[i];
+        }
+    }
+    Ok(Preconditioned {
+        converged: false,
+        iterations: max_iterations,
+    })
+}
+
 /// `inverse[order[k]] = k`; [`SolveError::InvalidOrder`] names the first entry of `order`
 /// that is out of range or repeated.
 pub(crate) fn inverse_permutation(order: &[usize]) -> Result<Vec<usize>, SolveError> {
@@ -367,7 +384,11 @@ pub(crate) fn inverse_permutation(order: &[usize]) -> Result<Vec<usize>, SolveEr
 
 /// `y = M x` for a Hermitian `M` given by its lower triangle (entries above the diagonal
 /// are ignored).
-fn symmetric_lower_product<T: Scalar>(m: SparseColMatRef<'_, usize, T>, x: &[T], y: &mut [T]) {
+pub(crate) fn symmetric_lower_product<T: Scalar>(
+    m: SparseColMatRef<'_, usize, T>,
+    x: &[T],
+    y: &mut [T],
+) {
     y.iter_mut().for_each(|v| *v = T::from_f64(0.0));
     for j in 0..m.ncols() {
         for (i, &v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
@@ -381,7 +402,7 @@ fn symmetric_lower_product<T: Scalar>(m: SparseColMatRef<'_, usize, T>, x: &[T],
     }
 }
 
-fn column_mut<T>(v: &mut [T]) -> MatMut<'_, T> {
+pub(crate) fn column_mut<T>(v: &mut [T]) -> MatMut<'_, T> {
     let n = v.len();
     MatMut::from_column_major_slice_mut(v, n, 1)
 }

@@ -1,5 +1,7 @@
 //! `beltrami bench`: timings printed as tables (the figures go to docs/benchmarks.md).
 
+#[cfg(feature = "cg-bench")]
+mod cg;
 mod fem;
 mod flow;
 mod load;
@@ -26,6 +28,10 @@ pub enum BenchKind {
     /// the LSCM system (complex N form and real 2N form), against faer on the same
     /// matrices.
     Fem(fem::FemArgs),
+    /// The flow's preconditioned conjugate gradients against faer's, on the systems of
+    /// flows and registrations (feature `cg-bench`).
+    #[cfg(feature = "cg-bench")]
+    Cg(cg::CgArgs),
     /// Fill-reducing orders (AMD, nested dissection by level sets and by multilevel
     /// separators, METIS) on meshes' vertex graphs: order time, factor cost, one
     /// numeric factorization.
@@ -50,6 +56,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         BenchKind::Fem(a) => fem::run(a),
         BenchKind::Flow(a) => flow::run(a),
         BenchKind::Ordering(a) => ordering::run(a),
+        #[cfg(feature = "cg-bench")]
+        BenchKind::Cg(a) => cg::run(a),
         BenchKind::Qcmc(a) => qcmc::run(a),
         BenchKind::Render(a) => render::run(a),
         BenchKind::Spatial(a) => spatial::run(a),
