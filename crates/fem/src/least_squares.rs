@@ -39,7 +39,9 @@ pub use normal::normal_pattern_of_cells;
 
 use crate::dof::{DofMap, DofScalar};
 use beltrami_sparse::check::{check_finite, check_finite_matrix, check_finite_solution, check_len};
-use beltrami_sparse::{PlannedCholesky, SolveError, SolveOptions, SpdSolver, solve_saddle_point};
+use beltrami_sparse::{
+    PlannedCholesky, Preconditioned, SolveError, SolveOptions, SpdSolver, solve_saddle_point,
+};
 use faer::sparse::{
     SparseColMat, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef, Triplet,
 };
@@ -90,6 +92,8 @@ pub struct LeastSquaresSolver<T: DofScalar> {
     residual: Vec<T>,
     /// Right-hand side, then solution, of the normal equations (`n`).
     y: Vec<T>,
+    /// A copy of `y` solved by conjugate gradients, kept when they converge.
+    trial: Vec<T>,
 }
 
 impl<T: DofScalar> fmt::Debug for LeastSquaresSolver<T> {
@@ -165,6 +169,7 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
             cholesky,
             residual: vec![zero; m],
             y: vec![zero; n],
+            trial: Vec::new(),
         })
     }
 
@@ -240,6 +245,58 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
                 expected: self.dofs.full_len(),
                 got: x.len(),
             })
+    }
+
+    /// [`solve_into`](Self::solve_into) for a matrix `A` (or weights) near the last
+    /// one factored, as in iterations whose system changes a little per step: the
+    /// normal equations are solved by conjugate gradients preconditioned with the kept
+    /// factorization (`SpdSolver::solve_preconditioned`) to the relative residual
+    /// `tolerance` within `max_iterations`, and factored anew (as `solve_into` does)
+    /// only when that fails or nothing is factored yet. Returns the conjugate-gradient
+    /// iterations done and whether it factored.
+    pub fn solve_into_reusing(
+        &mut self,
+        a: SparseColMatRef<'_, usize, T>,
+        weights: Option<&[f64]>,
+        b: &[T],
+        x: &mut [T],
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<Preconditioned, SolveError> {
+        self.check_inputs(a, weights, b)?;
+        check_len("the length of x", self.dofs.full_len(), x.len())?;
+        self.assemble(a, weights, b);
+        let mut outcome = Preconditioned {
+            converged: false,
+            iterations: 0,
+        };
+        if let Some(cholesky) = &mut self.cholesky {
+            if cholesky.is_factored() {
+                self.trial.clone_from(&self.y);
+                outcome = cholesky.solve_preconditioned(
+                    self.normal.matrix(),
+                    &mut self.trial,
+                    tolerance,
+                    max_iterations,
+                )?;
+            }
+            if outcome.converged {
+                std::mem::swap(&mut self.y, &mut self.trial);
+            } else {
+                cholesky
+                    .factorize(self.normal.matrix())
+                    .map_err(|error| singular_at_node(error, &self.dofs))?;
+                cholesky.solve_vector_in_place(&mut self.y)?;
+            }
+        }
+        self.dofs
+            .expand_into(&self.y, x)
+            .map_err(|_| SolveError::Length {
+                what: "the length of x",
+                expected: self.dofs.full_len(),
+                got: x.len(),
+            })?;
+        Ok(outcome)
     }
 
     /// The normal equations of `A`, `W`, `b` in `y`: the matrix `K^H A^H W A K` and,

@@ -327,6 +327,48 @@ fn symbolic_reuse_matches_fresh_factorization() {
     reuse_matches_fresh(&DofMap::complex(40, &constraints(false)).unwrap(), 5);
 }
 
+/// A nearby system (every value of `A` moved by up to 1e-3 of its size) is solved by
+/// conjugate gradients on the kept factorization, without factoring, to the dense
+/// answer within the tolerance; a system far from it fails to converge in the
+/// iterations given and is factored, as a first call (nothing factored) is.
+#[test]
+fn reusing_solves_a_nearby_system_without_factoring_and_factors_a_far_one() {
+    let dofs = DofMap::complex(40, &constraints(false)).unwrap();
+    let mut rng = Rng(11);
+    let m = 3 * dofs.full_len();
+    let Problem { positions, a, w, b } = random_problem(&mut rng, &dofs, m);
+    let mut solver = LeastSquaresSolver::new(a.symbolic(), &dofs, SolveOptions::default()).unwrap();
+    let mut x = vec![c(0.0, 0.0); dofs.full_len()];
+    let first = solver
+        .solve_into_reusing(a.as_ref(), Some(&w), &b, &mut x, 1e-10, 5)
+        .unwrap();
+    assert!(!first.converged && first.iterations == 0, "{first:?}");
+    let reference = dense_reference(&a, &w, &b, &dofs);
+    assert!(max_diff(&x, &reference) <= 1e-10 * max_abs(&reference));
+
+    let nearby: Vec<Complex64> = a
+        .val()
+        .iter()
+        .map(|&z| z * (1.0 + 1e-3 * rng.uniform()))
+        .collect();
+    let a_near = SparseColMat::new(a.symbolic().to_owned().unwrap(), nearby);
+    let near = solver
+        .solve_into_reusing(a_near.as_ref(), Some(&w), &b, &mut x, 1e-10, 5)
+        .unwrap();
+    assert!(near.converged && near.iterations >= 1, "{near:?}");
+    let reference = dense_reference(&a_near, &w, &b, &dofs);
+    assert!(max_diff(&x, &reference) <= 1e-8 * max_abs(&reference));
+
+    let far = random_values::<Complex64>(&mut rng, positions.len());
+    let a_far = assemble(m, dofs.full_len(), &positions, &far);
+    let outcome = solver
+        .solve_into_reusing(a_far.as_ref(), Some(&w), &b, &mut x, 1e-10, 2)
+        .unwrap();
+    assert!(!outcome.converged, "{outcome:?}");
+    let reference = dense_reference(&a_far, &w, &b, &dofs);
+    assert!(max_diff(&x, &reference) <= 1e-10 * max_abs(&reference));
+}
+
 fn matches_dense<T: Random>(dofs: &DofMap<T>, seed: u64) {
     let mut rng = Rng(seed);
     let m = 2 * dofs.full_len() + 5;

@@ -141,6 +141,20 @@ pub struct SplitOrder {
     pub sides: Option<[usize; 2]>,
 }
 
+impl SplitOrder {
+    /// The order of a system with `k` unknowns per row of this order's (unknown
+    /// `k r + j` for row `r`, `j < k`: a vertex's coordinates, a vertex's affine map),
+    /// each row's unknowns eliminated together in its place and the sides `k` times
+    /// as long. A graph's order carries over so: the blocks' pattern is the graph's with
+    /// each entry a dense `k x k` block, and it is cheaper to order the graph.
+    pub fn in_blocks(&self, k: usize) -> SplitOrder {
+        SplitOrder {
+            order: self.order.iter().flat_map(|&r| k * r..k * r + k).collect(),
+            sides: self.sides.map(|[a, b]| [k * a, k * b]),
+        }
+    }
+}
+
 impl From<nested_dissection::Dissected> for SplitOrder {
     fn from(dissected: nested_dissection::Dissected) -> Self {
         Self {

@@ -169,6 +169,12 @@ impl<T: Scalar> SpdSolver<T> {
         })
     }
 
+    /// Whether the last [`SpdSolver::factorize`] succeeded: then
+    /// [`SpdSolver::solve_preconditioned`] and the direct solves have a factor to use.
+    pub fn is_factored(&self) -> bool {
+        self.factored
+    }
+
     /// The pattern of the matrices the solver factors (their lower triangle is read).
     pub fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
         self.pattern.as_ref()

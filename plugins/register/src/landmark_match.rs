@@ -37,6 +37,16 @@ const K_MAX: f64 = 0.8;
 /// Steps after the first at most.
 const MAX_STEPS: usize = 60;
 
+/// Relative residual at which a rebuild solved by conjugate gradients, preconditioned
+/// with the factorization of an earlier step's system, is taken ([`Reconstruction::solve`]).
+const CG_TOLERANCE: f64 = 1e-7;
+
+/// Conjugate-gradient iterations a rebuild tries before it factors its own system: the
+/// steps change `nu` a little, and three in four rebuilds of a feature match converge
+/// within it (fsaverage5 pial onto white by the sulcal depth: 141 of 187, 787
+/// iterations, the rebuilds 1.95 s -> 1.56 s, the same mean distance to the truth, 0.625 mm).
+const CG_ITERATIONS: usize = 5;
+
 /// Smoothing passes applied to the coefficient between two steps.
 const SMOOTHING_PASSES: usize = 2;
 
@@ -189,14 +199,24 @@ impl<'m> Reconstruction<'m> {
     }
 
     /// The map whose coefficient is `nu` (per face) in the least-squares sense, with the
-    /// held vertices at their values.
+    /// held vertices at their values. Successive calls reuse the last factorization as a
+    /// preconditioner ([`CG_ITERATIONS`]) and factor only when that does not converge.
     pub(crate) fn solve(&mut self, nu: &[Complex64]) -> Result<Vec<Complex64>, RegisterError> {
         let operator =
             beltrami_operator(self.mesh, &self.elements, nu).map_err(RegisterError::Measure)?;
         let side = self.side;
+        let mut map = vec![Complex64::new(0.0, 0.0); self.mesh.vertex_count()];
         self.solver
-            .solve(operator.as_ref(), Some(&self.weights), &self.rhs)
-            .map_err(|error| RegisterError::Solve { side, error })
+            .solve_into_reusing(
+                operator.as_ref(),
+                Some(&self.weights),
+                &self.rhs,
+                &mut map,
+                CG_TOLERANCE,
+                CG_ITERATIONS,
+            )
+            .map_err(|error| RegisterError::Solve { side, error })?;
+        Ok(map)
     }
 
     /// The coefficient of `map` per face and the number of judged faces it flips.

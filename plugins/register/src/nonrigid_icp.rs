@@ -36,8 +36,9 @@
 
 use beltrami_fem::FemError;
 use beltrami_fem::assembly::Pattern;
+use beltrami_fem::vertex_graph::vertex_graph_pattern;
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector3};
-use beltrami_sparse::{SolveError, SolveOptions, SpdSolver};
+use beltrami_sparse::{SolveError, SolveOptions, SpdSolver, two_core_order};
 use beltrami_spatial::{Located, SurfaceIndex};
 use faer::Mat;
 
@@ -167,8 +168,17 @@ impl NormalEquations {
             degree[b] += 1.0;
         }
         let pattern = block_pattern(n, &edges).map_err(assembly_error)?;
-        let solver = SpdSolver::new(pattern.symbolic().as_ref(), SolveOptions::default())
-            .map_err(solve_error)?;
+        // Ordered on the vertex graph, each vertex's four unknowns together: the
+        // factorizations and solves of fsaverage5's 41K unknowns then run on two cores
+        // (2.0 s -> 1.0 s and 1.6 s -> 1.1 s of a registration by shape).
+        let vertex_split =
+            two_core_order(vertex_graph_pattern(source).as_ref()).map_err(solve_error)?;
+        let solver = SpdSolver::with_split_order(
+            pattern.symbolic().as_ref(),
+            &vertex_split.in_blocks(4),
+            SolveOptions::default(),
+        )
+        .map_err(solve_error)?;
         Ok(Self {
             pattern,
             homogeneous,
