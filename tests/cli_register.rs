@@ -217,6 +217,24 @@ fn a_torus_onto_a_modified_torus_with_the_l3_norm() {
 }
 
 #[test]
+fn in_place_is_refused_without_the_shape_match() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    let run = beltrami(&[
+        "register",
+        "meshes/spot.obj",
+        "meshes/blob.obj",
+        "--in-place",
+        "-o",
+        s(&out),
+    ]);
+    assert!(!run.status.success());
+    let stderr = text(&run.stderr);
+    assert!(stderr.contains("--match-shape"), "{stderr}");
+    assert!(!out.exists());
+}
+
+#[test]
 fn mismatched_topologies_fail_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out.obj");

@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """Registration by shape, side by side: `beltrami register --match-shape` against
 trimesh's non-rigid ICP (`trimesh.registration.nricp_amberg`, Amberg et al. 2007) and the
-closest point of the similarity-placed source, on pairs whose true correspondence is
-known (vertex i of the source corresponds to vertex i of the target).
+closest point of the similarity-placed source and of the source where it is, on pairs
+whose true correspondence is known (vertex i of the source corresponds to vertex i of the
+target).
 
 Pairs:
 - `spot`: ../shared/meshes/g0_spot.obj onto its smooth deformation
   D(x, y, z) = (1.3 x + 0.15 sin 2y, y + 0.1 x^2, 0.8 z + 0.1 cos 3x), same faces;
 - `pial-white` (with --fs DIR, the output of benches/fsaverage.py): fsaverage5 left pial
-  onto white, also with the sulcal depth as a feature (nricp only with --nricp-cortex:
+  onto white, also taken in place (`--in-place`: both surfaces of one subject lie in
+  one frame) and with the sulcal depth as a feature (nricp only with --nricp-cortex:
   it runs for minutes there).
 
 For each method: the mean / median / max distance of the images from the true ones, the
@@ -128,6 +130,8 @@ def compare(label, source, target_path, beltrami, work, run_nricp, extra=()) -> 
         print(row(name, images, tv, sf, tf, seconds))
     _, _, closest = ClosestPoints(tv, tf).query(placed(sv, sf, tv, tf))
     print(row("closest point of the placed source", closest, tv, sf, tf, None))
+    _, _, closest = ClosestPoints(tv, tf).query(sv)
+    print(row("closest point of the source in place", closest, tv, sf, tf, None))
     if run_nricp:
         start = time.perf_counter()
         deformed = trimesh.registration.nricp_amberg(
@@ -167,6 +171,7 @@ def main() -> None:
                 work,
                 args.nricp_cortex,
                 [
+                    (["--match-shape", "--in-place"], "beltrami register --match-shape --in-place"),
                     (["--features", sulc, sulc], "beltrami register --features sulc"),
                     (
                         ["--match-shape", "--features", sulc, sulc],

@@ -1011,6 +1011,7 @@ def register(
     allow_flips: bool = ...,
     allow_missed_landmarks: bool = ...,
     match_shape: bool = ...,
+    in_place: bool = ...,
     inverse_consistency: bool = ...,
     options: Optional[Dict[str, Any]] = ...,
     progress: Optional[Progress] = ...,
@@ -1035,6 +1036,7 @@ def register(
     allow_flips: bool = ...,
     allow_missed_landmarks: bool = ...,
     match_shape: bool = ...,
+    in_place: bool = ...,
     inverse_consistency: bool = ...,
     options: Optional[Dict[str, Any]] = ...,
     progress: Optional[Progress] = ...,
@@ -1058,6 +1060,7 @@ def register(
     allow_flips: bool = False,
     allow_missed_landmarks: bool = False,
     match_shape: bool = False,
+    in_place: bool = False,
     inverse_consistency: bool = False,
     options: Optional[Dict[str, Any]] = None,
     progress: Optional[Progress] = None,
@@ -1078,7 +1081,10 @@ def register(
     ``match_shape=True`` pulls each image towards where the source, placed on the
     target by an affine closest-point fit, lies (a non-rigid ICP that stays a
     bijection; disks and closed genus-0 surfaces; the report's ``shape`` has the mean
-    distance before and after). ``inverse_consistency=True`` also registers ``TV, TF`` onto ``V, F`` (landmark
+    distance before and after). With ``in_place=True`` (with ``match_shape``) the meshes
+    lie in one frame and the source near its correspondence (a subject's pial and white
+    surfaces): the source is taken where it is, not aligned, and deformed with the
+    supple end of the non-rigid ICP's schedule. ``inverse_consistency=True`` also registers ``TV, TF`` onto ``V, F`` (landmark
     pairs reversed, features exchanged) and puts how far each vertex lands from where it
     started, carried there and back, in the report (``info=True``):
     ``inverse_consistency: {mean, max, worst_vertex, relative_mean, relative_max}``.
@@ -1116,6 +1122,7 @@ def register(
             allow_flips=True if allow_flips else None,
             allow_missed_landmarks=True if allow_missed_landmarks else None,
             match_shape=True if match_shape else None,
+            in_place=True if in_place else None,
         ),
         "defaults": {"tolerance": "1e-05", "max-iters": "100"},
     }

@@ -225,6 +225,20 @@ def test_register_match_shape_matches_the_command(cli, tmp_path):
     assert info["shape"]["after"] < info["shape"]["before"]
 
 
+def test_register_in_place_matches_the_command(cli, tmp_path):
+    # The shape matched from the source where it is, both ways; without the shape
+    # match the keyword is refused before any work.
+    source, target = MESHES / "spot.obj", MESHES / "blob.obj"
+    V, F = beltrami.read_mesh(source)
+    TV, TF = beltrami.read_mesh(target)
+    out = tmp_path / "out.obj"
+    cli("register", source, target, "--max-iters", "3", "--match-shape", "--in-place", "-o", out)
+    P, face, bary = beltrami.register(V, F, TV, TF, max_iters=3, match_shape=True, in_place=True)
+    close(P, positions_of(out))
+    with pytest.raises(beltrami.BeltramiError, match="match-shape"):
+        beltrami.register(V, F, TV, TF, in_place=True)
+
+
 def test_register_inverse_consistency_matches_the_command(cli, tmp_path):
     source, target = MESHES / "spot.obj", MESHES / "blob.obj"
     landmarks = tmp_path / "marks.txt"

@@ -46,6 +46,13 @@ pub struct RegisterArgs {
     /// surfaces of one subject. With --features, both are matched together.
     #[arg(long = "match-shape")]
     pub match_shape: bool,
+    /// With --match-shape: the meshes lie in one frame and the source already near its
+    /// correspondence (two surfaces of one scan, such as a subject's pial and white
+    /// surfaces): the source is taken where it is, not aligned, and deformed with the
+    /// supple end of the non-rigid ICP's schedule only, so that it is not slid along
+    /// the target by a fit as a whole.
+    #[arg(long = "in-place", requires = "match_shape")]
+    pub in_place: bool,
     /// Most flow iterations [default: 100].
     #[arg(long = "max-iters")]
     pub max_iters: Option<usize>,
@@ -187,6 +194,7 @@ fn spec_of(args: &RegisterArgs) -> ProblemSpec {
             "match-shape",
             args.match_shape.then_some(OptionValue::Bool(true)),
         ),
+        ("in-place", args.in_place.then_some(OptionValue::Bool(true))),
     ];
     for (name, value) in given {
         if let Some(value) = value {

@@ -4,10 +4,12 @@
 //!
 //! 1. the similarity that best carries the source's vertices onto their images
 //!    (`SpatialMatch::fitted`, Umeyama 1991), refined by an affine closest-point fit,
-//!    places the source in the target's frame;
+//!    places the source in the target's frame; a source in place ([`Placement::InPlace`],
+//!    the register option `in-place`) is taken where it is;
 //! 2. the placed source is deformed onto the target by the optimal-step non-rigid ICP
 //!    of Amberg, Romdhani and Vetter (CVPR 2007; module `nonrigid_icp`): a template
-//!    `T_i` per source vertex, near the target and smooth, but not a bijection;
+//!    `T_i` per source vertex, near the target and smooth, but not a bijection (in
+//!    place, with the schedule's supple end only: `SUPPLE_STIFFNESS`);
 //! 3. the three coordinates of `T_i` at the source's vertices and of `y_j` at the
 //!    target's are matched as fields (module `feature_match`), both divided by the
 //!    target's root-mean-square distance from its centroid: each image is pulled
@@ -24,7 +26,19 @@ use crate::affine_alignment::{apply, closest_point_affine, spread_vertices};
 use crate::error::RegisterError;
 use crate::feature_match::Channel;
 use crate::landmarks::SpatialMatch;
-use crate::nonrigid_icp::nonrigid_icp;
+use crate::nonrigid_icp::{STIFFNESS, SUPPLE_STIFFNESS, nonrigid_icp};
+
+/// Where the shape match takes the source from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Placement {
+    /// Placed by the similarity of the registration's images and an affine
+    /// closest-point fit, then deformed with the whole stiffness schedule.
+    Aligned,
+    /// Taken where it is (both meshes in one frame, the source near its
+    /// correspondence: two surfaces of one scan), deformed with the supple end of the
+    /// schedule only.
+    InPlace,
+}
 
 /// The source placed in the target's frame (an affine map, then the non-rigid ICP's
 /// template) and its coordinate fields on both meshes.
@@ -36,13 +50,14 @@ pub(crate) struct Shape {
 }
 
 impl Shape {
-    /// The placed source (module docs): the similarity that best carries the source's
-    /// vertices onto their images `points` on `target`, refined by an affine
-    /// closest-point fit (rounds of: each sampled source vertex's closest point on the
-    /// target, pairs beyond `TRIM` median distances dropped, the least-squares affine
-    /// map of the rest) while it lowers the trimmed mean distance, then deformed by the
-    /// non-rigid ICP. `None` when the images do not fix a similarity (every image on a
-    /// line).
+    /// The placed source (module docs): [`Placement::Aligned`], the similarity that
+    /// best carries the source's vertices onto their images `points` on `target`,
+    /// refined by an affine closest-point fit (rounds of: each sampled source vertex's
+    /// closest point on the target, pairs beyond `TRIM` median distances dropped, the
+    /// least-squares affine map of the rest) while it lowers the trimmed mean distance;
+    /// [`Placement::InPlace`], the source as it is; then deformed by the non-rigid ICP.
+    /// `None` when the images do not fix a similarity (every image on a line) for an
+    /// alignment.
     ///
     /// # Errors
     /// [`RegisterError::Spatial`] when a closest point cannot be found,
@@ -52,7 +67,13 @@ impl Shape {
         target: &Mesh,
         index: &SurfaceIndex<'_>,
         points: &[SurfacePoint],
+        placement: Placement,
     ) -> Result<Option<Self>, RegisterError> {
+        let (_, scale) = centroid_and_spread(target.positions());
+        if placement == Placement::InPlace {
+            let placed = nonrigid_icp(source, index, source.positions(), &SUPPLE_STIFFNESS)?;
+            return Ok((scale > 0.0).then_some(Self { placed, scale }));
+        }
         let picked = spread_vertices(source);
         let samples: Vec<Point3<f64>> = picked.iter().map(|&v| source.position(v)).collect();
         let images: Vec<Point3<f64>> = picked
@@ -64,13 +85,12 @@ impl Shape {
         };
         let alignment =
             closest_point_affine(&samples, index, similarity.as_affine(), similarity.scale())?;
-        let (_, scale) = centroid_and_spread(target.positions());
         let affine: Vec<Point3<f64>> = source
             .positions()
             .iter()
             .map(|p| apply(&alignment, p))
             .collect();
-        let placed = nonrigid_icp(source, index, &affine)?;
+        let placed = nonrigid_icp(source, index, &affine, &STIFFNESS)?;
         Ok((scale > 0.0).then_some(Self { placed, scale }))
     }
 
@@ -158,7 +178,7 @@ mod tests {
             .map(|v| SurfacePoint::at_vertex(&target, v))
             .collect();
         let index = SurfaceIndex::new(&target).unwrap();
-        let shape = Shape::new(&source, &target, &index, &points)
+        let shape = Shape::new(&source, &target, &index, &points, Placement::Aligned)
             .unwrap()
             .unwrap();
         assert!(shape.distance(&source, &target, &points) < 1e-9);

@@ -11,7 +11,7 @@ use beltrami_spatial::SurfaceIndex;
 
 use crate::compose::flipped_faces;
 use crate::feature_match::Channel;
-use crate::shape::Shape;
+use crate::shape::{Placement, Shape};
 use crate::{InitialMap, RegisterError, check_topology, initial_map_for, match_features_after};
 
 /// Surface registration: the initial bijection of `initial_map` (through a common
@@ -55,7 +55,7 @@ const ACCEPTS: Accepts = Accepts {
 };
 
 /// The options register adds to the flow's.
-const OWN_OPTIONS: [OptionSpec; 3] = [
+const OWN_OPTIONS: [OptionSpec; 4] = [
     OptionSpec {
         name: "allow-flips",
         kind: OptionKind::Bool { default: false },
@@ -67,6 +67,11 @@ const OWN_OPTIONS: [OptionSpec; 3] = [
         help: "after the conformal registration, pull each image towards where the source, aligned by a similarity, lies on the target (a bijective non-rigid ICP; disks and closed genus-0 surfaces)",
     },
     OptionSpec {
+        name: "in-place",
+        kind: OptionKind::Bool { default: false },
+        help: "with match-shape: the meshes lie in one frame and the source near its correspondence (two surfaces of one scan, such as pial and white): take the source where it is, not aligned, and deform it with the supple end of the non-rigid ICP's schedule",
+    },
+    OptionSpec {
         name: "allow-missed-landmarks",
         kind: OptionKind::Bool { default: false },
         help: "keep a map whose landmarks are not all exact (their distances are in the report) instead of failing",
@@ -76,7 +81,8 @@ const OWN_OPTIONS: [OptionSpec; 3] = [
 /// How many options register takes: the flow's and its own.
 const OPTION_COUNT: usize = beltrami_flow_engine::OPTIONS.len() + OWN_OPTIONS.len();
 
-/// The flow's options, `allow-flips`, `match-shape` and `allow-missed-landmarks`.
+/// The flow's options, `allow-flips`, `match-shape`, `in-place` and
+/// `allow-missed-landmarks`.
 const OPTIONS: [OptionSpec; OPTION_COUNT] = {
     let flow = beltrami_flow_engine::OPTIONS;
     let mut options = [OWN_OPTIONS[0]; OPTION_COUNT];
@@ -289,6 +295,12 @@ impl Solver for Register {
             _ => None,
         };
         let shape = settings.flag("match-shape");
+        if settings.flag("in-place") && !shape {
+            return Err(SolverError::invalid(
+                NAME,
+                "in-place says where the shape match takes the source from: give it with match-shape",
+            ));
+        }
         if (features.is_some() || shape) && problem.constraints.curves().next().is_some() {
             return Err(SolverError::unsupported(
                 NAME,
@@ -312,14 +324,14 @@ impl Solver for Register {
 }
 
 /// The conformal registration `solution` of `flow` bent in the common domain so that
-/// `features` match and, with `shape`, the source's aligned coordinates (modules
+/// `features` match and, with `shape`, the source's coordinates placed so (modules
 /// `feature_match`, `shape`), then measured by the flow engine with no step (a step
 /// would pull it back towards conformal).
 fn after_features(
     flow: &Problem<'_>,
     initial: &InitialMap,
     features: Option<&Features>,
-    shape: bool,
+    shape: Option<Placement>,
     solution: Solution,
     context: &mut Context<'_>,
 ) -> Result<Solution, SolverError> {
@@ -341,10 +353,10 @@ fn after_features(
         .into_iter()
         .collect();
     let mut report = solution.report.clone();
-    let shape = if shape {
+    let shape = if let Some(placement) = shape {
         let fitted = context.stage("shape template", &mut report, || {
             let index = SurfaceIndex::new(target).map_err(|e| registration_error(e.into()))?;
-            Shape::new(flow.source, target, &index, points)
+            Shape::new(flow.source, target, &index, points, placement)
                 .map_err(registration_error)?
                 .ok_or_else(|| {
                     registration_error(RegisterError::Features {
@@ -410,8 +422,14 @@ pub(crate) fn register(
         Goal::Features(features) => Some(features),
         _ => None,
     };
-    let shape = settings.flag("match-shape");
-    let matched = features.is_some() || shape;
+    let shape = settings.flag("match-shape").then(|| {
+        if settings.flag("in-place") {
+            Placement::InPlace
+        } else {
+            Placement::Aligned
+        }
+    });
+    let matched = features.is_some() || shape.is_some();
     let cancel = context.cancel_flag();
     let initial = context.stage("initial map", &mut report, || {
         initial_map_for(source, target, &marks, matched, &cancel).map_err(registration_error)

@@ -14,19 +14,33 @@ use beltrami_register::Register;
 use common::run_against_truth;
 use fixtures::{blob_pair, deform};
 
-/// Registers `source` onto `target`, with the shape matched when `shape` (checks of
-/// [`run_against_truth`]).
+/// Registers `source` onto `target`, with the shape matched when `shape`, taken in
+/// place when `in_place` (checks of [`run_against_truth`]).
+fn register_with(
+    source: &Mesh,
+    target: &Mesh,
+    truth: &dyn Fn(&Point3<f64>) -> Point3<f64>,
+    shape: bool,
+    in_place: bool,
+) -> (f64, Solution) {
+    let mut problem = Problem::new(source, Target::Mesh(target));
+    if shape {
+        problem.options.set("match-shape", OptionValue::Bool(true));
+    }
+    if in_place {
+        problem.options.set("in-place", OptionValue::Bool(true));
+    }
+    run_against_truth(&problem, source, target, truth)
+}
+
+/// [`register_with`] with the source aligned.
 fn register(
     source: &Mesh,
     target: &Mesh,
     truth: &dyn Fn(&Point3<f64>) -> Point3<f64>,
     shape: bool,
 ) -> (f64, Solution) {
-    let mut problem = Problem::new(source, Target::Mesh(target));
-    if shape {
-        problem.options.set("match-shape", OptionValue::Bool(true));
-    }
-    run_against_truth(&problem, source, target, truth)
+    register_with(source, target, truth, shape, false)
 }
 
 #[test]
@@ -44,6 +58,61 @@ fn a_deformed_blob_is_found_by_its_shape() {
     assert!(
         matched < 0.3 * conformal,
         "mean distance to the truth: {matched:.4} with the shape, {conformal:.4} without"
+    );
+}
+
+/// The blob of `blob_pair(level)` and an offset of it, every vertex moved along its
+/// normal by `thickness` (as a cortex's pial surface lies outside its white surface):
+/// `(offset, blob)`, vertex `i` of one onto vertex `i` of the other.
+fn offset_pair(level: usize, thickness: f64) -> (Mesh, Mesh) {
+    let (blob, _) = blob_pair(level);
+    let mut soup = primitives::icosphere(level);
+    for v in blob.vertices() {
+        soup.positions[blob.vertex_map().to_input(v)] =
+            blob.position(v) + thickness * blob.vertex_normal(v);
+    }
+    (Mesh::from_soup(&soup).unwrap(), blob)
+}
+
+#[test]
+fn an_offset_surface_in_place_lands_near_its_correspondence() {
+    // An offset is no similarity of the blob: aligned as a whole, the source slides
+    // along the target; taken in place, the supple non-rigid ICP follows the normals.
+    let thickness = 0.05;
+    let (source, target) = offset_pair(4, thickness);
+    let truth = |p: &Point3<f64>| {
+        let v = source
+            .vertices()
+            .find(|&v| source.position(v) == *p)
+            .expect("a source vertex");
+        let input = source.vertex_map().to_input(v);
+        target.position(
+            target
+                .vertex_map()
+                .from_input(input)
+                .expect("one numbering"),
+        )
+    };
+    let (aligned, _) = register_with(&source, &target, &truth, true, false);
+    let (in_place, _) = register_with(&source, &target, &truth, true, true);
+    eprintln!(
+        "offset blob: mean distance to the truth {in_place:.4} in place, {aligned:.4} aligned"
+    );
+    assert!(
+        in_place < 0.5 * aligned && in_place < 0.5 * thickness,
+        "mean distance to the truth: {in_place:.4} in place, {aligned:.4} aligned"
+    );
+}
+
+#[test]
+fn in_place_without_the_shape_match_is_refused_before_work() {
+    let (source, target) = blob_pair(2);
+    let mut problem = Problem::new(&source, Target::Mesh(&target));
+    problem.options.set("in-place", OptionValue::Bool(true));
+    let error = Register.check(&problem).unwrap_err();
+    assert!(
+        error.to_string().contains("in-place") && error.to_string().contains("match-shape"),
+        "{error}"
     );
 }
 
