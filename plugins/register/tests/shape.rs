@@ -53,7 +53,7 @@ fn a_deformed_blob_is_found_by_its_shape() {
     eprintln!(
         "deformed blob: mean distance to the truth {matched:.4} with the shape, {conformal:.4} without"
     );
-    // Measured 0.030 against 0.169: the non-rigid ICP's template follows the
+    // Measured 0.029 against 0.169: the non-rigid ICP's template follows the
     // deformation and the matched coordinates keep the map a bijection.
     assert!(
         matched < 0.3 * conformal,
