@@ -369,10 +369,6 @@ impl ProblemSpec {
             .unwrap_or_else(|| self.target.default_solver())
     }
 
-    fn refuse(&self, word: Word, message: String) -> Result<(), SpecError> {
-        Err(SpecError::Words { word, message })
-    }
-
     /// Refuses, before any mesh is read, words that the others make meaningless (they
     /// would be ignored silently) or that need another: a boundary condition off the
     /// plane and space, a boundary map without the `given` boundary, the normal and
@@ -383,111 +379,115 @@ impl ProblemSpec {
         let target = s.setting(Word::Target, self.target.name());
         let space = self.target == TargetName::Space;
         if self.boundary.is_some() && !matches!(self.target, TargetName::Plane) && !space {
-            self.refuse(
-                Word::Boundary,
-                format!(
+            return Err(SpecError::Words {
+                word: Word::Boundary,
+                message: format!(
                     "{} is the boundary condition of {} and space; {target} has its own",
                     s.word(Word::Boundary),
                     s.setting(Word::Target, "plane")
                 ),
-            )?;
+            });
         }
         if let Some(w) = self.normal_constraint {
             if !space {
-                self.refuse(
-                    Word::NormalConstraint,
-                    format!(
+                return Err(SpecError::Words {
+                    word: Word::NormalConstraint,
+                    message: format!(
                         "{} keeps a map into space near the surface: it needs {}",
                         s.word(Word::NormalConstraint),
                         s.setting(Word::Target, "space")
                     ),
-                )?;
+                });
             }
             if !(w.is_finite() && w > 0.0) {
-                self.refuse(
-                    Word::NormalConstraint,
-                    format!(
+                return Err(SpecError::Words {
+                    word: Word::NormalConstraint,
+                    message: format!(
                         "{} {w}: the weight must be a positive number",
                         s.word(Word::NormalConstraint)
                     ),
-                )?;
+                });
             }
         }
         if self.area_constraint && !space {
-            self.refuse(
-                Word::AreaConstraint,
-                format!(
+            return Err(SpecError::Words {
+                word: Word::AreaConstraint,
+                message: format!(
                     "{} keeps the area of a map into space: it needs {}",
                     s.word(Word::AreaConstraint),
                     s.setting(Word::Target, "space")
                 ),
-            )?;
+            });
         }
         let given = self.boundary == Some(BoundaryName::Given);
         if space && !given && self.constraints.pins().next().is_none() {
-            self.refuse(
-                Word::Target,
-                format!(
+            return Err(SpecError::Words {
+                word: Word::Target,
+                message: format!(
                     "{target} holds vertices where they go: the boundary at the positions of a map (add {} {}), or vertices where they are ({})",
                     s.setting(Word::Boundary, "given"),
                     s.word(Word::BoundaryMap),
                     s.word(Word::Pins)
                 ),
-            )?;
+            });
         }
         match (&self.boundary_map, given) {
-            (None, true) => self.refuse(
-                Word::BoundaryMap,
-                format!(
-                    "{} needs {}",
-                    s.setting(Word::Boundary, "given"),
-                    s.word(Word::BoundaryMap)
-                ),
-            )?,
-            (Some(BoundaryMap::Planar(_)), true) if space => self.refuse(
-                Word::BoundaryMap,
-                format!(
-                    "{} holds the boundary at points of R^3: {} gives points in the plane",
-                    s.setting(Word::Target, "space"),
-                    s.word(Word::BoundaryMap)
-                ),
-            )?,
+            (None, true) => {
+                return Err(SpecError::Words {
+                    word: Word::BoundaryMap,
+                    message: format!(
+                        "{} needs {}",
+                        s.setting(Word::Boundary, "given"),
+                        s.word(Word::BoundaryMap)
+                    ),
+                });
+            }
+            (Some(BoundaryMap::Planar(_)), true) if space => {
+                return Err(SpecError::Words {
+                    word: Word::BoundaryMap,
+                    message: format!(
+                        "{} holds the boundary at points of R^3: {} gives points in the plane",
+                        s.setting(Word::Target, "space"),
+                        s.word(Word::BoundaryMap)
+                    ),
+                });
+            }
             _ => {}
         }
         if self.boundary_map.is_some() && !given {
-            self.refuse(
-                Word::BoundaryMap,
-                format!(
+            return Err(SpecError::Words {
+                word: Word::BoundaryMap,
+                message: format!(
                     "{} gives the boundary of {}; add that or drop {}",
                     s.word(Word::BoundaryMap),
                     s.setting(Word::Boundary, "given"),
                     s.word(Word::BoundaryMap)
                 ),
-            )?;
+            });
         }
         let planar_landmarks = self
             .constraints
             .landmarks()
             .any(|l| matches!(l.position, Position::Planar(_)));
         if planar_landmarks && self.target != TargetName::Disk {
-            self.refuse(
-                Word::Landmarks,
-                format!(
+            return Err(SpecError::Words {
+                word: Word::Landmarks,
+                message: format!(
                     "{} moves boundary points of {} (the four-point problem); {target} holds its boundary otherwise",
                     s.word(Word::Landmarks),
                     s.setting(Word::Target, "disk")
                 ),
-            )?;
+            });
         }
         if self.free_radius && self.target != TargetName::Annulus {
-            self.refuse(
-                Word::FreeRadius,
-                format!(
+            return Err(SpecError::Words {
+                word: Word::FreeRadius,
+                message: format!(
                     "{} lets the inner radius of {} move; {target} has none",
                     s.word(Word::FreeRadius),
                     s.setting(Word::Target, "annulus")
                 ),
-            )?;
+            });
         }
         Ok(())
     }

@@ -381,6 +381,16 @@ pub fn solve<'py>(
     };
     let registry = beltrami::registry();
     let solver = registry.get(solver).map_err(|e| errors::from_solver(&e))?;
+    // `solve` returns maps; the remeshing makes a new mesh, refused before any work.
+    if solver.name() == beltrami::remesh_solver::NAME {
+        return Err(errors::raise(
+            Kind::Solver,
+            format!(
+                "{} makes a new mesh, not a map of this one: call beltrami.remesh or beltrami.remesh_in_place",
+                solver.name()
+            ),
+        ));
+    }
     let mesh = arrays::mesh(v.as_array(), f.as_array())?;
     let target_mesh = match (target_v, target_f) {
         (Some(tv), Some(tf)) => Some(arrays::mesh(tv.as_array(), tf.as_array())?),
@@ -416,10 +426,7 @@ pub fn solve<'py>(
     let Some(map) = solution.map() else {
         return Err(errors::raise(
             Kind::Solver,
-            format!(
-                "{} makes a new mesh, not a map of this one: call beltrami.remesh or beltrami.remesh_in_place",
-                solver.name()
-            ),
+            format!("{} gave no map of this mesh", solver.name()),
         ));
     };
     let image = map_file::image(solved, map, target_mesh.as_ref())

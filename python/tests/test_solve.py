@@ -45,6 +45,14 @@ def test_an_unknown_name_and_a_refused_target_are_typed_errors(disk):
         beltrami.solve("tutte", V, F, target="sphere")
 
 
+def test_a_remeshing_by_name_is_refused_before_any_work(disk):
+    # `solve` returns maps; the remeshing (here to ten million vertices, which would
+    # take minutes) makes a new mesh and is refused at once, pointing at its calls.
+    V, F = disk
+    with pytest.raises(beltrami.SolverError, match="beltrami.remesh"):
+        beltrami.solve("remesh", V, F, options={"vertices": 10_000_000})
+
+
 def test_a_new_solver_is_reached_without_edits_of_the_python_package(disk):
     # `affine` is one folder under plugins/ and one registry line (docs/adding-a-solver.md).
     V, F = disk

@@ -49,9 +49,9 @@ pub enum Topology {
 }
 
 impl Topology {
-    /// Every one-component topology: what a solver that maps any connected surface
+    /// Every topology, several components last: what a solver that takes any mesh
     /// lists in [`Accepts::topologies`].
-    pub const CONNECTED: &'static [Topology] = &[
+    pub const ANY: &'static [Topology] = &[
         Topology::Disk,
         Topology::Annulus,
         Topology::MultiplyConnected,
@@ -59,7 +59,12 @@ impl Topology {
         Topology::Torus,
         Topology::HigherGenus,
         Topology::BoundedHigherGenus,
+        Topology::Components,
     ];
+
+    /// Every one-component topology ([`Topology::ANY`] but `Components`): what a solver
+    /// that maps any connected surface lists in [`Accepts::topologies`].
+    pub const CONNECTED: &'static [Topology] = Self::ANY.split_at(Self::ANY.len() - 1).0;
 
     /// The topology of `mesh`.
     pub fn of(mesh: &Mesh) -> Self {

@@ -552,6 +552,29 @@ fn topologies_are_classified() {
     ))
     .unwrap();
     assert_eq!(Topology::of(&torus), Topology::Torus);
+    // The lists solvers accept: every classified mesh is in ANY, the two components of
+    // two disks are not CONNECTED, each connected one is.
+    let two = Mesh::from_soup(&beltrami_mesh::PolygonSoup::from_triangles(
+        vec![
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.0, 0.0),
+            Point3::new(0.0, 1.0, 0.0),
+            Point3::new(3.0, 0.0, 0.0),
+            Point3::new(4.0, 0.0, 0.0),
+            Point3::new(3.0, 1.0, 0.0),
+        ],
+        &[[0, 1, 2], [3, 4, 5]],
+    ))
+    .unwrap();
+    assert_eq!(Topology::of(&two), Topology::Components);
+    for mesh in [&disk, &sphere, &torus, &two] {
+        let topology = Topology::of(mesh);
+        assert!(Topology::ANY.contains(&topology));
+        assert_eq!(
+            Topology::CONNECTED.contains(&topology),
+            topology != Topology::Components
+        );
+    }
 }
 
 #[test]

@@ -129,13 +129,7 @@ pub(crate) fn solve<T: Scalar>(
         return conjugate_gradients(cholesky, matrix, rhs, tolerance, max_iterations);
     }
     let run = if mode == Mode::Own as u8 {
-        let start = Instant::now();
-        let outcome = conjugate_gradients(cholesky, matrix, rhs, tolerance, max_iterations)?;
-        Run {
-            converged: outcome.converged,
-            iterations: outcome.iterations,
-            seconds: start.elapsed().as_secs_f64(),
-        }
+        own_run(cholesky, matrix, rhs, tolerance, max_iterations)?
     } else {
         let (run, x) = faer_run(cholesky, matrix, rhs, tolerance, max_iterations)?;
         if run.converged {
@@ -153,6 +147,24 @@ pub(crate) fn solve<T: Scalar>(
     })
 }
 
+/// The solver's own loop on `x` (the right-hand side, then the solution when it
+/// converged), timed.
+fn own_run<T: Scalar>(
+    cholesky: &mut Cholesky<T>,
+    matrix: SparseColMatRef<'_, usize, T>,
+    x: &mut [T],
+    tolerance: f64,
+    max_iterations: usize,
+) -> Result<Run, SolveError> {
+    let start = Instant::now();
+    let outcome = conjugate_gradients(cholesky, matrix, x, tolerance, max_iterations)?;
+    Ok(Run {
+        converged: outcome.converged,
+        iterations: outcome.iterations,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
 /// Solves `matrix x = rhs` with both loops on copies of `rhs` and records the pair.
 fn compare<T: Scalar>(
     cholesky: &mut Cholesky<T>,
@@ -167,24 +179,18 @@ fn compare<T: Scalar>(
         .len()
         .is_multiple_of(2);
     let mut own_x = rhs.to_vec();
-    let mut own_run = |cholesky: &mut Cholesky<T>| -> Result<Run, SolveError> {
-        let start = Instant::now();
-        let outcome = conjugate_gradients(cholesky, matrix, &mut own_x, tolerance, max_iterations)?;
-        Ok(Run {
-            converged: outcome.converged,
-            iterations: outcome.iterations,
-            seconds: start.elapsed().as_secs_f64(),
-        })
-    };
     let (own, faer) = if own_first {
-        let own = own_run(cholesky)?;
+        let own = own_run(cholesky, matrix, &mut own_x, tolerance, max_iterations)?;
         (
             own,
             faer_run(cholesky, matrix, rhs, tolerance, max_iterations)?,
         )
     } else {
         let faer = faer_run(cholesky, matrix, rhs, tolerance, max_iterations)?;
-        (own_run(cholesky)?, faer)
+        (
+            own_run(cholesky, matrix, &mut own_x, tolerance, max_iterations)?,
+            faer,
+        )
     };
     let (faer, faer_x) = faer;
     let difference = (own.converged && faer.converged).then(|| {

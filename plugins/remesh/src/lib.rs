@@ -90,16 +90,7 @@ pub const NAME: &str = "remesh";
 /// `largest`.
 const ACCEPTS: Accepts = Accepts {
     elements: &[Element::Triangle, Element::Quad],
-    topologies: &[
-        Topology::Disk,
-        Topology::Annulus,
-        Topology::MultiplyConnected,
-        Topology::Sphere,
-        Topology::Torus,
-        Topology::HigherGenus,
-        Topology::BoundedHigherGenus,
-        Topology::Components,
-    ],
+    topologies: Topology::ANY,
     targets: &[TargetKind::Surface],
     goals: &[GoalKind::Conformal],
     constraints: &[],
