@@ -231,20 +231,8 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
         self.check_inputs(a, weights, b)?;
         check_len("the length of x", self.dofs.full_len(), x.len())?;
         self.assemble(a, weights, b);
-        if let Some(cholesky) = &mut self.cholesky {
-            cholesky
-                .factorize(self.normal.matrix())
-                .map_err(|error| singular_at_node(error, &self.dofs))?;
-            cholesky.solve_vector_in_place(&mut self.y)?;
-        }
-        // Lengths were checked above, so expansion cannot fail; map for completeness.
-        self.dofs
-            .expand_into(&self.y, x)
-            .map_err(|_| SolveError::Length {
-                what: "the length of x",
-                expected: self.dofs.full_len(),
-                got: x.len(),
-            })
+        self.factored_solve()?;
+        self.expand_solution(x)
     }
 
     /// [`solve_into`](Self::solve_into) for a matrix `A` (or weights) near the last
@@ -270,33 +258,46 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
             converged: false,
             iterations: 0,
         };
-        if let Some(cholesky) = &mut self.cholesky {
-            if cholesky.is_factored() {
-                self.trial.clone_from(&self.y);
-                outcome = cholesky.solve_preconditioned(
-                    self.normal.matrix(),
-                    &mut self.trial,
-                    tolerance,
-                    max_iterations,
-                )?;
-            }
-            if outcome.converged {
-                std::mem::swap(&mut self.y, &mut self.trial);
-            } else {
-                cholesky
-                    .factorize(self.normal.matrix())
-                    .map_err(|error| singular_at_node(error, &self.dofs))?;
-                cholesky.solve_vector_in_place(&mut self.y)?;
-            }
+        if let Some(cholesky) = self.cholesky.as_mut().filter(|c| c.is_factored()) {
+            self.trial.clone_from(&self.y);
+            outcome = cholesky.solve_preconditioned(
+                self.normal.matrix(),
+                &mut self.trial,
+                tolerance,
+                max_iterations,
+            )?;
         }
+        if outcome.converged {
+            std::mem::swap(&mut self.y, &mut self.trial);
+        } else {
+            self.factored_solve()?;
+        }
+        self.expand_solution(x)?;
+        Ok(outcome)
+    }
+
+    /// Factors the assembled normal equations and solves them in place of `y` (nothing
+    /// when every unknown is fixed).
+    fn factored_solve(&mut self) -> Result<(), SolveError> {
+        if let Some(cholesky) = &mut self.cholesky {
+            cholesky
+                .factorize(self.normal.matrix())
+                .map_err(|error| singular_at_node(error, &self.dofs))?;
+            cholesky.solve_vector_in_place(&mut self.y)?;
+        }
+        Ok(())
+    }
+
+    /// The full nodal vector of the solution `y` in `x` (its length checked by the
+    /// caller, so the expansion cannot fail; mapped for completeness).
+    fn expand_solution(&self, x: &mut [T]) -> Result<(), SolveError> {
         self.dofs
             .expand_into(&self.y, x)
             .map_err(|_| SolveError::Length {
                 what: "the length of x",
                 expected: self.dofs.full_len(),
                 got: x.len(),
-            })?;
-        Ok(outcome)
+            })
     }
 
     /// The normal equations of `A`, `W`, `b` in `y`: the matrix `K^H A^H W A K` and,
