@@ -92,8 +92,6 @@ pub struct LeastSquaresSolver<T: DofScalar> {
     residual: Vec<T>,
     /// Right-hand side, then solution, of the normal equations (`n`).
     y: Vec<T>,
-    /// A copy of `y` solved by conjugate gradients, kept when they converge.
-    trial: Vec<T>,
 }
 
 impl<T: DofScalar> fmt::Debug for LeastSquaresSolver<T> {
@@ -169,7 +167,6 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
             cholesky,
             residual: vec![zero; m],
             y: vec![zero; n],
-            trial: Vec::new(),
         })
     }
 
@@ -254,24 +251,15 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
         self.check_inputs(a, weights, b)?;
         check_len("the length of x", self.dofs.full_len(), x.len())?;
         self.assemble(a, weights, b);
-        let mut outcome = Preconditioned {
-            converged: false,
-            iterations: 0,
+        let outcome = match &mut self.cholesky {
+            Some(cholesky) => cholesky
+                .solve_reusing(self.normal.matrix(), &mut self.y, tolerance, max_iterations)
+                .map_err(|error| singular_at_node(error, &self.dofs))?,
+            None => Preconditioned {
+                converged: false,
+                iterations: 0,
+            },
         };
-        if let Some(cholesky) = self.cholesky.as_mut().filter(|c| c.is_factored()) {
-            self.trial.clone_from(&self.y);
-            outcome = cholesky.solve_preconditioned(
-                self.normal.matrix(),
-                &mut self.trial,
-                tolerance,
-                max_iterations,
-            )?;
-        }
-        if outcome.converged {
-            std::mem::swap(&mut self.y, &mut self.trial);
-        } else {
-            self.factored_solve()?;
-        }
         self.expand_solution(x)?;
         Ok(outcome)
     }

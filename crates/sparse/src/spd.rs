@@ -231,7 +231,8 @@ impl<T: Scalar> SpdSolver<T> {
     /// factorization, of a nearby matrix: iterative solvers whose matrix changes a little
     /// per step keep one factorization for several steps. Stops once
     /// `|matrix x - rhs| <= tolerance |rhs|` (then `rhs` holds `x`), or gives up (`rhs`
-    /// unspecified: factor `matrix` and solve directly) once `max_iterations` are done or,
+    /// as given: factor `matrix` and solve directly, as [`SpdSolver::solve_reusing`]
+    /// does) once `max_iterations` are done or,
     /// earlier, as soon as the mean reduction of the residual per iteration so far
     /// predicts more than `max_iterations`. `x` starts at zero.
     pub fn solve_preconditioned(
@@ -254,6 +255,32 @@ impl<T: Scalar> SpdSolver<T> {
         #[cfg(not(feature = "cg-compare"))]
         let solve = conjugate_gradients::<T>;
         solve(&mut self.cholesky, matrix, rhs, tolerance, max_iterations)
+    }
+
+    /// Solves `matrix x = rhs` in place for a matrix near the last one factored: by
+    /// [`SpdSolver::solve_preconditioned`] when there is a factorization, and, when
+    /// that gives up or there is none, by factoring `matrix` and solving directly.
+    /// Returns the conjugate gradients' outcome (not converged: `matrix` was factored).
+    pub fn solve_reusing(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, T>,
+        rhs: &mut [T],
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<Preconditioned, SolveError> {
+        let outcome = if self.factored {
+            self.solve_preconditioned(matrix, rhs, tolerance, max_iterations)?
+        } else {
+            Preconditioned {
+                converged: false,
+                iterations: 0,
+            }
+        };
+        if !outcome.converged {
+            self.factorize(matrix)?;
+            self.solve_vector_in_place(rhs)?;
+        }
+        Ok(outcome)
     }
 
     /// [`SpdSolver::solve_in_place`] for one right-hand side given as a slice: `x` is
