@@ -205,6 +205,10 @@ pub enum RegisterError {
         /// The mesh on which they do not.
         other: &'static str,
     },
+    /// The registration was stopped (a Ctrl-C, or the flow beside the shape template
+    /// failed) while the shape template was being fitted.
+    #[error("stopped while fitting the shape template")]
+    Stopped,
     /// Flipped faces remain after the flow and its untangling, and the solve was not
     /// asked to allow them.
     #[error(

@@ -73,16 +73,19 @@ const NORMAL_AGREEMENT: f64 = 0.5;
 
 /// The placed source `placed` (per source vertex) deformed onto the target of `index`
 /// (module docs) with the stiffness schedule `schedule` (per `sqrt(n)`, stiff to
-/// supple: [`STIFFNESS`] or [`SUPPLE_STIFFNESS`]).
+/// supple: [`STIFFNESS`] or [`SUPPLE_STIFFNESS`]). `stopped` is asked before each
+/// round.
 ///
 /// # Errors
-/// [`RegisterError::Spatial`] when a closest point cannot be found, and
-/// [`RegisterError::Solve`] when a round's system cannot be solved.
+/// [`RegisterError::Spatial`] when a closest point cannot be found,
+/// [`RegisterError::Solve`] when a round's system cannot be solved, and
+/// [`RegisterError::Stopped`] when `stopped` says so.
 pub(crate) fn nonrigid_icp(
     source: &Mesh,
     index: &SurfaceIndex<'_>,
     placed: &[Point3<f64>],
     schedule: &[f64],
+    stopped: &dyn Fn() -> bool,
 ) -> Result<Vec<Point3<f64>>, RegisterError> {
     let (centre, radius) = centroid_and_spread(placed);
     if radius.is_nan() || radius <= 0.0 {
@@ -100,6 +103,9 @@ pub(crate) fn nonrigid_icp(
         let alpha2 = (stiffness * stiffness) * n as f64;
         let mut weights = None;
         for _ in 0..ROUNDS {
+            if stopped() {
+                return Err(RegisterError::Stopped);
+            }
             let positions: Vec<Point3<f64>> = images.iter().map(from_unit).collect();
             let closest = match &hints {
                 Some(faces) => index.locate_all_near(&positions, faces)?,
@@ -320,12 +326,30 @@ mod tests {
                 / at.len() as f64
         };
         let start = error(source.positions());
-        let template = nonrigid_icp(&source, &index, source.positions(), &STIFFNESS).unwrap();
+        let template =
+            nonrigid_icp(&source, &index, source.positions(), &STIFFNESS, &|| false).unwrap();
         let end = error(&template);
         eprintln!("deformed blob: the template {start:.4} -> {end:.4} from the truth");
         assert!(
             end < 0.3 * start,
             "mean distance to the truth {start} -> {end}"
         );
+    }
+
+    #[test]
+    fn a_stop_ends_the_rounds() {
+        let (source, target) = blob_pair(2);
+        let index = SurfaceIndex::new(&target).unwrap();
+        let rounds = std::cell::Cell::new(0);
+        let third = || {
+            rounds.set(rounds.get() + 1);
+            rounds.get() > 3
+        };
+        let stopped = nonrigid_icp(&source, &index, source.positions(), &STIFFNESS, &third);
+        assert!(
+            matches!(stopped, Err(RegisterError::Stopped)),
+            "{stopped:?}"
+        );
+        assert_eq!(rounds.get(), 4);
     }
 }

@@ -1,11 +1,13 @@
 //! The source's shape matched on the target: a bijective non-rigid alignment.
 //!
-//! After the conformal registration `f` (a bijection, the landmarks exact):
+//! From the initial map (the common parameter domain's composition, before the
+//! conformal flow; the template is fitted beside the flow, on the other core) and the
+//! conformal registration `f` (a bijection, the landmarks exact):
 //!
-//! 1. the similarity that best carries the source's vertices onto their images
-//!    (`SpatialMatch::fitted`, Umeyama 1991), refined by an affine closest-point fit,
-//!    places the source in the target's frame; a source in place ([`Placement::InPlace`],
-//!    the register option `in-place`) is taken where it is;
+//! 1. the similarity that best carries the source's vertices onto their images under
+//!    the initial map (`SpatialMatch::fitted`, Umeyama 1991), refined by an affine
+//!    closest-point fit, places the source in the target's frame; a source in place
+//!    ([`Placement::InPlace`], the register option `in-place`) is taken where it is;
 //! 2. the placed source is deformed onto the target by the optimal-step non-rigid ICP
 //!    of Amberg, Romdhani and Vetter (CVPR 2007; module `nonrigid_icp`): a template
 //!    `T_i` per source vertex, near the target and smooth, but not a bijection (in
@@ -55,23 +57,31 @@ impl Shape {
     /// refined by an affine closest-point fit (rounds of: each sampled source vertex's
     /// closest point on the target, pairs beyond `TRIM` median distances dropped, the
     /// least-squares affine map of the rest) while it lowers the trimmed mean distance;
-    /// [`Placement::InPlace`], the source as it is; then deformed by the non-rigid ICP.
-    /// `None` when the images do not fix a similarity (every image on a line) for an
-    /// alignment.
+    /// [`Placement::InPlace`], the source as it is; then deformed by the non-rigid ICP
+    /// (which asks `stopped` before each round). `None` when the images do not fix a
+    /// similarity (every image on a line) for an alignment.
     ///
     /// # Errors
     /// [`RegisterError::Spatial`] when a closest point cannot be found,
-    /// [`RegisterError::Solve`] when a non-rigid ICP system cannot be solved.
+    /// [`RegisterError::Solve`] when a non-rigid ICP system cannot be solved,
+    /// [`RegisterError::Stopped`] when `stopped` says so.
     pub(crate) fn new(
         source: &Mesh,
         target: &Mesh,
         index: &SurfaceIndex<'_>,
         points: &[SurfacePoint],
         placement: Placement,
+        stopped: &dyn Fn() -> bool,
     ) -> Result<Option<Self>, RegisterError> {
         let (_, scale) = centroid_and_spread(target.positions());
         if placement == Placement::InPlace {
-            let placed = nonrigid_icp(source, index, source.positions(), &SUPPLE_STIFFNESS)?;
+            let placed = nonrigid_icp(
+                source,
+                index,
+                source.positions(),
+                &SUPPLE_STIFFNESS,
+                stopped,
+            )?;
             return Ok((scale > 0.0).then_some(Self { placed, scale }));
         }
         let picked = spread_vertices(source);
@@ -90,7 +100,7 @@ impl Shape {
             .iter()
             .map(|p| apply(&alignment, p))
             .collect();
-        let placed = nonrigid_icp(source, index, &affine, &STIFFNESS)?;
+        let placed = nonrigid_icp(source, index, &affine, &STIFFNESS, stopped)?;
         Ok((scale > 0.0).then_some(Self { placed, scale }))
     }
 
@@ -178,9 +188,16 @@ mod tests {
             .map(|v| SurfacePoint::at_vertex(&target, v))
             .collect();
         let index = SurfaceIndex::new(&target).unwrap();
-        let shape = Shape::new(&source, &target, &index, &points, Placement::Aligned)
-            .unwrap()
-            .unwrap();
+        let shape = Shape::new(
+            &source,
+            &target,
+            &index,
+            &points,
+            Placement::Aligned,
+            &|| false,
+        )
+        .unwrap()
+        .unwrap();
         assert!(shape.distance(&source, &target, &points) < 1e-9);
         let channels = shape.channels(&target);
         assert_eq!(channels.len(), 3);
