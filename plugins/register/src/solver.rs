@@ -569,6 +569,23 @@ mod tests {
         assert!(crate::initial_map_for(&source, &target, &[], false, &Arc::default()).is_ok());
     }
 
+    #[test]
+    fn a_stopped_shape_template_is_a_cancellation() {
+        // The template fitted beside the flow asks its stop between rounds; stopped, the
+        // registration ends as cancelled, not as a failure.
+        let source = Mesh::from_soup(&icosphere(2)).unwrap();
+        let target = Mesh::from_soup(&octahedral_sphere(3)).unwrap();
+        let initial = crate::initial_map_for(&source, &target, &[], true, &Arc::default()).unwrap();
+        for placement in [Placement::Aligned, Placement::InPlace] {
+            let stopped = shape_template(&source, &target, &initial.points, placement, &|| true);
+            let error = stopped.err().map(registration_error);
+            assert!(matches!(error, Some(SolverError::Cancelled)), "{error:?}");
+            assert!(
+                shape_template(&source, &target, &initial.points, placement, &|| false).is_ok()
+            );
+        }
+    }
+
     /// A sphere with five deep radial folds (ridges along meridians), the positions of
     /// `soup` (on the unit sphere) pushed out to `1 + 0.3 sin(5 phi) (1 - z^2)`.
     fn folded(mut soup: PolygonSoup) -> PolygonSoup {
