@@ -37,6 +37,7 @@
 //! See `docs/register.md` for the conventions, the choice of loops and the timings.
 
 mod affine_alignment;
+mod anderson;
 mod compose;
 mod consistency;
 mod disk;

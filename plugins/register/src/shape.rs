@@ -11,7 +11,7 @@
 //! 2. the placed source is deformed onto the target by the optimal-step non-rigid ICP
 //!    of Amberg, Romdhani and Vetter (CVPR 2007; module `nonrigid_icp`): a template
 //!    `T_i` per source vertex, near the target and smooth, but not a bijection (in
-//!    place, with the schedule's supple end only: `SUPPLE_STIFFNESS`);
+//!    place, with the schedule's supple end only: `IN_PLACE_SCHEDULE`);
 //! 3. the three coordinates of `T_i` at the source's vertices and of `y_j` at the
 //!    target's are matched as fields (module `feature_match`), both divided by the
 //!    target's root-mean-square distance from its centroid: each image is pulled
@@ -28,7 +28,7 @@ use crate::affine_alignment::{apply, closest_point_affine, spread_vertices};
 use crate::error::RegisterError;
 use crate::feature_match::Channel;
 use crate::landmarks::SpatialMatch;
-use crate::nonrigid_icp::{STIFFNESS, SUPPLE_STIFFNESS, nonrigid_icp};
+use crate::nonrigid_icp::{ALIGNED_SCHEDULE, IN_PLACE_SCHEDULE, nonrigid_icp};
 
 /// Where the shape match takes the source from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -79,7 +79,7 @@ impl Shape {
                 source,
                 index,
                 source.positions(),
-                &SUPPLE_STIFFNESS,
+                &IN_PLACE_SCHEDULE,
                 stopped,
             )?;
             return Ok((scale > 0.0).then_some(Self { placed, scale }));
@@ -100,7 +100,7 @@ impl Shape {
             .iter()
             .map(|p| apply(&alignment, p))
             .collect();
-        let placed = nonrigid_icp(source, index, &affine, &STIFFNESS, stopped)?;
+        let placed = nonrigid_icp(source, index, &affine, &ALIGNED_SCHEDULE, stopped)?;
         Ok((scale > 0.0).then_some(Self { placed, scale }))
     }
 
