@@ -378,7 +378,7 @@ mod tests {
         let (source, target) = blob_pair(2);
         let index = SurfaceIndex::new(&target).unwrap();
         let rounds = std::cell::Cell::new(0);
-        let third = || {
+        let after_three = || {
             rounds.set(rounds.get() + 1);
             rounds.get() > 3
         };
@@ -387,7 +387,7 @@ mod tests {
             &index,
             source.positions(),
             &ALIGNED_SCHEDULE,
-            &third,
+            &after_three,
         );
         assert!(
             matches!(stopped, Err(RegisterError::Stopped)),

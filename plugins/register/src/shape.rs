@@ -33,7 +33,7 @@ use crate::nonrigid_icp::{ALIGNED_SCHEDULE, IN_PLACE_SCHEDULE, nonrigid_icp};
 /// Where the shape match takes the source from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Placement {
-    /// Placed by the similarity of the registration's images and an affine
+    /// Placed by the similarity of the initial map's images and an affine
     /// closest-point fit, then deformed with the whole stiffness schedule.
     Aligned,
     /// Taken where it is (both meshes in one frame, the source near its

@@ -405,7 +405,7 @@ fn shape_template(
     let index = SurfaceIndex::new(target)?.with_threads(0);
     Shape::new(source, target, &index, points, placement, stopped)?.ok_or_else(|| {
         RegisterError::Features {
-            reason: "the registration's images lie on a line: no similarity places the source for match-shape".to_string(),
+            reason: "the initial map's images lie on a line: no similarity places the source for match-shape".to_string(),
         }
     })
 }
