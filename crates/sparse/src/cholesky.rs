@@ -9,13 +9,15 @@ use crate::nested_dissection::Dissected;
 use crate::ordering::{Choice, NESTED_DISSECTION_FROM, choose, dissected, nested_dissection_sure};
 use crate::spd::inverse_permutation;
 use crate::two_domains::{TwoDomains, TwoDomainsPlan};
-use crate::{Scalar, SolveError};
+use crate::{Kernel, Scalar, SolveError, SolveOptions};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::perm::PermRef;
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
 use faer::sparse::linalg::cholesky::{
-    LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
+    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::triangular_solve;
 use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMatRef};
@@ -55,12 +57,12 @@ impl<T: Scalar> Cholesky<T> {
     /// taken is the same either way.
     pub(super) fn new(
         pattern: SymbolicSparseColMatRef<'_, usize>,
-        par: Par,
+        options: SolveOptions,
     ) -> Result<Self, SolveError> {
         if pattern.nrows() < NESTED_DISSECTION_FROM {
-            return Self::with_ordering(pattern, None, par);
+            return Self::with_ordering(pattern, None, options);
         }
-        Self::from_dissection(pattern, dissected(pattern)?, par)
+        Self::from_dissection(pattern, dissected(pattern)?, options)
     }
 
     /// [`Cholesky::new`] with the nested-dissection order `dissected` of `pattern`
@@ -69,11 +71,11 @@ impl<T: Scalar> Cholesky<T> {
     pub(super) fn from_dissection(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         dissected: Dissected,
-        par: Par,
+        options: SolveOptions,
     ) -> Result<Self, SolveError> {
         let n = pattern.nrows();
         let plan = match dissected.halves {
-            Some(halves) => TwoDomainsPlan::new(pattern, &dissected.order, halves)?,
+            Some(halves) => TwoDomainsPlan::new(pattern, &dissected.order, halves, options.kernel)?,
             None => None,
         };
         let sure = plan
@@ -88,7 +90,7 @@ impl<T: Scalar> Cholesky<T> {
             (Choice::Nested(_), Some(plan)) => Ok(Self::Halves(Box::new(plan.into_factors()?))),
             // The order whole: the dissection whose sides could not be planned, or AMD's.
             (Choice::Nested(Dissected { order, .. }) | Choice::Amd(order), _) => {
-                Self::split(pattern, &order, None, par)
+                Self::split(pattern, &order, None, options)
             }
         }
     }
@@ -101,16 +103,16 @@ impl<T: Scalar> Cholesky<T> {
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: &[usize],
         sides: Option<[usize; 2]>,
-        par: Par,
+        options: SolveOptions,
     ) -> Result<Self, SolveError> {
         // The inverse also checks that the order is a permutation before either path.
         let inverse = inverse_permutation(order)?;
         if let Some(sides) = sides
-            && let Some(two) = TwoDomains::new(pattern, order, sides)?
+            && let Some(two) = TwoDomains::new(pattern, order, sides, options.kernel)?
         {
             return Ok(Self::Halves(Box::new(two)));
         }
-        Self::with_ordering(pattern, Some((order, &inverse)), par)
+        Self::with_ordering(pattern, Some((order, &inverse)), options)
     }
 
     /// [`Cholesky::new`] with the elimination order `order` (`order[k]` is the row
@@ -118,7 +120,7 @@ impl<T: Scalar> Cholesky<T> {
     pub(super) fn with_ordering(
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: Option<(&[usize], &[usize])>,
-        par: Par,
+        options: SolveOptions,
     ) -> Result<Self, SolveError> {
         let ordering = match order {
             Some((forward, inverse)) => {
@@ -130,7 +132,7 @@ impl<T: Scalar> Cholesky<T> {
             pattern,
             Side::Lower,
             ordering,
-            par,
+            options,
         )?)))
     }
 
@@ -182,9 +184,12 @@ impl<T: Scalar> Factor<T> {
         pattern: SymbolicSparseColMatRef<'_, usize>,
         side: Side,
         ordering: SymmetricOrdering<'_, usize>,
-        par: Par,
+        options: SolveOptions,
     ) -> Result<Self, SolveError> {
-        Self::with_storage(analyse(pattern, side, ordering)?, par)
+        Self::with_storage(
+            analyse(pattern, side, ordering, options.kernel)?,
+            options.par(),
+        )
     }
 
     /// The factorization of `symbolic`'s pattern, its storage written now (see
@@ -418,17 +423,23 @@ impl<T: Scalar> Factor<T> {
     }
 }
 
-/// The symbolic analysis of [`Factor::build`], without the factor's storage.
+/// The symbolic analysis of [`Factor::build`], without the factor's storage, for
+/// faer's numeric `kernel`.
 pub(super) fn analyse(
     pattern: SymbolicSparseColMatRef<'_, usize>,
     side: Side,
     ordering: SymmetricOrdering<'_, usize>,
+    kernel: Kernel,
 ) -> Result<SymbolicCholesky<usize>, SolveError> {
+    let params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: match kernel {
+            Kernel::Auto => SupernodalThreshold::AUTO,
+            Kernel::Supernodal => SupernodalThreshold::FORCE_SUPERNODAL,
+        },
+        ..Default::default()
+    };
     Ok(factorize_symbolic_cholesky(
-        pattern,
-        side,
-        ordering,
-        Default::default(),
+        pattern, side, ordering, params,
     )?)
 }
 

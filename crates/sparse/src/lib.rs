@@ -55,7 +55,7 @@ mod vertex_separator;
 
 pub use error::SolveError;
 pub use factor_count::{FactorCount, factor_count};
-pub use options::{SolveOptions, default_singularity_tolerance};
+pub use options::{Kernel, SolveOptions, default_singularity_tolerance};
 pub use ordering::{
     NESTED_DISSECTION_FROM, SplitOrder, amd_order, fill_reducing_order, first_split_order,
     nested_dissection_order, nested_dissection_split, two_core_order,

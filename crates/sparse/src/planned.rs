@@ -48,7 +48,7 @@ impl<T: Scalar> PlannedCholesky<T> {
         let n = pattern.nrows();
         check_len("the column count of the pattern", n, pattern.ncols())?;
         let cholesky = if n > 0 {
-            Some(Cholesky::new(pattern.as_ref(), options.par())?)
+            Some(Cholesky::new(pattern.as_ref(), options)?)
         } else {
             None
         };
@@ -85,10 +85,10 @@ impl<T: Scalar> PlannedCholesky<T> {
             Some(Cholesky::from_dissection(
                 pattern.as_ref(),
                 dissected,
-                options.par(),
+                options,
             )?)
         } else if n > 0 {
-            Some(Cholesky::new(pattern.as_ref(), options.par())?)
+            Some(Cholesky::new(pattern.as_ref(), options)?)
         } else {
             None
         };

@@ -99,7 +99,7 @@ impl<T: Scalar> SpdSolver<T> {
         )?;
         Ok(Self {
             pattern: pattern.to_owned()?,
-            cholesky: Cholesky::new(pattern, options.par())?,
+            cholesky: Cholesky::new(pattern, options)?,
             options,
             factored: false,
         })
@@ -121,7 +121,7 @@ impl<T: Scalar> SpdSolver<T> {
         let inverse = inverse_permutation(order)?;
         Ok(Self {
             pattern: pattern.to_owned()?,
-            cholesky: Cholesky::with_ordering(pattern, Some((order, &inverse)), options.par())?,
+            cholesky: Cholesky::with_ordering(pattern, Some((order, &inverse)), options)?,
             options,
             factored: false,
         })
@@ -142,7 +142,7 @@ impl<T: Scalar> SpdSolver<T> {
         check_len("the length of the order", n, split.order.len())?;
         Ok(Self {
             pattern: pattern.to_owned()?,
-            cholesky: Cholesky::split(pattern, &split.order, split.sides, options.par())?,
+            cholesky: Cholesky::split(pattern, &split.order, split.sides, options)?,
             options,
             factored: false,
         })
@@ -159,7 +159,7 @@ impl<T: Scalar> SpdSolver<T> {
     ) -> Result<Self, SolveError> {
         let cholesky = match planned.cholesky {
             Some(cholesky) => cholesky,
-            None => Cholesky::new(planned.pattern.as_ref(), options.par())?,
+            None => Cholesky::new(planned.pattern.as_ref(), options)?,
         };
         Ok(Self {
             pattern: planned.pattern,

@@ -41,7 +41,7 @@
 
 use crate::cholesky::{Factor, FactorFailure, analyse, eliminated};
 use crate::factor_count::{column_multiply_subtracts, stored_multiply_subtracts};
-use crate::{Scalar, SolveError};
+use crate::{Kernel, Scalar, SolveError};
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::solvers::{Llt, Solve};
@@ -128,6 +128,7 @@ impl TwoDomainsPlan {
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: &[usize],
         halves: [usize; 2],
+        kernel: Kernel,
     ) -> Result<Option<Self>, SolveError> {
         let n = pattern.nrows();
         let [a, b] = halves;
@@ -151,7 +152,8 @@ impl TwoDomainsPlan {
                 }
             }
         }
-        let by_side = |side| SidePlan::new(pattern, order, &side_of, side, &separator_index);
+        let by_side =
+            |side| SidePlan::new(pattern, order, &side_of, side, &separator_index, kernel);
         let (side_a, side_b) = join(|| by_side(0), || by_side(1));
         let (Some(side_a), Some(side_b)) = (side_a?, side_b?) else {
             return Ok(None);
@@ -203,8 +205,9 @@ impl<T: Scalar> TwoDomains<T> {
         pattern: SymbolicSparseColMatRef<'_, usize>,
         order: &[usize],
         halves: [usize; 2],
+        kernel: Kernel,
     ) -> Result<Option<Self>, SolveError> {
-        TwoDomainsPlan::new(pattern, order, halves)?
+        TwoDomainsPlan::new(pattern, order, halves, kernel)?
             .map(TwoDomainsPlan::into_factors)
             .transpose()
     }
@@ -320,6 +323,7 @@ impl SidePlan {
         side_of: &[u8],
         side: u8,
         separator_index: &[usize],
+        kernel: Kernel,
     ) -> Result<Option<Self>, SolveError> {
         let other = 1 - side;
         let n = pattern.nrows();
@@ -388,7 +392,12 @@ impl SidePlan {
         let source: Vec<u32> = cells.iter().map(|&(_, source)| source).collect();
         let sub = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
         let upper = sub.as_ref().transpose().to_col_major()?;
-        let symbolic = analyse(upper.as_ref(), Side::Upper, SymmetricOrdering::Identity)?;
+        let symbolic = analyse(
+            upper.as_ref(),
+            Side::Upper,
+            SymmetricOrdering::Identity,
+            kernel,
+        )?;
         drop(upper);
         let s = rows.iter().filter(|&&i| side_of[i] != side).count();
         let first = m - s;
@@ -577,9 +586,14 @@ mod tests {
 
     /// The two-domain factorization of `m` in its nested-dissection order.
     fn split(m: &SparseColMat<usize, Complex64>) -> TwoDomains<Complex64> {
+        split_with(m, Kernel::Auto)
+    }
+
+    /// [`split`] with the sides analysed for `kernel`.
+    fn split_with(m: &SparseColMat<usize, Complex64>, kernel: Kernel) -> TwoDomains<Complex64> {
         let dissection = dissected(m.symbolic()).unwrap();
         let halves = dissection.halves.expect("a split");
-        TwoDomains::new(m.symbolic(), &dissection.order, halves)
+        TwoDomains::new(m.symbolic(), &dissection.order, halves, kernel)
             .unwrap()
             .expect("the split separates")
     }
@@ -609,7 +623,7 @@ mod tests {
         let m = grid(120, 0.05, true, 1);
         let dissection = dissected(m.symbolic()).unwrap();
         let halves = dissection.halves.expect("a split");
-        let plan = TwoDomainsPlan::new(m.symbolic(), &dissection.order, halves)
+        let plan = TwoDomainsPlan::new(m.symbolic(), &dissection.order, halves, Kernel::Auto)
             .unwrap()
             .expect("the split separates");
         let exact = factor_count(m.symbolic(), &dissection.order)
@@ -651,10 +665,15 @@ mod tests {
     #[test]
     fn sides_with_simplicial_and_supernodal_factors_solve_alike() {
         // faer factors sparse small sides column by column (simplicial) and larger ones
-        // by supernodes; the forward and backward halves of both kernels are used.
-        for (k, supernodal) in [(17, false), (150, true)] {
+        // by supernodes, and small ones by supernodes when asked; the forward and
+        // backward halves of both kernels are used.
+        for (k, kernel, supernodal) in [
+            (17, Kernel::Auto, false),
+            (17, Kernel::Supernodal, true),
+            (150, Kernel::Auto, true),
+        ] {
             let m = grid(k, 0.05, true, 1);
-            let mut two = split(&m);
+            let mut two = split_with(&m, kernel);
             assert!(
                 two.sides
                     .iter()
@@ -713,7 +732,7 @@ mod tests {
         // Rows in plain order cut after the first row of the grid: rows 0 and 20 are
         // joined by an edge, but 0 is on one side and 20 on the other.
         let order: Vec<usize> = (0..m.nrows()).collect();
-        let two = TwoDomains::<Complex64>::new(m.symbolic(), &order, [20, 20]);
+        let two = TwoDomains::<Complex64>::new(m.symbolic(), &order, [20, 20], Kernel::Auto);
         assert!(two.unwrap().is_none());
     }
 }

@@ -40,7 +40,7 @@ use beltrami_fem::FemError;
 use beltrami_fem::assembly::Pattern;
 use beltrami_fem::vertex_graph::vertex_graph_pattern;
 use beltrami_mesh::{FaceId, Mesh, Point3, Vector3};
-use beltrami_sparse::{SolveError, SolveOptions, SpdSolver, two_core_order};
+use beltrami_sparse::{Kernel, SolveError, SolveOptions, SpdSolver, two_core_order};
 use beltrami_spatial::{Located, SurfaceIndex};
 use faer::Mat;
 
@@ -226,7 +226,11 @@ impl NormalEquations {
         let solver = SpdSolver::with_split_order(
             pattern.symbolic().as_ref(),
             &vertex_split.in_blocks(4),
-            SolveOptions::default(),
+            // Each vertex's four unknowns make a dense block.
+            SolveOptions {
+                kernel: Kernel::Supernodal,
+                ..SolveOptions::default()
+            },
         )
         .map_err(solve_error)?;
         Ok(Self {
