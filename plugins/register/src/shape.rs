@@ -28,7 +28,7 @@ use crate::affine_alignment::{apply, closest_point_affine, spread_vertices};
 use crate::error::RegisterError;
 use crate::feature_match::Channel;
 use crate::landmarks::SpatialMatch;
-use crate::nonrigid_icp::{ALIGNED_SCHEDULE, IN_PLACE_SCHEDULE, nonrigid_icp};
+use crate::nonrigid_icp::{ALIGNED_SCHEDULE, IN_PLACE_SCHEDULE, NormalEquations, nonrigid_icp};
 
 /// Where the shape match takes the source from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -58,8 +58,9 @@ impl Shape {
     /// closest point on the target, pairs beyond `TRIM` median distances dropped, the
     /// least-squares affine map of the rest) while it lowers the trimmed mean distance;
     /// [`Placement::InPlace`], the source as it is; then deformed by the non-rigid ICP
-    /// (which asks `stopped` before each round). `None` when the images do not fix a
-    /// similarity (every image on a line) for an alignment.
+    /// (which asks `stopped` before each round; its rounds solved with `equations`, of
+    /// `source`). `None` when the images do not fix a similarity (every image on a line)
+    /// for an alignment.
     ///
     /// # Errors
     /// [`RegisterError::Spatial`] when a closest point cannot be found,
@@ -69,6 +70,7 @@ impl Shape {
         source: &Mesh,
         target: &Mesh,
         index: &SurfaceIndex<'_>,
+        equations: &mut NormalEquations,
         points: &[SurfacePoint],
         placement: Placement,
         stopped: &dyn Fn() -> bool,
@@ -77,6 +79,7 @@ impl Shape {
         if placement == Placement::InPlace {
             let placed = nonrigid_icp(
                 source,
+                equations,
                 index,
                 source.positions(),
                 &IN_PLACE_SCHEDULE,
@@ -100,7 +103,14 @@ impl Shape {
             .iter()
             .map(|p| apply(&alignment, p))
             .collect();
-        let placed = nonrigid_icp(source, index, &affine, &ALIGNED_SCHEDULE, stopped)?;
+        let placed = nonrigid_icp(
+            source,
+            equations,
+            index,
+            &affine,
+            &ALIGNED_SCHEDULE,
+            stopped,
+        )?;
         Ok((scale > 0.0).then_some(Self { placed, scale }))
     }
 
@@ -192,6 +202,7 @@ mod tests {
             &source,
             &target,
             &index,
+            &mut NormalEquations::new(&source).unwrap(),
             &points,
             Placement::Aligned,
             &|| false,

@@ -9,9 +9,11 @@ use beltrami_core::{
 use beltrami_mesh::{Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Sender};
 
 use crate::compose::flipped_faces;
 use crate::feature_match::Channel;
+use crate::nonrigid_icp::NormalEquations;
 use crate::shape::{Placement, Shape};
 use crate::{InitialMap, RegisterError, check_topology, initial_map_for, match_features_after};
 
@@ -392,55 +394,73 @@ fn after_features(
     Ok(measured)
 }
 
+/// What the shape template needs before the initial map: the target's index (its
+/// closest points on both cores: fsaverage5's template 2.8 s -> 2.3 s, the same points,
+/// each search being exact) and the source's non-rigid ICP equations, their symbolic
+/// factorization done.
+struct TemplateSetup<'t> {
+    index: SurfaceIndex<'t>,
+    equations: NormalEquations,
+}
+
+impl<'t> TemplateSetup<'t> {
+    fn new(source: &Mesh, target: &'t Mesh) -> Result<Self, RegisterError> {
+        Ok(Self {
+            index: SurfaceIndex::new(target)?.with_threads(0),
+            equations: NormalEquations::new(source)?,
+        })
+    }
+}
+
 /// The source's shape placed on `target` (module `shape`) from the images `points` of
-/// its vertices, asking `stopped` between rounds; its closest points on both cores
-/// (fsaverage5's template 2.8 s -> 2.3 s, the same points: each search is exact).
+/// its vertices, asking `stopped` between rounds.
 fn shape_template(
     source: &Mesh,
     target: &Mesh,
+    setup: &mut TemplateSetup<'_>,
     points: &[SurfacePoint],
     placement: Placement,
     stopped: &dyn Fn() -> bool,
 ) -> Result<Shape, RegisterError> {
-    let index = SurfaceIndex::new(target)?.with_threads(0);
-    Shape::new(source, target, &index, points, placement, stopped)?.ok_or_else(|| {
-        RegisterError::Features {
-            reason: "the initial map's images lie on a line: no similarity places the source for match-shape".to_string(),
-        }
+    Shape::new(
+        source,
+        target,
+        &setup.index,
+        &mut setup.equations,
+        points,
+        placement,
+        stopped,
+    )?
+    .ok_or_else(|| RegisterError::Features {
+        reason: "the initial map's images lie on a line: no similarity places the source for match-shape".to_string(),
     })
 }
 
-/// The registration of `problem`, in the numbering of its meshes ([`Register`]).
-pub(crate) fn register(
-    problem: &Problem<'_>,
+/// The conformal registration of `problem`: the initial map (whose images are sent on
+/// `initial_images` as soon as it is made) and the flow from it. Returns the initial
+/// map, the flow's problem and its solution.
+fn conformal_registration<'p>(
+    problem: &Problem<'p>,
     settings: &Settings,
+    matched: bool,
+    initial_images: Sender<Vec<SurfacePoint>>,
+    mut report: Report,
     context: &mut Context<'_>,
-) -> Result<Solution, SolverError> {
+) -> Result<(InitialMap, Problem<'p>, Solution), SolverError> {
     let Target::Mesh(target) = problem.target else {
         return Err(SolverError::unsupported(
             NAME,
             "register maps onto a target mesh",
         ));
     };
-    let source = problem.source;
     let marks = landmarks(problem);
-    let mut report = Report::new(NAME);
-    let features = match &problem.goal {
-        Goal::Features(features) => Some(features),
-        _ => None,
-    };
-    let shape = settings.flag("match-shape").then(|| {
-        if settings.flag("in-place") {
-            Placement::InPlace
-        } else {
-            Placement::Aligned
-        }
-    });
-    let matched = features.is_some() || shape.is_some();
     let cancel = context.cancel_flag();
     let initial = context.stage("initial map", &mut report, || {
-        initial_map_for(source, target, &marks, matched, &cancel).map_err(registration_error)
+        initial_map_for(problem.source, target, &marks, matched, &cancel)
+            .map_err(registration_error)
     })?;
+    // Nobody listens when no template is fitted.
+    let _ = initial_images.send(initial.points.clone());
     report.notes.extend(initial.notes.iter().cloned());
     let mut flow = problem.clone();
     // With features the flow gives the conformal registration they start from.
@@ -466,48 +486,87 @@ pub(crate) fn register(
     }
     flow.constraints = held;
     flow.initial = Some(Map::OnMesh(initial.points.clone()));
+    let solution = beltrami_flow_engine::solve(
+        &flow,
+        settings,
+        initial.positions.clone(),
+        None,
+        report,
+        context,
+    )?;
+    Ok((initial, flow, solution))
+}
+
+/// The registration of `problem`, in the numbering of its meshes ([`Register`]).
+pub(crate) fn register(
+    problem: &Problem<'_>,
+    settings: &Settings,
+    context: &mut Context<'_>,
+) -> Result<Solution, SolverError> {
+    let Target::Mesh(target) = problem.target else {
+        return Err(SolverError::unsupported(
+            NAME,
+            "register maps onto a target mesh",
+        ));
+    };
+    let source = problem.source;
+    let features = match &problem.goal {
+        Goal::Features(features) => Some(features),
+        _ => None,
+    };
+    let shape = settings.flag("match-shape").then(|| {
+        if settings.flag("in-place") {
+            Placement::InPlace
+        } else {
+            Placement::Aligned
+        }
+    });
+    let matched = features.is_some() || shape.is_some();
+    let cancel = context.cancel_flag();
     // The shape template needs only the initial map: it is fitted on a second thread
     // while the flow runs (g0_spot onto its deformation: 1.6 s -> 1.2 s; the flow's
-    // images as its start measured 0.0143 from the truth, the initial map's 0.0147).
+    // images as its start measured 0.0143 from the truth, the initial map's 0.0147),
+    // and what it needs before that map is made while the map is (fsaverage5: the
+    // non-rigid ICP's symbolic factorization, 0.22 s).
     let stop = AtomicBool::new(false);
+    let (send_images, receive_images) = mpsc::channel();
     let flowed = std::thread::scope(|scope| {
         let template = shape.map(|placement| {
-            let (points, stop, cancel) = (&initial.points, &stop, &cancel);
+            let (stop, cancel) = (&stop, &cancel);
             scope.spawn(move || {
                 let stopped = || stop.load(Ordering::Relaxed) || cancel.load(Ordering::Relaxed);
-                shape_template(source, target, points, placement, &stopped)
+                let mut setup = TemplateSetup::new(source, target)?;
+                // No images come when the initial map failed: nothing to fit.
+                let points: Vec<SurfacePoint> =
+                    receive_images.recv().map_err(|_| RegisterError::Stopped)?;
+                shape_template(source, target, &mut setup, &points, placement, &stopped)
             })
         });
-        let flowed = beltrami_flow_engine::solve(
-            &flow,
-            settings,
-            initial.positions.clone(),
-            None,
-            report,
-            context,
-        )
-        .and_then(|mut solution| {
-            // Timed as the wait for the template after the flow (the stages add up to
-            // the run's time).
-            let fitted = template
-                .map(|handle| {
-                    context.stage("shape template", &mut solution.report, || {
-                        handle
-                            .join()
-                            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-                            .map_err(registration_error)
-                    })
-                })
-                .transpose()?;
-            Ok((solution, fitted))
-        });
+        let report = Report::new(NAME);
+        let flowed =
+            conformal_registration(problem, settings, matched, send_images, report, context)
+                .and_then(|(initial, flow, mut solution)| {
+                    // Timed as the wait for the template after the flow (the stages add up
+                    // to the run's time).
+                    let fitted = template
+                        .map(|handle| {
+                            context.stage("shape template", &mut solution.report, || {
+                                handle
+                                    .join()
+                                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                                    .map_err(registration_error)
+                            })
+                        })
+                        .transpose()?;
+                    Ok((initial, flow, solution, fitted))
+                });
         // An error (a Ctrl-C) ends the template's rounds before the scope joins it.
         if flowed.is_err() {
             stop.store(true, Ordering::Relaxed);
         }
         flowed
     });
-    let (mut solution, template) = flowed?;
+    let (initial, flow, mut solution, template) = flowed?;
     if matched {
         solution = after_features(&flow, &initial, features, template, solution, context)?;
     }
@@ -570,19 +629,35 @@ mod tests {
     }
 
     #[test]
+    fn a_registration_by_shape_cancelled_in_its_initial_map_ends_cancelled() {
+        // The template's thread waits for the initial map's images; when the map is
+        // cancelled none come, and the registration ends as cancelled instead of
+        // waiting for them.
+        let source = Mesh::from_soup(&folded(icosphere(2))).unwrap();
+        let target = Mesh::from_soup(&folded(octahedral_sphere(3))).unwrap();
+        let mut problem = Problem::new(&source, Target::Mesh(&target));
+        problem.options.set("match-shape", OptionValue::Bool(true));
+        let settings = Register.check(&problem).unwrap();
+        let mut context = Context::new().with_cancel_flag(Arc::new(AtomicBool::new(true)));
+        let error = register(&problem, &settings, &mut context).unwrap_err();
+        assert!(matches!(error, SolverError::Cancelled), "{error:?}");
+    }
+
+    #[test]
     fn a_stopped_shape_template_is_a_cancellation() {
         // The template fitted beside the flow asks its stop between rounds; stopped, the
         // registration ends as cancelled, not as a failure.
         let source = Mesh::from_soup(&icosphere(2)).unwrap();
         let target = Mesh::from_soup(&octahedral_sphere(3)).unwrap();
         let initial = crate::initial_map_for(&source, &target, &[], true, &Arc::default()).unwrap();
+        let mut setup = TemplateSetup::new(&source, &target).unwrap();
         for placement in [Placement::Aligned, Placement::InPlace] {
-            let stopped = shape_template(&source, &target, &initial.points, placement, &|| true);
+            let points = &initial.points;
+            let stopped = shape_template(&source, &target, &mut setup, points, placement, &|| true);
             let error = stopped.err().map(registration_error);
             assert!(matches!(error, Some(SolverError::Cancelled)), "{error:?}");
-            assert!(
-                shape_template(&source, &target, &initial.points, placement, &|| false).is_ok()
-            );
+            let fitted = shape_template(&source, &target, &mut setup, points, placement, &|| false);
+            assert!(fitted.is_ok());
         }
     }
 
