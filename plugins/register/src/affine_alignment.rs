@@ -20,8 +20,9 @@ use crate::error::RegisterError;
 /// Source vertices used to fit the alignment at most (evenly picked).
 const FIT_SAMPLES: usize = 2048;
 
-/// Rounds at most.
-const ROUNDS: usize = 30;
+/// Rounds at most of a placement that is final (the spatial correspondence of a
+/// registration without landmarks, the placed source whose arcs draw a cut graph).
+pub(crate) const ROUNDS: usize = 30;
 
 /// Pairs farther apart than this many times the median distance are left out of a fit.
 const TRIM: f64 = 2.5;
@@ -37,7 +38,8 @@ pub(crate) fn spread_vertices(mesh: &Mesh) -> Vec<VertexId> {
 }
 
 /// The affine map placing `samples` on the surface of `index`, refined from `start`
-/// (module docs); `scale` is the starting similarity's scale factor.
+/// (module docs) in at most `rounds` rounds; `scale` is the starting similarity's
+/// scale factor.
 ///
 /// # Errors
 /// [`RegisterError::Spatial`] when a closest point cannot be found.
@@ -46,10 +48,11 @@ pub(crate) fn closest_point_affine(
     index: &SurfaceIndex<'_>,
     start: Matrix3x4<f64>,
     scale: f64,
+    rounds: usize,
 ) -> Result<Matrix3x4<f64>, RegisterError> {
     let mut alignment = start;
     let mut best = f64::INFINITY;
-    for _ in 0..ROUNDS {
+    for _ in 0..rounds {
         let moved: Vec<Point3<f64>> = samples.iter().map(|p| apply(&alignment, p)).collect();
         let closest = index.locate_all(&moved)?;
         let mut distances: Vec<f64> = closest.iter().map(|l| l.distance).collect();

@@ -303,6 +303,7 @@ impl SpatialMatch {
             index,
             self.as_affine(),
             self.scale,
+            crate::affine_alignment::ROUNDS,
         )?;
         let linear: Matrix3<f64> = m.fixed_view::<3, 3>(0, 0).into_owned();
         Ok(Self {
