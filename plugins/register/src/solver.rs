@@ -327,24 +327,19 @@ impl Solver for Register {
     }
 }
 
-/// The conformal registration `solution` of `flow` bent in the common domain so that
-/// `features` match and, with `shape`, the source's coordinates placed so (modules
-/// `feature_match`, `shape`), then measured by the flow engine with no step (a step
-/// would pull it back towards conformal).
+/// The conformal registration `solution` of `flow` (onto its target mesh `target`) bent
+/// in the common domain so that `features` match and, with `shape`, the source's
+/// coordinates placed so (modules `feature_match`, `shape`), then measured by the flow
+/// engine with no step (a step would pull it back towards conformal).
 fn after_features(
     flow: &Problem<'_>,
+    target: &Mesh,
     initial: &InitialMap,
     features: Option<&Features>,
     shape: Option<Shape>,
     solution: Solution,
     context: &mut Context<'_>,
 ) -> Result<Solution, SolverError> {
-    let Target::Mesh(target) = flow.target else {
-        return Err(SolverError::unsupported(
-            NAME,
-            "register maps onto a target mesh",
-        ));
-    };
     let Some(Map::OnMesh(points)) = solution.map() else {
         return Ok(solution);
     };
@@ -436,23 +431,18 @@ fn shape_template(
     })
 }
 
-/// The conformal registration of `problem`: the initial map (whose images are sent on
-/// `initial_images` as soon as it is made) and the flow from it. Returns the initial
-/// map, the flow's problem and its solution.
+/// The conformal registration of `problem` onto its target mesh `target`: the initial
+/// map (whose images are sent on `initial_images` as soon as it is made) and the flow
+/// from it. Returns the initial map, the flow's problem and its solution.
 fn conformal_registration<'p>(
     problem: &Problem<'p>,
+    target: &Mesh,
     settings: &Settings,
     matched: bool,
     initial_images: Sender<Vec<SurfacePoint>>,
     mut report: Report,
     context: &mut Context<'_>,
 ) -> Result<(InitialMap, Problem<'p>, Solution), SolverError> {
-    let Target::Mesh(target) = problem.target else {
-        return Err(SolverError::unsupported(
-            NAME,
-            "register maps onto a target mesh",
-        ));
-    };
     let marks = landmarks(problem);
     let cancel = context.cancel_flag();
     let initial = context.stage("initial map", &mut report, || {
@@ -543,23 +533,30 @@ pub(crate) fn register(
             })
         });
         let report = Report::new(NAME);
-        let flowed =
-            conformal_registration(problem, settings, matched, send_images, report, context)
-                .and_then(|(initial, flow, mut solution)| {
-                    // Timed as the wait for the template after the flow (the stages add up
-                    // to the run's time).
-                    let fitted = template
-                        .map(|handle| {
-                            context.stage("shape template", &mut solution.report, || {
-                                handle
-                                    .join()
-                                    .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-                                    .map_err(registration_error)
-                            })
-                        })
-                        .transpose()?;
-                    Ok((initial, flow, solution, fitted))
-                });
+        let flowed = conformal_registration(
+            problem,
+            target,
+            settings,
+            matched,
+            send_images,
+            report,
+            context,
+        )
+        .and_then(|(initial, flow, mut solution)| {
+            // Timed as the wait for the template after the flow (the stages add up
+            // to the run's time).
+            let fitted = template
+                .map(|handle| {
+                    context.stage("shape template", &mut solution.report, || {
+                        handle
+                            .join()
+                            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+                            .map_err(registration_error)
+                    })
+                })
+                .transpose()?;
+            Ok((initial, flow, solution, fitted))
+        });
         // An error (a Ctrl-C) ends the template's rounds before the scope joins it.
         if flowed.is_err() {
             stop.store(true, Ordering::Relaxed);
@@ -568,7 +565,9 @@ pub(crate) fn register(
     });
     let (initial, flow, mut solution, template) = flowed?;
     if matched {
-        solution = after_features(&flow, &initial, features, template, solution, context)?;
+        solution = after_features(
+            &flow, target, &initial, features, template, solution, context,
+        )?;
     }
     // Judged against the target's normals at the images (the rule of `beltrami
     // distortion --target` and of the flow), when the initial map was built.
