@@ -559,6 +559,9 @@ fn a_registration_with_flips_fails_naming_them_unless_allowed() {
         "{notes}"
     );
     assert!(out.exists());
+    // The map kept with its flips is reported as `distortion --target` measures it,
+    // flat ears included.
+    distortion_agrees_with_register("ears", &source, &target, &["--allow-flips"]);
 }
 
 #[test]

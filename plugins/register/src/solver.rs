@@ -11,7 +11,7 @@ use beltrami_spatial::SurfaceIndex;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Sender};
 
-use crate::compose::flipped_faces;
+use crate::compose::{self, flipped_faces};
 use crate::feature_match::Channel;
 use crate::nonrigid_icp::NormalEquations;
 use crate::shape::{Placement, Shape};
@@ -589,6 +589,12 @@ pub(crate) fn register(
     .map_err(registration_error)?;
     if solution.metrics.flipped().unwrap_or(0) > 0 {
         let index = SurfaceIndex::new(target).map_err(|e| registration_error(e.into()))?;
+        // The flow counts on its own measure; a face it leaves flat (an ear whose corners
+        // lie on one straight stretch of the target's boundary) can count either way
+        // there. The report gives what `beltrami distortion --target` measures.
+        solution.metrics.distortion = Some(
+            compose::distortion(source, &index, &points, &positions).map_err(registration_error)?,
+        );
         judge_flips(
             source,
             &index,
