@@ -125,20 +125,20 @@ pub(crate) fn distortion(
     Ok(measured.stats)
 }
 
-/// The source faces whose image is flipped against the target's normals (the rule of
-/// [`distortion`]), each with the largest angle in degrees between the target's face
-/// normals at its corners' images: near 180 when the face's corners land on the two
-/// sides of a fold of the target that is finer than the source face.
+/// The map's [`distortion`] and the source faces whose image is flipped against the
+/// target's normals (its rule), each with the largest angle in degrees between the
+/// target's face normals at its corners' images: near 180 when the face's corners land
+/// on the two sides of a fold of the target that is finer than the source face.
 pub(crate) fn flipped_faces(
     source: &Mesh,
     target_index: &SurfaceIndex<'_>,
     points: &[SurfacePoint],
     positions: &[Point3<f64>],
-) -> Result<Vec<(FaceId, f64)>, RegisterError> {
+) -> Result<(DistortionStats, Vec<(FaceId, f64)>), RegisterError> {
     let normals = target_index.face_reference_normals(source, points)?;
     let measured = measure_surface(source, positions, ReferenceNormal::PerFace(&normals))?;
     let target = target_index.mesh();
-    Ok(source
+    let flipped = source
         .faces()
         .zip(&measured.flipped)
         .filter(|&(_, &flipped)| flipped)
@@ -155,5 +155,6 @@ pub(crate) fn flipped_faces(
             }
             (f, widest)
         })
-        .collect())
+        .collect();
+    Ok((measured.stats, flipped))
 }

@@ -124,8 +124,8 @@ pub(crate) fn nonrigid_icp(
     }
     let to_unit = |p: &Point3<f64>| (p.coords - centre) / radius;
     let from_unit = |x: &Vector3<f64>| Point3::from(x * radius + centre);
-    equations.place(placed.iter().map(to_unit));
     let mut images: Vec<Vector3<f64>> = placed.iter().map(to_unit).collect();
+    equations.place(&images);
     let n = images.len();
     // Each round's closest points start their search from the last round's faces: the
     // images move little between rounds (the answer does not depend on the start).
@@ -250,8 +250,8 @@ impl NormalEquations {
     }
 
     /// The source's vertices at `unit` (unit-radius coordinates, one per vertex).
-    fn place(&mut self, unit: impl Iterator<Item = Vector3<f64>>) {
-        self.homogeneous = unit.map(|x| [x.x, x.y, x.z, 1.0]).collect();
+    fn place(&mut self, unit: &[Vector3<f64>]) {
+        self.homogeneous = unit.iter().map(|x| [x.x, x.y, x.z, 1.0]).collect();
         debug_assert_eq!(self.homogeneous.len(), self.degree.len());
     }
 

@@ -6,12 +6,12 @@ use beltrami_core::{
     Report, Settings, ShapeDistance, Solution, Solver, SolverError, SolverInfo, Target, TargetKind,
     solve_renumbered,
 };
-use beltrami_mesh::{Mesh, Point3, SurfacePoint};
+use beltrami_mesh::{FaceId, Mesh, Point3, SurfacePoint};
 use beltrami_spatial::SurfaceIndex;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Sender};
 
-use crate::compose::{self, flipped_faces};
+use crate::compose::flipped_faces;
 use crate::feature_match::Channel;
 use crate::nonrigid_icp::NormalEquations;
 use crate::shape::{Placement, Shape};
@@ -123,17 +123,15 @@ fn registration_error(error: RegisterError) -> SolverError {
 /// Most flipped faces named in an error or a note.
 const NAMED_FLIPS: usize = 10;
 
-/// The flipped faces of the map `points` (with `positions`) of `source` on the target
-/// of `index`, as an error, or as a note when `allowed`.
+/// The `flipped` faces of a map of `source` (with the largest angle between the
+/// target's normals at their corners, [`flipped_faces`]), as an error, or as a note
+/// when `allowed`.
 fn judge_flips(
     source: &Mesh,
-    index: &SurfaceIndex<'_>,
-    points: &[SurfacePoint],
-    positions: &[Point3<f64>],
+    flipped: &[(FaceId, f64)],
     allowed: bool,
     report: &mut Report,
 ) -> Result<(), RegisterError> {
-    let flipped = flipped_faces(source, index, points, positions)?;
     if flipped.is_empty() {
         return Ok(());
     }
@@ -432,14 +430,15 @@ fn shape_template(
 }
 
 /// The conformal registration of `problem` onto its target mesh `target`: the initial
-/// map (whose images are sent on `initial_images` as soon as it is made) and the flow
+/// map (whose images are sent on `initial_images`, when given, as soon as it is made)
+/// and the flow
 /// from it. Returns the initial map, the flow's problem and its solution.
 fn conformal_registration<'p>(
     problem: &Problem<'p>,
     target: &Mesh,
     settings: &Settings,
     matched: bool,
-    initial_images: Sender<Vec<SurfacePoint>>,
+    initial_images: Option<Sender<Vec<SurfacePoint>>>,
     mut report: Report,
     context: &mut Context<'_>,
 ) -> Result<(InitialMap, Problem<'p>, Solution), SolverError> {
@@ -449,8 +448,11 @@ fn conformal_registration<'p>(
         initial_map_for(problem.source, target, &marks, matched, &cancel)
             .map_err(registration_error)
     })?;
-    // Nobody listens when no template is fitted.
-    let _ = initial_images.send(initial.points.clone());
+    if let Some(images) = initial_images {
+        // A template that failed in its setup no longer listens: its error comes after
+        // the flow.
+        let _ = images.send(initial.points.clone());
+    }
     report.notes.extend(initial.notes.iter().cloned());
     let mut flow = problem.clone();
     // With features the flow gives the conformal registration they start from.
@@ -538,7 +540,7 @@ pub(crate) fn register(
             target,
             settings,
             matched,
-            send_images,
+            shape.is_some().then_some(send_images),
             report,
             context,
         )
@@ -592,14 +594,12 @@ pub(crate) fn register(
         // The flow counts on its own measure; a face it leaves flat (an ear whose corners
         // lie on one straight stretch of the target's boundary) can count either way
         // there. The report gives what `beltrami distortion --target` measures.
-        solution.metrics.distortion = Some(
-            compose::distortion(source, &index, &points, &positions).map_err(registration_error)?,
-        );
+        let (measured, flipped) =
+            flipped_faces(source, &index, &points, &positions).map_err(registration_error)?;
+        solution.metrics.distortion = Some(measured);
         judge_flips(
             source,
-            &index,
-            &points,
-            &positions,
+            &flipped,
             settings.flag("allow-flips"),
             &mut solution.report,
         )
