@@ -112,8 +112,9 @@ pub enum RegisterError {
         /// The boundary error.
         error: BoundaryError,
     },
-    /// A Tutte system could not be solved.
-    #[error("Tutte embedding of the {side}: {error}")]
+    /// A linear system (a Tutte embedding, a map's rebuild from its coefficient, the
+    /// shape template's equations) could not be solved.
+    #[error("a linear system of the {side}: {error}")]
     Solve {
         /// Which mesh.
         side: Side,
