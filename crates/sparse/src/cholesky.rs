@@ -242,7 +242,7 @@ impl<T: Scalar> Factor<T> {
                 .row_idx_of_col(j)
                 .zip(matrix.val_of_col(j))
                 .find(|&(i, _)| i == j)
-                .map_or(0.0, |(_, v)| faer::traits::ComplexField::real_part_impl(v));
+                .map_or(0.0, |(_, v)| v.real());
         }
         let result = self.symbolic.factorize_numeric_llt::<T>(
             &mut self.values,

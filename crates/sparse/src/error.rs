@@ -105,6 +105,18 @@ pub enum SolveError {
     /// [`SpdSolver::solve_in_place`](crate::SpdSolver::solve_in_place) was called without a successful factorization.
     #[error("no factorization to solve with: factorize a matrix first")]
     NotFactored,
+    /// A mixed-precision solve ([`MixedSpdSolver`](crate::MixedSpdSolver)) whose
+    /// refinement did not reach its tolerance: the matrix is too ill-conditioned for a
+    /// factorization in `f32`.
+    #[error(
+        "the f32 factorization's solution still changed by {correction:e} (relative) after {steps} refinement steps: the matrix is too ill-conditioned for mixed precision"
+    )]
+    Refinement {
+        /// Refinement steps done.
+        steps: usize,
+        /// The relative size of the last correction.
+        correction: f64,
+    },
     /// The solution has a NaN or infinite entry.
     #[error("the solution is not finite at index {index}: the system is singular or overflows")]
     NonFiniteSolution {

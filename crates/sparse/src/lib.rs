@@ -3,7 +3,7 @@
 //!
 //! The sparse direct solvers under every beltrami solver, on faer's sparse kernels:
 //! nothing here knows about meshes; matrices are faer's compressed-column matrices of
-//! `f64` or [`Complex64`](num_complex::Complex64) ([`Scalar`]).
+//! `f64`, [`Complex64`](num_complex::Complex64) or `f32` ([`Scalar`]).
 //!
 //! One entry point per job:
 //!
@@ -11,6 +11,7 @@
 //! |---|---|
 //! | one Hermitian positive definite solve `M X = R` | [`solve_spd`] |
 //! | the same pattern factored again and again (a flow's steps) | [`SpdSolver`] |
+//! | the same in `f32`, its solutions refined in `f64` where needed | [`MixedSpdSolver`] |
 //! | the symbolic work done on another thread, ahead of the values | [`PlannedCholesky`] |
 //! | a fill-reducing elimination order | [`fill_reducing_order`] (AMD or nested dissection, whichever factors cheaper) |
 //! | the order that factors fastest on two cores | [`two_core_order`] ([`SplitOrder`]) |
@@ -43,6 +44,7 @@ pub mod check;
 mod cholesky;
 mod error;
 mod factor_count;
+mod mixed;
 mod nested_dissection;
 mod options;
 mod ordering;
@@ -55,6 +57,7 @@ mod vertex_separator;
 
 pub use error::SolveError;
 pub use factor_count::{FactorCount, factor_count};
+pub use mixed::{MixedSpdSolver, Refined};
 pub use options::{Kernel, SolveOptions, default_singularity_tolerance};
 pub use ordering::{
     NESTED_DISSECTION_FROM, SplitOrder, amd_order, fill_reducing_order, first_split_order,

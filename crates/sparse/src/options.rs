@@ -1,5 +1,6 @@
 //! The options every solver takes.
 
+use crate::Scalar;
 use faer::Par;
 
 /// The default [`SolveOptions::singularity_tolerance`] for `n` unknowns:
@@ -58,5 +59,13 @@ impl SolveOptions {
     pub(crate) fn tolerance(&self, n: usize) -> f64 {
         self.singularity_tolerance
             .unwrap_or_else(|| default_singularity_tolerance(n))
+    }
+
+    /// [`SolveOptions::tolerance`] for a factorization in the scalar `T`: by default
+    /// [`Scalar::TOLERANCE_PER_UNKNOWN`] times `n` (for `f64`,
+    /// [`default_singularity_tolerance`]).
+    pub(crate) fn tolerance_in<T: Scalar>(&self, n: usize) -> f64 {
+        self.singularity_tolerance
+            .unwrap_or_else(|| n.max(1) as f64 * T::TOLERANCE_PER_UNKNOWN)
     }
 }

@@ -211,7 +211,9 @@ impl<T: Scalar> SpdSolver<T> {
         check_finite_matrix("the matrix", matrix)?;
         #[cfg(feature = "cg-compare")]
         let start = std::time::Instant::now();
-        let factored = self.cholesky.factorize(matrix, self.options.tolerance(n));
+        let factored = self
+            .cholesky
+            .factorize(matrix, self.options.tolerance_in::<T>(n));
         #[cfg(feature = "cg-compare")]
         crate::cg_compare::record_factorization(n, start.elapsed().as_secs_f64());
         factored.map_err(|failure| match failure {
@@ -344,7 +346,7 @@ pub(crate) fn conjugate_gradients<T: Scalar>(
             acc + faer::traits::ComplexField::conj_impl(&x) * y
         })
     };
-    let norm = |a: &[T]| faer::traits::ComplexField::real_part_impl(&dot(a, a)).sqrt();
+    let norm = |a: &[T]| dot(a, a).real().sqrt();
     let target = tolerance * norm(rhs);
     let mut residual = rhs.to_vec();
     let mut x = vec![zero; n];

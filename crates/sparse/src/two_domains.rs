@@ -237,7 +237,7 @@ impl<T: Scalar> TwoDomains<T> {
             let v = values[p];
             schur[(r, c)] -= v;
             if r == c {
-                diagonal[r] = faer::traits::ComplexField::real_part_impl(&v);
+                diagonal[r] = v.real();
             } else {
                 schur[(c, r)] -= v.conjugate();
             }

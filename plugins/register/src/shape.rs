@@ -28,7 +28,9 @@ use crate::affine_alignment::{apply, closest_point_affine, spread_vertices};
 use crate::error::RegisterError;
 use crate::feature_match::Channel;
 use crate::landmarks::SpatialMatch;
-use crate::nonrigid_icp::{ALIGNED_SCHEDULE, IN_PLACE_SCHEDULE, NormalEquations, nonrigid_icp};
+use crate::nonrigid_icp::{
+    ALIGNED_SCHEDULE, IN_PLACE_SCHEDULE, NormalEquations, Schedule, nonrigid_icp,
+};
 
 /// Rounds at most of the affine closest-point fit that places the source before the
 /// non-rigid ICP. Where the two shapes differ (`g0_spot` onto its deformation) the fit
@@ -50,6 +52,16 @@ pub(crate) enum Placement {
     /// correspondence: two surfaces of one scan), deformed with the supple end of the
     /// schedule only.
     InPlace,
+}
+
+impl Placement {
+    /// The non-rigid ICP's stiffness schedule of this placement.
+    pub(crate) fn schedule(self) -> &'static Schedule {
+        match self {
+            Self::Aligned => &ALIGNED_SCHEDULE,
+            Self::InPlace => &IN_PLACE_SCHEDULE,
+        }
+    }
 }
 
 /// The source placed in the target's frame (an affine map, then the non-rigid ICP's
@@ -92,7 +104,7 @@ impl Shape {
                 equations,
                 index,
                 source.positions(),
-                &IN_PLACE_SCHEDULE,
+                placement.schedule(),
                 stopped,
             )?;
             return Ok((scale > 0.0).then_some(Self { placed, scale }));
@@ -123,7 +135,7 @@ impl Shape {
             equations,
             index,
             &affine,
-            &ALIGNED_SCHEDULE,
+            placement.schedule(),
             stopped,
         )?;
         Ok((scale > 0.0).then_some(Self { placed, scale }))
@@ -217,7 +229,7 @@ mod tests {
             &source,
             &target,
             &index,
-            &mut NormalEquations::new(&source).unwrap(),
+            &mut NormalEquations::new(&source, &ALIGNED_SCHEDULE).unwrap(),
             &points,
             Placement::Aligned,
             &|| false,

@@ -397,10 +397,10 @@ struct TemplateSetup<'t> {
 }
 
 impl<'t> TemplateSetup<'t> {
-    fn new(source: &Mesh, target: &'t Mesh) -> Result<Self, RegisterError> {
+    fn new(source: &Mesh, target: &'t Mesh, placement: Placement) -> Result<Self, RegisterError> {
         Ok(Self {
             index: SurfaceIndex::new(target)?.with_threads(0),
-            equations: NormalEquations::new(source)?,
+            equations: NormalEquations::new(source, placement.schedule())?,
         })
     }
 }
@@ -527,7 +527,7 @@ pub(crate) fn register(
             let (stop, cancel) = (&stop, &cancel);
             scope.spawn(move || {
                 let stopped = || stop.load(Ordering::Relaxed) || cancel.load(Ordering::Relaxed);
-                let mut setup = TemplateSetup::new(source, target)?;
+                let mut setup = TemplateSetup::new(source, target, placement)?;
                 // No images come when the initial map failed: nothing to fit.
                 let points: Vec<SurfacePoint> =
                     receive_images.recv().map_err(|_| RegisterError::Stopped)?;
@@ -655,7 +655,7 @@ mod tests {
         let source = Mesh::from_soup(&icosphere(2)).unwrap();
         let target = Mesh::from_soup(&octahedral_sphere(3)).unwrap();
         let initial = crate::initial_map_for(&source, &target, &[], true, &Arc::default()).unwrap();
-        let mut setup = TemplateSetup::new(&source, &target).unwrap();
+        let mut setup = TemplateSetup::new(&source, &target, Placement::Aligned).unwrap();
         for placement in [Placement::Aligned, Placement::InPlace] {
             let points = &initial.points;
             let stopped = shape_template(&source, &target, &mut setup, points, placement, &|| true);

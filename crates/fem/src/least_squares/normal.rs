@@ -786,7 +786,10 @@ mod tests {
         let w: Vec<f64> = (0..a.nrows()).map(|_| 1.5 + noise(&mut state)).collect();
         let r: Vec<T> = (0..a.nrows()).map(|_| value(&mut state)).collect();
         let (expected, expected_rhs) = dense(&a, dofs, &w, &r);
-        let scale = expected.norm_max();
+        let scale = (0..expected.ncols())
+            .flat_map(|d| (0..expected.nrows()).map(move |c| (c, d)))
+            .map(|(c, d)| expected[(c, d)].norm_sqr().sqrt())
+            .fold(0.0, f64::max);
         for narrow in [true, false] {
             let mut normal = NormalEquations::build(a.symbolic(), dofs, narrow).unwrap();
             assert_eq!(matches!(normal.maps, AnyMaps::Narrow(_)), narrow);
