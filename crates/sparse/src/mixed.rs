@@ -279,11 +279,14 @@ mod tests {
         SparseColMat::try_new_from_triplets(n, n, &triplets).unwrap()
     }
 
-    fn whole_order(n: usize) -> SplitOrder {
-        SplitOrder {
-            order: (0..n).collect(),
+    /// The solver of `matrix`'s pattern factored as a whole in the rows' order.
+    fn whole_solver(matrix: &SparseColMat<usize, f64>) -> MixedSpdSolver {
+        let order = SplitOrder {
+            order: (0..matrix.nrows()).collect(),
             sides: None,
-        }
+        };
+        MixedSpdSolver::with_split_order(matrix.symbolic(), &order, SolveOptions::default())
+            .unwrap()
     }
 
     /// The solution of the `f64` solver, to compare with.
@@ -309,12 +312,7 @@ mod tests {
         let matrix = grid_system(40, 1e1, true);
         let n = matrix.nrows();
         let rhs = Mat::<f64>::from_fn(n, 3, |i, j| ((i * (j + 3)) as f64 * 0.37).sin());
-        let mut solver = MixedSpdSolver::with_split_order(
-            matrix.symbolic(),
-            &whole_order(n),
-            SolveOptions::default(),
-        )
-        .unwrap();
+        let mut solver = whole_solver(&matrix);
         solver.factorize(matrix.as_ref()).unwrap();
         for _ in 0..2 {
             let mut x = rhs.clone();
@@ -362,12 +360,7 @@ mod tests {
     fn a_matrix_beyond_f32_is_an_error_and_a_solve_needs_a_factorization() {
         let matrix = grid_system(4, 1.0, true);
         let n = matrix.nrows();
-        let mut solver = MixedSpdSolver::with_split_order(
-            matrix.symbolic(),
-            &whole_order(n),
-            SolveOptions::default(),
-        )
-        .unwrap();
+        let mut solver = whole_solver(&matrix);
         let mut rhs = Mat::<f64>::zeros(n, 1);
         assert!(matches!(
             solver.solve_in_place(rhs.as_mut(), 1e-6),
@@ -389,13 +382,7 @@ mod tests {
     fn a_singular_matrix_fails_at_f32_precision() {
         // The graph Laplacian alone (no diagonal term) is singular.
         let matrix = grid_system(20, 1.0, false);
-        let n = matrix.nrows();
-        let mut solver = MixedSpdSolver::with_split_order(
-            matrix.symbolic(),
-            &whole_order(n),
-            SolveOptions::default(),
-        )
-        .unwrap();
+        let mut solver = whole_solver(&matrix);
         let failed = solver.factorize(matrix.as_ref());
         assert!(
             matches!(

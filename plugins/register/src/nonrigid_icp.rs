@@ -131,7 +131,7 @@ const SETTLED: f64 = 1e-3;
 /// Registration by shape of fsaverage5 pial onto white, white onto pial, and the right
 /// hemisphere's two, and `g0_spot` onto its deformation, from the truth: with these
 /// levels ended at 1e-3 1.345, 1.363, 1.332, 1.353 mm and 0.0140 (70 rounds on
-/// fsaverage5); at 2.5e-4 1.291, 1.315, 1.278, 1.289 mm and 0.0135 (about 120 rounds,
+/// fsaverage5); at 2.5e-4 1.291, 1.315, 1.278, 1.289 mm and 0.0135 (about 110 rounds,
 /// solved in `f32`: [`MIXED_BELOW`]). The stiff levels ended at 2.5e-4 as well gain
 /// nothing (1.342, 1.372, 1.324, 1.357 mm).
 const SUPPLE_SETTLED: f64 = 2.5e-4;
@@ -271,7 +271,8 @@ pub(crate) struct NormalEquations {
 
 impl NormalEquations {
     /// The equations of `source`, its vertices still to be placed
-    /// ([`NormalEquations::place`]).
+    /// ([`NormalEquations::place`]), for the levels of `schedule`: an `f32` factor, and
+    /// an `f64` one when the schedule has a level from [`MIXED_BELOW`].
     ///
     /// # Errors
     /// [`RegisterError::Solve`] when the symbolic factorization fails (memory).
