@@ -129,7 +129,7 @@ impl MixedSpdSolver {
     /// # Errors
     /// [`SolveError::NotFactored`] without a factorization, [`SolveError::NonFinite`]
     /// for a non-finite right-hand side, [`SolveError::NonFiniteSolution`], and
-    /// [`SolveError::Refinement`] when [`MAX_REFINEMENTS`] steps leave a correction above
+    /// [`SolveError::Refinement`] when four steps leave a correction above
     /// `tolerance` (the matrix is too ill-conditioned for an `f32` factor).
     pub fn solve_in_place(
         &mut self,
