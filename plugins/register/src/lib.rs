@@ -100,7 +100,8 @@ pub struct InitialMap {
     /// against or orthogonal to it). No flips for a bijective map between well-shaped
     /// meshes.
     pub distortion: DistortionStats,
-    /// The road taken, in words: the common domain, where the landmarks are matched.
+    /// The road to this map, in words: the common domain, where the landmarks are
+    /// matched (a registration's report adds what followed).
     pub route: String,
     /// The smallest `sup |mu|` of any map homotopic to this one, when known: between
     /// two tori, from their conformal moduli in the markings the map pairs
@@ -313,24 +314,26 @@ pub(crate) fn check_features(
     }
 }
 
-/// The road of [`initial_map`] for `topology` with `landmarks` landmarks, in words.
+/// The road of [`initial_map`] for `topology` with `landmarks` landmarks, in words: the
+/// common domain and where the landmarks are matched (the registration adds what
+/// follows the initial map).
 fn route(topology: Topology, landmarks: usize) -> String {
     let matched = "every landmark matched in the domain";
     match topology {
         Topology::Sphere if landmarks > 0 => format!(
-            "sphere: both meshes conformally onto the unit sphere, {matched} (a landmark-matching quasiconformal map in a stereographic chart), composed with the target's sphere map; the flow on the target mesh polishes with every landmark held"
+            "sphere: both meshes conformally onto the unit sphere, {matched} (a landmark-matching quasiconformal map in a stereographic chart), composed with the target's sphere map"
         ),
-        Topology::Sphere => "sphere: both meshes onto the unit sphere, aligned by a rotation from a rough spatial match, composed with the target's sphere map; then the flow on the target mesh".to_string(),
+        Topology::Sphere => "sphere: both meshes onto the unit sphere, aligned by the Moebius transformation that best matches a rough spatial correspondence, composed with the target's sphere map".to_string(),
         Topology::Disk if landmarks > 0 => format!(
-            "disk: both meshes onto the target's Tutte disk, the boundary laid between the boundary landmarks, {matched} with the boundary held; then the flow on the target mesh polishes with every landmark held"
+            "disk: both meshes onto the target's Tutte disk, the boundary laid between the boundary landmarks, {matched} with the boundary held"
         ),
-        Topology::Disk => "disk: both meshes onto the target's Tutte disk, the boundary turned by a rough spatial match; then the flow on the target mesh".to_string(),
+        Topology::Disk => "disk: both meshes onto the target's Tutte disk, the boundary turned by a rough spatial match".to_string(),
         Topology::Torus if landmarks > 0 => format!(
-            "torus: both meshes onto the square glued periodically, a symmetry of the square and a translation chosen by the landmarks, {matched} (a landmark-matching quasiconformal map on the torus, the seams glued); then the flow on the target mesh polishes with every landmark held"
+            "torus: both meshes onto the square glued periodically, a symmetry of the square and a translation chosen by the landmarks, {matched} (a landmark-matching quasiconformal map on the torus, the seams glued)"
         ),
-        Topology::Torus => "torus: both meshes onto the square glued periodically, a symmetry of the square chosen by a rough spatial match; then the flow on the target mesh".to_string(),
-        Topology::MultiplyConnected | Topology::HigherGenus if landmarks > 0 => "polygon: both meshes cut along matched cut graphs into one polygon, every landmark a corner of it (drawn on the target at its vertex, or at the vertex nearest to its point and moved onto the point); then the flow on the target mesh polishes with every landmark held".to_string(),
-        Topology::MultiplyConnected | Topology::HigherGenus => "polygon: both meshes cut along matched cut graphs into one polygon, placed in space; then the flow on the target mesh".to_string(),
+        Topology::Torus => "torus: both meshes onto the square glued periodically, a symmetry of the square chosen by a rough spatial match".to_string(),
+        Topology::MultiplyConnected | Topology::HigherGenus if landmarks > 0 => "polygon: both meshes cut along matched cut graphs into one polygon, every landmark a corner of it (drawn on the target at its vertex, or at the vertex nearest to its point and moved onto the point)".to_string(),
+        Topology::MultiplyConnected | Topology::HigherGenus => "polygon: both meshes cut along matched cut graphs into one polygon, placed in space".to_string(),
     }
 }
 
