@@ -38,6 +38,9 @@ pub struct MixedSpdSolver {
     values: Vec<f64>,
     /// The same rounded to `f32`.
     rounded: Vec<f32>,
+    /// The right-hand sides of an `f32` solve, columns of `n` stacked (kept between
+    /// solves).
+    work: Vec<f32>,
     /// `|d_0| / |x_1|` of the first solve after the last factorization, once measured.
     unrefined_error: Option<f64>,
 }
@@ -78,6 +81,7 @@ impl MixedSpdSolver {
             factor,
             values: vec![0.0; stored],
             rounded: vec![0.0; stored],
+            work: Vec::new(),
             unrefined_error: None,
         })
     }
@@ -142,37 +146,64 @@ impl MixedSpdSolver {
             return Err(SolveError::NotFactored);
         }
         let columns = rhs.ncols();
+        for j in 0..columns {
+            for i in 0..n {
+                if !rhs[(i, j)].is_finite() {
+                    return Err(SolveError::NonFinite {
+                        what: "the right-hand side",
+                        index: i + j * n,
+                    });
+                }
+            }
+        }
+        if let Some(error) = self.unrefined_error
+            && error <= tolerance
+        {
+            // The f32 solution as it is, through the kept buffer.
+            self.work.clear();
+            for j in 0..columns {
+                self.work.extend((0..n).map(|i| rhs[(i, j)] as f32));
+            }
+            check_finite("the right-hand side rounded to f32", &self.work)?;
+            self.solve_work(columns)?;
+            for j in 0..columns {
+                for i in 0..n {
+                    rhs[(i, j)] = f64::from(self.work[i + j * n]);
+                }
+            }
+            return Ok(Refined {
+                steps: 0,
+                last_correction: error,
+            });
+        }
         let mut b = vec![0.0; n * columns];
         for j in 0..columns {
             for i in 0..n {
                 b[i + j * n] = rhs[(i, j)];
             }
         }
-        check_finite("the right-hand side", &b)?;
         let mut x = self.solve_rounded(&b, columns)?;
         let mut refined = Refined {
             steps: 0,
             last_correction: self.unrefined_error.unwrap_or(f64::INFINITY),
         };
-        if self.unrefined_error.is_none_or(|error| error > tolerance) {
-            loop {
-                if refined.steps == MAX_REFINEMENTS {
-                    return Err(SolveError::Refinement {
-                        steps: MAX_REFINEMENTS,
-                        correction: refined.last_correction,
-                    });
-                }
-                let residual = self.residual(&b, &x, columns);
-                let correction = self.solve_rounded(&residual, columns)?;
-                x.iter_mut().zip(&correction).for_each(|(a, d)| *a += d);
-                refined.steps += 1;
-                refined.last_correction = relative_size(&correction, &x, n);
-                if self.unrefined_error.is_none() {
-                    self.unrefined_error = Some(refined.last_correction);
-                }
-                if refined.last_correction <= tolerance {
-                    break;
-                }
+        loop {
+            if refined.steps == MAX_REFINEMENTS {
+                return Err(SolveError::Refinement {
+                    steps: MAX_REFINEMENTS,
+                    correction: refined.last_correction,
+                });
+            }
+            let residual = self.residual(&b, &x, columns);
+            let correction = self.solve_rounded(&residual, columns)?;
+            x.iter_mut().zip(&correction).for_each(|(a, d)| *a += d);
+            refined.steps += 1;
+            refined.last_correction = relative_size(&correction, &x, n);
+            if self.unrefined_error.is_none() {
+                self.unrefined_error = Some(refined.last_correction);
+            }
+            if refined.last_correction <= tolerance {
+                break;
             }
         }
         for j in 0..columns {
@@ -185,16 +216,22 @@ impl MixedSpdSolver {
 
     /// `M^-1 b` with the `f32` factor, columns of `n` stacked.
     fn solve_rounded(&mut self, b: &[f64], columns: usize) -> Result<Vec<f64>, SolveError> {
+        self.work.clear();
+        self.work.extend(b.iter().map(|&v| v as f32));
+        check_finite("the right-hand side rounded to f32", &self.work)?;
+        self.solve_work(columns)?;
+        Ok(self.work.iter().map(|&v| f64::from(v)).collect())
+    }
+
+    /// The kept buffer (`columns` right-hand sides) overwritten with its solutions.
+    fn solve_work(&mut self, columns: usize) -> Result<(), SolveError> {
         let n = self.len();
-        let mut rounded: Vec<f32> = b.iter().map(|&v| v as f32).collect();
-        check_finite("the right-hand side rounded to f32", &rounded)?;
         self.factor
             .solve_in_place(MatMut::from_column_major_slice_mut(
-                &mut rounded,
+                &mut self.work,
                 n,
                 columns,
-            ))?;
-        Ok(rounded.into_iter().map(f64::from).collect())
+            ))
     }
 
     /// `b - M x` in `f64`, columns of `n` stacked: one pass over the lower triangle of
@@ -347,6 +384,15 @@ mod tests {
         let off = largest_difference(&second, &exact);
         assert!(off < 1e-5 && off > 1e-12, "{off:e}");
         assert!(largest_difference(&first, &exact) < 1e-9);
+        // The unrefined path checks its right-hand sides as the refined one does.
+        for bad in [f64::NAN, 1e300] {
+            let mut beyond = rhs.clone();
+            beyond[(7, 1)] = bad;
+            assert!(matches!(
+                solver.solve_in_place(beyond.as_mut(), 1e-5),
+                Err(SolveError::NonFinite { .. })
+            ));
+        }
         // A new factorization measures again.
         solver.factorize(matrix.as_ref()).unwrap();
         let mut again = rhs.clone();

@@ -67,15 +67,17 @@ pub(crate) struct Schedule {
     /// A level ends when no vertex's map moves a point of the unit-radius source by
     /// more than this in a round ...
     pub(crate) settled: f64,
-    /// ... or, for the levels below the stiffness `supple.0`, by more than `supple.1`.
-    pub(crate) supple: (f64, f64),
+    /// ... or, for the levels below this stiffness, ...
+    pub(crate) supple_below: f64,
+    /// ... by more than this.
+    pub(crate) supple_settled: f64,
 }
 
 impl Schedule {
     /// The largest move of a settled round at the level `stiffness`.
     fn settled_at(&self, stiffness: f64) -> f64 {
-        if stiffness < self.supple.0 {
-            self.supple.1
+        if stiffness < self.supple_below {
+            self.supple_settled
         } else {
             self.settled
         }
@@ -97,7 +99,8 @@ pub(crate) const ALIGNED_SCHEDULE: Schedule = Schedule {
     rounds: 20,
     acceleration: 3,
     settled: SETTLED,
-    supple: (SUPPLE_BELOW, SUPPLE_SETTLED),
+    supple_below: SUPPLE_BELOW,
+    supple_settled: SUPPLE_SETTLED,
 };
 
 /// The schedule of a source already in place (the register option `in-place`): its two
@@ -117,7 +120,8 @@ pub(crate) const IN_PLACE_SCHEDULE: Schedule = Schedule {
     rounds: 10,
     acceleration: 0,
     settled: SETTLED,
-    supple: (0.0, SETTLED),
+    supple_below: 0.0,
+    supple_settled: SETTLED,
 };
 
 /// A level ends when no vertex's map moves a point of the unit-radius source by more
