@@ -110,7 +110,7 @@ pub(crate) const ALIGNED_SCHEDULE: Schedule = Schedule {
 /// the template lies 0.37 mm from the true correspondence with these two, 0.48 mm with
 /// the last alone, 1.37 mm from 0.03 down and 1.48 mm with the whole schedule
 /// (docs/benchmarks.md). On a pair that is not in place (`g0_spot` onto its smooth
-/// deformation, not moved first) it ends 0.085 from the truth against 0.0136 with the
+/// deformation, not moved first) it ends 0.107 from the truth against 0.0139 with the
 /// whole schedule: the stiff rounds are what find such a correspondence. Its rounds are
 /// the plain ones, up to 10 per stiffness: the true correspondence lies near the start,
 /// and rounds run to convergence carry each vertex to its closest point instead (the
