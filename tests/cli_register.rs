@@ -375,6 +375,30 @@ fn real_genus_zero_and_disk_pairs() {
     }
 }
 
+#[test]
+fn features_are_matched_from_an_initial_map_that_folds_faces() {
+    let Some(shared) = shared_meshes("features_are_matched_from_an_initial_map_that_folds_faces")
+    else {
+        return;
+    };
+    // The hemisphere's initial map onto the face folds faces (chords across curved parts
+    // of the target); no flow runs before the match, whose steps unfold them (measured:
+    // 6 -> 0), and `register` checks that none is left.
+    let (_, r) = register(
+        &shared.join("disk_hemisphere.obj"),
+        &shared.join("disk_human_face.obj"),
+        &["--features", "mean-curvature", "mean-curvature"],
+        f64::INFINITY,
+    );
+    assert!(r["initial_flipped"].as_u64().unwrap() > 0, "{r}");
+    let route = r["route"].as_str().unwrap();
+    assert!(
+        route.ends_with("then the feature match bends it (no flow before it)"),
+        "{route}"
+    );
+    assert_eq!(r["iterations"], 0, "{r}");
+}
+
 /// Registers `source` onto `target` (no assertion on the result), then measures the
 /// output with `beltrami distortion SOURCE OUT --target TARGET --json`: the flipped
 /// faces and the largest |mu| agree with the register report's final distortion.

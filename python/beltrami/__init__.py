@@ -1076,9 +1076,8 @@ def register(
     raises naming the farthest (``allow_missed_landmarks=True`` keeps the map; the
     report's ``landmarks`` lists each distance). ``features=(fs, ft)`` matches a scalar
     field given on both meshes (arrays with one value per row of ``V`` and of ``TV``, or
-    ``"mean-curvature"``): the initial map (untangled by the flow where it flips faces)
-    is bent in the common domain until the fields agree, the landmarks held (disks and
-    closed genus-0 surfaces).
+    ``"mean-curvature"``): the initial map is bent in the common domain until the
+    fields agree, the landmarks held (disks and closed genus-0 surfaces).
     ``match_shape=True`` pulls each image towards where the source, placed on the
     target by an affine closest-point fit, lies (a non-rigid ICP that stays a
     bijection; disks and closed genus-0 surfaces; the report's ``shape`` has the mean

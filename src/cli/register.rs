@@ -35,9 +35,8 @@ pub struct RegisterArgs {
     #[arg(long)]
     pub landmarks: Option<PathBuf>,
     /// Match a scalar field given on both meshes (one value per vertex per line, or the
-    /// computed `mean-curvature`): the initial map (untangled by the flow where it flips
-    /// faces) bent in the common domain until the fields agree, landmarks held (disks
-    /// and closed genus-0 surfaces).
+    /// computed `mean-curvature`): the initial map bent in the common domain until the
+    /// fields agree, landmarks held (disks and closed genus-0 surfaces).
     #[arg(long, num_args = 2, value_names = ["SOURCE_FIELD", "TARGET_FIELD"])]
     pub features: Option<Vec<PathBuf>>,
     /// Match the shapes: from the initial map, pull each image towards where

@@ -1,8 +1,8 @@
 //! The source's shape matched on the target: a bijective non-rigid alignment.
 //!
 //! From the initial map (the common parameter domain's composition; the template is
-//! fitted beside the flow, on the other core, when the flow runs to untangle it) and
-//! the registration `f` the match starts from (a bijection, the landmarks exact):
+//! fitted on the other core while the registration goes on) and the map `f` the match
+//! starts from (the initial map itself, the landmarks exact):
 //!
 //! 1. the similarity that best carries the source's vertices onto their images under
 //!    the initial map (`SpatialMatch::fitted`, Umeyama 1991), refined by an affine

@@ -22,9 +22,8 @@ use crate::{InitialMap, RegisterError, check_topology, initial_map_for, match_fe
 /// Beltrami flow on the target mesh ([`beltrami_flow_engine::solve`] with `Target::Mesh`).
 ///
 /// Reads: `target` (`Mesh` only), `goal` (`Conformal { 2 <= p <= 100 }`, `Prescribed`, or
-/// `Features`: fields matched in the common domain from the initial map, the flow run
-/// before only to untangle an initial map that flips faces, and none after, which
-/// would pull the map back towards conformal),
+/// `Features`: fields matched in the common domain from the initial map, with no flow
+/// before or after: it would pull the map towards conformal),
 /// landmarks (each with a `Position::Spatial` on the target; the vertex is pulled there
 /// and held), open curves (feature curves: a source chain onto a target chain, ends
 /// fixed, sliding between), and the flow's options. The map is `Map::OnMesh`. The
@@ -330,7 +329,7 @@ impl Solver for Register {
 }
 
 /// The registration `solution` of `flow` (onto its target mesh `target`; the initial
-/// map, or the flow's untangling of it: [`untangles_only`]) bent in the common domain so that `features` match and, with `shape`, the source's
+/// map, [`After::Match`]) bent in the common domain so that `features` match and, with `shape`, the source's
 /// coordinates placed so (modules `feature_match`, `shape`), then measured by the flow
 /// engine with no step (a step would pull it back towards conformal).
 fn after_features(
@@ -338,7 +337,7 @@ fn after_features(
     target: &Mesh,
     initial: &InitialMap,
     features: Option<&Features>,
-    shape: Option<Shape>,
+    shape: Option<&Shape>,
     solution: Solution,
     context: &mut Context<'_>,
 ) -> Result<Solution, SolverError> {
@@ -353,7 +352,7 @@ fn after_features(
         })
         .into_iter()
         .collect();
-    if let Some(fitted) = &shape {
+    if let Some(fitted) = shape {
         channels.extend(fitted.channels(target));
     }
     let mut report = solution.report.clone();
@@ -363,7 +362,7 @@ fn after_features(
             .map_err(registration_error)
     })?;
     report.notes.extend(notes);
-    let distance = shape.as_ref().map(|s| ShapeDistance {
+    let distance = shape.map(|s| ShapeDistance {
         before: s.distance(flow.source, target, points),
         after: s.distance(flow.source, target, &matched),
     });
@@ -433,43 +432,81 @@ fn shape_template(
     })
 }
 
-/// Whether the flow from `initial` runs only to untangle it, that is, not at all: a
-/// map to be bent by a feature match (`matched`) starts from an initial map with no
-/// flipped face as it is. The flow would make it conformal on the target, sliding it
-/// away from the correspondence the initial map fixed by the landmarks and the spatial
-/// alignment, which the match then has to find again: fsaverage5 pial onto white from
-/// the truth by shape 1.291 -> 1.275 mm, by the sulcal depth 0.625 -> 0.584 mm, in
-/// place 0.481 -> 0.455 mm (docs/register.md).
-fn untangles_only(matched: bool, initial: &InitialMap) -> bool {
-    matched && initial.flipped() == 0
+/// What followed the initial map of a registration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum After {
+    /// The flow (no field to match).
+    Flow,
+    /// The feature match from the initial map itself, with no flow before it: the flow
+    /// would make the map conformal on the target, sliding it away from the
+    /// correspondence the initial map fixed by the landmarks and the spatial alignment,
+    /// which the match then has to find again (fsaverage5 pial onto white from the
+    /// truth by shape 1.291 -> 1.275 mm, by the sulcal depth 0.625 -> 0.584 mm, with the
+    /// 24 landmarks as well 0.452 -> 0.392 mm, in place 0.481 -> 0.455 mm;
+    /// docs/register.md). Faces it leaves flipped (it keeps those the initial map
+    /// folds, but its steps unfold them in practice: none left on fsaverage5 with the
+    /// 24 landmarks, on the hemisphere onto the face, koala onto spot or bunny onto
+    /// koala, whose initial maps flip 1, 6, 4 and 2) fail the registration as any flip
+    /// does.
+    Match,
 }
 
-/// The road of a registration from `initial`, in words: the initial map's, then the
-/// flow (all of it, or only its untangling: [`untangles_only`]) and the feature match
-/// when `matched`.
-fn route(initial: &InitialMap, landmarks: bool, matched: bool) -> String {
+/// The road of a registration from `initial`, in words: the initial map's, then what
+/// followed it (`after`).
+fn route(initial: &InitialMap, landmarks: bool, after: After) -> String {
     let held = if landmarks {
         " with every landmark held"
     } else {
         ""
     };
-    let then = match (matched, untangles_only(matched, initial)) {
-        (false, _) => format!("then the flow on the target mesh{held}"),
-        (true, false) => format!(
-            "then the flow on the target mesh{held}, since the initial map flips faces, and the feature match bends its result"
-        ),
-        (true, true) => {
-            "then the feature match bends it (no flow: the initial map flips no face)".to_string()
-        }
+    let then = match after {
+        After::Flow => format!("then the flow on the target mesh{held}"),
+        After::Match => "then the feature match bends it (no flow before it)".to_string(),
     };
     format!("{}; {then}", initial.route)
 }
 
+/// The flow of `flow` from the initial map `initial` (its problem: [`conformal_registration`]),
+/// with no step unless `steps`: a map to be matched starts from the initial map.
+fn flow_from(
+    flow: &Problem<'_>,
+    settings: &Settings,
+    initial: &InitialMap,
+    steps: bool,
+    report: Report,
+    context: &mut Context<'_>,
+) -> Result<Solution, SolverError> {
+    let no_steps;
+    let settings = if steps {
+        settings
+    } else {
+        let mut options = flow.options.clone();
+        options.set("max-iters", OptionValue::Int(0));
+        no_steps = Settings::resolve(NAME, &OPTIONS, &options).map_err(SolverError::from)?;
+        &no_steps
+    };
+    let mut solution = beltrami_flow_engine::solve(
+        flow,
+        settings,
+        initial.positions.clone(),
+        None,
+        report,
+        context,
+    )?;
+    if !steps {
+        // The route says why no step was taken.
+        solution
+            .report
+            .notes
+            .retain(|n| !n.starts_with(NO_STEP_NOTE));
+    }
+    Ok(solution)
+}
+
 /// The conformal registration of `problem` onto its target mesh `target`: the initial
 /// map (whose images are sent on `initial_images`, when given, as soon as it is made)
-/// and the flow from it, which takes no step when the map is to be matched (`matched`)
-/// and flips no face ([`untangles_only`]). Returns the initial map, the flow's problem
-/// and its solution.
+/// and the flow from it, which takes no step when the map is to be matched (`matched`:
+/// [`After::Match`]). Returns the initial map, the flow's problem and its solution.
 fn conformal_registration<'p>(
     problem: &Problem<'p>,
     target: &Mesh,
@@ -492,7 +529,7 @@ fn conformal_registration<'p>(
     }
     report.notes.extend(initial.notes.iter().cloned());
     let mut flow = problem.clone();
-    // With features the flow, where it runs, untangles the map they start from.
+    // With features the flow takes no step: it only measures the map they start from.
     flow.goal = match &problem.goal {
         Goal::Features(_) => Goal::default(),
         goal => goal.clone(),
@@ -515,31 +552,8 @@ fn conformal_registration<'p>(
     }
     flow.constraints = held;
     flow.initial = Some(Map::OnMesh(initial.points.clone()));
-    let untangle_only = untangles_only(matched, &initial);
-    let no_steps;
-    let settings = if untangle_only {
-        let mut options = flow.options.clone();
-        options.set("max-iters", OptionValue::Int(0));
-        no_steps = Settings::resolve(NAME, &OPTIONS, &options).map_err(SolverError::from)?;
-        &no_steps
-    } else {
-        settings
-    };
-    let mut solution = beltrami_flow_engine::solve(
-        &flow,
-        settings,
-        initial.positions.clone(),
-        None,
-        report,
-        context,
-    )?;
-    if untangle_only {
-        // The route says why no step was taken.
-        solution
-            .report
-            .notes
-            .retain(|n| !n.starts_with(NO_STEP_NOTE));
-    }
+    // A map to be matched starts from the initial map ([`After::Match`]).
+    let solution = flow_from(&flow, settings, &initial, !matched, report, context)?;
     Ok((initial, flow, solution))
 }
 
@@ -620,11 +634,13 @@ pub(crate) fn register(
         flowed
     });
     let (initial, flow, mut solution, template) = flowed?;
-    if matched {
-        solution = after_features(
-            &flow, target, &initial, features, template, solution, context,
-        )?;
-    }
+    let after = if matched {
+        let shape = template.as_ref();
+        solution = after_features(&flow, target, &initial, features, shape, solution, context)?;
+        After::Match
+    } else {
+        After::Flow
+    };
     // Judged against the target's normals at the images (the rule of `beltrami
     // distortion --target` and of the flow), when the initial map was built.
     solution.metrics.initial_distortion = Some(initial.distortion);
@@ -632,7 +648,7 @@ pub(crate) fn register(
     solution.extras.route = Some(route(
         &initial,
         problem.constraints.landmarks().next().is_some(),
-        matched,
+        after,
     ));
     let Some(Map::OnMesh(points)) = solution.map().cloned() else {
         return Ok(solution);
