@@ -382,8 +382,9 @@ fn features_are_matched_from_an_initial_map_that_folds_faces() {
         return;
     };
     // The hemisphere's initial map onto the face folds faces (chords across curved parts
-    // of the target); no flow runs before the match, whose steps unfold them (measured:
-    // 6 -> 0), and `register` checks that none is left.
+    // of the target); the flow takes no step before the match, its untangling unfolds
+    // them (6 -> 0, and 8 -> 0 after the match), and `register` checks that none is
+    // left.
     let (_, r) = register(
         &shared.join("disk_hemisphere.obj"),
         &shared.join("disk_human_face.obj"),

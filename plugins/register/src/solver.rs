@@ -443,11 +443,9 @@ enum After {
     /// which the match then has to find again (fsaverage5 pial onto white from the
     /// truth by shape 1.291 -> 1.275 mm, by the sulcal depth 0.625 -> 0.584 mm, with the
     /// 24 landmarks as well 0.452 -> 0.392 mm, in place 0.481 -> 0.455 mm;
-    /// docs/register.md). Faces it leaves flipped (it keeps those the initial map
-    /// folds, but its steps unfold them in practice: none left on fsaverage5 with the
-    /// 24 landmarks, on the hemisphere onto the face, koala onto spot or bunny onto
-    /// koala, whose initial maps flip 1, 6, 4 and 2) fail the registration as any flip
-    /// does.
+    /// docs/register.md). The flow engine's untangling still runs, with no flow step:
+    /// it unfolds the faces the initial map folds before the match, and those the match
+    /// leaves after it (the hemisphere onto the face: 6 -> 0 before, 8 -> 0 after).
     Match,
 }
 
