@@ -208,7 +208,10 @@ def test_the_gil_is_released_during_a_solve():
 def test_ctrl_c_stops_a_long_solve(tmp_path):
     script = tmp_path / "long.py"
     script.write_text(textwrap.dedent(f"""
-        import sys, beltrami, numpy as np
+        import signal, sys, beltrami, numpy as np
+        # Python leaves SIGINT ignored when it starts so (a background job of a shell
+        # without job control): the Ctrl-C of a user's terminal is what is tested.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         V, F = beltrami.read_mesh({str(MESHES / "disk_hemisphere.obj")!r})
         # About 41K vertices: the flow towards a prescribed mu below takes about 8 s to
         # stall (a conformal goal settles within a second from its boundary-first start).
