@@ -329,7 +329,7 @@ impl Solver for Register {
 }
 
 /// The registration `solution` of `flow` (onto its target mesh `target`; the initial
-/// map, [`After::Match`]) bent in the common domain so that `features` match and, with `shape`, the source's
+/// map: [`route`]) bent in the common domain so that `features` match and, with `shape`, the source's
 /// coordinates placed so (modules `feature_match`, `shape`), then measured by the flow
 /// engine with no step (a step would pull it back towards conformal).
 fn after_features(
@@ -369,22 +369,7 @@ fn after_features(
     let mut measure = flow.clone();
     let positions = matched.iter().map(|p| p.position(target)).collect();
     measure.initial = Some(Map::OnMesh(matched));
-    measure.options.set("max-iters", OptionValue::Int(0));
-    let measure_settings =
-        Settings::resolve(NAME, &OPTIONS, &measure.options).map_err(SolverError::from)?;
-    let mut measured = beltrami_flow_engine::solve(
-        &measure,
-        &measure_settings,
-        positions,
-        None,
-        report,
-        context,
-    )?;
-    // The measuring run took no step by design: its stop is not news.
-    measured
-        .report
-        .notes
-        .retain(|n| !n.starts_with(NO_STEP_NOTE));
+    let mut measured = flow_from(&measure, None, positions, report, context)?;
     measured.extras.features = Some(mismatch);
     measured.extras.shape = distance;
     Ok(measured)
@@ -432,67 +417,56 @@ fn shape_template(
     })
 }
 
-/// What followed the initial map of a registration.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum After {
-    /// The flow (no field to match).
-    Flow,
-    /// The feature match from the initial map itself, with no flow before it: the flow
-    /// would make the map conformal on the target, sliding it away from the
-    /// correspondence the initial map fixed by the landmarks and the spatial alignment,
-    /// which the match then has to find again (fsaverage5 pial onto white from the
-    /// truth by shape 1.291 -> 1.275 mm, by the sulcal depth 0.625 -> 0.584 mm, with the
-    /// 24 landmarks as well 0.452 -> 0.392 mm, in place 0.481 -> 0.455 mm;
-    /// docs/register.md). The flow engine's untangling still runs, with no flow step:
-    /// it unfolds the faces the initial map folds before the match, and those the match
-    /// leaves after it (the hemisphere onto the face: 6 -> 0 before, 8 -> 0 after).
-    Match,
-}
-
-/// The road of a registration from `initial`, in words: the initial map's, then what
-/// followed it (`after`).
-fn route(initial: &InitialMap, landmarks: bool, after: After) -> String {
+/// The road of a registration from `initial`, in words: the initial map's, then the
+/// flow, or the feature match when `matched`.
+///
+/// A map to be matched takes no flow step before the match: the flow would make it
+/// conformal on the target, sliding it away from the correspondence the initial map
+/// fixed by the landmarks and the spatial alignment, which the match then has to find
+/// again (fsaverage5 pial onto white from the truth by shape 1.291 -> 1.275 mm, by the
+/// sulcal depth 0.625 -> 0.584 mm, with the 24 landmarks as well 0.452 -> 0.392 mm, in
+/// place 0.481 -> 0.455 mm; docs/register.md). The flow engine's untangling still
+/// runs, with no flow step: it unfolds the faces the initial map folds before the
+/// match, and those the match leaves after it (the hemisphere onto the face: 6 -> 0
+/// before, 8 -> 0 after).
+fn route(initial: &InitialMap, landmarks: bool, matched: bool) -> String {
     let held = if landmarks {
         " with every landmark held"
     } else {
         ""
     };
-    let then = match after {
-        After::Flow => format!("then the flow on the target mesh{held}"),
-        After::Match => "then the feature match bends it (no flow before it)".to_string(),
+    let then = if matched {
+        "then the feature match bends it (no flow before it)".to_string()
+    } else {
+        format!("then the flow on the target mesh{held}")
     };
     format!("{}; {then}", initial.route)
 }
 
-/// The flow of `flow` from the initial map `initial` (its problem: [`conformal_registration`]),
-/// with no step unless `steps`: a map to be matched starts from the initial map.
+/// The flow of `flow` from `positions` (the images of its initial map), with the
+/// settings `steps`, or with no step (the flow engine's measure and untangling only)
+/// when `None`: a map to be matched, before and after the match.
 fn flow_from(
     flow: &Problem<'_>,
-    settings: &Settings,
-    initial: &InitialMap,
-    steps: bool,
+    steps: Option<&Settings>,
+    positions: Vec<Point3<f64>>,
     report: Report,
     context: &mut Context<'_>,
 ) -> Result<Solution, SolverError> {
     let no_steps;
-    let settings = if steps {
-        settings
-    } else {
-        let mut options = flow.options.clone();
-        options.set("max-iters", OptionValue::Int(0));
-        no_steps = Settings::resolve(NAME, &OPTIONS, &options).map_err(SolverError::from)?;
-        &no_steps
+    let settings = match steps {
+        Some(settings) => settings,
+        None => {
+            let mut options = flow.options.clone();
+            options.set("max-iters", OptionValue::Int(0));
+            no_steps = Settings::resolve(NAME, &OPTIONS, &options).map_err(SolverError::from)?;
+            &no_steps
+        }
     };
-    let mut solution = beltrami_flow_engine::solve(
-        flow,
-        settings,
-        initial.positions.clone(),
-        None,
-        report,
-        context,
-    )?;
-    if !steps {
-        // The route says why no step was taken.
+    let mut solution =
+        beltrami_flow_engine::solve(flow, settings, positions, None, report, context)?;
+    if steps.is_none() {
+        // No step was taken by design: the stop is not news.
         solution
             .report
             .notes
@@ -504,7 +478,7 @@ fn flow_from(
 /// The conformal registration of `problem` onto its target mesh `target`: the initial
 /// map (whose images are sent on `initial_images`, when given, as soon as it is made)
 /// and the flow from it, which takes no step when the map is to be matched (`matched`:
-/// [`After::Match`]). Returns the initial map, the flow's problem and its solution.
+/// [`route`]). Returns the initial map, the flow's problem and its solution.
 fn conformal_registration<'p>(
     problem: &Problem<'p>,
     target: &Mesh,
@@ -550,8 +524,10 @@ fn conformal_registration<'p>(
     }
     flow.constraints = held;
     flow.initial = Some(Map::OnMesh(initial.points.clone()));
-    // A map to be matched starts from the initial map ([`After::Match`]).
-    let solution = flow_from(&flow, settings, &initial, !matched, report, context)?;
+    // A map to be matched starts from the initial map (`route`).
+    let steps = (!matched).then_some(settings);
+    let positions = initial.positions.clone();
+    let solution = flow_from(&flow, steps, positions, report, context)?;
     Ok((initial, flow, solution))
 }
 
@@ -632,13 +608,10 @@ pub(crate) fn register(
         flowed
     });
     let (initial, flow, mut solution, template) = flowed?;
-    let after = if matched {
+    if matched {
         let shape = template.as_ref();
         solution = after_features(&flow, target, &initial, features, shape, solution, context)?;
-        After::Match
-    } else {
-        After::Flow
-    };
+    }
     // Judged against the target's normals at the images (the rule of `beltrami
     // distortion --target` and of the flow), when the initial map was built.
     solution.metrics.initial_distortion = Some(initial.distortion);
@@ -646,7 +619,7 @@ pub(crate) fn register(
     solution.extras.route = Some(route(
         &initial,
         problem.constraints.landmarks().next().is_some(),
-        after,
+        matched,
     ));
     let Some(Map::OnMesh(points)) = solution.map().cloned() else {
         return Ok(solution);
