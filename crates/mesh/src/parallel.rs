@@ -27,10 +27,20 @@ pub fn available_threads() -> usize {
 /// a single thread, else about [`CHUNKS_PER_THREAD`] per thread of at least
 /// [`MIN_CHUNK`] items (at least one range), of equal sizes up to one.
 pub fn chunk_ranges(len: usize, threads: usize) -> Vec<Range<usize>> {
+    chunk_ranges_of(len, threads, MIN_CHUNK)
+}
+
+/// [`chunk_ranges`] with `min_chunk` items at least per range instead of [`MIN_CHUNK`]:
+/// for loops whose items cost much more than a thread start (a closest-point search,
+/// about a microsecond, against tens of microseconds), so that a few thousand of them
+/// are shared too.
+pub fn chunk_ranges_of(len: usize, threads: usize, min_chunk: usize) -> Vec<Range<usize>> {
     let count = if threads <= 1 {
         1
     } else {
-        (threads * CHUNKS_PER_THREAD).min(len / MIN_CHUNK).max(1)
+        (threads * CHUNKS_PER_THREAD)
+            .min(len / min_chunk.max(1))
+            .max(1)
     };
     (0..count)
         .map(|k| k * len / count..(k + 1) * len / count)
@@ -111,6 +121,17 @@ pub fn map_ranges<R: Send>(
     in_turns(chunk_ranges(len, threads), threads, work)
 }
 
+/// `work(range)` over the [`chunk_ranges_of`] of `0..len` (ranges of at least
+/// `min_chunk` items), results in range order.
+pub fn map_ranges_of<R: Send>(
+    len: usize,
+    threads: usize,
+    min_chunk: usize,
+    work: impl Fn(Range<usize>) -> R + Sync,
+) -> Vec<R> {
+    in_turns(chunk_ranges_of(len, threads, min_chunk), threads, work)
+}
+
 /// `work(range)` over consecutive ranges of `block` items (the last may be shorter) of
 /// `0..len`, results in range order. The ranges do not depend on `threads`, so a
 /// reduction that combines the results in order (a sum of floating-point terms) gives
@@ -171,6 +192,36 @@ mod tests {
                 assert!(ranges.iter().all(|r| r.len() >= MIN_CHUNK));
             }
         }
+    }
+
+    #[test]
+    fn a_smaller_least_chunk_shares_fewer_items() {
+        for (len, threads, least, count) in [
+            (2930, 2, 256, 11),
+            (2930, 2, MIN_CHUNK, 1),
+            (2930, 1, 256, 1),
+            (255, 2, 256, 1),
+            (100_000, 2, 256, 2 * CHUNKS_PER_THREAD),
+            (10, 2, 0, 10),
+        ] {
+            let ranges = chunk_ranges_of(len, threads, least);
+            assert_eq!(
+                ranges.len(),
+                count,
+                "{len} items, {threads} threads, {least}"
+            );
+            assert_eq!(ranges[0].start, 0);
+            assert_eq!(ranges.last().unwrap().end, len);
+            for pair in ranges.windows(2) {
+                assert_eq!(pair[0].end, pair[1].start);
+            }
+            if count > 1 {
+                assert!(ranges.iter().all(|r| r.len() >= least));
+            }
+        }
+        let lengths = map_ranges_of(2930, 2, 256, |r| r.len());
+        assert_eq!(lengths.len(), 11);
+        assert_eq!(lengths.iter().sum::<usize>(), 2930);
     }
 
     #[test]

@@ -58,6 +58,12 @@ pub const MAX_SPLIT_LEVEL: usize = 6;
 /// Quantile of the face radii used as the target sample radius.
 const TARGET_QUANTILE: f64 = 0.9;
 
+/// Points per stretch at least of a batch shared between threads
+/// ([`beltrami_mesh::parallel::chunk_ranges_of`]): a search takes about a microsecond and
+/// a thread start tens of them, so a batch of a few thousand points (`g0_spot`'s 2,930
+/// vertices, each round of the non-rigid ICP) is worth sharing.
+const SEARCH_CHUNK: usize = 256;
+
 /// Items per kd-tree leaf.
 const BUCKET: usize = 16;
 
@@ -432,23 +438,28 @@ impl<'m> SurfaceIndex<'m> {
     ) -> Vec<Located> {
         let order = crate::morton::order(points);
         // Each thread takes a stretch of the Morton order, its points near each other.
-        let stretches = beltrami_mesh::parallel::map_ranges(order.len(), self.threads, |range| {
-            let mut scratch = Scratch::new();
-            let mut previous: Option<(usize, FaceId)> = None;
-            order[range]
-                .iter()
-                .map(|&i| {
-                    let i = i as usize;
-                    let p = &points[i];
-                    let near = previous
-                        .filter(|&(j, _)| (points[j] - p).norm() <= self.max_radius)
-                        .map(|(_, face)| face);
-                    let located = self.search(p, start(i, near), &mut scratch);
-                    previous = Some((i, located.point.face));
-                    located
-                })
-                .collect::<Vec<_>>()
-        });
+        let stretches = beltrami_mesh::parallel::map_ranges_of(
+            order.len(),
+            self.threads,
+            SEARCH_CHUNK,
+            |range| {
+                let mut scratch = Scratch::new();
+                let mut previous: Option<(usize, FaceId)> = None;
+                order[range]
+                    .iter()
+                    .map(|&i| {
+                        let i = i as usize;
+                        let p = &points[i];
+                        let near = previous
+                            .filter(|&(j, _)| (points[j] - p).norm() <= self.max_radius)
+                            .map(|(_, face)| face);
+                        let located = self.search(p, start(i, near), &mut scratch);
+                        previous = Some((i, located.point.face));
+                        located
+                    })
+                    .collect::<Vec<_>>()
+            },
+        );
         let unset = Located {
             point: SurfacePoint {
                 face: FaceId(0),

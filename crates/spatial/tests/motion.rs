@@ -602,6 +602,14 @@ fn batches_on_several_threads_give_each_point_the_same_answer() {
             .unwrap();
         assert_eq!(walked, walked_one, "{threads} threads");
         assert_eq!(summary, summary_one);
+        // A few thousand searches are shared between threads too (in stretches of a
+        // few hundred points, each starting without the previous point's face).
+        let few = &points[..3_000];
+        assert_eq!(many.locate_all(few).unwrap(), located[..3_000]);
+        assert_eq!(
+            many.locate_all_near(few, &hints[..3_000]).unwrap(),
+            located[..3_000]
+        );
     }
     // A failure names the first bad point in point order, whatever the threads.
     let mut bad = steps.clone();
