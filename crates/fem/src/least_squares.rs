@@ -92,6 +92,9 @@ pub struct LeastSquaresSolver<T: DofScalar> {
     residual: Vec<T>,
     /// Right-hand side, then solution, of the normal equations (`n`).
     y: Vec<T>,
+    /// The solution `y` of the last solve, where the next
+    /// [`solve_into_reusing`](Self::solve_into_reusing) starts its conjugate gradients.
+    last: Option<Vec<T>>,
 }
 
 impl<T: DofScalar> fmt::Debug for LeastSquaresSolver<T> {
@@ -167,6 +170,7 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
             cholesky,
             residual: vec![zero; m],
             y: vec![zero; n],
+            last: None,
         })
     }
 
@@ -229,6 +233,7 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
         check_len("the length of x", self.dofs.full_len(), x.len())?;
         self.assemble(a, weights, b);
         self.factored_solve()?;
+        self.keep_solution();
         self.expand_solution(x)
     }
 
@@ -237,8 +242,10 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
     /// normal equations are solved by conjugate gradients preconditioned with the kept
     /// factorization (`SpdSolver::solve_preconditioned`) to the relative residual
     /// `tolerance` within `max_iterations`, and factored anew (as `solve_into` does)
-    /// only when that fails or nothing is factored yet. Returns the conjugate-gradient
-    /// iterations done and whether it factored.
+    /// only when that fails or nothing is factored yet. The iterations start from the
+    /// last solve's solution (`SpdSolver::solve_reusing_from`), whose residual is of
+    /// the size of the change of the system. Returns the conjugate-gradient iterations
+    /// done and whether it factored.
     pub fn solve_into_reusing(
         &mut self,
         a: SparseColMatRef<'_, usize, T>,
@@ -253,15 +260,30 @@ impl<T: DofScalar> LeastSquaresSolver<T> {
         self.assemble(a, weights, b);
         let outcome = match &mut self.cholesky {
             Some(cholesky) => cholesky
-                .solve_reusing(self.normal.matrix(), &mut self.y, tolerance, max_iterations)
+                .solve_reusing_from(
+                    self.normal.matrix(),
+                    &mut self.y,
+                    self.last.as_deref(),
+                    tolerance,
+                    max_iterations,
+                )
                 .map_err(|error| singular_at_node(error, &self.dofs))?,
             None => Preconditioned {
                 converged: false,
                 iterations: 0,
             },
         };
+        self.keep_solution();
         self.expand_solution(x)?;
         Ok(outcome)
+    }
+
+    /// Keeps the solution `y` just found as the next reusing solve's start.
+    fn keep_solution(&mut self) {
+        match &mut self.last {
+            Some(last) => last.copy_from_slice(&self.y),
+            None => self.last = Some(self.y.clone()),
+        }
     }
 
     /// Factors the assembled normal equations and solves them in place of `y` (nothing

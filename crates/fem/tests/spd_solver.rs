@@ -151,6 +151,56 @@ fn conjugate_gradients_reuse_a_nearby_factorization() {
 }
 
 #[test]
+fn conjugate_gradients_started_near_the_solution_take_fewer_iterations() {
+    let n = 16;
+    let (pattern, a) = matrix(n, 1.0);
+    let (_, near) = matrix(n, 1.05);
+    let (_, nearer) = matrix(n, 1.051);
+    let mut solver = SpdSolver::new(pattern.symbolic().as_ref(), SolveOptions::default()).unwrap();
+    let f = rhs(n * n);
+    solver.factorize(a.as_ref()).unwrap();
+    let solve_from = |solver: &mut SpdSolver<f64>, start: Option<&[f64]>| {
+        let mut x = f.clone();
+        let outcome = match start {
+            Some(start) => {
+                solver.solve_preconditioned_from(nearer.as_ref(), &mut x, start, 1e-10, 20)
+            }
+            None => solver.solve_preconditioned(nearer.as_ref(), &mut x, 1e-10, 20),
+        }
+        .unwrap();
+        assert!(outcome.converged, "{outcome:?}");
+        assert!(residual(&nearer, &x, &f) < 1e-10);
+        (outcome.iterations, x)
+    };
+    let (from_zero, solution) = solve_from(&mut solver, None);
+    // The solution of a system near `nearer` leaves a residual of the size of the change.
+    let mut previous = f.clone();
+    solver
+        .solve_preconditioned(near.as_ref(), &mut previous, 1e-12, 30)
+        .unwrap();
+    let (from_previous, _) = solve_from(&mut solver, Some(&previous));
+    assert!(
+        from_previous < from_zero,
+        "{from_previous} iterations from the last solution, {from_zero} from zero"
+    );
+    // From the solution itself, none.
+    let (from_solution, x) = solve_from(&mut solver, Some(&solution));
+    assert_eq!(from_solution, 0);
+    assert_eq!(x, solution);
+    let mut x = f.clone();
+    assert!(matches!(
+        solver.solve_preconditioned_from(nearer.as_ref(), &mut x, &solution[1..], 1e-10, 20),
+        Err(SolveError::Length { .. })
+    ));
+    let mut bad = solution.clone();
+    bad[7] = f64::NAN;
+    assert!(matches!(
+        solver.solve_preconditioned_from(nearer.as_ref(), &mut x, &bad, 1e-10, 20),
+        Err(SolveError::NonFinite { index: 7, .. })
+    ));
+}
+
+#[test]
 fn value_slots_point_at_the_summed_entries() {
     let positions = [(0, 0), (2, 0), (1, 1), (2, 0), (2, 2), (2, 1)];
     let pattern = Pattern::new(3, 3, &positions).unwrap();

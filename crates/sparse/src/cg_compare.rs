@@ -126,7 +126,7 @@ pub(crate) fn solve<T: Scalar>(
     let mode = MODE.load(Ordering::Relaxed);
     if mode == Mode::Compare as u8 {
         compare(cholesky, matrix, rhs, tolerance, max_iterations)?;
-        return conjugate_gradients(cholesky, matrix, rhs, tolerance, max_iterations);
+        return conjugate_gradients(cholesky, matrix, rhs, None, tolerance, max_iterations);
     }
     let run = if mode == Mode::Own as u8 {
         own_run(cholesky, matrix, rhs, tolerance, max_iterations)?
@@ -157,7 +157,7 @@ fn own_run<T: Scalar>(
     max_iterations: usize,
 ) -> Result<Run, SolveError> {
     let start = Instant::now();
-    let outcome = conjugate_gradients(cholesky, matrix, x, tolerance, max_iterations)?;
+    let outcome = conjugate_gradients(cholesky, matrix, x, None, tolerance, max_iterations)?;
     Ok(Run {
         converged: outcome.converged,
         iterations: outcome.iterations,
@@ -235,10 +235,10 @@ fn faer_run<T: Scalar>(
     let mut buffer = MemBuffer::try_new(scratch).map_err(|_| FaerError::OutOfMemory)?;
     // From `x = 0`, but faer 0.24 leaves the residual uninitialized when told so
     // (`InitialGuessStatus::Zero`): the default forms `b - A x` first.
-    let params = CgParams::<f64> {
+    let params = CgParams::<T::Real> {
         initial_guess: InitialGuessStatus::MaybeNonZero,
-        abs_tolerance: 0.0,
-        rel_tolerance: tolerance,
+        abs_tolerance: faer::traits::ComplexField::from_f64_impl(0.0),
+        rel_tolerance: faer::traits::ComplexField::from_f64_impl(tolerance),
         max_iters: max_iterations,
         ..Default::default()
     };

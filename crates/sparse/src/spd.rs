@@ -253,10 +253,55 @@ impl<T: Scalar> SpdSolver<T> {
         }
         // `beltrami bench cg` measures this loop against faer's on the caller's systems.
         #[cfg(feature = "cg-compare")]
-        let solve = crate::cg_compare::solve::<T>;
+        return crate::cg_compare::solve::<T>(
+            &mut self.cholesky,
+            matrix,
+            rhs,
+            tolerance,
+            max_iterations,
+        );
         #[cfg(not(feature = "cg-compare"))]
-        let solve = conjugate_gradients::<T>;
-        solve(&mut self.cholesky, matrix, rhs, tolerance, max_iterations)
+        conjugate_gradients(
+            &mut self.cholesky,
+            matrix,
+            rhs,
+            None,
+            tolerance,
+            max_iterations,
+        )
+    }
+
+    /// [`SpdSolver::solve_preconditioned`] with the iterations started at `start`
+    /// instead of zero: the solution of a nearby system (the last step's, in an
+    /// iteration whose matrix changes a little per step) leaves a residual of the size
+    /// of the change, so that fewer iterations reach `tolerance |rhs|` (the same
+    /// criterion). Errors as `solve_preconditioned`, and [`SolveError::Length`] /
+    /// [`SolveError::NonFinite`] for a bad `start`.
+    pub fn solve_preconditioned_from(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, T>,
+        rhs: &mut [T],
+        start: &[T],
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<Preconditioned, SolveError> {
+        let n = self.len();
+        check_len("the length of the right-hand side", n, rhs.len())?;
+        check_len("the length of the start", n, start.len())?;
+        check_len("the row count of the matrix", n, matrix.nrows())?;
+        check_finite("the right-hand side", rhs)?;
+        check_finite("the start", start)?;
+        if !self.factored {
+            return Err(SolveError::NotFactored);
+        }
+        conjugate_gradients(
+            &mut self.cholesky,
+            matrix,
+            rhs,
+            Some(start),
+            tolerance,
+            max_iterations,
+        )
     }
 
     /// Solves `matrix x = rhs` in place for a matrix near the last one factored: by
@@ -270,8 +315,26 @@ impl<T: Scalar> SpdSolver<T> {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<Preconditioned, SolveError> {
+        self.solve_reusing_from(matrix, rhs, None, tolerance, max_iterations)
+    }
+
+    /// [`SpdSolver::solve_reusing`] with the conjugate gradients started at `start`
+    /// when given ([`SpdSolver::solve_preconditioned_from`]).
+    pub fn solve_reusing_from(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, T>,
+        rhs: &mut [T],
+        start: Option<&[T]>,
+        tolerance: f64,
+        max_iterations: usize,
+    ) -> Result<Preconditioned, SolveError> {
         let outcome = if self.factored {
-            self.solve_preconditioned(matrix, rhs, tolerance, max_iterations)?
+            match start {
+                Some(start) => {
+                    self.solve_preconditioned_from(matrix, rhs, start, tolerance, max_iterations)?
+                }
+                None => self.solve_preconditioned(matrix, rhs, tolerance, max_iterations)?,
+            }
         } else {
             Preconditioned {
                 converged: false,
@@ -331,11 +394,13 @@ impl<T: Scalar> SpdSolver<T> {
 }
 
 /// The conjugate gradients of [`SpdSolver::solve_preconditioned`] (arguments checked
-/// there), preconditioned with the factorization `cholesky`.
+/// there), preconditioned with the factorization `cholesky`, from `start` (zero when
+/// `None`).
 pub(crate) fn conjugate_gradients<T: Scalar>(
     cholesky: &mut Cholesky<T>,
     matrix: SparseColMatRef<'_, usize, T>,
     rhs: &mut [T],
+    start: Option<&[T]>,
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<Preconditioned, SolveError> {
@@ -349,7 +414,17 @@ pub(crate) fn conjugate_gradients<T: Scalar>(
     let norm = |a: &[T]| dot(a, a).real().sqrt();
     let target = tolerance * norm(rhs);
     let mut residual = rhs.to_vec();
-    let mut x = vec![zero; n];
+    let mut product = vec![zero; n];
+    let mut x = match start {
+        Some(start) => {
+            symmetric_lower_product(matrix, start, &mut product);
+            for (r, p) in residual.iter_mut().zip(&product) {
+                *r -= *p;
+            }
+            start.to_vec()
+        }
+        None => vec![zero; n],
+    };
     let start = norm(&residual);
     if start <= target {
         rhs.copy_from_slice(&x);
@@ -362,7 +437,6 @@ pub(crate) fn conjugate_gradients<T: Scalar>(
     cholesky.solve_in_place(column_mut(&mut z))?;
     let mut direction = z.clone();
     let mut rz = dot(&residual, &z);
-    let mut product = vec![zero; n];
     for iteration in 1..=max_iterations {
         symmetric_lower_product(matrix, &direction, &mut product);
         let alpha = rz / dot(&direction, &product);
