@@ -44,16 +44,17 @@ pub(crate) fn locate(
     Ok((located.into_iter().map(|l| l.point).collect(), gap))
 }
 
-/// Locates points of the unit sphere in the inscribed polyhedron `domain` along rays
-/// from the origin: the closest point gives a start face, from which a walk crosses the
-/// edge opposite the most negative coordinate until all of the ray's barycentric
-/// coordinates are non-negative. Quads (no planar face to intersect) and walks that do
-/// not end keep the closest point. Returns the points and how many fell back.
+/// Locates points of the unit sphere in the inscribed polyhedron indexed by `index`
+/// along rays from the origin: the closest point gives a start face, from which a walk
+/// crosses the edge opposite the most negative coordinate until all of the ray's
+/// barycentric coordinates are non-negative. Quads (no planar face to intersect) and
+/// walks that do not end keep the closest point. Returns the points and how many fell
+/// back.
 pub(crate) fn locate_radial(
-    domain: &Mesh,
+    index: &SurfaceIndex<'_>,
     points: &[Point3<f64>],
 ) -> Result<(Vec<SurfacePoint>, usize), RegisterError> {
-    let index = SurfaceIndex::new(domain)?;
+    let domain = index.mesh();
     let located = index.locate_all(points)?;
     let mut fallbacks = 0;
     let out = points

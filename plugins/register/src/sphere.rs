@@ -159,7 +159,8 @@ pub(crate) fn map(
         Side::Target,
     )?;
     let points: Vec<Point3<f64>> = images.iter().map(|v| Point3::from(*v)).collect();
-    let (located, fallbacks) = compose::locate_radial(&domain, &points)?;
+    let index = SurfaceIndex::new(&domain)?.with_threads(0);
+    let (located, fallbacks) = compose::locate_radial(&index, &points)?;
     if fallbacks > 0 {
         notes.push(format!(
             "sphere: {fallbacks} source images were located by closest point instead of along the ray (quads or a target sphere map with inward faces)"
@@ -193,11 +194,12 @@ pub(crate) fn match_features_after(
         target_sphere.iter().map(|v| Point3::from(*v)).collect(),
         Side::Target,
     )?;
+    let index = SurfaceIndex::new(&domain)?.with_threads(0);
     let fields = || SphereFields {
         channels,
         target,
         target_sphere,
-        sphere_mesh: &domain,
+        sphere_index: &index,
     };
     let SphereMatch {
         mut images,
@@ -234,7 +236,7 @@ pub(crate) fn match_features_after(
         images = again.images;
     }
     let images: Vec<Point3<f64>> = images.iter().map(|v| Point3::from(*v)).collect();
-    let (located, _) = compose::locate_radial(&domain, &images)?;
+    let (located, _) = compose::locate_radial(&index, &images)?;
     Ok((located, mismatch))
 }
 
@@ -370,7 +372,7 @@ fn match_on_sphere(
     let mut mismatch = None;
     if let Some(fields) = fields {
         // The target in the same chart, punctured at the face the pole falls in.
-        let (at_pole, _) = compose::locate_radial(fields.sphere_mesh, &[Point3::from(centre)])?;
+        let (at_pole, _) = compose::locate_radial(fields.sphere_index, &[Point3::from(centre)])?;
         let pole_face = at_pole.first().map_or(FaceId(0), |p| p.face);
         let punctured_target =
             fields
@@ -438,8 +440,9 @@ struct SphereFields<'a> {
     channels: &'a [Channel],
     target: &'a Mesh,
     target_sphere: &'a [Vector3<f64>],
-    /// The target's sphere polyhedron (its faces over `target_sphere`).
-    sphere_mesh: &'a Mesh,
+    /// The index of the target's sphere polyhedron (its faces over `target_sphere`),
+    /// made once for every chart's pole and the images at the end.
+    sphere_index: &'a SurfaceIndex<'a>,
 }
 
 /// The face of a stereographic chart: its centroid direction on the sphere and the
