@@ -171,6 +171,20 @@ pub fn map_chunks_mut<T: Send, R: Send>(
 mod tests {
     use super::*;
 
+    /// `ranges` tile `0..len` in order, `count` of them, each of at least `least` items
+    /// when there are several.
+    fn assert_tiling(ranges: &[Range<usize>], len: usize, count: usize, least: usize) {
+        assert_eq!(ranges.len(), count, "{len} items, at least {least} a range");
+        assert_eq!(ranges[0].start, 0);
+        assert_eq!(ranges.last().unwrap().end, len);
+        for pair in ranges.windows(2) {
+            assert_eq!(pair[0].end, pair[1].start);
+        }
+        if count > 1 {
+            assert!(ranges.iter().all(|r| r.len() >= least));
+        }
+    }
+
     #[test]
     fn ranges_cover_the_items_in_order_with_enough_items_each() {
         for (len, threads, count) in [
@@ -181,21 +195,12 @@ mod tests {
             (MIN_CHUNK * 100 + 3, 3, 3 * CHUNKS_PER_THREAD),
             (MIN_CHUNK * 100, 1, 1),
         ] {
-            let ranges = chunk_ranges(len, threads);
-            assert_eq!(ranges.len(), count, "{len} items, {threads} threads");
-            assert_eq!(ranges[0].start, 0);
-            assert_eq!(ranges.last().unwrap().end, len);
-            for pair in ranges.windows(2) {
-                assert_eq!(pair[0].end, pair[1].start);
-            }
-            if count > 1 {
-                assert!(ranges.iter().all(|r| r.len() >= MIN_CHUNK));
-            }
+            assert_tiling(&chunk_ranges(len, threads), len, count, MIN_CHUNK);
         }
     }
 
     #[test]
-    fn a_smaller_least_chunk_shares_fewer_items() {
+    fn a_smaller_least_chunk_shares_smaller_batches() {
         for (len, threads, least, count) in [
             (2930, 2, 256, 11),
             (2930, 2, MIN_CHUNK, 1),
@@ -204,20 +209,7 @@ mod tests {
             (100_000, 2, 256, 2 * CHUNKS_PER_THREAD),
             (10, 2, 0, 10),
         ] {
-            let ranges = chunk_ranges_of(len, threads, least);
-            assert_eq!(
-                ranges.len(),
-                count,
-                "{len} items, {threads} threads, {least}"
-            );
-            assert_eq!(ranges[0].start, 0);
-            assert_eq!(ranges.last().unwrap().end, len);
-            for pair in ranges.windows(2) {
-                assert_eq!(pair[0].end, pair[1].start);
-            }
-            if count > 1 {
-                assert!(ranges.iter().all(|r| r.len() >= least));
-            }
+            assert_tiling(&chunk_ranges_of(len, threads, least), len, count, least);
         }
         let lengths = map_ranges_of(2930, 2, 256, |r| r.len());
         assert_eq!(lengths.len(), 11);

@@ -244,13 +244,7 @@ impl<T: Scalar> SpdSolver<T> {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<Preconditioned, SolveError> {
-        let n = self.len();
-        check_len("the length of the right-hand side", n, rhs.len())?;
-        check_len("the row count of the matrix", n, matrix.nrows())?;
-        check_finite("the right-hand side", rhs)?;
-        if !self.factored {
-            return Err(SolveError::NotFactored);
-        }
+        self.check_preconditioned(matrix, rhs)?;
         // `beltrami bench cg` measures this loop against faer's on the caller's systems.
         #[cfg(feature = "cg-compare")]
         return crate::cg_compare::solve::<T>(
@@ -285,15 +279,9 @@ impl<T: Scalar> SpdSolver<T> {
         tolerance: f64,
         max_iterations: usize,
     ) -> Result<Preconditioned, SolveError> {
-        let n = self.len();
-        check_len("the length of the right-hand side", n, rhs.len())?;
-        check_len("the length of the start", n, start.len())?;
-        check_len("the row count of the matrix", n, matrix.nrows())?;
-        check_finite("the right-hand side", rhs)?;
+        check_len("the length of the start", self.len(), start.len())?;
         check_finite("the start", start)?;
-        if !self.factored {
-            return Err(SolveError::NotFactored);
-        }
+        self.check_preconditioned(matrix, rhs)?;
         conjugate_gradients(
             &mut self.cholesky,
             matrix,
@@ -302,6 +290,24 @@ impl<T: Scalar> SpdSolver<T> {
             tolerance,
             max_iterations,
         )
+    }
+
+    /// The checks of the preconditioned solves: the sizes of `matrix` and `rhs`, a
+    /// finite `rhs` and a factorization to precondition with.
+    fn check_preconditioned(
+        &self,
+        matrix: SparseColMatRef<'_, usize, T>,
+        rhs: &[T],
+    ) -> Result<(), SolveError> {
+        let n = self.len();
+        check_len("the length of the right-hand side", n, rhs.len())?;
+        check_len("the row count of the matrix", n, matrix.nrows())?;
+        check_finite("the right-hand side", rhs)?;
+        if self.factored {
+            Ok(())
+        } else {
+            Err(SolveError::NotFactored)
+        }
     }
 
     /// Solves `matrix x = rhs` in place for a matrix near the last one factored: by
