@@ -42,6 +42,20 @@ impl BoundingBox {
     pub fn diagonal(&self) -> f64 {
         (self.max - self.min).norm()
     }
+
+    /// The squared distance from `p` to the box (0 inside): the sum over the axes of
+    /// `max(min_k - p_k, p_k - max_k, 0)^2`. No point of the box is nearer `p`, so a
+    /// face whose box lies farther than a distance found elsewhere can be passed over.
+    pub fn distance_squared(&self, p: &Point3<f64>) -> f64 {
+        (0..3)
+            .map(|k| {
+                (self.min[k] - p[k])
+                    .max(p[k] - self.max[k])
+                    .max(0.0)
+                    .powi(2)
+            })
+            .sum()
+    }
 }
 
 /// Gauss points of the 2-point rule on [0, 1]: 1/2 -+ 1/(2 sqrt 3).

@@ -118,7 +118,7 @@ pub fn map_ranges<R: Send>(
     threads: usize,
     work: impl Fn(Range<usize>) -> R + Sync,
 ) -> Vec<R> {
-    in_turns(chunk_ranges(len, threads), threads, work)
+    map_ranges_of(len, threads, MIN_CHUNK, work)
 }
 
 /// `work(range)` over the [`chunk_ranges_of`] of `0..len` (ranges of at least

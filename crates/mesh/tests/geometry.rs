@@ -495,6 +495,15 @@ fn bounding_boxes() {
     assert_eq!(b.min, Point3::new(-1.0, -2.0, 0.5));
     assert_eq!(b.max, Point3::new(1.0, 4.0, 3.0));
     assert!(close(b.diagonal(), (4.0f64 + 36.0 + 6.25).sqrt(), 1e-15));
+    // Inside, on a face, beside a face, beyond an edge and beyond a corner.
+    assert_eq!(b.distance_squared(&Point3::new(0.0, 1.0, 2.0)), 0.0);
+    assert_eq!(b.distance_squared(&Point3::new(1.0, 1.0, 2.0)), 0.0);
+    assert_eq!(b.distance_squared(&Point3::new(3.0, 1.0, 2.0)), 4.0);
+    assert_eq!(b.distance_squared(&Point3::new(0.0, -5.0, 0.0)), 9.0 + 0.25);
+    assert_eq!(
+        b.distance_squared(&Point3::new(-2.0, 5.0, 4.0)),
+        1.0 + 1.0 + 1.0
+    );
 }
 
 #[test]

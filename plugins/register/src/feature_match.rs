@@ -38,7 +38,7 @@
 use beltrami_fem::Frame;
 use beltrami_mesh::Point3;
 use beltrami_mesh::parallel;
-use beltrami_mesh::{FaceId, Mesh, SurfacePoint, VertexId};
+use beltrami_mesh::{BoundingBox, FaceId, Mesh, SurfacePoint, VertexId};
 use beltrami_spatial::SurfaceIndex;
 use beltrami_spatial::closest_point::{ClosestPoint, closest_on_face};
 use kiddo::SquaredEuclidean;
@@ -513,34 +513,26 @@ impl<'d> TargetField<'d> {
 /// passed over (its points lie farther still): the same answer as evaluating every face,
 /// at a few comparisons for most of them.
 fn closest_of_every_face(mesh: &Mesh, points: &[Point3<f64>]) -> Option<Vec<SurfacePoint>> {
-    let boxes: Vec<([f64; 3], [f64; 3])> = mesh
+    let positions = mesh.positions();
+    // A face has corners, so each box is `Some`; one per face keeps the zip aligned.
+    let boxes: Vec<Option<BoundingBox>> = mesh
         .faces()
-        .map(|f| {
-            let (lo, hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            mesh.face_vertices(f).fold((lo, hi), |(mut lo, mut hi), v| {
-                let q = mesh.position(v);
-                for k in 0..3 {
-                    lo[k] = lo[k].min(q[k]);
-                    hi[k] = hi[k].max(q[k]);
-                }
-                (lo, hi)
-            })
-        })
+        .map(|f| BoundingBox::around(mesh.face_vertices(f).map(|v| &positions[v.idx()])))
         .collect();
     points
         .iter()
         .map(|p| {
             let mut best: Option<(FaceId, ClosestPoint)> = None;
-            for (f, (lo, hi)) in mesh.faces().zip(&boxes) {
-                if let Some((_, b)) = &best {
-                    let outside: f64 = (0..3)
-                        .map(|k| (lo[k] - p[k]).max(p[k] - hi[k]).max(0.0).powi(2))
-                        .sum();
-                    // Padded so that rounding cannot pass over a face at the same
-                    // distance, which the tie rule may prefer.
-                    if outside > b.distance_squared * (1.0 + 1e-9) {
-                        continue;
-                    }
+            for (f, bounds) in mesh.faces().zip(&boxes) {
+                // Padded so that rounding cannot pass over a face at the same distance,
+                // which the tie rule may prefer.
+                let beyond = |(_, b): &(FaceId, ClosestPoint)| {
+                    bounds.is_some_and(|bounds| {
+                        bounds.distance_squared(p) > b.distance_squared * (1.0 + 1e-9)
+                    })
+                };
+                if best.as_ref().is_some_and(beyond) {
+                    continue;
                 }
                 let c = closest_on_face(mesh, f, p);
                 if best
