@@ -21,7 +21,7 @@
 //! frame by `mu e^{-2 i theta}` (Gruber-Aulisa 2022, Lemma 3.4), `theta` the angle
 //! between the two frames' real axes once the faces are unfolded about the edge.
 
-use beltrami_fem::beltrami::{face_mu, flipped_faces, planar_map, point_mu};
+use beltrami_fem::beltrami::{PointDerivatives, face_mu, flipped_faces, planar_map, point_mu};
 use beltrami_fem::operators::beltrami_operator;
 use beltrami_fem::{DofBuilder, DofError, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::{FaceId, Mesh, VertexId};
@@ -233,12 +233,22 @@ impl<'m> Reconstruction<'m> {
     ) -> Result<(Vec<Complex64>, usize), RegisterError> {
         let derivatives = planar_map(&self.elements, self.mesh.vertex_count(), map)
             .map_err(RegisterError::Measure)?;
-        let flipped = flipped_faces(&self.elements, &derivatives)
-            .iter()
-            .zip(&self.solved)
-            .filter(|&(&f, &s)| f && s)
-            .count();
+        let flipped = self.judged_flips(&derivatives).filter(|&f| f).count();
         Ok((face_mu(&self.elements, &point_mu(&derivatives)), flipped))
+    }
+
+    /// Which judged faces `map` flips, by face index.
+    pub(crate) fn flipped(&self, map: &[Complex64]) -> Result<Vec<bool>, RegisterError> {
+        let derivatives = planar_map(&self.elements, self.mesh.vertex_count(), map)
+            .map_err(RegisterError::Measure)?;
+        Ok(self.judged_flips(&derivatives).collect())
+    }
+
+    fn judged_flips(&self, derivatives: &[PointDerivatives]) -> impl Iterator<Item = bool> {
+        flipped_faces(&self.elements, derivatives)
+            .into_iter()
+            .zip(&self.solved)
+            .map(|(f, &s)| f && s)
     }
 
     /// `mu` smoothed over edge neighbours (`passes` times) and cut to `|nu| <= K_MAX`
@@ -248,13 +258,31 @@ impl<'m> Reconstruction<'m> {
         for _ in 0..passes {
             nu = self.neighbours.smooth(&nu, &self.areas);
         }
-        for m in &mut nu {
-            let r = m.norm();
-            if r > K_MAX {
-                *m *= K_MAX / r;
+        nu.into_iter().map(cut).collect()
+    }
+
+    /// `mu` smoothed over edge neighbours (`passes` times) on the faces within `rings`
+    /// edge steps of a face marked in `folded` only, and cut to `|nu| <= K_MAX`: the
+    /// mending of a step that folds a few faces, which keeps the step's change of
+    /// coefficient away from the folds (where [`Self::regularized`] smooths it all).
+    pub(crate) fn regularized_near(
+        &self,
+        mu: Vec<Complex64>,
+        folded: &[bool],
+        rings: usize,
+        passes: usize,
+    ) -> Vec<Complex64> {
+        let near = self.neighbours.grown(folded, rings);
+        let mut nu = mu;
+        for _ in 0..passes {
+            let smooth = self.neighbours.smooth(&nu, &self.areas);
+            for ((value, smoothed), &near) in nu.iter_mut().zip(smooth).zip(&near) {
+                if near {
+                    *value = smoothed;
+                }
             }
         }
-        nu
+        nu.into_iter().map(cut).collect()
     }
 
     /// The coefficient of a step from a map with coefficient `current` towards one with
@@ -275,11 +303,7 @@ impl<'m> Reconstruction<'m> {
         current
             .iter()
             .zip(change)
-            .map(|(&c, d)| {
-                let nu = c + d;
-                let r = nu.norm();
-                if r > K_MAX { nu * (K_MAX / r) } else { nu }
-            })
+            .map(|(&c, d)| cut(c + d))
             .collect()
     }
 
@@ -363,6 +387,12 @@ fn glued_dofs(
     Ok((builder.build()?, is_fixed))
 }
 
+/// `nu` scaled down to `|nu| = K_MAX` where it is larger.
+fn cut(nu: Complex64) -> Complex64 {
+    let r = nu.norm();
+    if r > K_MAX { nu * (K_MAX / r) } else { nu }
+}
+
 /// The edge neighbours of every face with the factor `e^{-2 i theta}` that carries a
 /// neighbour's coefficient into the face's frame (module docs).
 struct FaceNeighbours {
@@ -401,6 +431,21 @@ impl FaceNeighbours {
             faces,
             carry,
         }
+    }
+
+    /// The faces marked in `faces` and those within `rings` edge steps of one.
+    fn grown(&self, faces: &[bool], rings: usize) -> Vec<bool> {
+        let mut region = faces.to_vec();
+        for _ in 0..rings {
+            let last = region.clone();
+            for (f, marked) in region.iter_mut().enumerate() {
+                *marked = *marked
+                    || self.faces[self.start[f]..self.start[f + 1]]
+                        .iter()
+                        .any(|g| last[g.idx()]);
+            }
+        }
+        region
     }
 
     /// Each face's value averaged with its neighbours', weighted by area.
@@ -569,6 +614,50 @@ mod tests {
             assert!(d < 1e-12, "vertex {v}: {d}");
         }
         assert!(matched.mean_mu > 0.05, "the bend is not conformal");
+    }
+
+    #[test]
+    fn mending_near_the_folds_unfolds_and_keeps_the_rest() {
+        // A bend of the square (not conformal: its coefficient varies over every face)
+        // with one interior vertex pushed past its neighbour, so that a few faces fold:
+        // smoothing the coefficient within two rings of the folds and rebuilding
+        // unfolds them, and every face farther away keeps its coefficient exactly,
+        // where smoothing it all changes them.
+        let mesh = square(12);
+        let bend = |z: Complex64| z + 0.15 * z * z + 0.1 * z.conj() * z.conj() * z;
+        let mut map: Vec<Complex64> = identity(&mesh).into_iter().map(bend).collect();
+        let fixed: Vec<_> = boundary_fixed(&mesh)
+            .into_iter()
+            .map(|(v, _)| (v, map[v.idx()]))
+            .collect();
+        let (mut reconstruction, _) =
+            Reconstruction::new(&mesh, Frame::Face, &map, &fixed, &[], Side::Source).unwrap();
+        let (pushed, past) = (
+            vertex_at(&mesh, 0.5, 0.5),
+            vertex_at(&mesh, 0.5 + 2.0 / 12.0, 0.5),
+        );
+        map[pushed.idx()] = map[past.idx()] + Complex64::new(0.02, 0.01);
+        let (mu, flipped) = reconstruction.measure(&map).unwrap();
+        assert!(flipped > 0);
+        let folded = reconstruction.flipped(&map).unwrap();
+        assert_eq!(folded.iter().filter(|&&f| f).count(), flipped);
+
+        let nu = reconstruction.regularized_near(mu.clone(), &folded, 2, 2);
+        let rebuilt = reconstruction.solve(&nu).unwrap();
+        assert_eq!(reconstruction.measure(&rebuilt).unwrap().1, 0);
+        let everywhere = reconstruction.regularized(mu.clone(), 2);
+        let near = reconstruction.neighbours.grown(&folded, 2);
+        let (mut kept, mut changed) = (0, 0);
+        for f in mesh.faces().filter(|f| !near[f.idx()]) {
+            assert_eq!(nu[f.idx()], cut(mu[f.idx()]), "face {f}");
+            kept += 1;
+            changed += usize::from((everywhere[f.idx()] - mu[f.idx()]).norm() > 1e-6);
+        }
+        assert!(kept > mesh.face_count() / 2, "{kept} faces kept");
+        assert!(
+            changed > kept / 2,
+            "smoothing it all changed {changed} of {kept}"
+        );
     }
 
     #[test]

@@ -98,7 +98,7 @@ fn a_twisted_sphere_is_found_by_its_field() {
     );
     // A single field leaves the map free along its level sets; the regularization keeps
     // the initial map's own coefficient there, so about half the error goes (0.226 ->
-    // 0.113, the cap about the chart's pole matched in a second chart). Matched from the
+    // 0.115, the cap about the chart's pole matched in a second chart). Matched from the
     // flow's conformal map instead of the initial map (which flips no face here) it
     // went to 0.123, above this bound.
     assert!(
