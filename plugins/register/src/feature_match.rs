@@ -298,9 +298,10 @@ pub(crate) fn match_features(
             // measures it: most steps fold nothing and keep both.
             let (trial, measured) = parallel::join(
                 || target_field.probe(&rebuilt, Some(&probe)),
-                || reconstruction.measure(&rebuilt),
+                || reconstruction.measure_folds(&rebuilt),
             );
-            let (mut rebuilt_mu, mut flipped) = measured?;
+            let (mut rebuilt_mu, folded) = measured?;
+            let mut flipped = folded.iter().filter(|&&f| f).count();
             let mut trial = trial?;
             // Where the discrete rebuild still folds a few faces, its own coefficient is
             // smoothed and cut and the map rebuilt again: first near the folds only, then
@@ -308,7 +309,6 @@ pub(crate) fn match_features(
             if flipped > 0 {
                 for attempt in 0..MENDING {
                     let nu = if attempt == 0 {
-                        let folded = reconstruction.flipped(&rebuilt)?;
                         reconstruction.regularized_near(rebuilt_mu, &folded, MEND_RINGS, 2)
                     } else {
                         reconstruction.regularized(rebuilt_mu, 2)

@@ -21,7 +21,7 @@
 //! frame by `mu e^{-2 i theta}` (Gruber-Aulisa 2022, Lemma 3.4), `theta` the angle
 //! between the two frames' real axes once the faces are unfolded about the edge.
 
-use beltrami_fem::beltrami::{PointDerivatives, face_mu, flipped_faces, planar_map, point_mu};
+use beltrami_fem::beltrami::{face_mu, flipped_faces, planar_map, point_mu};
 use beltrami_fem::operators::beltrami_operator;
 use beltrami_fem::{DofBuilder, DofError, DofMap, Elements, Frame, LeastSquaresSolver};
 use beltrami_mesh::{FaceId, Mesh, VertexId};
@@ -231,24 +231,23 @@ impl<'m> Reconstruction<'m> {
         &self,
         map: &[Complex64],
     ) -> Result<(Vec<Complex64>, usize), RegisterError> {
-        let derivatives = planar_map(&self.elements, self.mesh.vertex_count(), map)
-            .map_err(RegisterError::Measure)?;
-        let flipped = self.judged_flips(&derivatives).filter(|&f| f).count();
-        Ok((face_mu(&self.elements, &point_mu(&derivatives)), flipped))
+        let (mu, folded) = self.measure_folds(map)?;
+        Ok((mu, folded.iter().filter(|&&f| f).count()))
     }
 
-    /// Which judged faces `map` flips, by face index.
-    pub(crate) fn flipped(&self, map: &[Complex64]) -> Result<Vec<bool>, RegisterError> {
+    /// The coefficient of `map` per face and which judged faces it flips, by face index.
+    pub(crate) fn measure_folds(
+        &self,
+        map: &[Complex64],
+    ) -> Result<(Vec<Complex64>, Vec<bool>), RegisterError> {
         let derivatives = planar_map(&self.elements, self.mesh.vertex_count(), map)
             .map_err(RegisterError::Measure)?;
-        Ok(self.judged_flips(&derivatives).collect())
-    }
-
-    fn judged_flips(&self, derivatives: &[PointDerivatives]) -> impl Iterator<Item = bool> {
-        flipped_faces(&self.elements, derivatives)
+        let folded = flipped_faces(&self.elements, &derivatives)
             .into_iter()
             .zip(&self.solved)
             .map(|(f, &s)| f && s)
+            .collect();
+        Ok((face_mu(&self.elements, &point_mu(&derivatives)), folded))
     }
 
     /// `mu` smoothed over edge neighbours (`passes` times) and cut to `|nu| <= K_MAX`
@@ -637,10 +636,10 @@ mod tests {
             vertex_at(&mesh, 0.5 + 2.0 / 12.0, 0.5),
         );
         map[pushed.idx()] = map[past.idx()] + Complex64::new(0.02, 0.01);
-        let (mu, flipped) = reconstruction.measure(&map).unwrap();
+        let (mu, folded) = reconstruction.measure_folds(&map).unwrap();
+        let flipped = folded.iter().filter(|&&f| f).count();
         assert!(flipped > 0);
-        let folded = reconstruction.flipped(&map).unwrap();
-        assert_eq!(folded.iter().filter(|&&f| f).count(), flipped);
+        assert_eq!(reconstruction.measure(&map).unwrap().1, flipped);
 
         let nu = reconstruction.regularized_near(mu.clone(), &folded, 2, 2);
         let rebuilt = reconstruction.solve(&nu).unwrap();
